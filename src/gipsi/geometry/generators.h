@@ -1,0 +1,44 @@
+#pragma once
+/// @file
+/// Mesh generators: structured tet boxes/beams, triangle sheets, and shells (the simplified left
+/// ventricle) through the Gmsh C++ API.
+
+#include <array>
+
+#include "gipsi/base/math.h"
+#include "gipsi/geometry/mesh.h"
+
+namespace gipsi {
+
+/// A box [min, max] split into cells[0]×cells[1]×cells[2] hexahedra, each cut into 6 positively
+/// oriented tets that conform across cells. Node (i,j,k) has index i + (nx+1)(j + (ny+1)k).
+/// Boundary triangles are included, with groups "xmin", "xmax", "ymin", "ymax", "zmin", "zmax"
+/// (dim 2) and "volume" (dim 3). Throws InputError unless max > min and cells >= 1.
+Mesh MakeTetBox(const Vec3& min, const Vec3& max, const std::array<int, 3>& cells);
+
+/// A flat sheet of triangles spanned by `origin + s·edge_u + t·edge_v`, s,t in [0,1], with
+/// cells[0]×cells[1] quads each cut into 2 triangles. Node (i,j) has index i + (nu+1)·j. Groups
+/// (dim 0, nodes): "u0", "u1", "v0", "v1" for the four edges. Throws InputError for cells < 1
+/// or parallel edges.
+Mesh MakeTriangleSheet(const Vec3& origin, const Vec3& edge_u, const Vec3& edge_v,
+                       const std::array<int, 2>& cells);
+
+/// Parameters of a truncated ellipsoidal shell (a simplified left ventricle): inner (endo) and
+/// outer (epi) semi-axes; x and y share the short radius, z the long one; the shell is cut at
+/// z = base_z and keeps z <= base_z.
+struct EllipsoidShellSpec {
+  double endo_short = 7, endo_long = 17;
+  double epi_short = 10, epi_long = 20;
+  double base_z = 5;
+  double mesh_size = 2;
+};
+/// Tet mesh of the shell by Gmsh. Groups: "endo", "epi", "base" (dim 2) and "wall" (dim 3).
+/// Throws InputError for inconsistent dimensions (endo must lie inside epi, base_z must cut
+/// both) or if Gmsh fails.
+Mesh MakeEllipsoidShell(const EllipsoidShellSpec& spec);
+
+/// A hollow cylinder around the z axis from z=0 to z=height. Groups: "inner", "outer",
+/// "bottom", "top" (dim 2), "wall" (dim 3). Throws InputError for inner >= outer etc.
+Mesh MakeCylinderShell(double inner_radius, double outer_radius, double height, double mesh_size);
+
+}  // namespace gipsi

@@ -1,0 +1,47 @@
+#pragma once
+/// @file
+/// Mappings between geometries: values known at the nodes of a source geometry interpolated at
+/// target points. Used for display geometries embedded in a domain (barycentric embedding), for
+/// probes at points, and by connectors between objects on different meshes.
+
+#include "gipsi/base/math.h"
+
+namespace gipsi {
+
+/// Fixed interpolation weights: target j gets Σ_k weights(k, j) · source[indices(k, j)], with up
+/// to four sources per target (unused slots have weight 0 and index 0). Built once, applied
+/// every step without allocating. Copyable and movable.
+class PointMap {
+ public:
+  PointMap() = default;
+
+  /// Barycentric embedding in a tet mesh (`nodes` 3 by N, `tets` 4 by E): each target uses the
+  /// tet containing it; a target outside the mesh uses the nearest tet with its barycentric
+  /// coordinates clamped to the tet (and `max_distance()` reports how far off it was).
+  static PointMap BarycentricInTets(const Points& nodes, const Tets& tets, const Points& targets);
+
+  /// Barycentric on a triangle surface: the closest point on any triangle.
+  static PointMap BarycentricOnTriangles(const Points& vertices, const Triangles& triangles,
+                                         const Points& targets);
+
+  /// Nearest source point (weight 1).
+  static PointMap Nearest(const Points& sources, const Points& targets);
+
+  [[nodiscard]] Index num_targets() const { return indices_.cols(); }
+  [[nodiscard]] const Eigen::Matrix4Xi& indices() const { return indices_; }
+  [[nodiscard]] const Eigen::Matrix4Xd& weights() const { return weights_; }
+  /// Largest distance between a target and the point its weights reproduce at build time.
+  [[nodiscard]] double max_distance() const { return max_distance_; }
+
+  /// out.col(j) = Σ_k w(k,j) · source.col(idx(k,j)). `source` is C by N_source, `out` C by
+  /// num_targets() (preconditions checked). Allocates nothing.
+  void Apply(const Eigen::Ref<const Eigen::MatrixXd>& source,
+             Eigen::Ref<Eigen::MatrixXd> out) const;
+
+ private:
+  Eigen::Matrix4Xi indices_ = Eigen::Matrix4Xi(4, 0);
+  Eigen::Matrix4Xd weights_ = Eigen::Matrix4Xd(4, 0);
+  double max_distance_ = 0;
+};
+
+}  // namespace gipsi

@@ -1,0 +1,105 @@
+#include "gipsi/geometry/mesh.h"
+
+#include <algorithm>
+#include <set>
+
+#include <fmt/format.h>
+
+#include "gipsi/base/error.h"
+
+namespace gipsi {
+namespace {
+
+template <class Conn>
+void CheckConnectivity(const Conn& conn, Index num_nodes, std::string_view kind,
+                       std::string_view source) {
+  for (Index e = 0; e < conn.cols(); ++e) {
+    for (Index a = 0; a < conn.rows(); ++a) {
+      int n = conn(a, e);
+      if (n < 0 || n >= num_nodes) {
+        ThrowInputError(source, fmt::format("{} {}", kind, e),
+                        fmt::format("node index {} out of range [0, {})", n, num_nodes));
+      }
+      for (Index b = 0; b < a; ++b) {
+        if (conn(b, e) == n)
+          ThrowInputError(source, fmt::format("{} {}", kind, e),
+                          fmt::format("repeats node {}", n));
+      }
+    }
+  }
+}
+
+}  // namespace
+
+const MeshGroup* Mesh::FindGroup(std::string_view name) const {
+  for (const auto& g : groups)
+    if (g.name == name) return &g;
+  return nullptr;
+}
+
+void Mesh::Validate(std::string_view source) const {
+  if (!nodes.allFinite()) {
+    for (Index i = 0; i < nodes.cols(); ++i)
+      if (!nodes.col(i).allFinite())
+        ThrowInputError(source, fmt::format("node {}", i), "coordinates are not finite");
+  }
+  CheckConnectivity(tets, num_nodes(), "tetrahedron", source);
+  CheckConnectivity(triangles, num_nodes(), "triangle", source);
+  std::set<std::string> names;
+  for (const auto& g : groups) {
+    if (!names.insert(g.name).second)
+      ThrowInputError(source, fmt::format("group '{}'", g.name), "duplicate group name");
+    Index limit = g.dim == 0 ? num_nodes() : g.dim == 2 ? num_triangles() : num_tets();
+    if (g.dim != 0 && g.dim != 2 && g.dim != 3)
+      ThrowInputError(source, fmt::format("group '{}'", g.name),
+                      fmt::format("dimension {} is not 0, 2 or 3", g.dim));
+    for (int i : g.items)
+      if (i < 0 || i >= limit)
+        ThrowInputError(source, fmt::format("group '{}'", g.name),
+                        fmt::format("item {} out of range [0, {})", i, limit));
+  }
+}
+
+std::vector<int> Mesh::RemoveUnusedNodes() {
+  std::vector<int> old_of_new;
+  if (num_tets() == 0 && num_triangles() == 0) {
+    old_of_new.resize(static_cast<std::size_t>(num_nodes()));
+    for (Index i = 0; i < num_nodes(); ++i) old_of_new[static_cast<std::size_t>(i)] = int(i);
+    return old_of_new;
+  }
+  std::vector<int> new_of_old(static_cast<std::size_t>(num_nodes()), -1);
+  auto mark = [&](auto& conn) {
+    for (Index e = 0; e < conn.cols(); ++e)
+      for (Index a = 0; a < conn.rows(); ++a) new_of_old[static_cast<std::size_t>(conn(a, e))] = 0;
+  };
+  mark(tets);
+  mark(triangles);
+  for (std::size_t i = 0; i < new_of_old.size(); ++i) {
+    if (new_of_old[i] == 0) {
+      new_of_old[i] = static_cast<int>(old_of_new.size());
+      old_of_new.push_back(static_cast<int>(i));
+    }
+  }
+  Points kept(3, static_cast<Index>(old_of_new.size()));
+  for (std::size_t j = 0; j < old_of_new.size(); ++j)
+    kept.col(static_cast<Index>(j)) = nodes.col(old_of_new[j]);
+  nodes = std::move(kept);
+  auto renumber = [&](auto& conn) {
+    for (Index e = 0; e < conn.cols(); ++e)
+      for (Index a = 0; a < conn.rows(); ++a)
+        conn(a, e) = new_of_old[static_cast<std::size_t>(conn(a, e))];
+  };
+  renumber(tets);
+  renumber(triangles);
+  for (auto& g : groups) {
+    if (g.dim != 0) continue;
+    std::vector<int> items;
+    for (int i : g.items)
+      if (new_of_old[static_cast<std::size_t>(i)] >= 0)
+        items.push_back(new_of_old[static_cast<std::size_t>(i)]);
+    g.items = std::move(items);
+  }
+  return old_of_new;
+}
+
+}  // namespace gipsi
