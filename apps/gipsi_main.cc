@@ -1,1 +1,241 @@
-int main() { return 0; }
+/// @file
+/// The `gipsi` command-line tool: run, validate and inspect scenes and meshes.
+///
+/// Exit codes: 0 success; 1 bad input (scene, mesh, plugin); 2 bad command line; 3 the run
+/// stopped because an object diverged or failed; 4 writing outputs failed; 130 interrupted.
+
+#include <unistd.h>
+
+#include <chrono>
+#include <csignal>
+#include <cstdio>
+#include <iostream>
+
+#include <fmt/format.h>
+#include <CLI/CLI.hpp>
+
+#include "gipsi/base/error.h"
+#include "gipsi/base/log.h"
+#include "gipsi/io/mesh_io.h"
+#include "gipsi/io/mesh_summary.h"
+#include "gipsi/io/outputs.h"
+#include "gipsi/io/scene.h"
+#include "gipsi/models/builtins.h"
+
+namespace {
+
+std::atomic<gipsi::Kernel*> g_running_kernel{nullptr};
+
+extern "C" void HandleStopSignal(int) {
+  if (gipsi::Kernel* kernel = g_running_kernel.load()) kernel->RequestStop();
+}
+
+/// Progress on a terminal: a bar rewritten in place at most 10 times a second; otherwise a plain
+/// line at every 10 % of the run.
+class Progress {
+ public:
+  explicit Progress(bool quiet) : quiet_(quiet), tty_(isatty(STDERR_FILENO) != 0) {}
+  void Update(double t, double end) {
+    if (quiet_ || end <= 0) return;
+    const double fraction = std::min(1.0, t / end);
+    auto now = std::chrono::steady_clock::now();
+    if (tty_) {
+      if (now - last_ < std::chrono::milliseconds(100) && fraction < 1.0) return;
+      last_ = now;
+      const int width = 30, filled = static_cast<int>(fraction * width);
+      std::fprintf(stderr, "\r[%s%s] %5.1f%%  t = %.4g / %.4g s", std::string(filled, '#').c_str(),
+                   std::string(width - filled, ' ').c_str(), 100 * fraction, t, end);
+      std::fflush(stderr);
+      dirty_ = true;
+    } else {
+      const int decile = static_cast<int>(fraction * 10 + 1e-9);
+      if (decile <= last_decile_) return;
+      last_decile_ = decile;
+      std::fprintf(stderr, "progress: %3d%%  t = %.6g s\n", decile * 10, t);
+    }
+  }
+  void Done() {
+    if (dirty_) std::fprintf(stderr, "\n");
+    dirty_ = false;
+  }
+
+ private:
+  bool quiet_, tty_;
+  bool dirty_ = false;
+  int last_decile_ = 0;
+  std::chrono::steady_clock::time_point last_{};
+};
+
+gipsi::Scene Load(const std::string& file, const std::vector<std::string>& plugins,
+                  gipsi::TypeRegistry& registry) {
+  gipsi::RegisterBuiltins(registry);
+  for (const auto& plugin : plugins) registry.LoadPlugin(plugin);
+  return gipsi::LoadScene(file, registry);
+}
+
+int Run(const std::string& file, const std::string& out_dir, double until, bool quiet, bool no_vtu,
+        const std::vector<std::string>& plugins) {
+  gipsi::TypeRegistry registry;
+  gipsi::Scene scene = Load(file, plugins, registry);
+  if (until > 0) scene.end_time = until;
+  if (no_vtu) scene.vtu.enabled = false;
+  std::filesystem::path out =
+      out_dir.empty() ? scene.output_directory : std::filesystem::path(out_dir);
+  gipsi::AttachOutputs(scene, out);
+
+  gipsi::Kernel& kernel = *scene.kernel;
+  Progress progress(quiet);
+  g_running_kernel.store(&kernel);
+  std::signal(SIGINT, HandleStopSignal);
+  std::signal(SIGTERM, HandleStopSignal);
+  gipsi::RunResult result =
+      kernel.Run(scene.end_time, [&](double t, double end) { progress.Update(t, end); });
+  g_running_kernel.store(nullptr);
+  std::signal(SIGINT, SIG_DFL);
+  std::signal(SIGTERM, SIG_DFL);
+  progress.Done();
+
+  std::string summary;
+  summary += fmt::format("simulated time:   {:.6g} s (from {:.6g} s)\n",
+                         result.end_time - result.start_time, result.start_time);
+  summary += fmt::format("wall time:        {:.3f} s\n", result.wall_seconds);
+  summary += fmt::format("real-time factor: {:.3g}\n", result.real_time_factor());
+  summary +=
+      fmt::format("macro steps:      {} of {:.6g} s\n", result.macro_steps, kernel.macro_dt());
+  const auto& coordinator = kernel.coordinator();
+  for (std::size_t i = 0; i < coordinator.num_objects(); ++i) {
+    const auto& object = coordinator.object(i);
+    summary += fmt::format("  {:<20} {:<14} {} steps of {:.6g} s\n", object.name(),
+                           object.type_name(), object.step_count(), coordinator.object_dt(i));
+  }
+  for (std::size_t i = 0; i < coordinator.num_connectors(); ++i) {
+    const auto& connector = coordinator.connector(i);
+    summary += fmt::format("  {:<20} {:<14} fired {} times\n", connector.name(),
+                           connector.type_name(), connector.fire_count());
+  }
+  for (const auto& [t, what] : kernel.fired_events())
+    summary += fmt::format("  event at {:.6g} s: {}\n", t, what);
+  summary += fmt::format("outputs:          {}\n", out.string());
+  if (!quiet || !result.ok()) std::cout << summary << std::flush;
+
+  switch (result.outcome) {
+    case gipsi::RunResult::Outcome::kCompleted:
+      return 0;
+    case gipsi::RunResult::Outcome::kDiverged:
+      std::cerr << "gipsi: error: " << result.diagnostic << "\n";
+      return 3;
+    case gipsi::RunResult::Outcome::kOutputFailed:
+      std::cerr << "gipsi: error: " << result.diagnostic << "\n";
+      return 4;
+    case gipsi::RunResult::Outcome::kStopped:
+      std::cerr << "gipsi: " << result.diagnostic << "\n";
+      return 130;
+  }
+  return 0;
+}
+
+int Validate(const std::string& file, const std::vector<std::string>& plugins) {
+  gipsi::TypeRegistry registry;
+  gipsi::Scene scene = Load(file, plugins, registry);
+  const auto& coordinator = scene.kernel->coordinator();
+  std::cout << fmt::format("{}: valid scene\n", file);
+  std::cout << fmt::format("  end time {:.6g} s, macro step {:.6g} s\n", scene.end_time,
+                           scene.kernel->macro_dt());
+  for (const auto& [name, mesh] : scene.meshes)
+    std::cout << fmt::format("  mesh {:<16} {} nodes, {} tets, {} triangles\n", name,
+                             mesh->num_nodes(), mesh->num_tets(), mesh->num_triangles());
+  for (std::size_t i = 0; i < coordinator.num_objects(); ++i) {
+    const auto& object = coordinator.object(i);
+    std::cout << fmt::format("  object {:<14} {} (dt {:.6g} s, {} sub-steps per macro step)\n",
+                             object.name(), object.type_name(), coordinator.object_dt(i),
+                             coordinator.object_substeps(i));
+    for (const auto& field : object.fields())
+      std::cout << fmt::format(
+          "      field {:<22} {:<16} {}x [{}] {}\n", field.name, gipsi::ToString(field.location),
+          field.components, field.units,
+          field.writable() ? (field.readable() ? "read/write" : "write") : "read");
+  }
+  for (std::size_t i = 0; i < coordinator.num_connectors(); ++i)
+    std::cout << fmt::format("  connector {:<11} {}\n", coordinator.connector(i).name(),
+                             coordinator.connector(i).type_name());
+  for (const auto& [key, bc] : scene.boundary_conditions)
+    std::cout << fmt::format("  condition {:<22} {} vertices, {} faces\n", key, bc.vertices.size(),
+                             bc.faces.size());
+  for (const auto& probe : scene.probes)
+    std::cout << fmt::format("  probe {:<15} {}\n", probe.name, probe.Header());
+  return 0;
+}
+
+int Info(const std::string& file) {
+  gipsi::Mesh mesh = gipsi::ReadMesh(file);
+  std::cout << file << "\n" << gipsi::DescribeMesh(mesh);
+  return 0;
+}
+
+int Types(const std::vector<std::string>& plugins) {
+  gipsi::TypeRegistry registry;
+  gipsi::RegisterBuiltins(registry);
+  for (const auto& plugin : plugins) registry.LoadPlugin(plugin);
+  auto print = [](const char* title, const auto& list) {
+    std::cout << title << ":\n";
+    for (const auto& [name, description] : list)
+      std::cout << fmt::format("  {:<18} {}\n", name, description);
+  };
+  print("objects", registry.objects.List());
+  print("connectors", registry.connectors.List());
+  print("integrators", registry.integrators.List());
+  print("material laws", registry.materials.List());
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"GiPSi: an open-architecture framework for organ-level and surgical simulation"};
+  app.set_version_flag("--version", "gipsi 0.1.0");
+  app.require_subcommand(1);
+  std::string scene_file, out_dir, mesh_file;
+  double until = 0;
+  bool quiet = false, no_vtu = false, verbose = false;
+  std::vector<std::string> plugins;
+  app.add_flag("-v,--verbose", verbose, "Log more (debug level)");
+
+  auto* run =
+      app.add_subcommand("run", "Run a scene headless, writing VTU/PVD series and probe CSVs");
+  run->add_option("SCENE", scene_file, "Scene file (JSON)")->required();
+  run->add_option("-o,--out", out_dir, "Output directory (default: the scene's, or out/<scene>)");
+  run->add_option("--until", until, "End time in seconds, overriding schedule.end")
+      ->check(CLI::PositiveNumber);
+  run->add_flag("-q,--quiet", quiet, "No progress bar and no summary unless the run fails");
+  run->add_flag("--no-vtu", no_vtu, "Do not write VTU/PVD series (probes are still written)");
+  run->add_option("--plugin", plugins, "Load a plugin shared library (repeatable)");
+
+  auto* validate = app.add_subcommand("validate", "Check a scene without running it");
+  validate->add_option("SCENE", scene_file, "Scene file (JSON)")->required();
+  validate->add_option("--plugin", plugins, "Load a plugin shared library (repeatable)");
+
+  auto* info = app.add_subcommand(
+      "info", "Describe a mesh file: counts, named regions, bounding box, element quality");
+  info->add_option("MESH", mesh_file, "Mesh file (.msh, .node/.ele, .vtk, .vtu, .obj, .stl)")
+      ->required();
+
+  auto* types =
+      app.add_subcommand("types", "List the registered object, connector, integrator and material types");
+  types->add_option("--plugin", plugins, "Load a plugin shared library (repeatable)");
+
+  CLI11_PARSE(app, argc, argv);
+  gipsi::Log().set_level(verbose ? spdlog::level::debug : spdlog::level::info);
+  try {
+    if (*run) return Run(scene_file, out_dir, until, quiet, no_vtu, plugins);
+    if (*validate) return Validate(scene_file, plugins);
+    if (*info) return Info(mesh_file);
+    if (*types) return Types(plugins);
+  } catch (const gipsi::InputError& e) {
+    std::cerr << "gipsi: error: " << e.what() << "\n";
+    return 1;
+  } catch (const std::exception& e) {
+    std::cerr << "gipsi: error: " << e.what() << "\n";
+    return 1;
+  }
+  return 0;
+}

@@ -40,11 +40,11 @@ namespace internal {
 }  // namespace gipsi
 
 /// Always-on check of a programmer error (a violated precondition of a public API). Aborts.
-#define GIPSI_CHECK(cond, ...)                                                      \
-  do {                                                                              \
-    if (!(cond)) [[unlikely]]                                                       \
-      ::gipsi::internal::AbortWithMessage(#cond, __FILE__, __LINE__,                \
-                                          ::fmt::format("" __VA_OPT__(, ) __VA_ARGS__)); \
+#define GIPSI_CHECK(cond, ...)                                            \
+  do {                                                                    \
+    if (!(cond)) [[unlikely]]                                             \
+      ::gipsi::internal::AbortWithMessage(#cond, __FILE__, __LINE__,      \
+                                          ::fmt::format("" __VA_ARGS__)); \
   } while (false)
 
 #ifdef NDEBUG

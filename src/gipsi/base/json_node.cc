@@ -229,6 +229,13 @@ JsonDocument JsonDocument::Parse(std::string_view text, std::string name) {
     std::string detail = pos == std::string::npos ? what : what.substr(pos + 2);
     ThrowInputError(name, fmt::format("line {}, column {}", line, col),
                     fmt::format("invalid JSON: {}", detail));
+  } catch (const nlohmann::json::exception& e) {
+    // e.g. out_of_range 406 for a number literal that overflows a double (1e999).
+    std::string what = e.what();
+    auto pos = what.find("] ");
+    ThrowInputError(
+        name, "",
+        fmt::format("invalid JSON: {}", pos == std::string::npos ? what : what.substr(pos + 2)));
   }
   return JsonDocument(std::move(json), std::move(name));
 }

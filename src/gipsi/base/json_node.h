@@ -58,13 +58,13 @@ class JsonNode {
   void CheckKeys(const std::vector<std::string>& allowed) const;
 
   // Conversions of this value; each throws on a wrong type.
-  [[nodiscard]] double AsNumber() const;          ///< a finite number
-  [[nodiscard]] double AsPositive() const;        ///< a finite number > 0
-  [[nodiscard]] double AsNonNegative() const;     ///< a finite number >= 0
-  [[nodiscard]] std::int64_t AsInt() const;       ///< an integer
+  [[nodiscard]] double AsNumber() const;       ///< a finite number
+  [[nodiscard]] double AsPositive() const;     ///< a finite number > 0
+  [[nodiscard]] double AsNonNegative() const;  ///< a finite number >= 0
+  [[nodiscard]] std::int64_t AsInt() const;    ///< an integer
   [[nodiscard]] bool AsBool() const;
   [[nodiscard]] std::string AsString() const;
-  [[nodiscard]] Vec3 AsVec3() const;              ///< an array of 3 finite numbers
+  [[nodiscard]] Vec3 AsVec3() const;  ///< an array of 3 finite numbers
   [[nodiscard]] std::vector<double> AsNumbers() const;
   [[nodiscard]] std::vector<std::int64_t> AsInts() const;
   [[nodiscard]] std::vector<std::string> AsStrings() const;
@@ -76,9 +76,7 @@ class JsonNode {
   [[nodiscard]] double Number(std::string_view key, double fallback) const;
   [[nodiscard]] double Positive(std::string_view key) const { return At(key).AsPositive(); }
   [[nodiscard]] double Positive(std::string_view key, double fallback) const;
-  [[nodiscard]] double NonNegative(std::string_view key) const {
-    return At(key).AsNonNegative();
-  }
+  [[nodiscard]] double NonNegative(std::string_view key) const { return At(key).AsNonNegative(); }
   [[nodiscard]] double NonNegative(std::string_view key, double fallback) const;
   [[nodiscard]] std::int64_t Int(std::string_view key) const { return At(key).AsInt(); }
   [[nodiscard]] std::int64_t Int(std::string_view key, std::int64_t fallback) const;

@@ -4,6 +4,7 @@
 /// is a 3 by N matrix (column j is point j), as in Eigen's column-major layout.
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>  // cross products everywhere
 
 namespace gipsi {
 

@@ -32,13 +32,17 @@ struct EllipsoidShellSpec {
   double base_z = 5;
   double mesh_size = 2;
 };
-/// Tet mesh of the shell by Gmsh. Groups: "endo", "epi", "base" (dim 2) and "wall" (dim 3).
-/// Throws InputError for inconsistent dimensions (endo must lie inside epi, base_z must cut
-/// both) or if Gmsh fails.
+/// Tet mesh of the shell by Gmsh (OpenCASCADE kernel; `mesh_size` is the largest element size).
+/// Tets are positively oriented; the boundary triangles are the closed boundary of the tets,
+/// oriented out of the wall (on "endo" they point into the cavity). Groups: "endo", "epi",
+/// "base" (dim 2) and "wall" (dim 3). Throws InputError for inconsistent dimensions (endo must
+/// lie inside epi, base_z must cut both), a mesh size giving over 2e7 tets, or if Gmsh fails.
+/// Thread-safe: Gmsh's global state is guarded by a process-wide mutex.
 Mesh MakeEllipsoidShell(const EllipsoidShellSpec& spec);
 
-/// A hollow cylinder around the z axis from z=0 to z=height. Groups: "inner", "outer",
-/// "bottom", "top" (dim 2), "wall" (dim 3). Throws InputError for inner >= outer etc.
+/// A hollow cylinder around the z axis from z=0 to z=height, meshed like `MakeEllipsoidShell`.
+/// Groups: "inner", "outer", "bottom", "top" (dim 2), "wall" (dim 3). Throws InputError for
+/// inner >= outer, a non-positive size, too many tets, or if Gmsh fails.
 Mesh MakeCylinderShell(double inner_radius, double outer_radius, double height, double mesh_size);
 
 }  // namespace gipsi

@@ -18,13 +18,18 @@ class PointMap {
   /// Barycentric embedding in a tet mesh (`nodes` 3 by N, `tets` 4 by E): each target uses the
   /// tet containing it; a target outside the mesh uses the nearest tet with its barycentric
   /// coordinates clamped to the tet (and `max_distance()` reports how far off it was).
+  /// Candidate tets come from a uniform grid of tet bounding boxes (no search over all tets).
+  /// Throws InputError if there are targets but no tets, or a target is not finite.
   static PointMap BarycentricInTets(const Points& nodes, const Tets& tets, const Points& targets);
 
-  /// Barycentric on a triangle surface: the closest point on any triangle.
+  /// Barycentric on a triangle surface: the closest point on any triangle (Ericson, Real-Time
+  /// Collision Detection, §5.1.5). Throws InputError if there are targets but no triangles, or
+  /// a target is not finite.
   static PointMap BarycentricOnTriangles(const Points& vertices, const Triangles& triangles,
                                          const Points& targets);
 
-  /// Nearest source point (weight 1).
+  /// Nearest source point (weight 1). Throws InputError if there are targets but no sources,
+  /// or a target is not finite.
   static PointMap Nearest(const Points& sources, const Points& targets);
 
   [[nodiscard]] Index num_targets() const { return indices_.cols(); }

@@ -22,8 +22,7 @@ void CheckConnectivity(const Conn& conn, Index num_nodes, std::string_view kind,
       }
       for (Index b = 0; b < a; ++b) {
         if (conn(b, e) == n)
-          ThrowInputError(source, fmt::format("{} {}", kind, e),
-                          fmt::format("repeats node {}", n));
+          ThrowInputError(source, fmt::format("{} {}", kind, e), fmt::format("repeats node {}", n));
       }
     }
   }

@@ -23,10 +23,10 @@ struct MeshGroup {
 /// Nodes plus tetrahedra and/or triangles. Both connectivity blocks may be present (a tet mesh
 /// with tagged boundary triangles, as Gmsh writes them). Plain data: copyable and movable.
 struct Mesh {
-  Points nodes = Points(3, 0);          ///< 3 by N node coordinates (scene units)
-  Tets tets = Tets(4, 0);               ///< 4 by E node indices of each tetrahedron
+  Points nodes = Points(3, 0);            ///< 3 by N node coordinates (scene units)
+  Tets tets = Tets(4, 0);                 ///< 4 by E node indices of each tetrahedron
   Triangles triangles = Triangles(3, 0);  ///< 3 by T node indices of each triangle
-  std::vector<MeshGroup> groups;        ///< named groups, unique names
+  std::vector<MeshGroup> groups;          ///< named groups, unique names
 
   [[nodiscard]] Index num_nodes() const { return nodes.cols(); }
   [[nodiscard]] Index num_tets() const { return tets.cols(); }

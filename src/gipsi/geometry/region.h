@@ -19,12 +19,14 @@ struct BoxRegion {
   Vec3 min = Vec3::Zero();
   Vec3 max = Vec3::Zero();
 };
-/// Points x with (x − point)·normal >= −tolerance (the side the normal points to).
+/// Points x with (x − point)·n >= −tolerance, n = normal/|normal| (the side the normal points
+/// to; the tolerance is 1e-9 of the mesh diagonal). A zero normal is an InputError.
 struct HalfSpaceRegion {
   Vec3 point = Vec3::Zero();
   Vec3 normal = Vec3::UnitZ();
 };
-/// Ball of given centre and radius.
+/// Ball of given centre and radius (>= 0; inclusive, with a tolerance of 1e-9 of the mesh
+/// diagonal).
 struct SphereRegion {
   Vec3 center = Vec3::Zero();
   double radius = 0;
@@ -43,7 +45,8 @@ using Region =
     std::variant<AllRegion, BoxRegion, HalfSpaceRegion, SphereRegion, GroupRegion, NodeIdsRegion>;
 
 /// Domain nodes in `region`, sorted and unique. Throws InputError for an unknown group name
-/// (listing the available ones) or an out-of-range id.
+/// (listing the available ones), an out-of-range id, a zero half-space normal or a negative
+/// sphere radius.
 std::vector<int> SelectNodes(const Region& region, const Mesh& mesh);
 
 /// Boundary vertices (indices into `boundary.vertex_to_node`) whose domain node is in `region`.

@@ -1,0 +1,28 @@
+#!/usr/bin/env bash
+# Installs the dependencies, then builds and runs every test: the release build, the same suite
+# under AddressSanitizer + UndefinedBehaviorSanitizer, and a clang-format check.
+# Usage: bash scripts/test.sh [--fast]   (--fast: release build and tests only)
+set -euo pipefail
+cd "$(dirname "$0")/.."
+bash scripts/install-deps.sh
+
+# Warnings are errors in CI (CI=true), and only warnings elsewhere.
+export GIPSI_WERROR=OFF
+if [ "${CI:-}" = "true" ]; then export GIPSI_WERROR=ON; fi
+
+echo "== clang-format"
+mapfile -t sources < <(git ls-files '*.h' '*.cc' 2>/dev/null || find src apps tests plugins bench -name '*.h' -o -name '*.cc')
+clang-format --dry-run --Werror "${sources[@]}"
+echo "clang-format: ${#sources[@]} files formatted"
+
+echo "== release"
+cmake --preset release
+cmake --build --preset release
+ctest --preset release
+
+if [ "${1:-}" != "--fast" ]; then
+  echo "== asan (address + undefined behavior sanitizers)"
+  cmake --preset asan
+  cmake --build --preset asan
+  ctest --preset asan
+fi

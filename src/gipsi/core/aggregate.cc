@@ -1,0 +1,89 @@
+#include "gipsi/core/aggregate.h"
+
+#include <fmt/format.h>
+
+#include "gipsi/base/error.h"
+
+namespace gipsi {
+
+AggregateObject::AggregateObject(std::string name, Coordinator parts)
+    : SimObject(std::move(name)), parts_(std::move(parts)) {
+  for (std::size_t i = 0; i < parts_.num_objects(); ++i) {
+    SimObject& part = parts_.object(i);
+    for (std::size_t f = 0; f < part.fields().size(); ++f) {
+      FieldInfo info = part.fields()[f];
+      // Only global fields keep their meaning without the part's geometry in this object;
+      // the others are still reachable through the part itself ("heart.muscle").
+      if (info.location != FieldLocation::kGlobal) continue;
+      info.name = part.name() + "." + info.name;
+      DeclareField(info);
+      proxies_.push_back({&part, FieldId(static_cast<std::int64_t>(f))});
+    }
+  }
+}
+
+void AggregateObject::CollectLeaves(std::vector<const SimObject*>& out) const {
+  for (std::size_t i = 0; i < parts_.num_objects(); ++i) parts_.object(i).CollectLeaves(out);
+}
+
+SimObject* AggregateObject::FindPart(std::string_view name) const {
+  return parts_.FindObject(name);
+}
+
+StepStatus AggregateObject::DoStep(double t, double /*dt*/) {
+  if (auto failure = parts_.MacroStep(t, step_count())) {
+    SimObject* part = failure->is_connector ? nullptr : parts_.FindObject(failure->who);
+    std::string inner = part ? part->failure_detail() : std::string();
+    failure_detail_ = std::string(failure->is_connector ? "connector '" : "part '") +
+                      std::string(failure->who) + "'" + (inner.empty() ? "" : ", " + inner);
+    return failure->status;
+  }
+  return StepStatus::Ok();
+}
+
+void AggregateObject::DoReadField(FieldId id, Eigen::Ref<Eigen::MatrixXd> out) const {
+  const Proxy& p = proxies_[static_cast<std::size_t>(id.value())];
+  p.part->ReadField(p.field, out);
+}
+
+void AggregateObject::DoWriteField(FieldId id, const Eigen::Ref<const Eigen::MatrixXd>& in) {
+  const Proxy& p = proxies_[static_cast<std::size_t>(id.value())];
+  p.part->WriteField(p.field, in);
+}
+
+void RegisterAggregate(TypeRegistry& registry) {
+  registry.objects.Register(
+      "Aggregate",
+      [](const ObjectBuildContext& ctx) -> std::unique_ptr<SimObject> {
+        const JsonNode& p = ctx.params;
+        ctx.CheckKeys({"parts", "connectors", "order"});
+        Coordinator parts;
+        JsonNode part_nodes = p.At("parts");
+        if (part_nodes.size() == 0) part_nodes.Expected("at least one part");
+        for (const auto& [name, node] : part_nodes.Members()) {
+          BuiltObject built = ctx.build_object(name, node);
+          try {
+            parts.AddObject(std::move(built.object), built.dt);
+          } catch (const InputError& e) {
+            node.Fail(e.what());
+          }
+        }
+        if (auto connectors = p.Find("connectors")) {
+          for (const auto& [name, node] : connectors->Members()) {
+            auto connector = ctx.registry.CreateConnector(name, node, parts);
+            parts.AddConnector(std::move(connector), static_cast<int>(node.Int("every", 1)));
+          }
+        }
+        if (auto order = p.Find("order")) parts.SetOrder(order->AsStrings(), order->path());
+        JsonNode dt = p.At("dt");
+        try {
+          parts.Prepare(dt.AsPositive());
+        } catch (const InputError& e) {
+          dt.Fail(e.what());
+        }
+        return std::make_unique<AggregateObject>(ctx.name, std::move(parts));
+      },
+      "an object made of parts and the connectors between them");
+}
+
+}  // namespace gipsi

@@ -1,0 +1,52 @@
+#pragma once
+/// @file
+/// `AggregateObject`: an object made of objects and the connectors between them (the paper's
+/// Heart = bioelectricity + muscle + blood). Its step runs its own coordination: parts sub-step
+/// at their own rates inside the aggregate's step, connectors fire in the given order. Its fields
+/// are its parts' fields under dotted names ("muscle.position").
+
+#include <memory>
+#include <vector>
+
+#include "gipsi/core/coordinator.h"
+#include "gipsi/core/registry.h"
+#include "gipsi/core/sim_object.h"
+
+namespace gipsi {
+
+/// Not copyable or movable.
+class AggregateObject final : public SimObject {
+ public:
+  /// Takes a prepared coordinator (parts, connectors, order; `Prepare(dt)` called with this
+  /// aggregate's dt) and exposes its parts' fields.
+  AggregateObject(std::string name, Coordinator parts);
+
+  [[nodiscard]] std::string_view type_name() const override { return "Aggregate"; }
+  [[nodiscard]] const Points& domain_positions() const override { return empty_; }
+  void CollectLeaves(std::vector<const SimObject*>& out) const override;
+  [[nodiscard]] SimObject* FindPart(std::string_view name) const override;
+  void BeginMacroStep() override { parts_.BeginMacroStep(); }
+  [[nodiscard]] const Coordinator& parts() const { return parts_; }
+  [[nodiscard]] std::string failure_detail() const override { return failure_detail_; }
+
+ protected:
+  StepStatus DoStep(double t, double dt) override;
+  void DoReadField(FieldId id, Eigen::Ref<Eigen::MatrixXd> out) const override;
+  void DoWriteField(FieldId id, const Eigen::Ref<const Eigen::MatrixXd>& in) override;
+
+ private:
+  struct Proxy {
+    SimObject* part;
+    FieldId field;
+  };
+  Coordinator parts_;
+  std::vector<Proxy> proxies_;  // indexed by this object's FieldId
+  Points empty_ = Points(3, 0);
+  std::string failure_detail_;  // set only when a part fails
+};
+
+/// Registers "Aggregate": {"type": "Aggregate", "dt": macro step, "parts": {name: object...},
+/// "connectors": {name: connector...}, "order": [names...]}.
+void RegisterAggregate(TypeRegistry& registry);
+
+}  // namespace gipsi

@@ -1,0 +1,44 @@
+#pragma once
+/// @file
+/// `Connector`: couples simulation objects, either through a shared boundary (boundary values of
+/// one → boundary conditions of the other) or through a shared volume (Get a field of one → Set a
+/// field of the other). Connectors convert semantics and map between different meshes.
+
+#include <string>
+#include <string_view>
+
+#include "gipsi/core/step_status.h"
+
+namespace gipsi {
+
+/// Base class of connectors. Not copyable or movable.
+///
+/// A connector resolves everything it needs (objects, field ids, mappings, buffers) when it is
+/// built, throwing InputError for bad wiring; `Fire` then only transfers values: it never
+/// throws and allocates nothing.
+class Connector {
+ public:
+  Connector(const Connector&) = delete;
+  Connector& operator=(const Connector&) = delete;
+  virtual ~Connector() = default;
+
+  [[nodiscard]] const std::string& name() const { return name_; }
+  [[nodiscard]] virtual std::string_view type_name() const = 0;
+
+  /// Transfers values at simulated time `t`.
+  StepStatus Fire(double t) {
+    ++fire_count_;
+    return DoFire(t);
+  }
+  [[nodiscard]] std::int64_t fire_count() const { return fire_count_; }
+
+ protected:
+  explicit Connector(std::string name) : name_(std::move(name)) {}
+  virtual StepStatus DoFire(double t) = 0;
+
+ private:
+  std::string name_;
+  std::int64_t fire_count_ = 0;
+};
+
+}  // namespace gipsi

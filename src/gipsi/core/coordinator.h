@@ -1,0 +1,95 @@
+#pragma once
+/// @file
+/// `Coordinator`: the user-defined coordination of a set of objects and connectors: execution
+/// order, a time step per object (multi-rate sub-stepping inside a macro step) and how often each
+/// connector fires. Used by the `Kernel` for the whole scene and by `AggregateObject` for its
+/// parts.
+
+#include <memory>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "gipsi/core/connector.h"
+#include "gipsi/core/sim_object.h"
+
+namespace gipsi {
+
+/// Where a macro step stopped, if it did not complete. `who` names the object or connector
+/// (points into its name; valid while the coordinator lives).
+struct ScheduleFailure {
+  StepStatus status;
+  std::string_view who;
+  bool is_connector = false;
+  double time = 0;  ///< simulated time at the start of the failing sub-step
+};
+
+/// Owns objects and connectors and runs them in order. Not copyable; movable.
+///
+/// Build phase: `AddObject`, `AddConnector`, optionally `SetOrder`, then `Prepare(macro_dt)`.
+/// Run phase: `MacroStep` repeatedly. Default order (no SetOrder): every connector in insertion
+/// order, then every object: a staggered exchange at the start of each macro step.
+class Coordinator {
+ public:
+  Coordinator() = default;
+  Coordinator(Coordinator&&) = default;
+  Coordinator& operator=(Coordinator&&) = default;
+
+  /// Adds an object stepped with time step `dt` (> 0). Throws InputError for a duplicate name.
+  SimObject& AddObject(std::unique_ptr<SimObject> object, double dt);
+  /// Adds a connector fired every `every` macro steps (>= 1).
+  Connector& AddConnector(std::unique_ptr<Connector> connector, int every = 1);
+  /// Sets the execution order: names of objects and connectors, each exactly once. Throws
+  /// InputError for unknown, repeated or missing names (`where` is prefixed to messages).
+  void SetOrder(const std::vector<std::string>& names, std::string_view where = "schedule.order");
+
+  /// Fixes the macro step and each object's sub-step count. Every object dt must divide
+  /// `macro_dt` to within 1e-9 relative; otherwise throws InputError naming the object.
+  void Prepare(double macro_dt);
+  /// Largest object dt (the natural macro step), or 0 when there are no objects.
+  [[nodiscard]] double max_object_dt() const;
+
+  /// Runs one macro step from time t: for each entry in order, sub-steps an object
+  /// `substeps` times or fires a due connector. Stops at the first failure. Never throws.
+  std::optional<ScheduleFailure> MacroStep(double t, std::int64_t macro_index);
+  /// Forwards `BeginMacroStep` to every object.
+  void BeginMacroStep();
+
+  [[nodiscard]] std::size_t num_objects() const { return objects_.size(); }
+  [[nodiscard]] std::size_t num_connectors() const { return connectors_.size(); }
+  [[nodiscard]] SimObject& object(std::size_t i) { return *objects_[i].object; }
+  [[nodiscard]] const SimObject& object(std::size_t i) const { return *objects_[i].object; }
+  [[nodiscard]] double object_dt(std::size_t i) const { return objects_[i].dt; }
+  [[nodiscard]] int object_substeps(std::size_t i) const { return objects_[i].substeps; }
+  [[nodiscard]] Connector& connector(std::size_t i) { return *connectors_[i].connector; }
+  [[nodiscard]] const Connector& connector(std::size_t i) const {
+    return *connectors_[i].connector;
+  }
+  /// The object called `name` (dotted names reach into aggregates: "heart.muscle"), or nullptr.
+  [[nodiscard]] SimObject* FindObject(std::string_view name) const;
+  /// Names of every object (for messages).
+  [[nodiscard]] std::vector<std::string> ObjectNames() const;
+
+ private:
+  struct ObjectSlot {
+    std::unique_ptr<SimObject> object;
+    double dt = 0;
+    int substeps = 1;
+  };
+  struct ConnectorSlot {
+    std::unique_ptr<Connector> connector;
+    int every = 1;
+  };
+  struct Entry {
+    bool is_connector = false;
+    std::size_t index = 0;
+  };
+  std::vector<ObjectSlot> objects_;
+  std::vector<ConnectorSlot> connectors_;
+  std::vector<Entry> order_;
+  bool has_order_ = false;
+  double macro_dt_ = 0;
+};
+
+}  // namespace gipsi

@@ -1,0 +1,140 @@
+#include "gipsi/core/kernel.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+#include <fmt/format.h>
+
+#include "gipsi/base/error.h"
+#include "gipsi/base/json_node.h"
+#include "gipsi/base/log.h"
+
+namespace gipsi {
+
+void Kernel::ScheduleEvent(ScheduledEvent event) {
+  if (!std::isfinite(event.time))
+    throw InputError(fmt::format("event '{}': time is not finite", event.description));
+  auto pos =
+      std::upper_bound(events_.begin() + static_cast<std::ptrdiff_t>(next_event_), events_.end(),
+                       event.time, [](double t, const ScheduledEvent& e) { return t < e.time; });
+  events_.insert(pos, std::move(event));
+}
+
+void Kernel::AddObserver(std::unique_ptr<Observer> observer) {
+  GIPSI_CHECK(observer != nullptr);
+  observers_.push_back(std::move(observer));
+}
+
+void Kernel::Initialize(double macro_dt) {
+  if (coordinator_.num_objects() == 0) throw InputError("the scene has no objects to simulate");
+  macro_dt_ = macro_dt > 0 ? macro_dt : coordinator_.max_object_dt();
+  coordinator_.Prepare(macro_dt_);
+}
+
+SimObject& Kernel::FindObject(std::string_view name) const {
+  if (SimObject* object = coordinator_.FindObject(name)) return *object;
+  auto names = coordinator_.ObjectNames();
+  std::string list;
+  for (const auto& n : names) list += (list.empty() ? "" : ", ") + n;
+  throw InputError(
+      fmt::format("no object named '{}'{}; objects: {}", name, SuggestClosest(name, names), list));
+}
+
+void Kernel::FireDueEvents(double t) {
+  const double tolerance = 1e-9 * macro_dt_;
+  while (next_event_ < events_.size() && events_[next_event_].time <= t + tolerance) {
+    ScheduledEvent& event = events_[next_event_++];
+    Log().info("t = {:.6g} s: event: {}", t, event.description);
+    event.action(*this);
+    fired_.emplace_back(t, event.description);
+  }
+}
+
+void Kernel::Notify(double t) {
+  for (auto& observer : observers_) observer->Observe(*this, t);
+}
+
+RunResult Kernel::Run(double end_time, const ProgressFn& progress) {
+  GIPSI_CHECK(macro_dt_ > 0, "Kernel::Initialize was not called");
+  using Clock = std::chrono::steady_clock;
+  const auto wall_start = Clock::now();
+  stop_requested_.store(false);
+  RunResult result;
+  result.start_time = time();
+  const auto last_step =
+      static_cast<std::int64_t>(std::ceil((end_time - start_time_) / macro_dt_ - 1e-9));
+
+  auto finish = [&](RunResult::Outcome outcome, std::string diagnostic) {
+    for (auto& observer : observers_) {
+      try {
+        observer->Finish(*this);
+      } catch (const std::exception& e) {
+        if (outcome == RunResult::Outcome::kCompleted) {
+          outcome = RunResult::Outcome::kOutputFailed;
+          diagnostic = fmt::format("writing outputs failed: {}", e.what());
+        }
+      }
+    }
+    result.outcome = outcome;
+    result.diagnostic = std::move(diagnostic);
+    result.end_time = time();
+    result.wall_seconds = std::chrono::duration<double>(Clock::now() - wall_start).count();
+    return result;
+  };
+
+  try {
+    if (!started_) {
+      started_ = true;
+      FireDueEvents(time());
+      Notify(time());
+    }
+  } catch (const std::exception& e) {
+    return finish(RunResult::Outcome::kOutputFailed, e.what());
+  }
+
+  while (macro_index_ < last_step) {
+    const double t = time();
+    try {
+      FireDueEvents(t);
+    } catch (const std::exception& e) {
+      return finish(RunResult::Outcome::kStopped,
+                    fmt::format("event at t = {:.6g} s failed: {}", t, e.what()));
+    }
+    coordinator_.BeginMacroStep();
+    if (auto failure = coordinator_.MacroStep(t, macro_index_)) {
+      std::string detail;
+      if (!failure->is_connector)
+        if (SimObject* object = coordinator_.FindObject(failure->who))
+          detail = object->failure_detail();
+      std::string where =
+          failure->status.item >= 0
+              ? fmt::format(" (item {}, value {:.6g})", failure->status.item, failure->status.value)
+              : std::string();
+      return finish(
+          RunResult::Outcome::kDiverged,
+          fmt::format("{} '{}'{} {} at t = {:.6g} s (macro step {}): {}{}; the run was "
+                      "stopped, outputs written up to t = {:.6g} s are kept",
+                      failure->is_connector ? "connector" : "object", failure->who,
+                      detail.empty() ? "" : " (" + detail + ")",
+                      failure->status.code == StepStatus::Code::kDiverged ? "diverged" : "failed",
+                      failure->time, macro_index_, failure->status.what, where, t));
+    }
+    ++macro_index_;
+    ++result.macro_steps;
+    try {
+      Notify(time());
+    } catch (const std::exception& e) {
+      return finish(RunResult::Outcome::kOutputFailed,
+                    fmt::format("writing outputs failed at t = {:.6g} s: {}", time(), e.what()));
+    }
+    if (progress) progress(time(), end_time);
+    if (stop_requested_.load()) {
+      return finish(RunResult::Outcome::kStopped,
+                    fmt::format("stopped on request at t = {:.6g} s", time()));
+    }
+  }
+  return finish(RunResult::Outcome::kCompleted, "");
+}
+
+}  // namespace gipsi

@@ -1,0 +1,112 @@
+#pragma once
+/// @file
+/// `Kernel`: owns the object pool (through a Coordinator), runs the macro-step loop with
+/// multi-rate sub-stepping, fires scheduled discrete events, notifies observers (output writers,
+/// probes) and applies the divergence policy: a failing object stops the run with a diagnostic,
+/// and everything already written stays written.
+
+#include <atomic>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "gipsi/core/coordinator.h"
+
+namespace gipsi {
+
+class Kernel;
+
+/// Something that watches the run: output writers and probes. Observe is called once before
+/// the first step (at the start time) and after every macro step; an observer decides itself
+/// whether it is due. Observers may throw std::exception (e.g. a full disk): the kernel stops
+/// the run with that message.
+class Observer {
+ public:
+  virtual ~Observer() = default;
+  virtual void Observe(const Kernel& kernel, double t) = 0;
+  /// Called once when the run ends, however it ends (flush files here).
+  virtual void Finish(const Kernel& /*kernel*/) {}
+};
+
+/// A discrete event scheduled at a simulated time, e.g. "at t = 0.5 s release the clamp".
+struct ScheduledEvent {
+  double time = 0;
+  std::string description;
+  std::function<void(Kernel&)> action;
+};
+
+/// How a run ended.
+struct RunResult {
+  enum class Outcome { kCompleted, kDiverged, kStopped, kOutputFailed };
+  Outcome outcome = Outcome::kCompleted;
+  std::string diagnostic;  ///< empty when completed
+  double start_time = 0, end_time = 0;
+  double wall_seconds = 0;
+  std::int64_t macro_steps = 0;
+  [[nodiscard]] bool ok() const { return outcome == Outcome::kCompleted; }
+  /// Simulated seconds per wall-clock second.
+  [[nodiscard]] double real_time_factor() const {
+    return wall_seconds > 0 ? (end_time - start_time) / wall_seconds : 0;
+  }
+};
+
+/// Progress callback: (current time, end time). Called after each macro step.
+using ProgressFn = std::function<void(double, double)>;
+
+/// The simulation kernel. Not copyable or movable (observers and events hold references).
+///
+/// Build: add objects and connectors to `coordinator()`, events, observers; then `Initialize`.
+/// Run: `Run(end_time)`; may be called again to continue.
+class Kernel {
+ public:
+  Kernel() = default;
+  Kernel(const Kernel&) = delete;
+  Kernel& operator=(const Kernel&) = delete;
+
+  [[nodiscard]] Coordinator& coordinator() { return coordinator_; }
+  [[nodiscard]] const Coordinator& coordinator() const { return coordinator_; }
+
+  /// Schedules `event`; events fire at the start of the first macro step whose start time is
+  /// >= event.time (to within 1e-9 of the macro step), in time order, ties in insertion order.
+  void ScheduleEvent(ScheduledEvent event);
+  void AddObserver(std::unique_ptr<Observer> observer);
+
+  /// Fixes the macro step: `macro_dt` if > 0, else the largest object dt. Throws InputError if
+  /// an object's dt does not divide it.
+  void Initialize(double macro_dt = 0);
+  [[nodiscard]] double macro_dt() const { return macro_dt_; }
+
+  /// Runs until `end_time` (rounded to a whole number of macro steps). Never throws for a
+  /// numerical failure: the outcome and diagnostic say what happened.
+  RunResult Run(double end_time, const ProgressFn& progress = {});
+  /// Asks a running `Run` to stop after the current macro step (thread- and signal-safe).
+  void RequestStop() { stop_requested_.store(true); }
+
+  [[nodiscard]] double time() const { return start_time_ + macro_index_ * macro_dt_; }
+  [[nodiscard]] std::int64_t macro_steps() const { return macro_index_; }
+  /// Descriptions and times of the events fired so far.
+  [[nodiscard]] const std::vector<std::pair<double, std::string>>& fired_events() const {
+    return fired_;
+  }
+  /// The object called `name` (dotted for parts of aggregates); throws InputError listing the
+  /// objects when there is none.
+  [[nodiscard]] SimObject& FindObject(std::string_view name) const;
+
+ private:
+  void FireDueEvents(double t);
+  void Notify(double t);
+
+  Coordinator coordinator_;
+  std::vector<ScheduledEvent> events_;  // sorted by time (stable)
+  std::size_t next_event_ = 0;
+  std::vector<std::unique_ptr<Observer>> observers_;
+  std::vector<std::pair<double, std::string>> fired_;
+  double macro_dt_ = 0;
+  double start_time_ = 0;
+  std::int64_t macro_index_ = 0;
+  bool started_ = false;
+  std::atomic<bool> stop_requested_{false};
+};
+
+}  // namespace gipsi

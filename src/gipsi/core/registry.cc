@@ -1,0 +1,171 @@
+#include "gipsi/core/registry.h"
+
+#include <dlfcn.h>
+
+#include <algorithm>
+#include <filesystem>
+
+#include <fmt/format.h>
+
+#include "gipsi/base/error.h"
+#include "gipsi/core/coordinator.h"
+
+namespace gipsi {
+
+const std::vector<std::string>& ObjectBuildContext::CommonKeys() {
+  static const std::vector<std::string> keys = {
+      "type", "dt", "domain", "display", "boundary_conditions", "integrator", "description"};
+  return keys;
+}
+
+void ObjectBuildContext::CheckKeys(std::initializer_list<std::string_view> own) const {
+  std::vector<std::string> allowed = CommonKeys();
+  allowed.insert(allowed.end(), own.begin(), own.end());
+  params.CheckKeys(allowed);
+}
+
+std::shared_ptr<const Mesh> ObjectBuildContext::DomainMesh() const {
+  JsonNode node = params.At("domain");
+  return meshes.GetMesh(node.AsString(), node);
+}
+
+void ConnectorBuildContext::CheckKeys(std::initializer_list<std::string_view> own) const {
+  std::vector<std::string> allowed = {"type", "every", "description"};
+  allowed.insert(allowed.end(), own.begin(), own.end());
+  params.CheckKeys(allowed);
+}
+
+SimObject& ConnectorBuildContext::Object(std::string_view key) const {
+  JsonNode node = params.At(key);
+  std::string name = node.AsString();
+  if (SimObject* object = scope.FindObject(name)) return *object;
+  auto names = scope.ObjectNames();
+  node.Fail(fmt::format("no object named '{}'{}", name, SuggestClosest(name, names)));
+}
+
+std::pair<SimObject*, FieldId> ConnectorBuildContext::ObjectField(std::string_view key) const {
+  JsonNode node = params.At(key);
+  std::string spec = node.AsString();
+  auto dot = spec.rfind('.');
+  if (dot == std::string::npos || dot == 0 || dot + 1 == spec.size())
+    node.Expected("\"object.field\"");
+  std::string object_name = spec.substr(0, dot);
+  SimObject* object = scope.FindObject(object_name);
+  if (!object)
+    node.Fail(fmt::format("no object named '{}'{}", object_name,
+                          SuggestClosest(object_name, scope.ObjectNames())));
+  try {
+    return {object, object->FindField(spec.substr(dot + 1))};
+  } catch (const InputError& e) {
+    node.Fail(e.what());
+  }
+}
+
+template <class Factory>
+void FactoryTable<Factory>::Register(const std::string& name, Factory factory,
+                                     std::string description) {
+  GIPSI_CHECK(!name.empty() && factory, "empty {} registration", kind_);
+  GIPSI_CHECK(!Contains(name), "{} '{}' registered twice", kind_, name);
+  table_.emplace(name, Entry{std::move(factory), std::move(description)});
+}
+
+template <class Factory>
+const Factory& FactoryTable<Factory>::Get(std::string_view name, const JsonNode& where) const {
+  auto it = table_.find(name);
+  if (it != table_.end()) return it->second.factory;
+  std::vector<std::string> names;
+  std::string list;
+  for (const auto& [n, e] : table_) {
+    names.push_back(n);
+    list += (list.empty() ? "" : ", ") + n;
+  }
+  where.Fail(
+      fmt::format("unknown {} '{}'{}; known: {}", kind_, name, SuggestClosest(name, names), list));
+}
+
+template <class Factory>
+std::vector<std::pair<std::string, std::string>> FactoryTable<Factory>::List() const {
+  std::vector<std::pair<std::string, std::string>> out;
+  for (const auto& [n, e] : table_) out.emplace_back(n, e.description);
+  return out;
+}
+
+template class FactoryTable<ObjectFactory>;
+template class FactoryTable<ConnectorFactory>;
+template class FactoryTable<IntegratorFactory>;
+template class FactoryTable<MaterialFactory>;
+
+std::unique_ptr<SimObject> TypeRegistry::CreateObject(const std::string& name,
+                                                      const JsonNode& params,
+                                                      const MeshProvider& meshes,
+                                                      const BuildObjectFn& build_object) const {
+  JsonNode type = params.At("type");
+  const ObjectFactory& factory = objects.Get(type.AsString(), type);
+  ObjectBuildContext context{name, params, *this, meshes, build_object};
+  auto object = factory(context);
+  GIPSI_CHECK(object != nullptr, "factory for '{}' returned null", type.AsString());
+  return object;
+}
+
+std::unique_ptr<Connector> TypeRegistry::CreateConnector(const std::string& name,
+                                                         const JsonNode& params,
+                                                         const Coordinator& scope) const {
+  JsonNode type = params.At("type");
+  const ConnectorFactory& factory = connectors.Get(type.AsString(), type);
+  ConnectorBuildContext context{name, params, *this, scope};
+  auto connector = factory(context);
+  GIPSI_CHECK(connector != nullptr, "factory for '{}' returned null", type.AsString());
+  return connector;
+}
+
+std::unique_ptr<ExplicitIntegrator> TypeRegistry::CreateIntegrator(const JsonNode& where) const {
+  return integrators.Get(where.AsString(), where)();
+}
+
+std::shared_ptr<const Material> TypeRegistry::CreateMaterial(const JsonNode& node,
+                                                             std::string_view family) const {
+  JsonNode law = node.At("law");
+  auto material = materials.Get(law.AsString(), law)(node);
+  GIPSI_CHECK(material != nullptr, "factory for '{}' returned null", law.AsString());
+  if (material->family() != family)
+    law.Fail(fmt::format("'{}' is a {} law; this object needs a {} law", law.AsString(),
+                         material->family(), family));
+  return material;
+}
+
+void RegisterIntegrators(TypeRegistry& registry) {
+  registry.integrators.Register(
+      "ExplicitEuler", [] { return std::make_unique<ExplicitEuler>(); },
+      "forward Euler, first order");
+  registry.integrators.Register(
+      "SymplecticEuler", [] { return std::make_unique<SymplecticEuler>(); },
+      "semi-implicit Euler for mechanical systems, first order, energy stays bounded");
+  registry.integrators.Register(
+      "RK4", [] { return std::make_unique<RungeKutta4>(); }, "classic Runge-Kutta, fourth order");
+}
+
+void TypeRegistry::LoadPlugin(const std::string& path) {
+  std::error_code ec;
+  std::string canonical = std::filesystem::weakly_canonical(path, ec).string();
+  if (ec) canonical = path;
+  if (std::find(plugins_.begin(), plugins_.end(), canonical) != plugins_.end()) return;
+  if (!std::filesystem::exists(canonical)) ThrowInputError(path, "", "plugin file not found");
+  // Never dlclose: objects created by the plugin's factories must keep their code.
+  void* handle = dlopen(canonical.c_str(), RTLD_NOW | RTLD_LOCAL);
+  if (!handle) ThrowInputError(path, "", fmt::format("cannot load plugin: {}", dlerror()));
+  auto version = reinterpret_cast<int (*)()>(dlsym(handle, "gipsi_plugin_abi_version"));
+  auto registrar =
+      reinterpret_cast<void (*)(TypeRegistry&)>(dlsym(handle, "gipsi_register_plugin"));
+  if (!version || !registrar)
+    ThrowInputError(path, "",
+                    "not a GiPSi plugin: it must export gipsi_plugin_abi_version() and "
+                    "gipsi_register_plugin(gipsi::TypeRegistry&)");
+  if (version() != GIPSI_PLUGIN_ABI_VERSION)
+    ThrowInputError(path, "",
+                    fmt::format("plugin built for plugin ABI {}, this GiPSi has {}", version(),
+                                GIPSI_PLUGIN_ABI_VERSION));
+  registrar(*this);
+  plugins_.push_back(canonical);
+}
+
+}  // namespace gipsi

@@ -1,0 +1,132 @@
+#pragma once
+/// @file
+/// `SimObject`: one physical process (or an aggregate of processes) with its three geometries,
+/// named fields, boundary conditions and a `Step`. The GiPSi simulation API.
+
+#include <memory>
+#include <optional>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "gipsi/base/math.h"
+#include "gipsi/core/boundary_conditions.h"
+#include "gipsi/core/field.h"
+#include "gipsi/core/step_status.h"
+#include "gipsi/geometry/boundary.h"
+#include "gipsi/geometry/mapping.h"
+#include "gipsi/geometry/mesh.h"
+
+namespace gipsi {
+
+/// What an object is drawn with: a triangle surface whose vertices follow the domain through a
+/// mapping (barycentric embedding of a finer or coarser surface), or the boundary itself.
+/// Copyable and movable.
+struct DisplayGeometry {
+  Triangles triangles = Triangles(3, 0);  ///< 3 by T, in display-vertex numbering
+  /// Maps current domain positions to display vertices; when empty, the display geometry is
+  /// the boundary surface (vertices gathered from the domain).
+  std::optional<PointMap> map;
+  Points positions = Points(3, 0);  ///< 3 by V current display vertex positions
+};
+
+/// Base class of every simulation object. Not copyable or movable (others hold references).
+///
+/// Subclasses: declare their fields in the constructor (`DeclareField`), set their geometries
+/// (`SetGeometry`), and implement `DoStep`, `DoReadField`, `DoWriteField` and
+/// `domain_positions()`. The public methods check their arguments and call those hooks.
+class SimObject {
+ public:
+  SimObject(const SimObject&) = delete;
+  SimObject& operator=(const SimObject&) = delete;
+  virtual ~SimObject() = default;
+
+  [[nodiscard]] const std::string& name() const { return name_; }
+  /// The registered type name, e.g. "MassSpring".
+  [[nodiscard]] virtual std::string_view type_name() const = 0;
+
+  // --- Geometries ---
+  /// Reference (rest) domain geometry. Objects without a mesh have an empty Mesh.
+  [[nodiscard]] const Mesh& domain() const { return *domain_; }
+  [[nodiscard]] const std::shared_ptr<const Mesh>& domain_ptr() const { return domain_; }
+  /// Current positions of the domain nodes, 3 by domain().num_nodes().
+  [[nodiscard]] virtual const Points& domain_positions() const = 0;
+  /// Boundary geometry (triangles and the domain node of each boundary vertex).
+  [[nodiscard]] const BoundarySurface& boundary() const { return boundary_; }
+  [[nodiscard]] const DisplayGeometry& display() const { return display_; }
+  /// Recomputes display().positions from the current domain positions (a cache derived from the
+  /// state, hence const). Allocation-free.
+  void UpdateDisplay() const;
+  /// Replaces the display geometry by `triangles` on `rest_vertices` (3 by V), embedded in the
+  /// domain barycentrically (tet domains) or by closest point (surface domains). Throws
+  /// InputError if a vertex lies farther than `max_distance` from the domain.
+  void EmbedDisplay(const Points& rest_vertices, const Triangles& triangles, double max_distance);
+
+  // --- Boundary conditions ---
+  [[nodiscard]] BoundaryConditions& boundary_conditions() { return bcs_; }
+  [[nodiscard]] const BoundaryConditions& boundary_conditions() const { return bcs_; }
+
+  // --- Fields (Get/Set) ---
+  [[nodiscard]] std::span<const FieldInfo> fields() const { return fields_; }
+  /// The field called `name`, or std::nullopt.
+  [[nodiscard]] std::optional<FieldId> TryFindField(std::string_view name) const;
+  /// The field called `name`; throws InputError naming the object and listing its fields.
+  [[nodiscard]] FieldId FindField(std::string_view name) const;
+  [[nodiscard]] const FieldInfo& field_info(FieldId id) const;
+  /// Number of items of a field (nodes, elements, boundary vertices/faces, or 1).
+  [[nodiscard]] Index FieldCount(FieldId id) const;
+  /// Copies the field into `out` (components by count). Preconditions (checked, abort): the
+  /// field is readable and `out` has the right shape. Allocates nothing.
+  void ReadField(FieldId id, Eigen::Ref<Eigen::MatrixXd> out) const;
+  /// Sets the field from `in` (components by count). Preconditions as ReadField, for writing.
+  void WriteField(FieldId id, const Eigen::Ref<const Eigen::MatrixXd>& in);
+
+  // --- Simulation ---
+  /// Advances by `dt` > 0 from time(). Never throws; reports trouble in the status.
+  StepStatus Step(double dt);
+  /// Simulated time of this object [s].
+  [[nodiscard]] double time() const { return time_; }
+  /// Sets the object's clock (the kernel re-synchronises it to the exact macro-step time after
+  /// sub-stepping, so round-off does not accumulate; checkpoints restore it).
+  void SetTime(double t) { time_ = t; }
+  /// Number of successful steps taken.
+  [[nodiscard]] std::int64_t step_count() const { return step_count_; }
+  /// Leaf objects for output (an aggregate returns its parts; a plain object returns itself).
+  virtual void CollectLeaves(std::vector<const SimObject*>& out) const { out.push_back(this); }
+  /// A part of an aggregate by (possibly dotted) name; plain objects have none (nullptr).
+  [[nodiscard]] virtual SimObject* FindPart(std::string_view /*name*/) const { return nullptr; }
+  /// After a failed step, extra context for the diagnostic (an aggregate names the failing
+  /// part); empty by default.
+  [[nodiscard]] virtual std::string failure_detail() const { return {}; }
+  /// Called by the kernel at the start of every macro step (aggregates forward it).
+  virtual void BeginMacroStep() { bcs_.ClearCouplingLoads(); }
+
+ protected:
+  explicit SimObject(std::string name);
+
+  /// Sets the domain and boundary geometries and sizes the boundary conditions. The display
+  /// geometry defaults to the boundary surface.
+  void SetGeometry(std::shared_ptr<const Mesh> domain, BoundarySurface boundary);
+  /// Declares a field; returns its id. Call from the constructor only.
+  FieldId DeclareField(FieldInfo info);
+
+  virtual StepStatus DoStep(double t, double dt) = 0;
+  virtual void DoReadField(FieldId id, Eigen::Ref<Eigen::MatrixXd> out) const = 0;
+  virtual void DoWriteField(FieldId id, const Eigen::Ref<const Eigen::MatrixXd>& in) = 0;
+
+ private:
+  std::string name_;
+  std::shared_ptr<const Mesh> domain_;
+  BoundarySurface boundary_;
+  mutable DisplayGeometry display_;  // positions are a cache of the state
+  BoundaryConditions bcs_;
+  std::vector<FieldInfo> fields_;
+  double time_ = 0;
+  std::int64_t step_count_ = 0;
+};
+
+/// Number of domain elements: tets if the domain has any, else triangles.
+Index NumDomainElements(const Mesh& mesh);
+
+}  // namespace gipsi

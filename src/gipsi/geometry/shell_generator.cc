@@ -1,0 +1,302 @@
+/// @file
+/// `MakeEllipsoidShell` and `MakeCylinderShell` through the Gmsh C++ API with the OpenCASCADE
+/// kernel (Debian's libgmsh 4.8 is built with it): solids are made by boolean cuts, meshed in
+/// 3-D, and read back as nodes and linear tets. The boundary is then extracted from the tets
+/// (`ExtractTetBoundary`, so it is closed and outward) and its triangles are grouped by where
+/// they lie (base plane, inner or outer surface) instead of by Gmsh entity tags, which would
+/// depend on the numbering OpenCASCADE gives the faces after the cuts.
+///
+/// Gmsh keeps global state, so every use goes through `GmshSession`: a process-wide mutex held
+/// from `gmsh::initialize` to `gmsh::finalize`.
+
+#include <gmsh.h>
+
+#include <clocale>
+#include <cmath>
+#include <functional>
+#include <mutex>
+#include <numbers>
+#include <string>
+#include <vector>
+
+#include <fmt/format.h>
+#include <Eigen/Geometry>
+
+#include "gipsi/base/error.h"
+#include "gipsi/geometry/boundary.h"
+#include "gipsi/geometry/generators.h"
+#include "gipsi/geometry/quality.h"
+
+namespace gipsi {
+namespace {
+
+/// Gmsh element type of the 4-node tetrahedron.
+constexpr int kGmshTet4 = 4;
+/// Refuse to mesh when the estimated number of tets exceeds this (a too small mesh size).
+constexpr double kMaxEstimatedTets = 2e7;
+
+std::mutex& GmshMutex() {
+  static std::mutex mutex;
+  return mutex;
+}
+
+/// One Gmsh API session: holds the Gmsh mutex, initialises Gmsh quietly (no terminal output,
+/// no configuration files, one thread for reproducible meshes) and finalises it on exit, also
+/// when an exception leaves the scope. Gmsh sets the process locale from the environment; the
+/// session restores the previous one. Neither copyable nor movable.
+class GmshSession {
+ public:
+  GmshSession() : lock_(GmshMutex()) {
+    if (const char* locale = std::setlocale(LC_ALL, nullptr)) saved_locale_ = locale;
+    gmsh::initialize(0, nullptr, /*readConfigFiles=*/false);
+    gmsh::option::setNumber("General.Terminal", 0);
+    gmsh::option::setNumber("General.Verbosity", 0);
+    gmsh::option::setNumber("General.NumThreads", 1);
+  }
+  ~GmshSession() {
+    try {
+      gmsh::finalize();
+    } catch (...) {  // nothing sensible to do in a destructor
+    }
+    if (!saved_locale_.empty()) std::setlocale(LC_ALL, saved_locale_.c_str());
+  }
+  GmshSession(const GmshSession&) = delete;
+  GmshSession& operator=(const GmshSession&) = delete;
+
+ private:
+  std::lock_guard<std::mutex> lock_;
+  std::string saved_locale_;
+};
+
+std::string LastGmshError() {
+  std::string error;
+  try {
+    gmsh::logger::getLastError(error);
+  } catch (...) {
+  }
+  return error.empty() ? "no details" : error;
+}
+
+/// Reads all nodes and linear tets of the current Gmsh model into a mesh, with every tet
+/// positively oriented and unused nodes dropped.
+Mesh ReadGmshTets() {
+  std::vector<std::size_t> node_tags;
+  std::vector<double> coords, params;
+  gmsh::model::mesh::getNodes(node_tags, coords, params, -1, -1, /*includeBoundary=*/false,
+                              /*returnParametricCoord=*/false);
+  std::size_t max_tag = 0;
+  for (std::size_t tag : node_tags) max_tag = std::max(max_tag, tag);
+  std::vector<int> index_of_tag(max_tag + 1, -1);
+  Mesh mesh;
+  mesh.nodes.resize(3, Index(node_tags.size()));
+  for (std::size_t i = 0; i < node_tags.size(); ++i) {
+    index_of_tag[node_tags[i]] = int(i);
+    mesh.nodes.col(Index(i)) = Vec3(coords[3 * i], coords[3 * i + 1], coords[3 * i + 2]);
+  }
+  std::vector<std::size_t> element_tags, element_nodes;
+  gmsh::model::mesh::getElementsByType(kGmshTet4, element_tags, element_nodes);
+  mesh.tets.resize(4, Index(element_tags.size()));
+  for (std::size_t e = 0; e < element_tags.size(); ++e) {
+    for (std::size_t a = 0; a < 4; ++a) {
+      const std::size_t tag = element_nodes[4 * e + a];
+      GIPSI_CHECK(tag <= max_tag && index_of_tag[tag] >= 0, "Gmsh tet refers to unknown node");
+      mesh.tets(Index(a), Index(e)) = index_of_tag[tag];
+    }
+    const auto t = mesh.tets.col(Index(e));
+    if (TetSignedVolume(mesh.nodes.col(t[0]), mesh.nodes.col(t[1]), mesh.nodes.col(t[2]),
+                        mesh.nodes.col(t[3])) < 0)
+      std::swap(mesh.tets(2, Index(e)), mesh.tets(3, Index(e)));
+  }
+  mesh.RemoveUnusedNodes();
+  return mesh;
+}
+
+/// Adds the boundary triangles of `mesh` (outward), grouped by `classify`, which maps the
+/// three corners of a boundary triangle to an index into `names` (or -1: not expected), then a
+/// dim-3 group `volume_name` of all tets. Throws InputError naming `what` for an unexpected
+/// triangle or an empty group.
+void AddBoundaryGroups(Mesh& mesh, const std::vector<std::string>& names,
+                       const std::function<int(const Vec3&, const Vec3&, const Vec3&)>& classify,
+                       const std::string& volume_name, const std::string& what) {
+  const BoundarySurface boundary = ExtractTetBoundary(mesh.nodes, mesh.tets);
+  std::vector<MeshGroup> groups;
+  for (const auto& name : names) groups.push_back(MeshGroup{name, 2, {}});
+  mesh.triangles.resize(3, boundary.num_triangles());
+  std::vector<std::vector<Index>> by_group(names.size());
+  for (Index t = 0; t < boundary.num_triangles(); ++t) {
+    Vec3 x[3];
+    for (int a = 0; a < 3; ++a)
+      x[a] = mesh.nodes.col(boundary.vertex_to_node[std::size_t(boundary.triangles(a, t))]);
+    const int g = classify(x[0], x[1], x[2]);
+    if (g < 0)
+      ThrowInputError("", what,
+                      fmt::format("Gmsh produced a boundary triangle off the expected surfaces, "
+                                  "near ({:.4g}, {:.4g}, {:.4g})",
+                                  x[0].x(), x[0].y(), x[0].z()));
+    by_group[std::size_t(g)].push_back(t);
+  }
+  Index next = 0;
+  for (std::size_t g = 0; g < names.size(); ++g) {
+    if (by_group[g].empty())
+      ThrowInputError("", what, fmt::format("Gmsh produced no '{}' surface", names[g]));
+    for (Index t : by_group[g]) {
+      for (int a = 0; a < 3; ++a)
+        mesh.triangles(a, next) = boundary.vertex_to_node[std::size_t(boundary.triangles(a, t))];
+      groups[g].items.push_back(int(next++));
+    }
+  }
+  MeshGroup volume{volume_name, 3, std::vector<int>(std::size_t(mesh.num_tets()))};
+  for (std::size_t e = 0; e < volume.items.size(); ++e) volume.items[e] = int(e);
+  groups.push_back(std::move(volume));
+  mesh.groups = std::move(groups);
+}
+
+/// Runs `build` (which creates and synchronises an OpenCASCADE model) in a Gmsh session,
+/// meshes it in 3-D with maximal element size `mesh_size` and reads the tets back. Gmsh
+/// failures become InputError naming `what`.
+Mesh MeshWithGmsh(const std::string& what, double mesh_size, const std::function<void()>& build) {
+  GmshSession session;
+  try {
+    gmsh::model::add("gipsi_shell");
+    build();
+    gmsh::model::occ::synchronize();
+    gmsh::option::setNumber("Mesh.MeshSizeMax", mesh_size);
+    gmsh::option::setNumber("Mesh.MeshSizeMin", 0.0);
+    gmsh::model::mesh::generate(3);
+    Mesh mesh = ReadGmshTets();
+    if (mesh.num_tets() == 0) ThrowInputError("", what, "Gmsh produced no tetrahedra");
+    return mesh;
+  } catch (const InputError&) {
+    throw;
+  } catch (const std::exception& e) {
+    ThrowInputError("", what, fmt::format("Gmsh failed: {} ({})", e.what(), LastGmshError()));
+  } catch (...) {
+    ThrowInputError("", what, fmt::format("Gmsh failed: {}", LastGmshError()));
+  }
+}
+
+void CheckPositive(const std::string& what, const char* name, double value) {
+  if (!(value > 0) || !std::isfinite(value))
+    ThrowInputError("", what, fmt::format("{} must be a positive number, got {}", name, value));
+}
+
+void CheckMeshCount(const std::string& what, double volume, double mesh_size) {
+  // A regular tet of edge h has volume h³/(6√2).
+  const double estimate = volume / (mesh_size * mesh_size * mesh_size / (6 * std::sqrt(2.0)));
+  if (estimate > kMaxEstimatedTets)
+    ThrowInputError("", what,
+                    fmt::format("mesh_size {} is too small for this shell (about {:.3g} "
+                                "tetrahedra, limit {:.3g})",
+                                mesh_size, estimate, kMaxEstimatedTets));
+}
+
+/// Volume of the ellipsoid (x²+y²)/a² + z²/c² <= 1 below z = zb (−c <= zb <= c):
+/// π a² ∫_{−c}^{zb} (1 − z²/c²) dz.
+double TruncatedEllipsoidVolume(double a, double c, double zb) {
+  return std::numbers::pi * a * a * ((zb + c) - (zb * zb * zb + c * c * c) / (3 * c * c));
+}
+
+}  // namespace
+
+Mesh MakeEllipsoidShell(const EllipsoidShellSpec& spec) {
+  const std::string what = "ellipsoid shell";
+  CheckPositive(what, "endo_short", spec.endo_short);
+  CheckPositive(what, "endo_long", spec.endo_long);
+  CheckPositive(what, "epi_short", spec.epi_short);
+  CheckPositive(what, "epi_long", spec.epi_long);
+  CheckPositive(what, "mesh_size", spec.mesh_size);
+  if (!(spec.endo_short < spec.epi_short) || !(spec.endo_long < spec.epi_long))
+    ThrowInputError("", what,
+                    fmt::format("the endocardium ({} x {}) must lie inside the epicardium "
+                                "({} x {}): both semi-axes must be smaller",
+                                spec.endo_short, spec.endo_long, spec.epi_short, spec.epi_long));
+  if (!(std::abs(spec.base_z) < spec.endo_long))
+    ThrowInputError("", what,
+                    fmt::format("base_z {} must cut both surfaces: expected |base_z| < endo_long "
+                                "{}",
+                                spec.base_z, spec.endo_long));
+  CheckMeshCount(what,
+                 TruncatedEllipsoidVolume(spec.epi_short, spec.epi_long, spec.base_z) -
+                     TruncatedEllipsoidVolume(spec.endo_short, spec.endo_long, spec.base_z),
+                 spec.mesh_size);
+
+  Mesh mesh = MeshWithGmsh(what, spec.mesh_size, [&] {
+    namespace occ = gmsh::model::occ;
+    const int epi = occ::addSphere(0, 0, 0, 1);
+    occ::dilate({{3, epi}}, 0, 0, 0, spec.epi_short, spec.epi_short, spec.epi_long);
+    const int endo = occ::addSphere(0, 0, 0, 1);
+    occ::dilate({{3, endo}}, 0, 0, 0, spec.endo_short, spec.endo_short, spec.endo_long);
+    gmsh::vectorpair shell, cut;
+    std::vector<gmsh::vectorpair> map;
+    occ::cut({{3, epi}}, {{3, endo}}, shell, map);
+    const double l = 2 * (spec.epi_short + spec.epi_long);
+    const int top = occ::addBox(-l, -l, spec.base_z, 2 * l, 2 * l, l);
+    occ::cut(shell, {{3, top}}, cut, map);
+  });
+
+  // Group boundary triangles: base (all corners on z = base_z), else the closer ellipsoid.
+  const double plane_tol = 1e-6 * spec.epi_long;
+  auto ellipsoid_gap = [](const Vec3& x, double a, double c) {
+    const double f = (x.x() * x.x() + x.y() * x.y()) / (a * a) + x.z() * x.z() / (c * c);
+    return std::abs(std::sqrt(f) - 1) * a;
+  };
+  AddBoundaryGroups(
+      mesh, {"endo", "epi", "base"},
+      [&](const Vec3& a, const Vec3& b, const Vec3& c) {
+        if (std::abs(a.z() - spec.base_z) <= plane_tol &&
+            std::abs(b.z() - spec.base_z) <= plane_tol &&
+            std::abs(c.z() - spec.base_z) <= plane_tol)
+          return 2;
+        const Vec3 centroid = (a + b + c) / 3;
+        return ellipsoid_gap(centroid, spec.endo_short, spec.endo_long) <
+                       ellipsoid_gap(centroid, spec.epi_short, spec.epi_long)
+                   ? 0
+                   : 1;
+      },
+      "wall", what);
+  return mesh;
+}
+
+Mesh MakeCylinderShell(double inner_radius, double outer_radius, double height, double mesh_size) {
+  const std::string what = "cylinder shell";
+  CheckPositive(what, "inner_radius", inner_radius);
+  CheckPositive(what, "outer_radius", outer_radius);
+  CheckPositive(what, "height", height);
+  CheckPositive(what, "mesh_size", mesh_size);
+  if (!(inner_radius < outer_radius))
+    ThrowInputError("", what,
+                    fmt::format("inner_radius {} must be smaller than outer_radius {}",
+                                inner_radius, outer_radius));
+  CheckMeshCount(
+      what, std::numbers::pi * (outer_radius * outer_radius - inner_radius * inner_radius) * height,
+      mesh_size);
+
+  Mesh mesh = MeshWithGmsh(what, mesh_size, [&] {
+    namespace occ = gmsh::model::occ;
+    const int outer = occ::addCylinder(0, 0, 0, 0, 0, height, outer_radius);
+    // The hole sticks out at both ends so that the cut has no coincident faces.
+    const int inner = occ::addCylinder(0, 0, -height, 0, 0, 3 * height, inner_radius);
+    gmsh::vectorpair out;
+    std::vector<gmsh::vectorpair> map;
+    occ::cut({{3, outer}}, {{3, inner}}, out, map);
+  });
+
+  const double plane_tol = 1e-6 * std::max(height, outer_radius);
+  AddBoundaryGroups(
+      mesh, {"inner", "outer", "bottom", "top"},
+      [&](const Vec3& a, const Vec3& b, const Vec3& c) {
+        for (int g = 0; g < 2; ++g) {
+          const double z = g == 0 ? 0.0 : height;
+          if (std::abs(a.z() - z) <= plane_tol && std::abs(b.z() - z) <= plane_tol &&
+              std::abs(c.z() - z) <= plane_tol)
+            return 2 + g;
+        }
+        const Vec3 centroid = (a + b + c) / 3;
+        const double r = centroid.head<2>().norm();
+        return std::abs(r - inner_radius) < std::abs(r - outer_radius) ? 0 : 1;
+      },
+      "wall", what);
+  return mesh;
+}
+
+}  // namespace gipsi

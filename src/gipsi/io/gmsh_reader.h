@@ -1,0 +1,34 @@
+#pragma once
+/// @file
+/// Reader for Gmsh `.msh` files: format 1.0 (`$NOD`/`$ELM`), 2.x ASCII and binary, and 4.1
+/// ASCII and binary.
+
+#include <filesystem>
+
+#include "gipsi/geometry/mesh.h"
+
+namespace gipsi {
+
+/// Reads a Gmsh mesh file.
+///
+/// Kept elements: 4-node tetrahedra (type 4) and 3-node triangles (type 2); second-order
+/// tetrahedra (type 11) and triangles (type 9) contribute their corner nodes. Other element types
+/// (points, lines, quads, hexahedra, ...) are not kept, but their physical groups are.
+///
+/// Node tags may be any distinct positive integers: nodes are renumbered 0..N-1 in file order and
+/// all nodes are kept (also those no kept element uses).
+///
+/// Physical groups become `MeshGroup`s: a group of volumes holds tet indices (dim 3), a group of
+/// surfaces triangle indices (dim 2), a group of curves or points node indices (dim 0). Names come
+/// from `$PhysicalNames`; an unnamed group with tag t is called `physical_<t>`. If two groups of
+/// different dimensions share a name, the later one gets the suffix `_dim<d>`. In format 4.1
+/// elements inherit the physical tags of their entity (`$Entities`); in 1.0/2.x the first
+/// element tag is the physical tag (0: none).
+///
+/// Throws InputError naming the file and the line (or byte offset for binary data) for a missing
+/// file, an unsupported version, truncated sections, malformed numbers, non-finite coordinates,
+/// elements with the wrong number of nodes, references to undefined nodes, and duplicate node
+/// tags. The result has passed `Mesh::Validate`.
+Mesh ReadGmsh(const std::filesystem::path& path);
+
+}  // namespace gipsi

@@ -1,0 +1,16 @@
+#pragma once
+/// @file
+/// A human-readable summary of a mesh, for `gipsi info`.
+
+#include <string>
+
+#include "gipsi/geometry/mesh.h"
+
+namespace gipsi {
+
+/// Counts (nodes, tets, triangles, boundary faces), named groups, bounding box, element quality
+/// (inverted and degenerate tets with their ids, aspect ratios, volume) and, for surfaces,
+/// whether they are closed and manifold.
+std::string DescribeMesh(const Mesh& mesh);
+
+}  // namespace gipsi

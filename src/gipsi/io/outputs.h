@@ -1,0 +1,50 @@
+#pragma once
+/// @file
+/// Result writers attached to a scene's kernel: VTU/PVD time series of every (leaf) object's
+/// domain with its node and element fields, of embedded display surfaces, and probe CSVs.
+///
+/// Layout of an output directory:
+///   <out>/<object>.pvd                 ParaView collection (open this one)
+///   <out>/<object>/<object>_NNNNNN.vtu one frame per output time
+///   <out>/<object>_display.pvd, <out>/<object>_display/...   display surface (if embedded)
+///   <out>/probes/<probe>.csv           one row per sample: time, values
+
+#include <filesystem>
+#include <memory>
+#include <vector>
+
+#include "gipsi/core/kernel.h"
+#include "gipsi/io/scene.h"
+#include "gipsi/io/vtu_writer.h"
+
+namespace gipsi {
+
+/// Writes VTU frames and keeps the PVD collections current after every frame, so a run that
+/// stops early leaves a valid series up to its last frame.
+class VtuSeriesWriter final : public Observer {
+ public:
+  /// Creates `directory` and one collection per object; throws std::exception on I/O errors.
+  VtuSeriesWriter(std::vector<const SimObject*> objects, const std::filesystem::path& directory,
+                  double every, bool display);
+  void Observe(const Kernel& kernel, double t) override;
+
+ private:
+  struct Series {
+    const SimObject* object;
+    PvdWriter domain;
+    std::unique_ptr<PvdWriter> display;
+  };
+  void WriteFrame(Series& series, double t);
+
+  std::filesystem::path directory_;
+  double every_;
+  double next_ = 0;
+  std::int64_t frame_ = 0;
+  std::vector<Series> series_;
+};
+
+/// Attaches the scene's outputs (VTU series if enabled, probe CSVs) to its kernel, writing under
+/// `directory`. Throws std::exception if the directory or files cannot be created.
+void AttachOutputs(Scene& scene, const std::filesystem::path& directory);
+
+}  // namespace gipsi

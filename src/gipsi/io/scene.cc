@@ -1,0 +1,361 @@
+#include "gipsi/io/scene.h"
+
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
+
+#include <fmt/format.h>
+
+#include "gipsi/base/error.h"
+#include "gipsi/base/log.h"
+#include "gipsi/geometry/generators.h"
+#include "gipsi/io/mesh_io.h"
+
+namespace gipsi {
+namespace {
+
+std::array<int, 3> Cells3(const JsonNode& node) {
+  auto v = node.AsInts();
+  if (v.size() != 3) node.Expected("an array of 3 positive integers");
+  std::array<int, 3> out{};
+  for (int i = 0; i < 3; ++i) {
+    if (v[static_cast<std::size_t>(i)] < 1 || v[static_cast<std::size_t>(i)] > 1000)
+      node.Expected("an array of 3 integers in [1, 1000]");
+    out[static_cast<std::size_t>(i)] = static_cast<int>(v[static_cast<std::size_t>(i)]);
+  }
+  return out;
+}
+
+class SceneMeshes final : public MeshProvider {
+ public:
+  explicit SceneMeshes(const std::map<std::string, std::shared_ptr<const Mesh>>& meshes)
+      : meshes_(meshes) {}
+  std::shared_ptr<const Mesh> GetMesh(std::string_view name, const JsonNode& where) const override {
+    auto it = meshes_.find(std::string(name));
+    if (it != meshes_.end()) return it->second;
+    std::vector<std::string> names;
+    for (const auto& [n, m] : meshes_) names.push_back(n);
+    where.Fail(fmt::format("no mesh named '{}'{} in 'meshes'", name, SuggestClosest(name, names)));
+  }
+
+ private:
+  const std::map<std::string, std::shared_ptr<const Mesh>>& meshes_;
+};
+
+/// Builds objects with the keys every object shares (dt, boundary_conditions, display).
+class ObjectBuilder {
+ public:
+  ObjectBuilder(const TypeRegistry& registry, const SceneMeshes& meshes, Scene& scene,
+                double default_dt)
+      : registry_(registry), meshes_(meshes), scene_(scene), default_dt_(default_dt) {
+    fn_ = [this](const std::string& name, const JsonNode& node) { return Build(name, node); };
+  }
+
+  BuiltObject Build(const std::string& name, const JsonNode& node) {
+    if (name.empty() || name.find_first_of("./ ") != std::string::npos)
+      node.Fail(fmt::format("object name '{}' must be non-empty without '.', '/' or spaces", name));
+    auto object = registry_.CreateObject(name, node, meshes_, fn_);
+    double dt = default_dt_;
+    if (auto d = node.Find("dt")) dt = d->AsPositive();
+    if (!(dt > 0)) node.Fail("missing required key 'dt' (and schedule.dt is not set)");
+    if (auto display = node.Find("display")) ApplyDisplay(*object, *display);
+    if (auto bcs = node.Find("boundary_conditions")) {
+      auto items = bcs->Items();
+      for (std::size_t i = 0; i < items.size(); ++i) {
+        BoundaryConditionSpec spec = ParseBoundaryCondition(items[i], *object, i);
+        spec.Apply(object->boundary_conditions());
+        std::string key = name + "/" + spec.name;
+        if (!scene_.boundary_conditions.emplace(key, spec).second)
+          items[i].At("name").Fail(fmt::format("duplicate condition name '{}'", spec.name));
+      }
+    }
+    object->UpdateDisplay();
+    return {std::move(object), dt};
+  }
+
+  const BuildObjectFn& fn() const { return fn_; }
+
+ private:
+  void ApplyDisplay(SimObject& object, const JsonNode& node) {
+    node.CheckKeys({"mesh", "mapping", "max_distance"});
+    auto mesh = meshes_.GetMesh(node.At("mesh").AsString(), node.At("mesh"));
+    if (mesh->num_triangles() == 0)
+      node.At("mesh").Fail("a display mesh needs triangles (a surface)");
+    if (auto mapping = node.Find("mapping")) (void)mapping->AsChoice({"barycentric"});
+    const Points& nodes = object.domain().nodes;
+    const double diag = (nodes.rowwise().maxCoeff() - nodes.rowwise().minCoeff()).norm();
+    try {
+      object.EmbedDisplay(mesh->nodes, mesh->triangles,
+                          node.NonNegative("max_distance", 0.05 * diag));
+    } catch (const InputError& e) {
+      node.Fail(e.what());
+    }
+  }
+
+  const TypeRegistry& registry_;
+  const SceneMeshes& meshes_;
+  Scene& scene_;
+  double default_dt_;
+  BuildObjectFn fn_;
+};
+
+void ParseEvent(const JsonNode& node, Scene& scene) {
+  node.CheckKeys({"at", "object", "apply", "remove", "set_field", "description"});
+  const double at = node.At("at").AsNonNegative();
+  JsonNode object_node = node.At("object");
+  std::string object_name = object_node.AsString();
+  SimObject* object = nullptr;
+  try {
+    object = &scene.kernel->FindObject(object_name);
+  } catch (const InputError& e) {
+    object_node.Fail(e.what());
+  }
+  int actions = int(node.Has("apply")) + int(node.Has("remove")) + int(node.Has("set_field"));
+  if (actions != 1) node.Fail("expected exactly one of 'apply', 'remove', 'set_field'");
+  ScheduledEvent event;
+  event.time = at;
+  if (auto apply = node.Find("apply")) {
+    BoundaryConditionSpec spec = ParseBoundaryCondition(*apply, *object, 1000);
+    event.description =
+        node.String("description",
+                    fmt::format("apply boundary condition '{}' to '{}'", spec.name, object_name));
+    event.action = [object, spec](Kernel&) { spec.Apply(object->boundary_conditions()); };
+    scene.boundary_conditions.emplace(object_name + "/" + spec.name, spec);
+  } else if (auto remove = node.Find("remove")) {
+    std::string key = object_name + "/" + remove->AsString();
+    auto it = scene.boundary_conditions.find(key);
+    if (it == scene.boundary_conditions.end())
+      remove->Fail(
+          fmt::format("object '{}' has no boundary condition named '{}' (declared "
+                      "before this event)",
+                      object_name, remove->AsString()));
+    BoundaryConditionSpec spec = it->second;
+    event.description = node.String(
+        "description",
+        fmt::format("remove boundary condition '{}' from '{}'", spec.name, object_name));
+    event.action = [object, spec](Kernel&) { spec.Remove(object->boundary_conditions()); };
+  } else {
+    JsonNode set = node.At("set_field");
+    set.CheckKeys({"field", "value"});
+    FieldId id;
+    try {
+      id = object->FindField(set.String("field"));
+    } catch (const InputError& e) {
+      set.At("field").Fail(e.what());
+    }
+    const FieldInfo& info = object->field_info(id);
+    if (!info.writable()) set.At("field").Fail("the field is read-only");
+    JsonNode value = set.At("value");
+    Eigen::VectorXd v(info.components);
+    if (info.components == 1 && value.is_number()) {
+      v[0] = value.AsNumber();
+    } else {
+      auto numbers = value.AsNumbers();
+      if (static_cast<int>(numbers.size()) != info.components)
+        value.Expected(fmt::format("{} numbers", info.components));
+      for (int c = 0; c < info.components; ++c) v[c] = numbers[static_cast<std::size_t>(c)];
+    }
+    Eigen::MatrixXd data = v.replicate(1, object->FieldCount(id));
+    event.description =
+        node.String("description", fmt::format("set field '{}' of '{}'", info.name, object_name));
+    event.action = [object, id, data](Kernel&) { object->WriteField(id, data); };
+  }
+  scene.kernel->ScheduleEvent(std::move(event));
+}
+
+}  // namespace
+
+std::string ResolvePlugin(const std::string& entry, const std::filesystem::path& base_dir) {
+  namespace fs = std::filesystem;
+  if (entry.find('/') != std::string::npos) {
+    fs::path path = entry;
+    return (path.is_relative() ? base_dir / path : path).string();
+  }
+  const std::string file = entry.ends_with(".so") ? entry : entry + ".so";
+  std::vector<fs::path> dirs;
+  if (const char* env = std::getenv("GIPSI_PLUGIN_PATH")) {
+    std::stringstream list(env);
+    for (std::string dir; std::getline(list, dir, ':');)
+      if (!dir.empty()) dirs.emplace_back(dir);
+  }
+  std::error_code ec;
+  fs::path exe = fs::read_symlink("/proc/self/exe", ec);
+  if (!ec) {
+    dirs.push_back(exe.parent_path().parent_path() / "plugins");            // build tree
+    dirs.push_back(exe.parent_path().parent_path() / "lib/gipsi/plugins");  // installed
+  }
+  for (const auto& dir : dirs)
+    if (fs::exists(dir / file)) return (dir / file).string();
+  return (base_dir / file).string();  // LoadPlugin reports it missing, with this path
+}
+
+Mesh BuildMesh(const JsonNode& node, const std::filesystem::path& base_dir) {
+  node.CheckKeys({"file", "generate", "scale", "translate", "min", "max", "cells", "origin", "u",
+                  "v", "endo", "epi", "base_z", "size", "inner_radius", "outer_radius", "height",
+                  "description"});
+  Mesh mesh;
+  if (node.Has("file") == node.Has("generate"))
+    node.Fail("expected exactly one of 'file', 'generate'");
+  if (auto file = node.Find("file")) {
+    std::filesystem::path path = file->AsString();
+    if (path.is_relative()) path = base_dir / path;
+    try {
+      mesh = ReadMesh(path);
+    } catch (const InputError& e) {
+      file->Fail(e.what());
+    }
+  } else {
+    JsonNode gen = node.At("generate");
+    std::string kind = gen.AsChoice({"box", "sheet", "ellipsoid_shell", "cylinder_shell"});
+    try {
+      if (kind == "box") {
+        mesh = MakeTetBox(node.Vector3("min"), node.Vector3("max"), Cells3(node.At("cells")));
+      } else if (kind == "sheet") {
+        auto cells = node.At("cells").AsInts();
+        if (cells.size() != 2 || cells[0] < 1 || cells[1] < 1 || cells[0] > 2000 || cells[1] > 2000)
+          node.At("cells").Expected("an array of 2 integers in [1, 2000]");
+        mesh = MakeTriangleSheet(node.Vector3("origin"), node.Vector3("u"), node.Vector3("v"),
+                                 {static_cast<int>(cells[0]), static_cast<int>(cells[1])});
+      } else if (kind == "ellipsoid_shell") {
+        EllipsoidShellSpec spec;
+        auto endo = node.At("endo").AsNumbers();
+        auto epi = node.At("epi").AsNumbers();
+        if (endo.size() != 2) node.At("endo").Expected("[short radius, long radius]");
+        if (epi.size() != 2) node.At("epi").Expected("[short radius, long radius]");
+        spec.endo_short = endo[0];
+        spec.endo_long = endo[1];
+        spec.epi_short = epi[0];
+        spec.epi_long = epi[1];
+        spec.base_z = node.Number("base_z", spec.base_z);
+        spec.mesh_size = node.Positive("size", spec.mesh_size);
+        mesh = MakeEllipsoidShell(spec);
+      } else {
+        mesh = MakeCylinderShell(node.Positive("inner_radius"), node.Positive("outer_radius"),
+                                 node.Positive("height"), node.Positive("size"));
+      }
+    } catch (const InputError& e) {
+      std::string what = e.what();
+      if (what.rfind(node.file(), 0) == 0) throw;  // already located
+      node.Fail(what);
+    }
+  }
+  if (auto scale = node.Find("scale")) mesh.nodes *= scale->AsPositive();
+  if (auto translate = node.Find("translate")) mesh.nodes.colwise() += translate->AsVec3();
+  return mesh;
+}
+
+Scene LoadScene(const std::filesystem::path& file, TypeRegistry& registry) {
+  std::ifstream in(file, std::ios::binary);
+  if (!in) ThrowInputError(file.string(), "", "cannot open scene file for reading");
+  std::stringstream text;
+  text << in.rdbuf();
+  return LoadSceneFromString(text.str(), file.string(), file.parent_path(), registry);
+}
+
+Scene LoadSceneFromString(std::string_view text, const std::string& name,
+                          const std::filesystem::path& base_dir, TypeRegistry& registry) {
+  JsonDocument doc = JsonDocument::Parse(text, name);
+  JsonNode root = doc.root();
+  if (!root.is_object()) root.Expected("a JSON object");
+  root.CheckKeys({"gipsi", "description", "units", "plugins", "meshes", "objects", "connectors",
+                  "schedule", "probes", "outputs"});
+  if (auto version = root.Find("gipsi"); version && version->AsInt() != 1)
+    version->Fail("this GiPSi reads scene format version 1");
+  if (auto units = root.Find("units")) (void)units->AsChoice({"SI"});
+
+  Scene scene;
+  scene.file = name;
+  scene.kernel = std::make_unique<Kernel>();
+
+  if (auto plugins = root.Find("plugins")) {
+    for (const auto& item : plugins->Items()) {
+      std::string path = ResolvePlugin(item.AsString(), base_dir);
+      try {
+        registry.LoadPlugin(path);
+      } catch (const InputError& e) {
+        item.Fail(e.what());
+      }
+    }
+  }
+
+  if (auto meshes = root.Find("meshes")) {
+    for (const auto& [mesh_name, node] : meshes->Members())
+      scene.meshes[mesh_name] = std::make_shared<const Mesh>(BuildMesh(node, base_dir));
+  }
+  SceneMeshes mesh_provider(scene.meshes);
+
+  JsonNode schedule = root.At("schedule");
+  schedule.CheckKeys({"end", "dt", "order", "events"});
+  scene.end_time = schedule.At("end").AsPositive();
+  const double macro_dt = schedule.Positive("dt", 0.0);
+
+  ObjectBuilder builder(registry, mesh_provider, scene, macro_dt);
+  JsonNode objects = root.At("objects");
+  if (objects.size() == 0) objects.Expected("at least one object");
+  for (const auto& [object_name, node] : objects.Members()) {
+    BuiltObject built = builder.Build(object_name, node);
+    try {
+      scene.kernel->coordinator().AddObject(std::move(built.object), built.dt);
+    } catch (const InputError& e) {
+      node.Fail(e.what());
+    }
+  }
+  if (auto connectors = root.Find("connectors")) {
+    for (const auto& [connector_name, node] : connectors->Members()) {
+      auto connector = registry.CreateConnector(connector_name, node, scene.kernel->coordinator());
+      int every = static_cast<int>(node.Int("every", 1));
+      if (every < 1) node.At("every").Expected("an integer >= 1");
+      try {
+        scene.kernel->coordinator().AddConnector(std::move(connector), every);
+      } catch (const InputError& e) {
+        node.Fail(e.what());
+      }
+    }
+  }
+  if (auto order = schedule.Find("order")) {
+    try {
+      scene.kernel->coordinator().SetOrder(order->AsStrings(), order->path());
+    } catch (const InputError& e) {
+      order->Fail(e.what());
+    }
+  }
+  try {
+    scene.kernel->Initialize(macro_dt);
+  } catch (const InputError& e) {
+    ThrowInputError(name, "objects", e.what());
+  }
+  if (auto events = schedule.Find("events"))
+    for (const auto& event : events->Items()) ParseEvent(event, scene);
+
+  if (auto probes = root.Find("probes"))
+    for (const auto& [probe_name, node] : probes->Members())
+      scene.probes.push_back(ParseProbe(probe_name, node, *scene.kernel));
+
+  scene.output_directory = std::filesystem::path("out") / std::filesystem::path(name).stem();
+  if (auto outputs = root.Find("outputs")) {
+    outputs->CheckKeys({"directory", "vtu"});
+    if (auto dir = outputs->Find("directory")) scene.output_directory = dir->AsString();
+    if (auto vtu = outputs->Find("vtu")) {
+      if (vtu->raw().is_boolean()) {
+        scene.vtu.enabled = vtu->AsBool();
+      } else {
+        vtu->CheckKeys({"every", "objects", "display"});
+        scene.vtu.every = vtu->NonNegative("every", 0.0);
+        scene.vtu.display = vtu->Bool("display", true);
+        if (auto names = vtu->Find("objects")) {
+          scene.vtu.objects = names->AsStrings();
+          for (std::size_t i = 0; i < scene.vtu.objects.size(); ++i) {
+            try {
+              (void)scene.kernel->FindObject(scene.vtu.objects[i]);
+            } catch (const InputError& e) {
+              names->Item(i).Fail(e.what());
+            }
+          }
+        }
+      }
+    }
+  }
+  return scene;
+}
+
+}  // namespace gipsi

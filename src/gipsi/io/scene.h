@@ -1,0 +1,59 @@
+#pragma once
+/// @file
+/// Scene files: one JSON document describes a simulation (meshes, objects with their boundary
+/// conditions, connectors, schedule with events, probes, outputs). The format is documented in
+/// docs/scene-format.md. Every error names the file and the JSON path and says what was
+/// expected.
+
+#include <filesystem>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "gipsi/core/kernel.h"
+#include "gipsi/core/registry.h"
+#include "gipsi/io/boundary_condition_spec.h"
+#include "gipsi/io/probes.h"
+
+namespace gipsi {
+
+/// What to write as VTU/PVD series.
+struct VtuOutputSpec {
+  bool enabled = true;
+  double every = 0;                  ///< seconds of simulated time; 0 = every macro step
+  std::vector<std::string> objects;  ///< leaf object names; empty = all
+  bool display = true;               ///< also write embedded display surfaces
+};
+
+/// A loaded, ready-to-run scene. Not copyable; movable.
+struct Scene {
+  std::filesystem::path file;
+  std::unique_ptr<Kernel> kernel;
+  double end_time = 0;
+  std::filesystem::path output_directory;  ///< from the scene (relative to the working dir)
+  std::vector<Probe> probes;
+  VtuOutputSpec vtu;
+  std::map<std::string, std::shared_ptr<const Mesh>> meshes;
+  /// Boundary conditions by "object/name", for events and `gipsi validate`.
+  std::map<std::string, BoundaryConditionSpec> boundary_conditions;
+};
+
+/// Loads `file` with the types in `registry` (loading the scene's plugins into it first) and
+/// builds the kernel (Initialize is called). Throws InputError on any problem.
+Scene LoadScene(const std::filesystem::path& file, TypeRegistry& registry);
+/// The same from text; `name` is used in messages and `base_dir` resolves relative paths.
+Scene LoadSceneFromString(std::string_view text, const std::string& name,
+                          const std::filesystem::path& base_dir, TypeRegistry& registry);
+
+/// Where a scene's "plugins" entry points: a path with a '/' is taken relative to `base_dir`; a
+/// bare name ("gipsi_example_plugin", ".so" optional) is searched in $GIPSI_PLUGIN_PATH
+/// (colon-separated), then in `plugins/` and `lib/gipsi/plugins/` beside the executable's
+/// folder, then in `base_dir`.
+std::string ResolvePlugin(const std::string& entry, const std::filesystem::path& base_dir);
+
+/// Builds a mesh from a scene "meshes" entry (file or generator, then scale/translate).
+/// `base_dir` resolves relative file paths. Throws InputError.
+Mesh BuildMesh(const JsonNode& node, const std::filesystem::path& base_dir);
+
+}  // namespace gipsi

@@ -1,0 +1,141 @@
+#include "gipsi/io/vtu_writer.h"
+
+#include <cstdint>
+#include <cstring>
+#include <utility>
+
+#include <fmt/format.h>
+
+#include "gipsi/base/error.h"
+#include "gipsi/io/base64.h"
+#include "gipsi/io/text_reader.h"
+
+namespace gipsi {
+namespace {
+
+std::string EscapeXml(std::string_view s) {
+  std::string out;
+  for (char c : s) {
+    switch (c) {
+      case '&':
+        out += "&amp;";
+        break;
+      case '<':
+        out += "&lt;";
+        break;
+      case '>':
+        out += "&gt;";
+        break;
+      case '"':
+        out += "&quot;";
+        break;
+      default:
+        out += c;
+    }
+  }
+  return out;
+}
+
+/// VTK's inline binary layout: base64(UInt64 byte count) followed by base64(bytes).
+std::string EncodeBlock(const void* data, std::size_t bytes) {
+  auto header = static_cast<std::uint64_t>(bytes);
+  std::string out =
+      internal::EncodeBase64(std::string_view(reinterpret_cast<const char*>(&header), 8));
+  out += internal::EncodeBase64(std::string_view(static_cast<const char*>(data), bytes));
+  return out;
+}
+
+void AppendArray(std::string& xml, std::string_view type, std::string_view name, int components,
+                 const void* data, std::size_t bytes) {
+  xml += fmt::format("        <DataArray type=\"{}\"", type);
+  if (!name.empty()) xml += fmt::format(" Name=\"{}\"", EscapeXml(name));
+  if (components != 1) xml += fmt::format(" NumberOfComponents=\"{}\"", components);
+  xml += " format=\"binary\">\n          ";
+  xml += EncodeBlock(data, bytes);
+  xml += "\n        </DataArray>\n";
+}
+
+void AppendFields(std::string& xml, const char* tag, const std::vector<NamedArray>& arrays,
+                  Index count) {
+  xml += fmt::format("      <{}>\n", tag);
+  for (const NamedArray& a : arrays) {
+    GIPSI_CHECK(a.components >= 1 && a.values.rows() == a.components && a.values.cols() == count,
+                "{} array '{}' is {} by {}, expected {} by {}", tag, a.name, a.values.rows(),
+                a.values.cols(), a.components, count);
+    AppendArray(xml, "Float64", a.name, a.components, a.values.data(),
+                sizeof(double) * static_cast<std::size_t>(a.values.size()));
+  }
+  xml += fmt::format("      </{}>\n", tag);
+}
+
+}  // namespace
+
+void WriteVtu(const std::filesystem::path& path, const Points& nodes, const Tets& tets,
+              const Triangles& triangles, const VtuFields& fields) {
+  const Index num_nodes = nodes.cols();
+  const Index num_cells = tets.cols() + triangles.cols();
+  GIPSI_CHECK(tets.size() == 0 || (tets.minCoeff() >= 0 && tets.maxCoeff() < num_nodes),
+              "tet node index out of range [0, {})", num_nodes);
+  GIPSI_CHECK(
+      triangles.size() == 0 || (triangles.minCoeff() >= 0 && triangles.maxCoeff() < num_nodes),
+      "triangle node index out of range [0, {})", num_nodes);
+  std::vector<std::int64_t> conn;
+  std::vector<std::int64_t> offsets;
+  std::vector<std::uint8_t> types;
+  conn.reserve(static_cast<std::size_t>(tets.size() + triangles.size()));
+  offsets.reserve(static_cast<std::size_t>(num_cells));
+  types.reserve(static_cast<std::size_t>(num_cells));
+  for (Index e = 0; e < tets.cols(); ++e) {
+    for (Index a = 0; a < 4; ++a) conn.push_back(tets(a, e));
+    offsets.push_back(static_cast<std::int64_t>(conn.size()));
+    types.push_back(10);
+  }
+  for (Index t = 0; t < triangles.cols(); ++t) {
+    for (Index a = 0; a < 3; ++a) conn.push_back(triangles(a, t));
+    offsets.push_back(static_cast<std::int64_t>(conn.size()));
+    types.push_back(5);
+  }
+  std::string xml = "<?xml version=\"1.0\"?>\n";
+  xml += fmt::format(
+      "<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"{}\" "
+      "header_type=\"UInt64\">\n  <UnstructuredGrid>\n"
+      "    <Piece NumberOfPoints=\"{}\" NumberOfCells=\"{}\">\n",
+      internal::HostIsLittleEndian() ? "LittleEndian" : "BigEndian", num_nodes, num_cells);
+  AppendFields(xml, "PointData", fields.point_data, num_nodes);
+  AppendFields(xml, "CellData", fields.cell_data, num_cells);
+  xml += "      <Points>\n";
+  AppendArray(xml, "Float64", "Points", 3, nodes.data(),
+              sizeof(double) * static_cast<std::size_t>(nodes.size()));
+  xml += "      </Points>\n      <Cells>\n";
+  AppendArray(xml, "Int64", "connectivity", 1, conn.data(), sizeof(std::int64_t) * conn.size());
+  AppendArray(xml, "Int64", "offsets", 1, offsets.data(), sizeof(std::int64_t) * offsets.size());
+  AppendArray(xml, "UInt8", "types", 1, types.data(), types.size());
+  xml += "      </Cells>\n    </Piece>\n  </UnstructuredGrid>\n</VTKFile>\n";
+  internal::WriteFileBytes(path, xml);
+}
+
+void WriteVtu(const std::filesystem::path& path, const Mesh& mesh, const VtuFields& fields) {
+  WriteVtu(path, mesh.nodes, mesh.tets, mesh.triangles, fields);
+}
+
+PvdWriter::PvdWriter(std::filesystem::path path) : path_(std::move(path)) { Rewrite(); }
+
+void PvdWriter::AddFrame(double time, const std::string& file) {
+  frames_.push_back({time, file});
+  Rewrite();
+}
+
+void PvdWriter::Rewrite() const {
+  std::string xml = "<?xml version=\"1.0\"?>\n";
+  xml += fmt::format("<VTKFile type=\"Collection\" version=\"0.1\" byte_order=\"{}\">\n",
+                     internal::HostIsLittleEndian() ? "LittleEndian" : "BigEndian");
+  xml += "  <Collection>\n";
+  for (const Frame& f : frames_) {
+    xml += fmt::format("    <DataSet timestep=\"{}\" group=\"\" part=\"0\" file=\"{}\"/>\n", f.time,
+                       EscapeXml(f.file));
+  }
+  xml += "  </Collection>\n</VTKFile>\n";
+  internal::WriteFileAtomically(path_, xml);
+}
+
+}  // namespace gipsi

@@ -1,0 +1,81 @@
+#pragma once
+/// @file
+/// Writers for ParaView output: VTK XML unstructured grids (`.vtu`) with point and cell data, and
+/// `.pvd` collections that index them by time.
+
+#include <cstddef>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "gipsi/base/math.h"
+#include "gipsi/geometry/mesh.h"
+
+namespace gipsi {
+
+/// A named data array attached to points or cells: `values` is `components` by count (column j
+/// holds the tuple of point or cell j). Plain data: copyable and movable.
+struct NamedArray {
+  std::string name;
+  int components = 1;
+  Eigen::MatrixXd values;
+};
+
+/// Point and cell data written with a `.vtu`. Point arrays have one column per node; cell arrays
+/// one column per cell, tets first then triangles (the order `WriteVtu` writes cells in).
+struct VtuFields {
+  std::vector<NamedArray> point_data;
+  std::vector<NamedArray> cell_data;
+};
+
+/// Writes an unstructured grid: `nodes` (3 by N), the tets (4 by E, VTK type 10) followed by the
+/// triangles (3 by T, VTK type 5), and `fields`. All arrays are inline base64 binary without
+/// compression (`header_type="UInt64"`): coordinates and data Float64, connectivity and offsets
+/// Int64, types UInt8 — readable by ParaView/VTK and by `ReadVtu`, bit-exact.
+///
+/// Preconditions (checked, abort on violation): connectivity indices in [0, N); for each array,
+/// `values.rows() == components >= 1` and `values.cols()` is N (point data) or E+T (cell data).
+/// Throws InputError if the file cannot be written.
+void WriteVtu(const std::filesystem::path& path, const Points& nodes, const Tets& tets,
+              const Triangles& triangles, const VtuFields& fields = {});
+
+/// `WriteVtu(path, mesh.nodes, mesh.tets, mesh.triangles, fields)`.
+void WriteVtu(const std::filesystem::path& path, const Mesh& mesh, const VtuFields& fields = {});
+
+/// Maintains a ParaView `.pvd` collection: a list of (time, file) frames. The `.pvd` file is
+/// rewritten after each added frame by writing a temporary file and renaming it over the old
+/// one, so that the file on disk is always a complete, valid collection (also after a crash).
+/// Movable, not copyable (it stands for one file).
+class PvdWriter {
+ public:
+  /// Starts a collection at `path` and writes it (empty). Throws InputError if it cannot be
+  /// written.
+  explicit PvdWriter(std::filesystem::path path);
+
+  PvdWriter(const PvdWriter&) = delete;
+  PvdWriter& operator=(const PvdWriter&) = delete;
+  PvdWriter(PvdWriter&&) = default;
+  PvdWriter& operator=(PvdWriter&&) = default;
+
+  /// Adds a frame at simulation time `time` (seconds) stored in `file` (a path relative to the
+  /// `.pvd`'s folder, as ParaView resolves it), then rewrites the collection. Throws InputError
+  /// if the collection cannot be written.
+  void AddFrame(double time, const std::string& file);
+
+  [[nodiscard]] const std::filesystem::path& path() const { return path_; }
+  [[nodiscard]] std::size_t num_frames() const { return frames_.size(); }
+
+ private:
+  struct Frame {
+    double time;
+    std::string file;
+  };
+  void Rewrite() const;
+
+  std::filesystem::path path_;
+  std::vector<Frame> frames_;
+};
+
+}  // namespace gipsi

@@ -1,0 +1,19 @@
+#include "gipsi/models/builtins.h"
+
+#include "gipsi/core/aggregate.h"
+#include "gipsi/models/connectors/boundary_coupling.h"
+#include "gipsi/models/connectors/field_copy.h"
+#include "gipsi/models/mass_spring/mass_spring.h"
+
+namespace gipsi {
+
+void RegisterBuiltins(TypeRegistry& registry) {
+  RegisterIntegrators(registry);
+  RegisterSpringLaws(registry);
+  RegisterMassSpring(registry);
+  RegisterAggregate(registry);
+  RegisterFieldCopy(registry);
+  RegisterBoundaryCoupling(registry);
+}
+
+}  // namespace gipsi

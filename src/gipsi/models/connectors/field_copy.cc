@@ -1,0 +1,102 @@
+#include "gipsi/models/connectors/field_copy.h"
+
+#include <cmath>
+
+#include <fmt/format.h>
+
+#include "gipsi/base/error.h"
+#include "gipsi/models/connectors/item_positions.h"
+
+namespace gipsi {
+
+FieldCopy::FieldCopy(std::string name, SimObject& from, FieldId from_field, SimObject& to,
+                     FieldId to_field, Mapping mapping, double scale)
+    : Connector(std::move(name)),
+      from_(from),
+      from_field_(from_field),
+      to_(to),
+      to_field_(to_field),
+      mapping_(mapping),
+      scale_(scale) {
+  const FieldInfo& src = from.field_info(from_field);
+  const FieldInfo& dst = to.field_info(to_field);
+  auto fail = [&](const std::string& what) {
+    throw InputError(fmt::format("connector '{}' ({}.{} → {}.{}): {}", this->name(), from.name(),
+                                 src.name, to.name(), dst.name, what));
+  };
+  if (!src.readable()) fail("the source field is not readable");
+  if (!dst.writable()) fail("the target field is not writable");
+  if (src.components != dst.components)
+    fail(fmt::format("component counts differ ({} vs {})", src.components, dst.components));
+  const Index n_src = from.FieldCount(from_field), n_dst = to.FieldCount(to_field);
+  if ((src.location == FieldLocation::kGlobal) != (dst.location == FieldLocation::kGlobal))
+    fail("a global field can only be copied to a global field");
+
+  Points src_pos = ItemRestPositions(from, src.location);
+  Points dst_pos = ItemRestPositions(to, dst.location);
+  if (mapping_ == Mapping::kAuto) {
+    bool coincide = n_src == n_dst && (src.location == FieldLocation::kGlobal ||
+                                       (src_pos - dst_pos).cwiseAbs().maxCoeff() <= 1e-12);
+    mapping_ = coincide                               ? Mapping::kDirect
+               : src.location == FieldLocation::kNode ? Mapping::kBarycentric
+                                                      : Mapping::kNearest;
+  }
+  if (mapping_ == Mapping::kDirect && n_src != n_dst)
+    fail(fmt::format("'direct' mapping needs equal item counts ({} vs {})", n_src, n_dst));
+  if (mapping_ == Mapping::kBarycentric) {
+    if (src.location != FieldLocation::kNode)
+      fail("'barycentric' mapping needs a node field as source");
+    const Mesh& mesh = from.domain();
+    map_ = mesh.num_tets() > 0
+               ? PointMap::BarycentricInTets(mesh.nodes, mesh.tets, dst_pos)
+               : PointMap::BarycentricOnTriangles(mesh.nodes, mesh.triangles, dst_pos);
+  } else if (mapping_ == Mapping::kNearest) {
+    map_ = PointMap::Nearest(src_pos, dst_pos);
+  }
+  source_.resize(src.components, n_src);
+  target_.resize(dst.components, n_dst);
+}
+
+StepStatus FieldCopy::DoFire(double /*t*/) {
+  from_.ReadField(from_field_, source_);
+  if (map_) {
+    map_->Apply(source_, target_);
+  } else {
+    target_ = source_;
+  }
+  if (scale_ != 1.0) target_ *= scale_;
+  for (Index i = 0; i < target_.size(); ++i)
+    if (!std::isfinite(target_.data()[i]))
+      return StepStatus::Diverged("non-finite value transferred at item", i / target_.rows(),
+                                  target_.data()[i]);
+  to_.WriteField(to_field_, target_);
+  return StepStatus::Ok();
+}
+
+void RegisterFieldCopy(TypeRegistry& registry) {
+  registry.connectors.Register(
+      "FieldCopy",
+      [](const ConnectorBuildContext& ctx) -> std::unique_ptr<Connector> {
+        ctx.CheckKeys({"from", "to", "mapping", "scale"});
+        auto [from, from_field] = ctx.ObjectField("from");
+        auto [to, to_field] = ctx.ObjectField("to");
+        using Mapping = FieldCopy::Mapping;
+        Mapping mapping = Mapping::kAuto;
+        if (auto m = ctx.params.Find("mapping")) {
+          std::string s = m->AsChoice({"auto", "direct", "barycentric", "nearest"});
+          mapping = s == "direct"        ? Mapping::kDirect
+                    : s == "barycentric" ? Mapping::kBarycentric
+                    : s == "nearest"     ? Mapping::kNearest
+                                         : Mapping::kAuto;
+        }
+        try {
+          return std::make_unique<FieldCopy>(ctx.name, *from, from_field, *to, to_field, mapping,
+                                             ctx.params.Number("scale", 1.0));
+        } catch (const InputError& e) {
+          ctx.params.Fail(e.what());
+        }
+      },
+      "volume coupling: Get a field of one object, map it, Set it on another");
+}
+
+}  // namespace gipsi

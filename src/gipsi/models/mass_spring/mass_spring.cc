@@ -1,0 +1,379 @@
+#include "gipsi/models/mass_spring/mass_spring.h"
+
+#include <algorithm>
+#include <cmath>
+#include <set>
+#include <utility>
+
+#include <fmt/format.h>
+
+#include "gipsi/base/error.h"
+#include "gipsi/base/log.h"
+#include "gipsi/geometry/quality.h"
+
+namespace gipsi {
+namespace {
+
+Eigen::Matrix2Xi UniqueEdges(const Mesh& mesh) {
+  std::set<std::pair<int, int>> edges;
+  auto add = [&](int a, int b) { edges.emplace(std::min(a, b), std::max(a, b)); };
+  for (Index e = 0; e < mesh.num_tets(); ++e)
+    for (int i = 0; i < 4; ++i)
+      for (int j = i + 1; j < 4; ++j) add(mesh.tets(i, e), mesh.tets(j, e));
+  if (mesh.num_tets() == 0)
+    for (Index e = 0; e < mesh.num_triangles(); ++e)
+      for (int i = 0; i < 3; ++i) add(mesh.triangles(i, e), mesh.triangles((i + 1) % 3, e));
+  Eigen::Matrix2Xi out(2, static_cast<Index>(edges.size()));
+  Index s = 0;
+  for (const auto& [a, b] : edges) {
+    out(0, s) = a;
+    out(1, s) = b;
+    ++s;
+  }
+  return out;
+}
+
+}  // namespace
+
+MassSpring::MassSpring(std::string name, std::shared_ptr<const Mesh> domain,
+                       const MassSpringParams& params,
+                       std::unique_ptr<ExplicitIntegrator> integrator)
+    : SimObject(std::move(name)), params_(params), integrator_(std::move(integrator)) {
+  GIPSI_CHECK(domain != nullptr && integrator_ != nullptr);
+  const Mesh& mesh = *domain;
+  if (mesh.num_tets() == 0 && mesh.num_triangles() == 0)
+    throw InputError(
+        fmt::format("object '{}': a MassSpring domain needs tets or triangles", this->name()));
+  SetGeometry(domain, MakeBoundary(mesh));
+  const Index n = mesh.num_nodes();
+
+  springs_ = UniqueEdges(mesh);
+  mass_ = VecX::Zero(n);
+  if (mesh.num_tets() > 0) {
+    for (Index e = 0; e < mesh.num_tets(); ++e) {
+      double volume = std::abs(
+          TetSignedVolume(mesh.nodes.col(mesh.tets(0, e)), mesh.nodes.col(mesh.tets(1, e)),
+                          mesh.nodes.col(mesh.tets(2, e)), mesh.nodes.col(mesh.tets(3, e))));
+      for (int a = 0; a < 4; ++a) mass_[mesh.tets(a, e)] += params_.density * volume / 4.0;
+    }
+  } else {
+    for (Index e = 0; e < mesh.num_triangles(); ++e) {
+      const Vec3 p0 = mesh.nodes.col(mesh.triangles(0, e));
+      double area = 0.5 * (mesh.nodes.col(mesh.triangles(1, e)) - p0)
+                              .cross(mesh.nodes.col(mesh.triangles(2, e)) - p0)
+                              .norm();
+      for (int a = 0; a < 3; ++a)
+        mass_[mesh.triangles(a, e)] += params_.density * params_.thickness * area / 3.0;
+    }
+  }
+  Finish();
+}
+
+MassSpring::MassSpring(std::string name, const Points& nodes, const Eigen::Matrix2Xi& springs,
+                       const VecX& masses, const MassSpringParams& params,
+                       std::unique_ptr<ExplicitIntegrator> integrator)
+    : SimObject(std::move(name)), params_(params), integrator_(std::move(integrator)) {
+  GIPSI_CHECK(integrator_ != nullptr);
+  const Index n = nodes.cols();
+  if (masses.size() != n)
+    throw InputError(
+        fmt::format("object '{}': {} masses for {} nodes", this->name(), masses.size(), n));
+  for (Index s = 0; s < springs.cols(); ++s)
+    for (int a = 0; a < 2; ++a)
+      if (springs(a, s) < 0 || springs(a, s) >= n)
+        throw InputError(fmt::format("object '{}': spring {} refers to node {} (have {})",
+                                     this->name(), s, springs(a, s), n));
+  auto mesh = std::make_shared<Mesh>();
+  mesh->nodes = nodes;
+  BoundarySurface boundary;
+  for (Index i = 0; i < n; ++i) boundary.vertex_to_node.push_back(static_cast<int>(i));
+  SetGeometry(std::move(mesh), std::move(boundary));
+  springs_ = springs;
+  mass_ = masses;
+  Finish();
+}
+
+void MassSpring::Finish() {
+  if (!params_.law) params_.law = std::make_shared<HookeSpring>();
+  const Mesh& mesh = domain();
+  const Index n = mesh.num_nodes();
+  rest_length_.resize(num_springs());
+  for (Index s = 0; s < num_springs(); ++s) {
+    rest_length_[s] = (mesh.nodes.col(springs_(1, s)) - mesh.nodes.col(springs_(0, s))).norm();
+    if (!(rest_length_[s] > 0))
+      throw InputError(
+          fmt::format("object '{}': spring between nodes {} and {} has zero rest "
+                      "length (coincident nodes)",
+                      this->name(), springs_(0, s), springs_(1, s)));
+  }
+  for (Index i = 0; i < n; ++i)
+    if (!(mass_[i] > 0))
+      throw InputError(
+          fmt::format("object '{}': node {} has no mass (it belongs to no element "
+                      "or only to degenerate ones)",
+                      this->name(), i));
+
+  x_ = VecX::Zero(6 * n);
+  x_.head(3 * n) = Eigen::Map<const VecX>(mesh.nodes.data(), 3 * n);
+  positions_ = mesh.nodes;
+  external_force_ = Points::Zero(3, n);
+  force_.resize(3 * n);
+  integrator_->Prepare(ode_size());
+
+  using L = FieldLocation;
+  using A = FieldAccess;
+  f_position_ =
+      DeclareField({"position", L::kNode, 3, "m", A::kReadWrite, "current node position"});
+  f_velocity_ = DeclareField({"velocity", L::kNode, 3, "m/s", A::kReadWrite, "node velocity"});
+  f_displacement_ =
+      DeclareField({"displacement", L::kNode, 3, "m", A::kRead, "position minus rest position"});
+  f_external_force_ = DeclareField({"external_force", L::kNode, 3, "N", A::kReadWrite,
+                                    "extra nodal force (volume coupling input)"});
+  f_mass_ = DeclareField({"mass", L::kNode, 1, "kg", A::kRead, "lumped node mass"});
+  f_bposition_ = DeclareField({"boundary_position", L::kBoundaryVertex, 3, "m", A::kRead,
+                               "current boundary vertex position"});
+  f_bvelocity_ = DeclareField(
+      {"boundary_velocity", L::kBoundaryVertex, 3, "m/s", A::kRead, "boundary vertex velocity"});
+  f_bdisplacement_ = DeclareField({"boundary_displacement", L::kBoundaryVertex, 3, "m", A::kRead,
+                                   "boundary vertex displacement"});
+  f_reaction_ = DeclareField({"reaction_force", L::kBoundaryVertex, 3, "N", A::kRead,
+                              "force the constraints exert on constrained boundary vertices"});
+  f_kinetic_ = DeclareField({"kinetic_energy", L::kGlobal, 1, "J", A::kRead, "½ Σ m v²"});
+  f_potential_ = DeclareField(
+      {"potential_energy", L::kGlobal, 1, "J", A::kRead, "spring plus gravitational energy"});
+  f_momentum_ = DeclareField({"momentum", L::kGlobal, 3, "kg·m/s", A::kRead, "Σ m v"});
+}
+
+void MassSpring::CalcForces(double /*t*/, Eigen::Ref<const VecX> x, Eigen::Ref<VecX> f) const {
+  const Index n = num_nodes();
+  const auto q = x.head(3 * n);
+  const auto v = x.tail(3 * n);
+  const SpringLaw& law = *params_.law;
+  for (Index i = 0; i < n; ++i) {
+    f.segment<3>(3 * i) =
+        mass_[i] * (params_.gravity - params_.drag * v.segment<3>(3 * i)) + external_force_.col(i);
+  }
+  for (Index s = 0; s < num_springs(); ++s) {
+    const Index a = springs_(0, s), b = springs_(1, s);
+    const Vec3 d = q.segment<3>(3 * b) - q.segment<3>(3 * a);
+    const double length = d.norm();
+    if (length <= 0) continue;  // coincident nodes: no direction; CheckState reports stretch
+    const Vec3 dir = d / length;
+    const double rate = (v.segment<3>(3 * b) - v.segment<3>(3 * a)).dot(dir);
+    const Vec3 fs =
+        (law.Tension(length, rest_length_[s], params_.stiffness) + params_.damping * rate) * dir;
+    f.segment<3>(3 * a) += fs;
+    f.segment<3>(3 * b) -= fs;
+  }
+  const BoundarySurface& bnd = boundary();
+  const BoundaryConditions& bcs = boundary_conditions();
+  for (Index j = 0; j < bnd.num_vertices(); ++j)
+    f.segment<3>(3 * bnd.vertex_to_node[static_cast<std::size_t>(j)]) += bcs.force(j);
+  if (bcs.any_face_load()) {
+    for (Index t = 0; t < bnd.num_triangles(); ++t) {
+      const int i0 = bnd.vertex_to_node[static_cast<std::size_t>(bnd.triangles(0, t))];
+      const int i1 = bnd.vertex_to_node[static_cast<std::size_t>(bnd.triangles(1, t))];
+      const int i2 = bnd.vertex_to_node[static_cast<std::size_t>(bnd.triangles(2, t))];
+      const Vec3 p0 = q.segment<3>(3 * i0);
+      // area_normal = 2·area·n (outward for tet boundaries).
+      const Vec3 area_normal = (q.segment<3>(3 * i1) - p0).cross(q.segment<3>(3 * i2) - p0);
+      const Vec3 load = (0.5 / 3.0) * (-bcs.pressure(t) * area_normal +
+                                       area_normal.norm() * Vec3(bcs.traction(t)));
+      f.segment<3>(3 * i0) += load;
+      f.segment<3>(3 * i1) += load;
+      f.segment<3>(3 * i2) += load;
+    }
+  }
+}
+
+void MassSpring::CalcDerivative(double t, Eigen::Ref<const VecX> x, Eigen::Ref<VecX> xdot) const {
+  const Index n = num_nodes();
+  CalcForces(t, x, force_);
+  xdot.head(3 * n) = x.tail(3 * n);
+  for (Index i = 0; i < n; ++i)
+    xdot.segment<3>(3 * n + 3 * i) = force_.segment<3>(3 * i) / mass_[i];
+  // Constrained axes: no acceleration; displacement-held axes do not move within a step.
+  const BoundarySurface& bnd = boundary();
+  const BoundaryConditions& bcs = boundary_conditions();
+  for (Index j = 0; j < bnd.num_vertices(); ++j) {
+    const Index node = bnd.vertex_to_node[static_cast<std::size_t>(j)];
+    for (int a = 0; a < 3; ++a) {
+      ConstraintKind kind = bcs.kind(j, a);
+      if (kind == ConstraintKind::kFree) continue;
+      xdot[3 * n + 3 * node + a] = 0;
+      if (kind == ConstraintKind::kDisplacement) xdot[3 * node + a] = 0;
+    }
+  }
+}
+
+void MassSpring::ApplyConstraints(double /*dt*/) {
+  const Index n = num_nodes();
+  const BoundarySurface& bnd = boundary();
+  const BoundaryConditions& bcs = boundary_conditions();
+  const Points& rest = domain().nodes;
+  for (Index j = 0; j < bnd.num_vertices(); ++j) {
+    const Index node = bnd.vertex_to_node[static_cast<std::size_t>(j)];
+    for (int a = 0; a < 3; ++a) {
+      switch (bcs.kind(j, a)) {
+        case ConstraintKind::kFree:
+          break;
+        case ConstraintKind::kDisplacement:
+          x_[3 * node + a] = rest(a, node) + bcs.value(j)[a];
+          x_[3 * n + 3 * node + a] = 0;
+          break;
+        case ConstraintKind::kVelocity:
+          x_[3 * n + 3 * node + a] = bcs.value(j)[a];
+          break;
+      }
+    }
+  }
+}
+
+StepStatus MassSpring::CheckState() const {
+  for (Index i = 0; i < x_.size(); ++i)
+    if (!std::isfinite(x_[i]))
+      return StepStatus::Diverged("non-finite position or velocity at node",
+                                  (i % (3 * num_nodes())) / 3, x_[i]);
+  const Index n = num_nodes();
+  for (Index s = 0; s < num_springs(); ++s) {
+    const double length =
+        (x_.segment<3>(3 * springs_(1, s)) - x_.segment<3>(3 * springs_(0, s))).norm();
+    if (length > params_.max_stretch * rest_length_[s])
+      return StepStatus::Diverged(
+          "spring stretched beyond max_stretch times its rest length (time step too large for "
+          "an explicit integrator?); spring",
+          s, length / rest_length_[s]);
+  }
+  (void)n;
+  return StepStatus::Ok();
+}
+
+StepStatus MassSpring::DoStep(double t, double dt) {
+  ApplyConstraints(dt);
+  integrator_->Step(OdeView(*this), t, dt, x_);
+  const Index n = num_nodes();
+  positions_ = Eigen::Map<const Points>(x_.data(), 3, n);
+  return CheckState();
+}
+
+double MassSpring::stable_dt_estimate() const {
+  VecX k_sum = VecX::Zero(num_nodes());
+  for (Index s = 0; s < num_springs(); ++s) {
+    k_sum[springs_(0, s)] += params_.stiffness;
+    k_sum[springs_(1, s)] += params_.stiffness;
+  }
+  double omega2 = 0;
+  for (Index i = 0; i < num_nodes(); ++i) omega2 = std::max(omega2, 4.0 * k_sum[i] / mass_[i]);
+  return omega2 > 0 ? 2.0 / std::sqrt(omega2) : std::numeric_limits<double>::infinity();
+}
+
+double MassSpring::KineticEnergy() const {
+  const Index n = num_nodes();
+  double e = 0;
+  for (Index i = 0; i < n; ++i) e += 0.5 * mass_[i] * x_.segment<3>(3 * n + 3 * i).squaredNorm();
+  return e;
+}
+
+double MassSpring::PotentialEnergy() const {
+  double e = 0;
+  for (Index s = 0; s < num_springs(); ++s) {
+    const double length =
+        (x_.segment<3>(3 * springs_(1, s)) - x_.segment<3>(3 * springs_(0, s))).norm();
+    e += params_.law->Energy(length, rest_length_[s], params_.stiffness);
+  }
+  for (Index i = 0; i < num_nodes(); ++i)
+    e -= mass_[i] * params_.gravity.dot(x_.segment<3>(3 * i) - domain().nodes.col(i));
+  return e;
+}
+
+Vec3 MassSpring::Momentum() const {
+  const Index n = num_nodes();
+  Vec3 p = Vec3::Zero();
+  for (Index i = 0; i < n; ++i) p += mass_[i] * x_.segment<3>(3 * n + 3 * i);
+  return p;
+}
+
+void MassSpring::DoReadField(FieldId id, Eigen::Ref<Eigen::MatrixXd> out) const {
+  const Index n = num_nodes();
+  const auto& v2n = boundary().vertex_to_node;
+  auto node_block = [&](Index offset) {  // 3 by N view into x_
+    return Eigen::Map<const Points>(x_.data() + offset, 3, n);
+  };
+  if (id == f_position_) {
+    out = positions_;
+  } else if (id == f_velocity_) {
+    out = node_block(3 * n);
+  } else if (id == f_displacement_) {
+    out = positions_ - domain().nodes;
+  } else if (id == f_external_force_) {
+    out = external_force_;
+  } else if (id == f_mass_) {
+    out = mass_.transpose();
+  } else if (id == f_bposition_ || id == f_bvelocity_ || id == f_bdisplacement_) {
+    for (std::size_t j = 0; j < v2n.size(); ++j) {
+      const Index node = v2n[j];
+      const auto col = static_cast<Index>(j);
+      if (id == f_bposition_) out.col(col) = positions_.col(node);
+      if (id == f_bvelocity_) out.col(col) = x_.segment<3>(3 * n + 3 * node);
+      if (id == f_bdisplacement_) out.col(col) = positions_.col(node) - domain().nodes.col(node);
+    }
+  } else if (id == f_reaction_) {
+    // Reaction = m·a_prescribed − f = −f on constrained axes (prescribed acceleration is zero).
+    CalcForces(time(), x_, force_);
+    const BoundaryConditions& bcs = boundary_conditions();
+    for (std::size_t j = 0; j < v2n.size(); ++j) {
+      const auto col = static_cast<Index>(j);
+      for (int a = 0; a < 3; ++a)
+        out(a, col) = bcs.kind(col, a) == ConstraintKind::kFree ? 0.0 : -force_[3 * v2n[j] + a];
+    }
+  } else if (id == f_kinetic_) {
+    out(0, 0) = KineticEnergy();
+  } else if (id == f_potential_) {
+    out(0, 0) = PotentialEnergy();
+  } else if (id == f_momentum_) {
+    out.col(0) = Momentum();
+  }
+}
+
+void MassSpring::DoWriteField(FieldId id, const Eigen::Ref<const Eigen::MatrixXd>& in) {
+  const Index n = num_nodes();
+  if (id == f_position_) {
+    positions_ = in;
+    x_.head(3 * n) = Eigen::Map<const VecX>(positions_.data(), 3 * n);
+  } else if (id == f_velocity_) {
+    Eigen::Map<Points>(x_.data() + 3 * n, 3, n) = in;
+  } else if (id == f_external_force_) {
+    external_force_ = in;
+  }
+}
+
+void RegisterMassSpring(TypeRegistry& registry) {
+  registry.objects.Register(
+      "MassSpring",
+      [](const ObjectBuildContext& ctx) -> std::unique_ptr<SimObject> {
+        const JsonNode& p = ctx.params;
+        ctx.CheckKeys({"density", "thickness", "stiffness", "damping", "drag", "gravity",
+                       "max_stretch", "material"});
+        MassSpringParams params;
+        params.density = p.Positive("density", params.density);
+        params.thickness = p.Positive("thickness", params.thickness);
+        params.stiffness = p.Positive("stiffness", params.stiffness);
+        params.damping = p.NonNegative("damping", params.damping);
+        params.drag = p.NonNegative("drag", params.drag);
+        params.gravity = p.Vector3("gravity", params.gravity);
+        params.max_stretch = p.Positive("max_stretch", params.max_stretch);
+        if (auto material = p.Find("material"))
+          params.law = ctx.registry.CreateMaterialAs<SpringLaw>(*material, "spring");
+        auto integrator = p.Has("integrator") ? ctx.registry.CreateIntegrator(p.At("integrator"))
+                                              : std::make_unique<SymplecticEuler>();
+        auto object =
+            std::make_unique<MassSpring>(ctx.name, ctx.DomainMesh(), params, std::move(integrator));
+        if (auto dt = p.Find("dt"); dt && dt->AsPositive() > object->stable_dt_estimate())
+          Log().warn("{}: dt = {:.3g} s exceeds the estimated explicit stability limit {:.3g} s",
+                     dt->path(), dt->AsPositive(), object->stable_dt_estimate());
+        return object;
+      },
+      "mass-spring-damper tissue on the edges of a tet or triangle mesh");
+}
+
+}  // namespace gipsi

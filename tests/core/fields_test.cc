@@ -1,0 +1,80 @@
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "gipsi/base/error.h"
+#include "gipsi/geometry/generators.h"
+#include "gipsi/models/mass_spring/mass_spring.h"
+
+namespace gipsi {
+namespace {
+
+using ::testing::HasSubstr;
+
+std::unique_ptr<MassSpring> Cube() {
+  return std::make_unique<MassSpring>(
+      "cube", std::make_shared<const Mesh>(MakeTetBox(Vec3::Zero(), Vec3(1, 1, 1), {2, 2, 2})),
+      MassSpringParams{}, std::make_unique<SymplecticEuler>());
+}
+
+TEST(Fields, SetThenGetRoundTrips) {
+  auto cube = Cube();
+  FieldId velocity = cube->FindField("velocity");
+  Eigen::MatrixXd in = Eigen::MatrixXd::Random(3, cube->FieldCount(velocity));
+  cube->WriteField(velocity, in);
+  Eigen::MatrixXd out(3, cube->FieldCount(velocity));
+  cube->ReadField(velocity, out);
+  EXPECT_EQ(in, out);
+}
+
+TEST(Fields, CountsFollowTheirLocation) {
+  auto cube = Cube();
+  EXPECT_EQ(cube->FieldCount(cube->FindField("position")), 27);
+  EXPECT_EQ(cube->FieldCount(cube->FindField("reaction_force")), cube->boundary().num_vertices());
+  EXPECT_EQ(cube->FieldCount(cube->FindField("kinetic_energy")), 1);
+  EXPECT_EQ(cube->boundary().num_vertices(), 26);  // all but the centre node
+}
+
+TEST(Fields, UnknownNameListsTheFieldsAndSuggests) {
+  auto cube = Cube();
+  try {
+    (void)cube->FindField("velocty");
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("object 'cube' (MassSpring) has no field 'velocty' (did you "
+                                    "mean 'velocity'?); its fields are: position, velocity"));
+  }
+}
+
+TEST(FieldsDeathTest, WrongSizeIsAProgrammerErrorThatAborts) {
+  auto cube = Cube();
+  Eigen::MatrixXd wrong(3, 5);
+  EXPECT_DEATH(cube->ReadField(cube->FindField("position"), wrong), "is 3 by 27, buffer is 3 by 5");
+  EXPECT_DEATH(cube->WriteField(cube->FindField("displacement"), wrong), "read-only");
+}
+
+TEST(BoundaryConditions, FixThenReleaseFreesTheAxes) {
+  BoundaryConditions bcs(4, 2);
+  bcs.Fix(1, 0b101);
+  EXPECT_EQ(bcs.kind(1, 0), ConstraintKind::kDisplacement);
+  EXPECT_EQ(bcs.kind(1, 1), ConstraintKind::kFree);
+  EXPECT_EQ(bcs.kind(1, 2), ConstraintKind::kDisplacement);
+  EXPECT_TRUE(bcs.any_constraint());
+  bcs.Release(1);
+  EXPECT_FALSE(bcs.any_constraint());
+}
+
+TEST(BoundaryConditions, CouplingLoadsAddToAppliedLoadsAndClear) {
+  BoundaryConditions bcs(2, 1);
+  bcs.SetForce(0, Vec3(1, 0, 0));
+  bcs.AddCouplingForce(0, Vec3(0, 2, 0));
+  bcs.AddCouplingForce(0, Vec3(0, 3, 0));
+  EXPECT_EQ(bcs.force(0), Vec3(1, 5, 0));
+  bcs.AddCouplingPressure(0, 7);
+  EXPECT_TRUE(bcs.any_face_load());
+  bcs.ClearCouplingLoads();
+  EXPECT_EQ(bcs.force(0), Vec3(1, 0, 0));
+  EXPECT_EQ(bcs.pressure(0), 0);
+}
+
+}  // namespace
+}  // namespace gipsi

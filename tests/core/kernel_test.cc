@@ -1,0 +1,172 @@
+#include "gipsi/core/kernel.h"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "core/test_objects.h"
+#include "gipsi/core/aggregate.h"
+#include "gipsi/base/error.h"
+#include "gipsi/models/connectors/field_copy.h"
+
+namespace gipsi {
+namespace {
+
+using testing::CountingObject;
+using ::testing::HasSubstr;
+
+/// Records the times it is notified at and whether Finish was called.
+class Recorder final : public Observer {
+ public:
+  explicit Recorder(std::vector<double>& times, bool& finished)
+      : times_(times), finished_(finished) {}
+  void Observe(const Kernel&, double t) override { times_.push_back(t); }
+  void Finish(const Kernel&) override { finished_ = true; }
+
+ private:
+  std::vector<double>& times_;
+  bool& finished_;
+};
+
+TEST(Kernel, SubStepsEachObjectAtItsOwnRate) {
+  Kernel kernel;
+  auto& slow = static_cast<CountingObject&>(
+      kernel.coordinator().AddObject(std::make_unique<CountingObject>("slow"), 1e-3));
+  auto& fast = static_cast<CountingObject&>(
+      kernel.coordinator().AddObject(std::make_unique<CountingObject>("fast"), 1e-4));
+  kernel.Initialize();  // macro step = largest dt = 1 ms
+  EXPECT_EQ(kernel.macro_dt(), 1e-3);
+  EXPECT_EQ(kernel.coordinator().object_substeps(1), 10);
+  RunResult result = kernel.Run(0.05);
+  ASSERT_TRUE(result.ok()) << result.diagnostic;
+  EXPECT_EQ(slow.steps(), 50);
+  EXPECT_EQ(fast.steps(), 500);
+  EXPECT_EQ(result.macro_steps, 50);
+  // Clocks are re-synchronised to the macro grid, so 500 sub-steps leave no round-off.
+  EXPECT_EQ(fast.time(), kernel.time());
+  EXPECT_DOUBLE_EQ(kernel.time(), 0.05);
+}
+
+TEST(Kernel, RejectsTimeStepThatDoesNotDivideMacroStep) {
+  Kernel kernel;
+  kernel.coordinator().AddObject(std::make_unique<CountingObject>("a"), 1e-3);
+  kernel.coordinator().AddObject(std::make_unique<CountingObject>("b"), 3e-4);
+  try {
+    kernel.Initialize();
+    FAIL() << "expected InputError";
+  } catch (const InputError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("object 'b': its time step 0.0003 s does not divide the "
+                                    "macro step 0.001 s"));
+  }
+}
+
+TEST(Kernel, ScheduledEventFiresAtItsTime) {
+  Kernel kernel;
+  auto& object = static_cast<CountingObject&>(
+      kernel.coordinator().AddObject(std::make_unique<CountingObject>("a"), 1e-3));
+  double fired_at = -1;
+  std::int64_t steps_before = -1;
+  kernel.ScheduleEvent({0.005, "test event", [&](Kernel& k) {
+                          fired_at = k.time();
+                          steps_before = object.steps();
+                        }});
+  kernel.Initialize();
+  ASSERT_TRUE(kernel.Run(0.01).ok());
+  EXPECT_DOUBLE_EQ(fired_at, 0.005);
+  EXPECT_EQ(steps_before, 5);  // it fires at the start of the macro step beginning at 5 ms
+  ASSERT_EQ(kernel.fired_events().size(), 1u);
+  EXPECT_EQ(kernel.fired_events()[0].second, "test event");
+}
+
+TEST(Kernel, EventsBetweenMacroStepsFireAtTheNextOne) {
+  Kernel kernel;
+  kernel.coordinator().AddObject(std::make_unique<CountingObject>("a"), 1e-3);
+  std::vector<double> fired;
+  for (double t : {0.0025, 0.0, 0.0021})
+    kernel.ScheduleEvent({t, "e", [&fired](Kernel& k) { fired.push_back(k.time()); }});
+  kernel.Initialize();
+  ASSERT_TRUE(kernel.Run(0.01).ok());
+  ASSERT_EQ(fired.size(), 3u);
+  EXPECT_DOUBLE_EQ(fired[0], 0.0);
+  EXPECT_DOUBLE_EQ(fired[1], 0.003);
+  EXPECT_DOUBLE_EQ(fired[2], 0.003);
+}
+
+TEST(Kernel, DivergingObjectStopsRunWithDiagnosticAndKeepsOutputs) {
+  Kernel kernel;
+  kernel.coordinator().AddObject(std::make_unique<CountingObject>("healthy"), 1e-3);
+  kernel.coordinator().AddObject(std::make_unique<CountingObject>("tissue", 13), 1e-4);
+  std::vector<double> times;
+  bool finished = false;
+  kernel.AddObserver(std::make_unique<Recorder>(times, finished));
+  kernel.Initialize();
+  RunResult result = kernel.Run(1.0);
+  EXPECT_EQ(result.outcome, RunResult::Outcome::kDiverged);
+  EXPECT_THAT(result.diagnostic, HasSubstr("object 'tissue' diverged"));
+  EXPECT_THAT(result.diagnostic, HasSubstr("test divergence"));
+  EXPECT_THAT(result.diagnostic, HasSubstr("item 7"));
+  // Sub-step 13 of the fast object lies in macro step 1 (t in [1 ms, 2 ms)).
+  EXPECT_THAT(result.diagnostic, HasSubstr("at t = 0.0012 s"));
+  EXPECT_EQ(result.macro_steps, 1);
+  // The observer saw t = 0 and t = 1 ms, and was finished (files flushed).
+  EXPECT_EQ(times.size(), 2u);
+  EXPECT_TRUE(finished);
+}
+
+TEST(Kernel, ConnectorFiresEveryNMacroSteps) {
+  Kernel kernel;
+  auto& a = kernel.coordinator().AddObject(std::make_unique<CountingObject>("a"), 1e-3);
+  auto& b = kernel.coordinator().AddObject(std::make_unique<CountingObject>("b"), 1e-3);
+  auto& connector = kernel.coordinator().AddConnector(
+      std::make_unique<FieldCopy>("copy", a, a.FindField("value"), b, b.FindField("value"),
+                                  FieldCopy::Mapping::kAuto, 2.0),
+      3);
+  kernel.Initialize();
+  ASSERT_TRUE(kernel.Run(0.01).ok());
+  EXPECT_EQ(connector.fire_count(), 4);  // macro steps 0, 3, 6, 9
+}
+
+TEST(Coordinator, OrderMustNameEveryObjectAndConnectorOnce) {
+  Coordinator c;
+  c.AddObject(std::make_unique<CountingObject>("a"), 1e-3);
+  c.AddObject(std::make_unique<CountingObject>("b"), 1e-3);
+  EXPECT_THROW(c.SetOrder({"a"}), InputError);
+  EXPECT_THROW(c.SetOrder({"a", "b", "a"}), InputError);
+  try {
+    c.SetOrder({"a", "bb"});
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("no object or connector named 'bb' (did you mean 'b'?)"));
+  }
+  EXPECT_NO_THROW(c.SetOrder({"b", "a"}));
+}
+
+TEST(Coordinator, RejectsDuplicateNames) {
+  Coordinator c;
+  c.AddObject(std::make_unique<CountingObject>("a"), 1e-3);
+  EXPECT_THROW(c.AddObject(std::make_unique<CountingObject>("a"), 1e-3), InputError);
+}
+
+}  // namespace
+}  // namespace gipsi
+
+namespace gipsi {
+namespace {
+
+TEST(Kernel, DivergenceInsideAnAggregateNamesThePart) {
+  Coordinator parts;
+  parts.AddObject(std::make_unique<testing::CountingObject>("muscle"), 1e-3);
+  parts.AddObject(std::make_unique<testing::CountingObject>("blood", 3), 1e-3);
+  parts.Prepare(1e-3);
+  Kernel kernel;
+  kernel.coordinator().AddObject(std::make_unique<AggregateObject>("heart", std::move(parts)),
+                                 1e-3);
+  kernel.Initialize();
+  RunResult result = kernel.Run(1.0);
+  EXPECT_EQ(result.outcome, RunResult::Outcome::kDiverged);
+  EXPECT_THAT(result.diagnostic, ::testing::HasSubstr("object 'heart' (part 'blood') diverged"));
+  EXPECT_EQ(&kernel.FindObject("heart.blood"),
+            kernel.coordinator().object(0).FindPart("blood"));
+}
+
+}  // namespace
+}  // namespace gipsi

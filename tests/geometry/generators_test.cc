@@ -1,0 +1,127 @@
+#include "gipsi/geometry/generators.h"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <Eigen/Geometry>
+
+#include "gipsi/base/error.h"
+#include "gipsi/geometry/boundary.h"
+#include "gipsi/geometry/normals.h"
+#include "gipsi/geometry/quality.h"
+
+namespace gipsi {
+namespace {
+
+using ::testing::SizeIs;
+using ::testing::StrEq;
+using ::testing::ThrowsMessage;
+
+TEST(TetBox, TetsArePositiveAndFillTheBox) {
+  const Vec3 lo(-1, 2, 0.5), hi(1, 3, 2);
+  const Mesh box = MakeTetBox(lo, hi, {4, 3, 2});
+  EXPECT_NO_THROW(box.Validate("box"));
+  EXPECT_EQ(box.num_nodes(), 5 * 4 * 3);
+  EXPECT_EQ(box.num_tets(), 6 * 4 * 3 * 2);
+  const TetQualityReport report = CheckTetQuality(box.nodes, box.tets);
+  EXPECT_GT(report.min_volume, 0);
+  EXPECT_NEAR(report.total_volume, (hi - lo).prod(), 1e-13);
+}
+
+TEST(TetBox, NodesFollowTheLatticeNumbering) {
+  const Mesh box = MakeTetBox(Vec3(0, 0, 0), Vec3(2, 3, 4), {2, 3, 4});
+  for (int k = 0; k <= 4; ++k)
+    for (int j = 0; j <= 3; ++j)
+      for (int i = 0; i <= 2; ++i) EXPECT_EQ(box.nodes.col(i + 3 * (j + 4 * k)), Vec3(i, j, k));
+}
+
+TEST(TetBox, NeighbouringCellsConform) {
+  // Non-matching face diagonals between cells would leave interior faces on the boundary.
+  const Mesh box = MakeTetBox(Vec3(0, 0, 0), Vec3(1, 1, 1), {3, 3, 3});
+  EXPECT_EQ(ExtractTetBoundary(box.nodes, box.tets).num_triangles(), 6 * 3 * 3 * 2);
+}
+
+TEST(TetBox, BoundaryGroupsCoverEachFaceOutward) {
+  const Mesh box = MakeTetBox(Vec3(0, 0, 0), Vec3(1, 1, 1), {2, 3, 4});
+  const Points normals = FaceNormals(box.nodes, box.triangles);
+  const char* names[6] = {"xmin", "xmax", "ymin", "ymax", "zmin", "zmax"};
+  const int quads[3] = {3 * 4, 2 * 4, 2 * 3};  // cells on the faces normal to x, y, z
+  Index total = 0;
+  for (int f = 0; f < 6; ++f) {
+    const MeshGroup* group = box.FindGroup(names[f]);
+    ASSERT_NE(group, nullptr) << names[f];
+    EXPECT_EQ(group->dim, 2);
+    EXPECT_THAT(group->items, SizeIs(2 * quads[f / 2])) << names[f];
+    Vec3 outward = Vec3::Zero();
+    outward[f / 2] = f % 2 == 0 ? -1 : 1;
+    for (int t : group->items) EXPECT_EQ(normals.col(t), outward) << names[f];
+    total += Index(group->items.size());
+  }
+  EXPECT_EQ(total, box.num_triangles());
+  const MeshGroup* volume = box.FindGroup("volume");
+  ASSERT_NE(volume, nullptr);
+  EXPECT_EQ(volume->dim, 3);
+  EXPECT_THAT(volume->items, SizeIs(box.num_tets()));
+}
+
+TEST(TetBox, RejectsAnEmptyBoxAndZeroCells) {
+  EXPECT_THAT(
+      [] {
+        MakeTetBox(Vec3(0, 0, 0), Vec3(1, 0, 1), {1, 1, 1});
+      },
+      ThrowsMessage<InputError>(
+          StrEq("tet box: max (1, 0, 1) must exceed min (0, 0, 0) on every axis")));
+  EXPECT_THAT(
+      [] {
+        MakeTetBox(Vec3(0, 0, 0), Vec3(1, 1, 1), {1, 0, 1});
+      },
+      ThrowsMessage<InputError>(StrEq("tet box: cells must be >= 1 on every axis, got 1 x 0 x 1")));
+}
+
+TEST(TriangleSheet, SpansTheParallelogramWithNormalsAlongUCrossV) {
+  const Vec3 origin(1, 1, 1), u(2, 0, 0), v(0.5, 0, 3);
+  const Mesh sheet = MakeTriangleSheet(origin, u, v, {4, 3});
+  EXPECT_NO_THROW(sheet.Validate("sheet"));
+  EXPECT_EQ(sheet.num_nodes(), 5 * 4);
+  EXPECT_EQ(sheet.num_triangles(), 2 * 4 * 3);
+  EXPECT_EQ(sheet.num_tets(), 0);
+  EXPECT_LT((sheet.nodes.col(4 + 5 * 3) - (origin + u + v)).norm(), 1e-15);
+  EXPECT_NEAR(TriangleAreas(sheet.nodes, sheet.triangles).sum(), u.cross(v).norm(), 1e-13);
+  const Points normals = FaceNormals(sheet.nodes, sheet.triangles);
+  for (Index t = 0; t < normals.cols(); ++t)
+    EXPECT_LT((normals.col(t) - u.cross(v).normalized()).norm(), 1e-14);
+}
+
+TEST(TriangleSheet, EdgeGroupsHoldTheEdgeNodes) {
+  const Mesh sheet = MakeTriangleSheet(Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0), {4, 3});
+  const struct {
+    const char* name;
+    int axis;
+    double value;
+    std::size_t count;
+  } edges[] = {{"u0", 0, 0, 4}, {"u1", 0, 1, 4}, {"v0", 1, 0, 5}, {"v1", 1, 1, 5}};
+  for (const auto& edge : edges) {
+    const MeshGroup* group = sheet.FindGroup(edge.name);
+    ASSERT_NE(group, nullptr) << edge.name;
+    EXPECT_EQ(group->dim, 0);
+    EXPECT_THAT(group->items, SizeIs(edge.count)) << edge.name;
+    for (int n : group->items) EXPECT_EQ(sheet.nodes(edge.axis, n), edge.value) << edge.name;
+  }
+}
+
+TEST(TriangleSheet, RejectsParallelEdgesAndZeroCells) {
+  EXPECT_THAT(
+      [] {
+        MakeTriangleSheet(Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(2, 0, 0), {1, 1});
+      },
+      ThrowsMessage<InputError>(StrEq("triangle sheet: edges (1, 0, 0) and (2, 0, 0) "
+                                      "must be finite, non-zero and not parallel")));
+  EXPECT_THAT(
+      [] {
+        MakeTriangleSheet(Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0), {0, 1});
+      },
+      ThrowsMessage<InputError>(
+          StrEq("triangle sheet: cells must be >= 1 on both axes, got 0 x 1")));
+}
+
+}  // namespace
+}  // namespace gipsi

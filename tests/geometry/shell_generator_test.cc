@@ -1,0 +1,167 @@
+#include <chrono>
+#include <clocale>
+#include <cmath>
+#include <numbers>
+#include <string>
+#include <vector>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <Eigen/Geometry>
+
+#include "gipsi/base/error.h"
+#include "gipsi/geometry/boundary.h"
+#include "gipsi/geometry/generators.h"
+#include "gipsi/geometry/normals.h"
+#include "gipsi/geometry/quality.h"
+
+/// LeakSanitizer: libgmsh 4.8 leaks a few small allocations while meshing surfaces
+/// (`meshGFace`), which `gmsh::finalize` does not free. Weak, so that another definition in the
+/// test binary (or a suppressions file in LSAN_OPTIONS) takes precedence without a clash.
+extern "C" __attribute__((weak)) const char* __lsan_default_suppressions() {
+  return "leak:libgmsh.so\n";
+}
+
+namespace gipsi {
+namespace {
+
+using ::testing::HasSubstr;
+using ::testing::StrEq;
+using ::testing::ThrowsMessage;
+
+/// Volume of (x²+y²)/a² + z²/c² <= 1 below z = zb: π a² ∫_{−c}^{zb} (1 − z²/c²) dz.
+double TruncatedEllipsoidVolume(double a, double c, double zb) {
+  return std::numbers::pi * a * a * ((zb + c) - (zb * zb * zb + c * c * c) / (3 * c * c));
+}
+
+/// Checks what every shell must satisfy: valid, positive tets, the boundary triangles are
+/// exactly the closed outward boundary of the tets, and the groups partition them.
+void ExpectSoundShell(const Mesh& mesh, const std::vector<std::string>& surfaces) {
+  EXPECT_NO_THROW(mesh.Validate("shell"));
+  const TetQualityReport report = CheckTetQuality(mesh.nodes, mesh.tets);
+  EXPECT_GT(report.min_volume, 0);
+  EXPECT_TRUE(report.degenerate.empty());
+  EXPECT_EQ(ExtractTetBoundary(mesh.nodes, mesh.tets).num_triangles(), mesh.num_triangles());
+  std::size_t total = 0;
+  for (const auto& name : surfaces) {
+    const MeshGroup* group = mesh.FindGroup(name);
+    ASSERT_NE(group, nullptr) << name;
+    EXPECT_EQ(group->dim, 2);
+    EXPECT_FALSE(group->items.empty()) << name;
+    total += group->items.size();
+  }
+  EXPECT_EQ(total, std::size_t(mesh.num_triangles()));
+  const MeshGroup* wall = mesh.FindGroup("wall");
+  ASSERT_NE(wall, nullptr);
+  EXPECT_EQ(wall->dim, 3);
+  EXPECT_EQ(wall->items.size(), std::size_t(mesh.num_tets()));
+}
+
+/// Mean of dot(face normal, direction(centroid)) over the triangles of a group.
+template <class Direction>
+double MeanAlignment(const Mesh& mesh, const std::string& name, Direction&& direction) {
+  const Points normals = FaceNormals(mesh.nodes, mesh.triangles);
+  double sum = 0;
+  const MeshGroup* group = mesh.FindGroup(name);
+  for (int t : group->items) {
+    const Vec3 c = (mesh.nodes.col(mesh.triangles(0, t)) + mesh.nodes.col(mesh.triangles(1, t)) +
+                    mesh.nodes.col(mesh.triangles(2, t))) /
+                   3;
+    sum += normals.col(t).dot(direction(c));
+  }
+  return sum / double(group->items.size());
+}
+
+TEST(EllipsoidShell, HasPositiveTetsNamedSurfacesAndTheAnalyticVolume) {
+  EllipsoidShellSpec spec;
+  spec.mesh_size = 2.5;
+  const auto start = std::chrono::steady_clock::now();
+  const Mesh mesh = MakeEllipsoidShell(spec);
+  std::cout << "[ info     ] ellipsoid shell: " << mesh.num_nodes() << " nodes, " << mesh.num_tets()
+            << " tets in "
+            << std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count()
+            << " s\n";
+  ExpectSoundShell(mesh, {"endo", "epi", "base"});
+  const double analytic = TruncatedEllipsoidVolume(spec.epi_short, spec.epi_long, spec.base_z) -
+                          TruncatedEllipsoidVolume(spec.endo_short, spec.endo_long, spec.base_z);
+  const double volume = CheckTetQuality(mesh.nodes, mesh.tets).total_volume;
+  std::cout << "[ info     ] volume / analytic = " << volume / analytic << "\n";
+  EXPECT_NEAR(volume / analytic, 1, 0.03);
+  for (Index n = 0; n < mesh.num_nodes(); ++n) EXPECT_LE(mesh.nodes(2, n), spec.base_z + 1e-9);
+  // Outward from the wall: into the cavity on the endocardium, away from it on the
+  // epicardium, up on the base.
+  auto radial = [](const Vec3& c) { return c.normalized(); };
+  EXPECT_LT(MeanAlignment(mesh, "endo", radial), -0.8);
+  EXPECT_GT(MeanAlignment(mesh, "epi", radial), 0.8);
+  EXPECT_NEAR(MeanAlignment(mesh, "base", [](const Vec3&) { return Vec3(0, 0, 1); }), 1, 1e-12);
+}
+
+TEST(EllipsoidShell, RejectsInconsistentDimensions) {
+  EllipsoidShellSpec inside_out;
+  inside_out.endo_short = 12;
+  EXPECT_THAT([&] { MakeEllipsoidShell(inside_out); },
+              ThrowsMessage<InputError>(
+                  StrEq("ellipsoid shell: the endocardium (12 x 17) must lie inside the "
+                        "epicardium (10 x 20): both semi-axes must be smaller")));
+  EllipsoidShellSpec above;
+  above.base_z = 18;
+  EXPECT_THAT([&] { MakeEllipsoidShell(above); },
+              ThrowsMessage<InputError>(
+                  StrEq("ellipsoid shell: base_z 18 must cut both surfaces: expected |base_z| < "
+                        "endo_long 17")));
+  EllipsoidShellSpec tiny;
+  tiny.mesh_size = 0.01;
+  EXPECT_THAT([&] { MakeEllipsoidShell(tiny); },
+              ThrowsMessage<InputError>(HasSubstr("mesh_size 0.01 is too small")));
+  EllipsoidShellSpec zero;
+  zero.mesh_size = 0;
+  EXPECT_THAT([&] { MakeEllipsoidShell(zero); },
+              ThrowsMessage<InputError>(
+                  StrEq("ellipsoid shell: mesh_size must be a positive number, got 0")));
+}
+
+TEST(CylinderShell, HasPositiveTetsNamedSurfacesAndTheAnalyticVolume) {
+  const double r = 1, R = 2, h = 3;
+  const auto start = std::chrono::steady_clock::now();
+  const Mesh mesh = MakeCylinderShell(r, R, h, 0.5);
+  std::cout << "[ info     ] cylinder shell: " << mesh.num_nodes() << " nodes, " << mesh.num_tets()
+            << " tets in "
+            << std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count()
+            << " s\n";
+  ExpectSoundShell(mesh, {"inner", "outer", "bottom", "top"});
+  const double volume = CheckTetQuality(mesh.nodes, mesh.tets).total_volume;
+  const double analytic = std::numbers::pi * (R * R - r * r) * h;
+  std::cout << "[ info     ] volume / analytic = " << volume / analytic << "\n";
+  EXPECT_NEAR(volume / analytic, 1, 0.03);
+  auto radial = [](const Vec3& c) { return Vec3(c.x(), c.y(), 0).normalized(); };
+  EXPECT_LT(MeanAlignment(mesh, "inner", radial), -0.95);
+  EXPECT_GT(MeanAlignment(mesh, "outer", radial), 0.95);
+  EXPECT_NEAR(MeanAlignment(mesh, "top", [](const Vec3&) { return Vec3(0, 0, 1); }), 1, 1e-12);
+  EXPECT_NEAR(MeanAlignment(mesh, "bottom", [](const Vec3&) { return Vec3(0, 0, -1); }), 1, 1e-12);
+}
+
+TEST(CylinderShell, IsDeterministic) {
+  const Mesh a = MakeCylinderShell(1, 2, 1, 0.6);
+  const Mesh b = MakeCylinderShell(1, 2, 1, 0.6);
+  EXPECT_EQ(a.nodes, b.nodes);
+  EXPECT_EQ(a.tets, b.tets);
+  EXPECT_EQ(a.triangles, b.triangles);
+}
+
+TEST(CylinderShell, LeavesTheProcessLocaleUnchanged) {
+  const std::string before = std::setlocale(LC_ALL, nullptr);
+  MakeCylinderShell(1, 2, 1, 0.8);
+  EXPECT_EQ(std::setlocale(LC_ALL, nullptr), before);
+}
+
+TEST(CylinderShell, RejectsInnerRadiusNotBelowOuter) {
+  EXPECT_THAT([] { MakeCylinderShell(2, 2, 1, 0.5); },
+              ThrowsMessage<InputError>(
+                  StrEq("cylinder shell: inner_radius 2 must be smaller than outer_radius 2")));
+  EXPECT_THAT(
+      [] { MakeCylinderShell(1, 2, -1, 0.5); },
+      ThrowsMessage<InputError>(StrEq("cylinder shell: height must be a positive number, got -1")));
+}
+
+}  // namespace
+}  // namespace gipsi

@@ -1,0 +1,85 @@
+#pragma once
+/// @file
+/// Helpers shared by the mesh I/O tests: paths of test inputs, per-test scratch files, byte
+/// builders for binary formats, and capturing InputError messages.
+
+#include <cstdint>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <string>
+#include <string_view>
+
+#include <gtest/gtest.h>
+
+#include "gipsi/base/error.h"
+
+namespace gipsi::test {
+
+/// A hand-written input under tests/data/meshes/.
+inline std::filesystem::path MeshData(std::string_view name) {
+  return std::filesystem::path(GIPSI_SOURCE_DIR) / "tests" / "data" / "meshes" / name;
+}
+
+/// A file of the shared sample data (e.g. "liver/liver.msh").
+inline std::filesystem::path SharedData(std::string_view name) {
+  return std::filesystem::path(GIPSI_SHARED_DATA_DIR) / name;
+}
+
+/// A scratch path unique to the running test: TMPDIR/gipsi_io/<Suite>.<Test>/<name>.
+inline std::filesystem::path Scratch(std::string_view name) {
+  const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+  auto dir = std::filesystem::path(::testing::TempDir()) / "gipsi_io" /
+             (std::string(info->test_suite_name()) + "." + info->name());
+  std::filesystem::create_directories(dir);
+  return dir / name;
+}
+
+/// Writes `bytes` to `path` and returns the path.
+inline std::filesystem::path WriteBytes(const std::filesystem::path& path, std::string_view bytes) {
+  std::ofstream out(path, std::ios::binary | std::ios::trunc);
+  out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+  return path;
+}
+
+/// Reads a whole file.
+inline std::string ReadBytes(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+}
+
+/// The message of the InputError `f` throws; fails the test (returning "") if it throws
+/// nothing or something else.
+inline std::string InputErrorMessage(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const InputError& e) {
+    return e.what();
+  } catch (const std::exception& e) {
+    ADD_FAILURE() << "expected InputError, got another exception: " << e.what();
+    return "";
+  }
+  ADD_FAILURE() << "expected InputError, nothing was thrown";
+  return "";
+}
+
+/// Appends the bytes of `value` (host order), reversed if `swap`.
+template <class T>
+void Put(std::string& out, T value, bool swap = false) {
+  char bytes[sizeof(T)];
+  std::memcpy(bytes, &value, sizeof(T));
+  if (swap)
+    for (std::size_t i = 0; i < sizeof(T) / 2; ++i) std::swap(bytes[i], bytes[sizeof(T) - 1 - i]);
+  out.append(bytes, sizeof(T));
+}
+
+/// True on little-endian hosts.
+inline bool LittleEndianHost() {
+  std::uint16_t one = 1;
+  char first = 0;
+  std::memcpy(&first, &one, 1);
+  return first == 1;
+}
+
+}  // namespace gipsi::test

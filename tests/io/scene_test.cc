@@ -1,0 +1,199 @@
+#include "gipsi/io/scene.h"
+
+#include <filesystem>
+#include <fstream>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "gipsi/base/error.h"
+#include "gipsi/models/builtins.h"
+#include "gipsi/models/mass_spring/mass_spring.h"
+
+namespace gipsi {
+namespace {
+
+using ::testing::HasSubstr;
+
+/// A valid scene; tests replace parts of it to make it invalid.
+std::string SceneText(const std::string& object_extra = "", const std::string& top_extra = "") {
+  return R"({
+  "meshes": {"box": {"generate": "box", "min": [0,0,0], "max": [0.1,0.1,0.1], "cells": [2,2,2]}},
+  "objects": {
+    "cube": {"type": "MassSpring", "domain": "box", "dt": 0.0001, "stiffness": 100)" +
+         object_extra + R"(,
+             "boundary_conditions": [{"name": "top", "region": {"group": "zmax"}, "fix": true}]}
+  },
+  "schedule": {"end": 0.01, "dt": 0.001})" +
+         top_extra + "\n}";
+}
+
+std::string LoadError(const std::string& text) {
+  TypeRegistry registry;
+  RegisterBuiltins(registry);
+  try {
+    (void)LoadSceneFromString(text, "scene.json", ".", registry);
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "(no error)";
+}
+
+Scene Load(const std::string& text) {
+  static TypeRegistry* registry = [] {
+    auto* r = new TypeRegistry;
+    RegisterBuiltins(*r);
+    return r;
+  }();
+  return LoadSceneFromString(text, "scene.json", ".", *registry);
+}
+
+TEST(Scene, LoadsObjectsConditionsAndSchedule) {
+  Scene scene = Load(SceneText());
+  EXPECT_EQ(scene.end_time, 0.01);
+  EXPECT_EQ(scene.kernel->macro_dt(), 0.001);
+  EXPECT_EQ(scene.kernel->coordinator().object_substeps(0), 10);
+  const auto& bc = scene.boundary_conditions.at("cube/top");
+  EXPECT_EQ(bc.vertices.size(), 9u);  // 3x3 nodes on the top face
+  const SimObject& cube = scene.kernel->FindObject("cube");
+  EXPECT_EQ(cube.boundary_conditions().kind(bc.vertices[0], 2), ConstraintKind::kDisplacement);
+}
+
+TEST(Scene, RunsAndHoldsFixedVertices) {
+  Scene scene = Load(SceneText());
+  ASSERT_TRUE(scene.kernel->Run(scene.end_time).ok());
+  const auto& cube = static_cast<const MassSpring&>(scene.kernel->FindObject("cube"));
+  for (int v : scene.boundary_conditions.at("cube/top").vertices) {
+    int node = cube.boundary().vertex_to_node[static_cast<std::size_t>(v)];
+    EXPECT_EQ(cube.domain_positions().col(node), cube.domain().nodes.col(node));
+  }
+  // Everything else sagged.
+  EXPECT_LT(cube.domain_positions().row(2).minCoeff(), -1e-6);
+}
+
+TEST(SceneErrors, MalformedJsonGivesLineAndColumn) {
+  EXPECT_THAT(LoadError("{\n  \"objects\": {,\n}"),
+              HasSubstr("scene.json: line 2, column 15: invalid JSON: syntax error while parsing "
+                        "object key - unexpected ','; expected string literal"));
+}
+
+TEST(SceneErrors, UnknownTypeSuggestsTheClosest) {
+  std::string text = SceneText();
+  text.replace(text.find("\"MassSpring\""), 12, "\"MassSprign\"");
+  EXPECT_THAT(LoadError(text),
+              HasSubstr("scene.json: objects.cube.type: unknown object type 'MassSprign' (did "
+                        "you mean 'MassSpring'?); known: Aggregate, MassSpring"));
+}
+
+TEST(SceneErrors, WrongParameterTypeNamesThePath) {
+  std::string text = SceneText();
+  text.replace(text.find("\"stiffness\": 100"), 16, "\"stiffness\": \"abc\"");
+  EXPECT_EQ(LoadError(text),
+            "scene.json: objects.cube.stiffness: expected a positive number, got \"abc\"");
+}
+
+TEST(SceneErrors, NonFiniteParameterIsRejected) {
+  // JSON has no NaN literal; an overflowing literal is the way a non-finite value sneaks in,
+  // and the parser refuses it before any parameter sees it.
+  EXPECT_THAT(LoadError(SceneText(", \"damping\": 1e999")),
+              HasSubstr("scene.json: invalid JSON: number overflow parsing '1e999'"));
+}
+
+TEST(SceneErrors, NegativeParameterIsRejected) {
+  EXPECT_EQ(LoadError(SceneText(", \"density\": -5")),
+            "scene.json: objects.cube.density: expected a positive number, got -5");
+}
+
+TEST(SceneErrors, UnknownMaterialLawSuggestsTheClosest) {
+  EXPECT_THAT(LoadError(SceneText(R"(, "material": {"law": "Exponentail", "b": 5})")),
+              HasSubstr("objects.cube.material.law: unknown material law 'Exponentail' (did you "
+                        "mean 'Exponential'?); known: Exponential, Hooke"));
+  EXPECT_THAT(LoadError(SceneText(R"(, "material": {"law": "Exponential"})")),
+              HasSubstr("objects.cube.material: missing required key 'b'"));
+}
+
+TEST(SceneErrors, UnknownKeyIsATypo) {
+  EXPECT_THAT(LoadError(SceneText(", \"gravty\": [0,0,-9.81]")),
+              HasSubstr("objects.cube: unknown key 'gravty' (did you mean 'gravity'?)"));
+}
+
+TEST(SceneErrors, MissingMeshFileNamesTheFile) {
+  std::string text = SceneText();
+  text.replace(text.find("{\"generate\": \"box\""), 0, "{\"file\": \"nope/missing.msh\"}, \"x\": ");
+  EXPECT_THAT(LoadError(text), HasSubstr("meshes.box.file: "));
+  EXPECT_THAT(LoadError(text), HasSubstr("missing.msh"));
+}
+
+TEST(SceneErrors, MeshWithOutOfRangeIndexIsRejected) {
+  auto dir = std::filesystem::temp_directory_path() / "gipsi_scene_test";
+  std::filesystem::create_directories(dir);
+  {
+    std::ofstream f(dir / "bad.msh");
+    f << "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n4\n1 0 0 0\n2 1 0 0\n3 0 1 0\n4 0 0 1\n"
+         "$EndNodes\n$Elements\n1\n1 4 0 1 2 3 9\n$EndElements\n";
+  }
+  TypeRegistry registry;
+  RegisterBuiltins(registry);
+  std::string text = R"({"meshes": {"m": {"file": "bad.msh"}},
+    "objects": {"o": {"type": "MassSpring", "domain": "m", "dt": 0.001}},
+    "schedule": {"end": 1}})";
+  try {
+    (void)LoadSceneFromString(text, "scene.json", dir, registry);
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("meshes.m.file"));
+    EXPECT_THAT(e.what(), HasSubstr("bad.msh"));
+  }
+}
+
+TEST(SceneErrors, RegionThatSelectsNothingIsAnError) {
+  std::string text = SceneText();
+  text.replace(text.find("{\"group\": \"zmax\"}"), 17,
+               "{\"box\": {\"min\": [5,5,5], \"max\": [6,6,6]}}");
+  EXPECT_THAT(LoadError(text), HasSubstr("objects.cube.boundary_conditions[0]: the region "
+                                         "selects no boundary vertex of object 'cube'"));
+}
+
+TEST(SceneErrors, UnknownGroupListsTheGroups) {
+  std::string text = SceneText();
+  text.replace(text.find("\"zmax\""), 6, "\"top\"");
+  EXPECT_THAT(LoadError(text), HasSubstr("objects.cube.boundary_conditions[0].region"));
+  EXPECT_THAT(LoadError(text), HasSubstr("zmax"));
+}
+
+TEST(SceneErrors, TimeStepMustDivideMacroStep) {
+  std::string text = SceneText();
+  text.replace(text.find("\"dt\": 0.0001"), 12, "\"dt\": 0.0003");
+  EXPECT_THAT(LoadError(text), HasSubstr("object 'cube': its time step 0.0003 s does not divide"));
+}
+
+TEST(SceneErrors, EventRemovingUnknownConditionIsAnError) {
+  EXPECT_THAT(LoadError(SceneText("", "").replace(
+                  SceneText().find("\"schedule\": {\"end\": 0.01, \"dt\": 0.001}"), 38,
+                  "\"schedule\": {\"end\": 0.01, \"dt\": 0.001, \"events\": [{\"at\": "
+                  "0.005, \"object\": \"cube\", \"remove\": \"bottom\"}]}")),
+              HasSubstr("schedule.events[0].remove: object 'cube' has no boundary condition named "
+                        "'bottom'"));
+}
+
+TEST(SceneErrors, ProbeOutsideTheDomainIsAnError) {
+  EXPECT_THAT(LoadError(SceneText("", R"(, "probes": {"p": {"object": "cube", "point": [1, 1, 1],
+                                       "fields": ["displacement"]}})")),
+              HasSubstr("probes.p.point: the point lies"));
+}
+
+TEST(Scene, EventReleasesConditionAtItsTime) {
+  std::string text = SceneText();
+  text.replace(text.find("\"schedule\": {\"end\": 0.01, \"dt\": 0.001}"), 38,
+               R"("schedule": {"end": 0.01, "dt": 0.001,
+                   "events": [{"at": 0.005, "object": "cube", "remove": "top"}]})");
+  Scene scene = Load(text);
+  const SimObject& cube = scene.kernel->FindObject("cube");
+  ASSERT_TRUE(scene.kernel->Run(0.005).ok());
+  EXPECT_TRUE(cube.boundary_conditions().any_constraint());
+  ASSERT_TRUE(scene.kernel->Run(0.006).ok());
+  EXPECT_FALSE(cube.boundary_conditions().any_constraint());
+}
+
+}  // namespace
+}  // namespace gipsi

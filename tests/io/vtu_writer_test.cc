@@ -1,0 +1,106 @@
+#include "gipsi/io/vtu_writer.h"
+
+#include <cstring>
+#include <random>
+#include <string>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "gipsi/io/base64.h"
+#include "gipsi/io/gmsh_reader.h"
+#include "gipsi/io/vtu_reader.h"
+#include "io/io_test_util.h"
+
+namespace gipsi {
+namespace {
+
+using test::Scratch;
+using ::testing::HasSubstr;
+
+/// The liver tet mesh with a few boundary-like triangles and irrational coordinates.
+Mesh MixedMesh() {
+  Mesh mesh = ReadGmsh(test::SharedData("liver/liver.msh"));
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> noise(-1e-3, 1e-3);
+  for (Index i = 0; i < mesh.num_nodes(); ++i)
+    for (int k = 0; k < 3; ++k) mesh.nodes(k, i) += noise(rng) / 3.0;
+  mesh.triangles.resize(3, 5);
+  for (Index t = 0; t < 5; ++t) mesh.triangles.col(t) = mesh.tets.col(10 * t).head<3>();
+  return mesh;
+}
+
+TEST(VtuWriter, RoundTripsMixedTetsAndTrianglesExactly) {
+  Mesh mesh = MixedMesh();
+  auto path = Scratch("mixed.vtu");
+  WriteVtu(path, mesh);
+  Mesh back = ReadVtu(path);
+  ASSERT_EQ(back.num_nodes(), mesh.num_nodes());
+  EXPECT_LE((back.nodes - mesh.nodes).cwiseAbs().maxCoeff(), 1e-15);
+  EXPECT_EQ(back.tets, mesh.tets);
+  EXPECT_EQ(back.triangles, mesh.triangles);
+}
+
+TEST(VtuWriter, WritesPointAndCellDataBitExactly) {
+  Mesh mesh = MixedMesh();
+  VtuFields fields;
+  fields.point_data.push_back({"displacement", 3, Eigen::MatrixXd::Random(3, mesh.num_nodes())});
+  fields.cell_data.push_back({"stress <von Mises>", 1,
+                              Eigen::MatrixXd::Random(1, mesh.num_tets() + mesh.num_triangles())});
+  auto path = Scratch("fields.vtu");
+  WriteVtu(path, mesh.nodes, mesh.tets, mesh.triangles, fields);
+  std::string xml = test::ReadBytes(path);
+  EXPECT_THAT(xml, HasSubstr(R"(Name="displacement" NumberOfComponents="3" format="binary">)"));
+  EXPECT_THAT(xml, HasSubstr(R"(Name="stress &lt;von Mises&gt;" format="binary">)"));
+  // Decode the displacement array: UInt64 byte count, then the doubles.
+  std::size_t begin = xml.find('>', xml.find("Name=\"displacement\"")) + 1;
+  std::size_t end = xml.find("</DataArray>", begin);
+  auto bytes = internal::DecodeBase64(std::string_view(xml).substr(begin, end - begin));
+  ASSERT_TRUE(bytes.has_value());
+  const auto& values = fields.point_data[0].values;
+  std::uint64_t count = 0;
+  std::memcpy(&count, bytes->data(), 8);
+  ASSERT_EQ(count, sizeof(double) * std::size_t(values.size()));
+  ASSERT_EQ(bytes->size(), 8 + count);
+  EXPECT_EQ(std::memcmp(bytes->data() + 8, values.data(), count), 0);
+  EXPECT_EQ(ReadVtu(path).num_tets(), mesh.num_tets());  // still a readable grid
+}
+
+TEST(VtuWriter, RejectsUnwritablePath) {
+  EXPECT_THAT(test::InputErrorMessage([] { WriteVtu("/nonexistent/dir/x.vtu", Mesh{}); }),
+              HasSubstr("/nonexistent/dir/x.vtu: cannot open file for writing"));
+}
+
+TEST(VtuWriter, Base64RoundTripsEveryLengthAndSplitPadding) {
+  std::string data;
+  for (int n = 0; n < 40; ++n) {
+    auto decoded = internal::DecodeBase64(internal::EncodeBase64(data));
+    ASSERT_TRUE(decoded.has_value());
+    EXPECT_EQ(*decoded, data);
+    // Two separately padded encodings decode to the concatenation.
+    auto joined =
+        internal::DecodeBase64(internal::EncodeBase64(data) + "\n" + internal::EncodeBase64("xy"));
+    ASSERT_TRUE(joined.has_value());
+    EXPECT_EQ(*joined, data + "xy");
+    data += static_cast<char>(n * 37);
+  }
+  EXPECT_FALSE(internal::DecodeBase64("QUJD*").has_value());
+}
+
+TEST(PvdWriter, KeepsAValidCollectionAfterEveryFrame) {
+  auto path = Scratch("run.pvd");
+  PvdWriter pvd(path);
+  EXPECT_THAT(test::ReadBytes(path), HasSubstr("<Collection>\n  </Collection>"));
+  pvd.AddFrame(0.0, "run_0000.vtu");
+  pvd.AddFrame(0.125, "run_0001.vtu");
+  std::string xml = test::ReadBytes(path);
+  EXPECT_THAT(xml, HasSubstr(R"(<DataSet timestep="0" group="" part="0" file="run_0000.vtu"/>)"));
+  EXPECT_THAT(xml,
+              HasSubstr(R"(<DataSet timestep="0.125" group="" part="0" file="run_0001.vtu"/>)"));
+  EXPECT_THAT(xml, HasSubstr("</VTKFile>"));
+  EXPECT_EQ(pvd.num_frames(), 2u);
+  EXPECT_FALSE(std::filesystem::exists(path.string() + ".tmp"));
+}
+
+}  // namespace
+}  // namespace gipsi

@@ -1,0 +1,232 @@
+#include "gipsi/models/mass_spring/mass_spring.h"
+
+#include <random>
+
+#include <gtest/gtest.h>
+
+#include "gipsi/base/error.h"
+#include "gipsi/geometry/generators.h"
+
+namespace gipsi {
+namespace {
+
+std::shared_ptr<const Mesh> Box(int cells = 2) {
+  return std::make_shared<const Mesh>(
+      MakeTetBox(Vec3::Zero(), Vec3(0.1, 0.1, 0.1), {cells, cells, cells}));
+}
+
+std::unique_ptr<ExplicitIntegrator> Make(const std::string& name) {
+  if (name == "ExplicitEuler") return std::make_unique<ExplicitEuler>();
+  if (name == "RK4") return std::make_unique<RungeKutta4>();
+  return std::make_unique<SymplecticEuler>();
+}
+
+class MassSpringMomentum : public ::testing::TestWithParam<std::string> {};
+
+TEST_P(MassSpringMomentum, ConservesLinearMomentumWithoutGravityOrDamping) {
+  MassSpringParams params;
+  params.gravity.setZero();
+  params.stiffness = 50;
+  MassSpring object("cube", Box(), params, Make(GetParam()));
+  // Random velocities and a random distortion: springs push and pull internally only.
+  std::mt19937 rng(42);
+  std::uniform_real_distribution<double> u(-1, 1);
+  Eigen::MatrixXd v(3, object.num_nodes()), q = object.domain().nodes;
+  for (Index i = 0; i < v.size(); ++i) {
+    v.data()[i] = 0.1 * u(rng);
+    q.data()[i] += 0.005 * u(rng);
+  }
+  object.WriteField(object.FindField("velocity"), v);
+  object.WriteField(object.FindField("position"), q);
+  const Vec3 p0 = object.Momentum();
+  const double scale = object.masses().sum() * 0.1;  // |m v| scale
+  for (int k = 0; k < 2000; ++k) ASSERT_TRUE(object.Step(1e-4).ok());
+  // Each step adds spring forces that cancel pairwise: momentum changes only by round-off.
+  EXPECT_LT((object.Momentum() - p0).norm(), 1e-12 * scale);
+  EXPECT_GT(object.KineticEnergy(), 0);
+}
+
+INSTANTIATE_TEST_SUITE_P(AllIntegrators, MassSpringMomentum,
+                         ::testing::Values("ExplicitEuler", "SymplecticEuler", "RK4"));
+
+TEST(MassSpring, SingleSpringSagsByMgOverK) {
+  // One spring of stiffness k hangs a mass m from a fixed node: equilibrium extension m g / k.
+  Points nodes(3, 2);
+  nodes.col(0) = Vec3(0, 0, 0);
+  nodes.col(1) = Vec3(0, 0, -0.1);
+  Eigen::Matrix2Xi springs(2, 1);
+  springs << 0, 1;
+  VecX masses(2);
+  masses << 1.0, 0.05;
+  MassSpringParams params;
+  params.stiffness = 20;
+  params.damping = 0.5;  // critically damped-ish so it settles quickly
+  MassSpring object("spring", nodes, springs, masses, params, std::make_unique<SymplecticEuler>());
+  object.boundary_conditions().Fix(0);
+  for (int k = 0; k < 20000; ++k) ASSERT_TRUE(object.Step(1e-3).ok());
+  const double expected = 0.05 * 9.81 / 20;  // 0.024525 m
+  const double sag = -(object.domain_positions()(2, 1) - nodes(2, 1));
+  // After 20 s with damping the transient (decay rate ≈ c/2m = 5/s) is below 1e-40 of the sag;
+  // the equilibrium of the discrete scheme is exact, so only round-off remains.
+  EXPECT_NEAR(sag, expected, 1e-12);
+  // The fixed node stays put.
+  EXPECT_EQ(object.domain_positions().col(0), nodes.col(0));
+  Eigen::MatrixXd reaction(3, 2);
+  object.ReadField(object.FindField("reaction_force"), reaction);
+  // The support carries the spring tension m g plus the weight of the fixed node itself.
+  EXPECT_NEAR(reaction(2, 0), (0.05 + 1.0) * 9.81, 1e-10);
+}
+
+TEST(MassSpring, LumpedMassEqualsDensityTimesVolume) {
+  MassSpringParams params;
+  params.density = 1200;
+  MassSpring object("cube", Box(3), params, std::make_unique<SymplecticEuler>());
+  EXPECT_NEAR(object.masses().sum(), 1200 * 1e-3, 1e-12);
+}
+
+TEST(MassSpring, SheetMassUsesThickness) {
+  auto sheet = std::make_shared<const Mesh>(
+      MakeTriangleSheet(Vec3::Zero(), Vec3(0.2, 0, 0), Vec3(0, 0.1, 0), {4, 2}));
+  MassSpringParams params;
+  params.density = 1000;
+  params.thickness = 0.002;
+  MassSpring object("sheet", sheet, params, std::make_unique<SymplecticEuler>());
+  EXPECT_NEAR(object.masses().sum(), 1000 * 0.002 * 0.02, 1e-12);
+  // 4x2 quads: 15 nodes, 5·2 + 4·3 + 8 diagonals = 30 unique edges.
+  EXPECT_EQ(object.num_springs(), 30);
+}
+
+TEST(MassSpring, SymplecticEulerKeepsEnergyBoundedWithoutDamping) {
+  MassSpringParams params;
+  params.gravity.setZero();
+  MassSpring object("cube", Box(), params, std::make_unique<SymplecticEuler>());
+  Eigen::MatrixXd q = object.domain().nodes;
+  q.row(0) *= 1.05;  // stretch 5 % along x and let it vibrate
+  object.WriteField(object.FindField("position"), q);
+  const double e0 = object.PotentialEnergy() + object.KineticEnergy();
+  double worst = 0;
+  for (int k = 0; k < 20000; ++k) {
+    ASSERT_TRUE(object.Step(2e-4).ok());
+    worst = std::max(worst, std::abs(object.PotentialEnergy() + object.KineticEnergy() - e0));
+  }
+  // dt is well inside the stability limit; the symplectic energy error stays a few percent.
+  EXPECT_LT(2e-4, 0.5 * object.stable_dt_estimate());
+  EXPECT_LT(worst, 0.05 * e0);
+}
+
+TEST(MassSpring, PrescribedVelocityMovesVertexAtThatVelocity) {
+  MassSpring object("cube", Box(), MassSpringParams{}, std::make_unique<RungeKutta4>());
+  object.boundary_conditions().PrescribeVelocity(0, Vec3(0.01, 0, 0));
+  const int node = object.boundary().vertex_to_node[0];
+  const Vec3 start = object.domain_positions().col(node);
+  for (int k = 0; k < 100; ++k) ASSERT_TRUE(object.Step(1e-4).ok());
+  EXPECT_NEAR((object.domain_positions().col(node) - start).x(), 0.01 * 100 * 1e-4, 1e-15);
+}
+
+TEST(MassSpring, ReportsDivergenceForTooLargeStep) {
+  MassSpringParams params;
+  params.stiffness = 1e4;
+  MassSpring object("cube", Box(), params, std::make_unique<ExplicitEuler>());
+  StepStatus status;
+  int k = 0;
+  for (; k < 10000 && status.ok(); ++k) status = object.Step(0.05);
+  EXPECT_EQ(status.code, StepStatus::Code::kDiverged);
+  EXPECT_LT(k, 10000);
+  // The state it reports on is not silently NaN: the failing step is flagged, not hidden.
+  EXPECT_NE(std::string(status.what), "");
+}
+
+TEST(MassSpring, RejectsCoincidentNodes) {
+  Points nodes = Points::Zero(3, 2);
+  Eigen::Matrix2Xi springs(2, 1);
+  springs << 0, 1;
+  EXPECT_THROW(MassSpring("bad", nodes, springs, VecX::Ones(2), MassSpringParams{},
+                          std::make_unique<SymplecticEuler>()),
+               InputError);
+}
+
+TEST(MassSpring, PressureOnClosedSurfaceAddsNoNetForce) {
+  // A uniform pressure on a closed surface integrates to zero net force.
+  MassSpringParams params;
+  params.gravity.setZero();
+  MassSpring object("cube", Box(), params, std::make_unique<SymplecticEuler>());
+  for (Index f = 0; f < object.boundary().num_triangles(); ++f)
+    object.boundary_conditions().SetPressure(f, 1000);
+  for (int k = 0; k < 50; ++k) ASSERT_TRUE(object.Step(1e-4).ok());
+  EXPECT_LT(object.Momentum().norm(), 1e-14);
+  // ... but it compresses the cube: every boundary vertex moved inward (towards the centre).
+  const Vec3 centre(0.05, 0.05, 0.05);
+  const auto& v2n = object.boundary().vertex_to_node;
+  int inward = 0;
+  for (int node : v2n)
+    inward += (object.domain_positions().col(node) - centre).norm() <
+              (object.domain().nodes.col(node) - centre).norm();
+  EXPECT_EQ(inward, static_cast<int>(v2n.size()));
+}
+
+}  // namespace
+}  // namespace gipsi
+
+namespace gipsi {
+namespace {
+
+TEST(SpringLaw, ExponentialMatchesHookeForSmallStrainAndStiffens) {
+  HookeSpring hooke;
+  ExponentialSpring exponential(10);
+  const double k = 50, rest = 0.02;
+  // Small strain (1e-6): tensions agree to O(b ε) relative.
+  const double small = rest * (1 + 1e-6);
+  EXPECT_NEAR(exponential.Tension(small, rest, k) / hooke.Tension(small, rest, k), 1, 1e-5);
+  // At 20 % strain the exponential law is (e^{2} − 1)/2 ≈ 3.19 times stiffer in tension.
+  const double big = rest * 1.2;
+  EXPECT_NEAR(exponential.Tension(big, rest, k) / hooke.Tension(big, rest, k),
+              std::expm1(2.0) / 2.0, 1e-12);
+}
+
+TEST(SpringLaw, TensionIsTheDerivativeOfEnergy) {
+  ExponentialSpring exponential(7);
+  const double k = 30, rest = 0.05;
+  for (double length : {0.03, 0.05, 0.055, 0.08}) {
+    const double h = 1e-7;
+    const double numeric =
+        (exponential.Energy(length + h, rest, k) - exponential.Energy(length - h, rest, k)) /
+        (2 * h);
+    EXPECT_NEAR(exponential.Tension(length, rest, k), numeric, 1e-6);
+    const double tangent = (exponential.Tension(length + h, rest, k) -
+                            exponential.Tension(length - h, rest, k)) /
+                           (2 * h);
+    EXPECT_NEAR(exponential.TangentStiffness(length, rest, k), tangent, 1e-4 * tangent);
+  }
+  EXPECT_EQ(exponential.Energy(rest, rest, k), 0.0);
+}
+
+TEST(MassSpring, ExponentialSpringSagsLessThanHookeUnderTheSameLoad) {
+  auto sag = [](std::shared_ptr<const SpringLaw> law) {
+    Points nodes(3, 2);
+    nodes.col(0) = Vec3(0, 0, 0);
+    nodes.col(1) = Vec3(0, 0, -0.1);
+    Eigen::Matrix2Xi springs(2, 1);
+    springs << 0, 1;
+    VecX masses(2);
+    masses << 1.0, 0.2;
+    MassSpringParams params;
+    params.stiffness = 20;
+    params.damping = 1;
+    params.law = std::move(law);
+    MassSpring object("spring", nodes, springs, masses, params,
+                      std::make_unique<SymplecticEuler>());
+    object.boundary_conditions().Fix(0);
+    for (int k = 0; k < 20000; ++k) EXPECT_TRUE(object.Step(1e-3).ok());
+    return -(object.domain_positions()(2, 1) + 0.1);
+  };
+  const double hooke = sag(std::make_shared<HookeSpring>());
+  const double exponential = sag(std::make_shared<ExponentialSpring>(5));
+  EXPECT_NEAR(hooke, 0.2 * 9.81 / 20, 1e-12);
+  // Exponential equilibrium: (k L0 / b)(e^{b ε} − 1) = m g  →  ε = ln(1 + m g b / (k L0)) / b.
+  const double strain = std::log1p(0.2 * 9.81 * 5 / (20 * 0.1)) / 5;
+  EXPECT_NEAR(exponential, strain * 0.1, 1e-12);
+  EXPECT_LT(exponential, hooke);
+}
+
+}  // namespace
+}  // namespace gipsi
