@@ -1,7 +1,6 @@
 #include "gipsi/geometry/mapping.h"
 
 #include <algorithm>
-#include <chrono>
 #include <limits>
 #include <random>
 
@@ -142,20 +141,12 @@ TEST(PointMap, BarycentricInTetsFindsTheNearestTetForAnyOutsidePoint) {
   EXPECT_NEAR(map.max_distance(), max_gap, 1e-12);
 }
 
-TEST(PointMap, BarycentricInTetsScalesToLargeMeshes) {
-  // 48,000 tets and 10,000 targets, a third of them outside: a search over all tets per target
-  // would take about 5·10^8 tet tests; the grid needs a few dozen per target.
+TEST(PointMap, BarycentricInTetsMeasuresOutsideDistanceOnLargeMeshes) {
+  // 48,000 tets and 10,000 targets, a third of them outside. (Its speed is measured by
+  // bench/mass_spring_bench.cc, BM_BarycentricBuild, not here.)
   const Mesh box = MakeTetBox(Vec3(0, 0, 0), Vec3(1, 1, 1), {20, 20, 20});
   const Points targets = RandomPoints(10000, Vec3(-0.1, -0.1, -0.1), Vec3(1.1, 1.1, 1.1), 3);
-  const auto start = std::chrono::steady_clock::now();
   const PointMap map = PointMap::BarycentricInTets(box.nodes, box.tets, targets);
-  const double seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-#if defined(NDEBUG) && !defined(__SANITIZE_ADDRESS__)
-  EXPECT_LT(seconds, 2.0);  // about 0.1 s on one core; unoptimised builds are not timed
-#else
-  (void)seconds;
-#endif
   double max_gap = 0;  // distance from each target to the box [0,1]³
   for (Index j = 0; j < targets.cols(); ++j)
     max_gap = std::max(max_gap, (targets.col(j) - targets.col(j).cwiseMax(0).cwiseMin(1)).norm());

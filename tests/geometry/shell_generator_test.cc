@@ -1,4 +1,3 @@
-#include <chrono>
 #include <clocale>
 #include <cmath>
 #include <numbers>
@@ -75,12 +74,7 @@ double MeanAlignment(const Mesh& mesh, const std::string& name, Direction&& dire
 TEST(EllipsoidShell, HasPositiveTetsNamedSurfacesAndTheAnalyticVolume) {
   EllipsoidShellSpec spec;
   spec.mesh_size = 2.5;
-  const auto start = std::chrono::steady_clock::now();
   const Mesh mesh = MakeEllipsoidShell(spec);
-  std::cout << "[ info     ] ellipsoid shell: " << mesh.num_nodes() << " nodes, " << mesh.num_tets()
-            << " tets in "
-            << std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count()
-            << " s\n";
   ExpectSoundShell(mesh, {"endo", "epi", "base"});
   const double analytic = TruncatedEllipsoidVolume(spec.epi_short, spec.epi_long, spec.base_z) -
                           TruncatedEllipsoidVolume(spec.endo_short, spec.endo_long, spec.base_z);
@@ -122,12 +116,7 @@ TEST(EllipsoidShell, RejectsInconsistentDimensions) {
 
 TEST(CylinderShell, HasPositiveTetsNamedSurfacesAndTheAnalyticVolume) {
   const double r = 1, R = 2, h = 3;
-  const auto start = std::chrono::steady_clock::now();
   const Mesh mesh = MakeCylinderShell(r, R, h, 0.5);
-  std::cout << "[ info     ] cylinder shell: " << mesh.num_nodes() << " nodes, " << mesh.num_tets()
-            << " tets in "
-            << std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count()
-            << " s\n";
   ExpectSoundShell(mesh, {"inner", "outer", "bottom", "top"});
   const double volume = CheckTetQuality(mesh.nodes, mesh.tets).total_volume;
   const double analytic = std::numbers::pi * (R * R - r * r) * h;
