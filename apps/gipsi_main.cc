@@ -219,8 +219,8 @@ int main(int argc, char** argv) {
   info->add_option("MESH", mesh_file, "Mesh file (.msh, .node/.ele, .vtk, .vtu, .obj, .stl)")
       ->required();
 
-  auto* types =
-      app.add_subcommand("types", "List the registered object, connector, integrator and material types");
+  auto* types = app.add_subcommand(
+      "types", "List the registered object, connector, integrator and material types");
   types->add_option("--plugin", plugins, "Load a plugin shared library (repeatable)");
 
   CLI11_PARSE(app, argc, argv);

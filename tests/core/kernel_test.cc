@@ -4,8 +4,8 @@
 #include <gtest/gtest.h>
 
 #include "core/test_objects.h"
-#include "gipsi/core/aggregate.h"
 #include "gipsi/base/error.h"
+#include "gipsi/core/aggregate.h"
 #include "gipsi/models/connectors/field_copy.h"
 
 namespace gipsi {
@@ -164,8 +164,7 @@ TEST(Kernel, DivergenceInsideAnAggregateNamesThePart) {
   RunResult result = kernel.Run(1.0);
   EXPECT_EQ(result.outcome, RunResult::Outcome::kDiverged);
   EXPECT_THAT(result.diagnostic, ::testing::HasSubstr("object 'heart' (part 'blood') diverged"));
-  EXPECT_EQ(&kernel.FindObject("heart.blood"),
-            kernel.coordinator().object(0).FindPart("blood"));
+  EXPECT_EQ(&kernel.FindObject("heart.blood"), kernel.coordinator().object(0).FindPart("blood"));
 }
 
 }  // namespace

@@ -192,9 +192,9 @@ TEST(SpringLaw, TensionIsTheDerivativeOfEnergy) {
         (exponential.Energy(length + h, rest, k) - exponential.Energy(length - h, rest, k)) /
         (2 * h);
     EXPECT_NEAR(exponential.Tension(length, rest, k), numeric, 1e-6);
-    const double tangent = (exponential.Tension(length + h, rest, k) -
-                            exponential.Tension(length - h, rest, k)) /
-                           (2 * h);
+    const double tangent =
+        (exponential.Tension(length + h, rest, k) - exponential.Tension(length - h, rest, k)) /
+        (2 * h);
     EXPECT_NEAR(exponential.TangentStiffness(length, rest, k), tangent, 1e-4 * tangent);
   }
   EXPECT_EQ(exponential.Energy(rest, rest, k), 0.0);

@@ -52,8 +52,8 @@ class ExponentialSpring final : public SpringLaw {
   }
   double Energy(double length, double rest_length, double k) const override {
     const double strain = (length - rest_length) / rest_length;
-    return k * rest_length / b_ * (rest_length / b_ * std::expm1(b_ * strain) -
-                                   (length - rest_length));
+    return k * rest_length / b_ *
+           (rest_length / b_ * std::expm1(b_ * strain) - (length - rest_length));
   }
   double TangentStiffness(double length, double rest_length, double k) const override {
     return k * std::exp(b_ * (length - rest_length) / rest_length);
