@@ -146,12 +146,6 @@ TEST(Coordinator, RejectsDuplicateNames) {
   EXPECT_THROW(c.AddObject(std::make_unique<CountingObject>("a"), 1e-3), InputError);
 }
 
-}  // namespace
-}  // namespace gipsi
-
-namespace gipsi {
-namespace {
-
 TEST(Kernel, DivergenceInsideAnAggregateNamesThePart) {
   Coordinator parts;
   parts.AddObject(std::make_unique<testing::CountingObject>("muscle"), 1e-3);

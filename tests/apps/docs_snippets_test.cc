@@ -1,0 +1,48 @@
+// The complete scenes shown in the README and docs/ must load: a user copies them.
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <regex>
+#include <sstream>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "gipsi/io/scene.h"
+#include "gipsi/models/builtins.h"
+
+namespace gipsi {
+namespace {
+
+std::vector<std::string> CompleteSceneSnippets(const std::string& markdown_file) {
+  std::ifstream in(std::string(GIPSI_SOURCE_DIR) + "/" + markdown_file);
+  std::stringstream text;
+  text << in.rdbuf();
+  std::string s = text.str();
+  std::vector<std::string> snippets;
+  std::regex block("```json\\n([\\s\\S]*?)```");
+  for (auto it = std::sregex_iterator(s.begin(), s.end(), block); it != std::sregex_iterator();
+       ++it) {
+    std::string body = (*it)[1];
+    if (body.find("\"objects\"") != std::string::npos &&
+        body.find("\"schedule\"") != std::string::npos)
+      snippets.push_back(body);
+  }
+  return snippets;
+}
+
+TEST(DocsSnippets, EveryCompleteSceneInTheReadmeLoadsAndRuns) {
+  auto snippets = CompleteSceneSnippets("README.md");
+  ASSERT_FALSE(snippets.empty());
+  for (const auto& snippet : snippets) {
+    TypeRegistry registry;
+    RegisterBuiltins(registry);
+    Scene scene = LoadSceneFromString(snippet, "README.md", GIPSI_SOURCE_DIR, registry);
+    RunResult result = scene.kernel->Run(0.01);
+    EXPECT_TRUE(result.ok()) << result.diagnostic;
+  }
+}
+
+}  // namespace
+}  // namespace gipsi
