@@ -4,7 +4,6 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
-#include <regex>
 #include <sstream>
 
 #include <gmock/gmock.h>
@@ -54,9 +53,12 @@ std::vector<std::string> PvdFiles(const fs::path& pvd) {
   std::string s = text.str();
   EXPECT_THAT(s, HasSubstr("</VTKFile>"));  // complete document
   std::vector<std::string> files;
-  std::regex re("file=\"([^\"]+)\"");
-  for (auto it = std::sregex_iterator(s.begin(), s.end(), re); it != std::sregex_iterator(); ++it)
-    files.push_back((*it)[1]);
+  const std::string key = "file=\"";
+  for (auto pos = s.find(key); pos != std::string::npos; pos = s.find(key, pos)) {
+    pos += key.size();
+    auto end = s.find('"', pos);
+    files.push_back(s.substr(pos, end - pos));
+  }
   return files;
 }
 

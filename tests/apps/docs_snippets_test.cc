@@ -3,7 +3,6 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
-#include <regex>
 #include <sstream>
 
 #include <gmock/gmock.h>
@@ -21,10 +20,11 @@ std::vector<std::string> CompleteSceneSnippets(const std::string& markdown_file)
   text << in.rdbuf();
   std::string s = text.str();
   std::vector<std::string> snippets;
-  std::regex block("```json\\n([\\s\\S]*?)```");
-  for (auto it = std::sregex_iterator(s.begin(), s.end(), block); it != std::sregex_iterator();
-       ++it) {
-    std::string body = (*it)[1];
+  const std::string open = "```json\n", close = "```";
+  for (auto pos = s.find(open); pos != std::string::npos; pos = s.find(open, pos)) {
+    pos += open.size();
+    auto end = s.find(close, pos);
+    std::string body = s.substr(pos, end - pos);
     if (body.find("\"objects\"") != std::string::npos &&
         body.find("\"schedule\"") != std::string::npos)
       snippets.push_back(body);
