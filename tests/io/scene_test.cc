@@ -59,6 +59,17 @@ TEST(Scene, LoadsObjectsConditionsAndSchedule) {
   EXPECT_EQ(cube.boundary_conditions().kind(bc.vertices[0], 2), ConstraintKind::kDisplacement);
 }
 
+TEST(Scene, KeepsObjectsInFileOrder) {
+  // The default schedule steps objects in declaration order, so the file order must survive.
+  Scene scene = Load(R"({
+    "meshes": {"box": {"generate": "box", "min": [0,0,0], "max": [1,1,1], "cells": [1,1,1]}},
+    "objects": {"zeta": {"type": "MassSpring", "domain": "box", "dt": 0.001},
+                "alpha": {"type": "MassSpring", "domain": "box", "dt": 0.001}},
+    "schedule": {"end": 0.01}})");
+  EXPECT_EQ(scene.kernel->coordinator().object(0).name(), "zeta");
+  EXPECT_EQ(scene.kernel->coordinator().object(1).name(), "alpha");
+}
+
 TEST(Scene, RunsAndHoldsFixedVertices) {
   Scene scene = Load(SceneText());
   ASSERT_TRUE(scene.kernel->Run(scene.end_time).ok());

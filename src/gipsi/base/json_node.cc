@@ -12,7 +12,7 @@
 namespace gipsi {
 namespace {
 
-std::string Describe(const nlohmann::json& j) {
+std::string Describe(const nlohmann::ordered_json& j) {
   std::string s = j.dump();
   if (s.size() > 60) s = s.substr(0, 57) + "...";
   return s;
@@ -29,7 +29,7 @@ std::string JoinQuoted(const std::vector<std::string>& names) {
 
 }  // namespace
 
-JsonNode::JsonNode(const nlohmann::json& value, std::string file, std::string path)
+JsonNode::JsonNode(const nlohmann::ordered_json& value, std::string file, std::string path)
     : value_(&value),
       file_(std::make_shared<const std::string>(std::move(file))),
       path_(std::move(path)) {}
@@ -208,10 +208,10 @@ Vec3 JsonNode::Vector3(std::string_view key, const Vec3& fallback) const {
 }
 
 JsonDocument JsonDocument::Parse(std::string_view text, std::string name) {
-  auto json = std::make_unique<nlohmann::json>();
+  auto json = std::make_unique<nlohmann::ordered_json>();
   try {
-    *json = nlohmann::json::parse(text.begin(), text.end());
-  } catch (const nlohmann::json::parse_error& e) {
+    *json = nlohmann::ordered_json::parse(text.begin(), text.end());
+  } catch (const nlohmann::ordered_json::parse_error& e) {
     // Translate the byte offset into line and column.
     std::size_t byte = std::min<std::size_t>(e.byte == 0 ? 0 : e.byte - 1, text.size());
     std::size_t line = 1, col = 1;
@@ -229,7 +229,7 @@ JsonDocument JsonDocument::Parse(std::string_view text, std::string name) {
     std::string detail = pos == std::string::npos ? what : what.substr(pos + 2);
     ThrowInputError(name, fmt::format("line {}, column {}", line, col),
                     fmt::format("invalid JSON: {}", detail));
-  } catch (const nlohmann::json::exception& e) {
+  } catch (const nlohmann::ordered_json::exception& e) {
     // e.g. out_of_range 406 for a number literal that overflows a double (1e999).
     std::string what = e.what();
     auto pos = what.find("] ");

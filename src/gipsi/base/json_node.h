@@ -21,16 +21,17 @@
 namespace gipsi {
 
 /// A read-only view of one value inside a JSON document, with its file name and JSON path.
+/// Object members keep their order in the file (declaration order matters for schedules).
 /// Cheap to copy; it refers to the document, which must outlive it.
 class JsonNode {
  public:
   /// `file` is used only in error messages; `path` is this value's JSON path ("" for the root).
-  JsonNode(const nlohmann::json& value, std::string file, std::string path);
+  JsonNode(const nlohmann::ordered_json& value, std::string file, std::string path);
 
   [[nodiscard]] const std::string& file() const { return *file_; }
   /// The JSON path of this value, e.g. `objects.sheet.material` or `probes[2]`.
   [[nodiscard]] const std::string& path() const { return path_; }
-  [[nodiscard]] const nlohmann::json& raw() const { return *value_; }
+  [[nodiscard]] const nlohmann::ordered_json& raw() const { return *value_; }
 
   [[nodiscard]] bool is_object() const { return value_->is_object(); }
   [[nodiscard]] bool is_array() const { return value_->is_array(); }
@@ -92,10 +93,11 @@ class JsonNode {
   [[noreturn]] void Expected(std::string_view what) const;
 
  private:
-  const nlohmann::json* value_;
+  const nlohmann::ordered_json* value_;
   std::shared_ptr<const std::string> file_;
   std::string path_;
-  JsonNode(const nlohmann::json& value, std::shared_ptr<const std::string> file, std::string path)
+  JsonNode(const nlohmann::ordered_json& value, std::shared_ptr<const std::string> file,
+           std::string path)
       : value_(&value), file_(std::move(file)), path_(std::move(path)) {}
 };
 
@@ -117,9 +119,9 @@ class JsonDocument {
   [[nodiscard]] const std::string& name() const { return name_; }
 
  private:
-  JsonDocument(std::unique_ptr<nlohmann::json> json, std::string name)
+  JsonDocument(std::unique_ptr<nlohmann::ordered_json> json, std::string name)
       : json_(std::move(json)), name_(std::move(name)) {}
-  std::unique_ptr<nlohmann::json> json_;
+  std::unique_ptr<nlohmann::ordered_json> json_;
   std::string name_;
 };
 
