@@ -14,6 +14,7 @@
 #include <gtest/gtest.h>
 
 #include "gipsi/base/error.h"
+#include "gipsi/geometry/mesh.h"
 
 namespace gipsi::test {
 
@@ -47,6 +48,39 @@ inline std::filesystem::path WriteBytes(const std::filesystem::path& path, std::
 inline std::string ReadBytes(const std::filesystem::path& path) {
   std::ifstream in(path, std::ios::binary);
   return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+}
+
+/// Writes every strict prefix of `bytes` to `path` and reads it with `read` (which returns a
+/// Mesh). Each prefix must either throw InputError or give the whole file's mesh, or — for a
+/// cut exactly between the node and element sections, which is itself a valid node-only file —
+/// the whole file's nodes with no elements. Never a partial mesh, another exception, a crash or
+/// a sanitizer report. Returns how many prefixes were rejected.
+template <class Read>
+std::size_t CountRejectedPrefixes(const std::string& bytes, const std::filesystem::path& path,
+                                  Read read) {
+  WriteBytes(path, bytes);
+  const Mesh whole = read(path);
+  auto same = [](const auto& a, const auto& b) {
+    return a.rows() == b.rows() && a.cols() == b.cols() && a == b;
+  };
+  std::size_t rejected = 0;
+  for (std::size_t n = 0; n < bytes.size(); ++n) {
+    WriteBytes(path, std::string_view(bytes).substr(0, n));
+    try {
+      const Mesh mesh = read(path);
+      const bool nodes_only = mesh.num_tets() == 0 && mesh.num_triangles() == 0;
+      EXPECT_TRUE(same(mesh.nodes, whole.nodes))
+          << "prefix of " << n << " bytes: " << mesh.num_nodes() << " of " << whole.num_nodes()
+          << " nodes";
+      EXPECT_TRUE(nodes_only ||
+                  (same(mesh.tets, whole.tets) && same(mesh.triangles, whole.triangles)))
+          << "prefix of " << n << " bytes: " << mesh.num_tets() << " of " << whole.num_tets()
+          << " tets, " << mesh.num_triangles() << " of " << whole.num_triangles() << " triangles";
+    } catch (const InputError&) {
+      ++rejected;
+    }
+  }
+  return rejected;
 }
 
 /// The message of the InputError `f` throws; fails the test (returning "") if it throws

@@ -11,6 +11,7 @@
 namespace gipsi {
 namespace {
 
+using test::CountRejectedPrefixes;
 using test::InputErrorMessage;
 using test::MeshData;
 using test::Put;
@@ -136,14 +137,11 @@ TEST(VtkLegacyReader, RejectsUnsupportedDataset) {
 
 TEST(VtkLegacyReader, SurvivesEveryTruncationOfBinary) {
   const std::string bytes = TwoTetsBinary(true);
-  auto path = Scratch("cut.vtk");
-  for (std::size_t n = 0; n < bytes.size(); ++n) {
-    WriteBytes(path, bytes.substr(0, n));
-    try {
-      ReadVtkLegacy(path).Validate("cut");
-    } catch (const InputError&) {
-    }
-  }
+  const std::size_t rejected = CountRejectedPrefixes(
+      bytes, Scratch("cut.vtk"), [](const auto& p) { return ReadVtkLegacy(p); });
+  // Only cuts inside the trailing data the reader ignores give a mesh (the whole one, checked
+  // above); every cut before the connectivity ends is rejected.
+  EXPECT_GE(rejected, bytes.size() * 8 / 10);
 }
 
 TEST(VtkLegacyReader, RejectsMissingFile) {

@@ -14,6 +14,7 @@
 namespace gipsi {
 namespace {
 
+using test::CountRejectedPrefixes;
 using test::InputErrorMessage;
 using test::MeshData;
 using test::Put;
@@ -210,14 +211,11 @@ TEST(VtuReader, RejectsHugeDeclaredPointCountBeforeAllocating) {
 
 TEST(VtuReader, SurvivesEveryTruncationOfAppendedData) {
   const std::string bytes = TwoTetsVtu(Encoding::kAppendedRaw, false);
-  auto path = Scratch("cut.vtu");
-  for (std::size_t n = 0; n < bytes.size(); ++n) {
-    WriteBytes(path, bytes.substr(0, n));
-    try {
-      ReadVtu(path).Validate("cut");
-    } catch (const InputError&) {
-    }
-  }
+  const std::size_t rejected =
+      CountRejectedPrefixes(bytes, Scratch("cut.vtu"), [](const auto& p) { return ReadVtu(p); });
+  // Only cuts inside the trailing data the reader ignores give a mesh (the whole one, checked
+  // above); every cut before the connectivity ends is rejected.
+  EXPECT_GE(rejected, bytes.size() * 8 / 10);
 }
 
 TEST(VtuReader, RejectsMissingFile) {
