@@ -50,6 +50,17 @@ inline std::string ReadBytes(const std::filesystem::path& path) {
   return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
 }
 
+/// Checks the two-tets-and-a-triangle test mesh that the VTK and VTU inputs describe (5 nodes,
+/// tets 0-1-2-3 and 1-2-3-4, triangle 0-1-2).
+inline void ExpectTwoTetsAndTriangle(const Mesh& mesh) {
+  ASSERT_EQ(mesh.num_nodes(), 5);
+  ASSERT_EQ(mesh.num_tets(), 2);
+  ASSERT_EQ(mesh.num_triangles(), 1);
+  EXPECT_EQ(mesh.nodes.col(4), Vec3(1, 1, 1));
+  EXPECT_EQ(mesh.tets.col(1), Eigen::Vector4i(1, 2, 3, 4));
+  EXPECT_EQ(mesh.triangles.col(0), Eigen::Vector3i(0, 1, 2));
+}
+
 /// Writes every strict prefix of `bytes` to `path` and reads it with `read` (which returns a
 /// Mesh). Each prefix must either throw InputError or give the whole file's mesh, or — for a
 /// cut exactly between the node and element sections, which is itself a valid node-only file —

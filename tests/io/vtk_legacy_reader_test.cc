@@ -12,6 +12,7 @@ namespace gipsi {
 namespace {
 
 using test::CountRejectedPrefixes;
+using test::ExpectTwoTetsAndTriangle;
 using test::InputErrorMessage;
 using test::MeshData;
 using test::Put;
@@ -41,15 +42,6 @@ std::string TwoTetsBinary(bool layout51) {
   for (std::int32_t v : {0, 1, 2}) Put(s, v, kSwap);
   s += "\n";
   return s;
-}
-
-void ExpectTwoTetsAndTriangle(const Mesh& mesh) {
-  ASSERT_EQ(mesh.num_nodes(), 5);
-  ASSERT_EQ(mesh.num_tets(), 2);
-  ASSERT_EQ(mesh.num_triangles(), 1);
-  EXPECT_EQ(mesh.nodes.col(4), Vec3(1, 1, 1));
-  EXPECT_EQ(mesh.tets.col(1), Eigen::Vector4i(1, 2, 3, 4));
-  EXPECT_EQ(mesh.triangles.col(0), Eigen::Vector3i(0, 1, 2));
 }
 
 TEST(VtkLegacyReader, ReadsAsciiGridKeepingTetsAndTrianglesOnly) {

@@ -15,6 +15,7 @@ namespace gipsi {
 namespace {
 
 using test::CountRejectedPrefixes;
+using test::ExpectTwoTetsAndTriangle;
 using test::InputErrorMessage;
 using test::MeshData;
 using test::Put;
@@ -118,15 +119,6 @@ std::string TwoTetsVtu(Encoding enc, bool header64) {
     s += "<AppendedData encoding=\"raw\">\n_" + appended + "\n</AppendedData>\n";
   s += "</VTKFile>\n";
   return s;
-}
-
-void ExpectTwoTetsAndTriangle(const Mesh& mesh) {
-  ASSERT_EQ(mesh.num_nodes(), 5);
-  ASSERT_EQ(mesh.num_tets(), 2);
-  ASSERT_EQ(mesh.num_triangles(), 1);
-  EXPECT_EQ(mesh.nodes.col(4), Vec3(1, 1, 1));
-  EXPECT_EQ(mesh.tets.col(1), Eigen::Vector4i(1, 2, 3, 4));
-  EXPECT_EQ(mesh.triangles.col(0), Eigen::Vector3i(0, 1, 2));
 }
 
 Mesh ReadGenerated(Encoding enc, bool header64) {
