@@ -95,6 +95,7 @@ MassSpring::MassSpring(std::string name, const Points& nodes, const Eigen::Matri
 
 void MassSpring::Finish() {
   if (!params_.law) params_.law = std::make_shared<HookeSpring>();
+  hooke_ = dynamic_cast<const HookeSpring*>(params_.law.get()) != nullptr;
   const Mesh& mesh = domain();
   const Index n = mesh.num_nodes();
   rest_length_.resize(num_springs());
@@ -160,8 +161,10 @@ void MassSpring::CalcForces(double /*t*/, Eigen::Ref<const VecX> x, Eigen::Ref<V
     if (length <= 0) continue;  // coincident nodes: no direction; CheckState reports stretch
     const Vec3 dir = d / length;
     const double rate = (v.segment<3>(3 * b) - v.segment<3>(3 * a)).dot(dir);
-    const Vec3 fs =
-        (law.Tension(length, rest_length_[s], params_.stiffness) + params_.damping * rate) * dir;
+    // Hooke is the common case: inline it rather than pay a virtual call per spring.
+    const double tension = hooke_ ? params_.stiffness * (length - rest_length_[s])
+                                  : law.Tension(length, rest_length_[s], params_.stiffness);
+    const Vec3 fs = (tension + params_.damping * rate) * dir;
     f.segment<3>(3 * a) += fs;
     f.segment<3>(3 * b) -= fs;
   }

@@ -94,6 +94,7 @@ class MassSpring final : public SimObject {
   void Finish();
 
   MassSpringParams params_;
+  bool hooke_ = true;  // params_.law is HookeSpring (inlined in CalcForces)
   std::unique_ptr<ExplicitIntegrator> integrator_;
   Eigen::Matrix2Xi springs_;
   VecX rest_length_;
