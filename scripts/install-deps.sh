@@ -12,6 +12,7 @@ packages=(
   libpugixml-dev         # reading VTU (XML) meshes
   zlib1g-dev             # compressed VTU payloads
   libgmsh-dev gmsh       # Gmsh C++ API: shell (left-ventricle) mesh generation
+  libsuitesparse-dev libopenblas-dev  # CHOLMOD sparse Cholesky (with an optimised BLAS)
   libgtest-dev libgmock-dev libbenchmark-dev
   clang-format clang-tidy
 )

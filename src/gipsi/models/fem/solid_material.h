@@ -1,0 +1,58 @@
+#pragma once
+/// @file
+/// Solid constitutive laws (material family "solid") for the tetrahedral FEM object. A law maps
+/// the deformation gradient F (3×3, reference → current) of an element to its strain energy
+/// density W(F) [J/m³ = Pa], first Piola–Kirchhoff stress P = ∂W/∂F [Pa] and the tangent
+/// dP/dF (9×9). All laws are frame-indifferent except the small-strain "Linear" law.
+///
+/// Index convention for dP/dF: F and P are flattened column-major, vec(F)[i + 3 j] = F(i, j),
+/// and dPdF(i + 3 j, k + 3 l) = ∂P(i, j) / ∂F(k, l).
+
+#include <Eigen/Core>
+
+#include "gipsi/base/math.h"
+#include "gipsi/core/material.h"
+#include "gipsi/core/registry.h"
+
+namespace gipsi {
+
+using Mat9 = Eigen::Matrix<double, 9, 9>;
+
+/// Per-element data a law may use besides F. Plain struct; copyable.
+struct MaterialPoint {
+  /// Orthonormal material axes in the reference configuration, as columns: fibre f, sheet s,
+  /// sheet-normal n. Identity for isotropic laws.
+  Mat3 axes = Mat3::Identity();
+  /// Active tension Ta [Pa] along the fibre: adds the second Piola–Kirchhoff stress
+  /// S_a = Ta f ⊗ f (energy Ta E_ff). Zero when not driven.
+  double active_tension = 0;
+};
+
+/// Base class of solid laws. Immutable after construction, shared by all elements; all methods
+/// are const, thread-safe and allocation-free.
+class SolidMaterial : public Material {
+ public:
+  [[nodiscard]] std::string_view family() const final { return "solid"; }
+
+  /// Strain energy density W(F) [Pa]; +infinity where F is outside the law's domain (e.g.
+  /// det F <= 0 for laws with ln J), so a line search can reject such states.
+  [[nodiscard]] virtual double Energy(const Mat3& F, const MaterialPoint& mp) const = 0;
+  /// P(F). Returns false (P unspecified) when F is outside the law's domain.
+  [[nodiscard]] virtual bool Stress(const Mat3& F, const MaterialPoint& mp, Mat3& P) const = 0;
+  /// P(F) and dP/dF. Returns false when F is outside the law's domain.
+  [[nodiscard]] virtual bool StressAndTangent(const Mat3& F, const MaterialPoint& mp, Mat3& P,
+                                              Mat9& dPdF) const = 0;
+
+  /// True if the law reads MaterialPoint::axes (a fibre field is required).
+  [[nodiscard]] virtual bool needs_fibres() const { return false; }
+  /// Small-strain Young's modulus [Pa] and Poisson ratio of the law at rest, for time-step
+  /// estimates, wave speeds and solver scaling (for anisotropic laws, along the stiffest axis).
+  [[nodiscard]] virtual double small_strain_youngs_modulus() const = 0;
+  [[nodiscard]] virtual double small_strain_poisson_ratio() const = 0;
+};
+
+/// Registers the solid laws: "Linear", "Corotational", "StVenantKirchhoff", "NeoHookean",
+/// "Guccione" (see solid_laws.h for their equations and JSON parameters).
+void RegisterSolidLaws(TypeRegistry& registry);
+
+}  // namespace gipsi
