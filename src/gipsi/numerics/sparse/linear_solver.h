@@ -28,8 +28,10 @@ namespace gipsi {
 using SparseMatrix = Eigen::SparseMatrix<double, Eigen::ColMajor, int>;
 
 /// y = A x for a symmetric A stored in full (both triangles); parallel over rows (OpenMP,
-/// static schedule: the same bits for the same thread count). Preconditions (checked): sizes
-/// match, A is compressed. Allocates nothing.
+/// static schedule: the same bits for the same thread count; in fact each y[j] is one sequential
+/// sum, so the bits do not depend on the thread count either). Preconditions (checked): A is
+/// square and compressed, x.size() == y.size() == A.rows() (y is not resized), x and y are
+/// distinct vectors. Allocates nothing.
 void SymmetricSpMV(const SparseMatrix& A, const VecX& x, VecX& y);
 
 /// Which solver and how hard it works. Plain struct.
@@ -41,18 +43,28 @@ struct LinearSolverOptions {
   /// factorisation of an earlier matrix, refreshed only when CG needs more than
   /// `refactor_iterations` iterations with it).
   std::string preconditioner = "ic";
-  /// CG stops when ‖b − A x‖ ≤ tolerance · ‖b‖.
+  /// CG stops when ‖b − A x‖ ≤ tolerance · ‖b‖ (the true residual, checked with an SpMV; the
+  /// initial residual counts, so a good warm start can take 0 iterations). Direct solvers
+  /// report `converged` only if their residual also meets it.
   double tolerance = 1e-6;
+  /// CG iteration budget per Solve (≥ 1).
   int max_iterations = 2000;
+  /// For preconditioner "cholesky": a Solve needing more CG iterations than this (or not
+  /// converging) makes the next Factorize refactorise numerically (≥ 0).
   int refactor_iterations = 30;
 };
 
 /// What one Solve did. Plain struct.
 struct LinearSolveStats {
-  bool converged = false;
-  int iterations = 0;             ///< CG iterations (0 for direct solvers)
-  double relative_residual = 0;   ///< ‖b − A x‖ / ‖b‖ at exit (0 if b = 0)
-  bool refactorized = false;      ///< a numeric factorisation happened in the last Factorize
+  bool converged = false;  ///< the residual meets LinearSolverOptions::tolerance
+  int iterations = 0;      ///< CG iterations (0 for direct solvers)
+  /// ‖b − A x‖ / ‖b‖ at exit, always from the true residual (0 if b = 0; NaN or ∞ if b or
+  /// the iterate is not finite; +∞ if Solve ran without a successful Factorize).
+  double relative_residual = 0;
+  /// A numeric factorisation ran (successfully or not) in the last Factorize: always for
+  /// "ldlt", "cholmod" and "cg+ic", never for "cg+none"/"cg+jacobi", and for "cg+cholesky"
+  /// on the first Factorize and when the previous Solve asked for a refresh.
+  bool refactorized = false;
 };
 
 /// Not copyable (holds factorisations); not movable.
@@ -66,22 +78,35 @@ class LinearSolver {
   /// E.g. "cg+ic", "cholmod".
   [[nodiscard]] virtual std::string name() const = 0;
   /// Symbolic analysis (ordering, elimination tree) for matrices with A's pattern. Call again
-  /// only when the pattern changes.
+  /// only when the pattern changes (it also drops any factorisation). A must be square and
+  /// compressed (checked).
   virtual void AnalyzePattern(const SparseMatrix& A) = 0;
-  /// Numeric set-up for A (same pattern as analysed). Iterative solvers keep a pointer to A:
-  /// it must stay alive and unchanged until the next Factorize. Returns false if A is found
-  /// not to be positive definite (a failed factorisation); never throws.
+  /// Numeric set-up for A (same pattern as analysed; the size and nonzero count are checked,
+  /// and a Factorize without any earlier AnalyzePattern analyses A first). All solvers keep a
+  /// pointer to A (iterative ones to multiply, direct ones to measure the residual): it must
+  /// stay alive and unchanged until the next Factorize. Returns false if A has a non-finite
+  /// value or is found not to be positive definite (a failed factorisation, a non-positive
+  /// LDLᵀ pivot or Jacobi diagonal entry, or an incomplete Cholesky that fails even with
+  /// Eigen's diagonal shifts); Solve then reports not converged until a Factorize succeeds.
+  /// Never throws.
   [[nodiscard]] virtual bool Factorize(const SparseMatrix& A) = 0;
   /// Solves A x = b for the last factorised A. On entry x is the initial guess (warm start;
-  /// direct solvers ignore it). Never throws; `converged` is false on failure.
+  /// direct solvers ignore it; a CG guess of the wrong size is replaced by zeros). b must
+  /// have A's size (checked). b = 0 gives x = 0, converged. Non-finite values in b, x or along
+  /// the iteration stop the solve (no hang) with `converged` false. Never throws.
   virtual LinearSolveStats Solve(const VecX& b, VecX& x) = 0;
 };
 
-/// Builds the solver `options` describe. Throws InputError for an unknown type/preconditioner.
+/// Builds the solver `options` describe (names as in LinearSolver::name()). Throws InputError
+/// for an unknown type or preconditioner (listing the choices), for preconditioner "cholesky"
+/// with a type other than "cg", and for tolerance ≤ 0, max_iterations < 1 or
+/// refactor_iterations < 0. The preconditioner is ignored by the direct types.
 std::unique_ptr<LinearSolver> MakeLinearSolver(const LinearSolverOptions& options);
 
 /// Reads {"type", "preconditioner", "tolerance", "max_iterations", "refactor_iterations"} (all
-/// optional, defaults as in LinearSolverOptions); throws InputError naming the JSON path.
+/// optional, defaults as in LinearSolverOptions); throws InputError naming the JSON path for an
+/// unknown key, an unknown type/preconditioner (listing the choices), "cholesky" with a type
+/// other than "cg", a non-positive tolerance or an out-of-range iteration count.
 LinearSolverOptions ParseLinearSolverOptions(const JsonNode& node);
 
 }  // namespace gipsi

@@ -1,0 +1,115 @@
+// Solver selection: validation of LinearSolverOptions, the factory, and the JSON reader.
+
+#include "gipsi/numerics/sparse/linear_solver.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <optional>
+#include <vector>
+
+#include <fmt/format.h>
+
+#include "gipsi/base/error.h"
+#include "gipsi/numerics/sparse/solvers.h"
+
+namespace gipsi {
+namespace {
+
+constexpr std::array<std::string_view, 3> kTypes = {"cg", "ldlt", "cholmod"};
+constexpr std::array<std::string_view, 4> kPreconditioners = {"none", "jacobi", "ic", "cholesky"};
+
+/// Empty if `value` is one of `choices`, else e.g. "unknown linear solver type 'gmres';
+/// choices: 'cg', 'ldlt', 'cholmod'" (with a "did you mean" for a near miss).
+template <std::size_t N>
+std::optional<std::string> CheckChoice(std::string_view what, std::string_view value,
+                                       const std::array<std::string_view, N>& choices) {
+  if (std::find(choices.begin(), choices.end(), value) != choices.end()) return std::nullopt;
+  std::vector<std::string> names(choices.begin(), choices.end());
+  std::string list;
+  for (const std::string& name : names)
+    list += fmt::format("{}'{}'", list.empty() ? "" : ", ", name);
+  return fmt::format("unknown {} '{}'{}; choices: {}", what, value, SuggestClosest(value, names),
+                     list);
+}
+
+std::optional<std::string> CholeskyNeedsCg(const LinearSolverOptions& options) {
+  if (options.preconditioner == "cholesky" && options.type != "cg")
+    return fmt::format("preconditioner 'cholesky' applies to type 'cg' only (type is '{}')",
+                       options.type);
+  return std::nullopt;
+}
+
+/// A string member that must be one of `choices`.
+template <std::size_t N>
+std::string ReadChoice(const JsonNode& node, std::string_view what,
+                       const std::array<std::string_view, N>& choices) {
+  if (!node.is_string()) node.Expected("a string");
+  std::string value = node.AsString();
+  if (auto complaint = CheckChoice(what, value, choices)) node.Fail(*complaint);
+  return value;
+}
+
+/// An integer in [minimum, INT_MAX].
+int ReadInt(const JsonNode& node, int minimum) {
+  const std::int64_t value = node.AsInt();
+  if (value < minimum || value > std::numeric_limits<int>::max())
+    node.Fail(fmt::format("expected an integer in [{}, {}], got {}", minimum,
+                          std::numeric_limits<int>::max(), value));
+  return static_cast<int>(value);
+}
+
+}  // namespace
+
+bool AllValuesFinite(const SparseMatrix& A) {
+  return Eigen::Map<const VecX>(A.valuePtr(), A.nonZeros()).allFinite();
+}
+
+void CheckAnalysedShape(const SparseMatrix& A, Index rows, Index nonzeros, const char* who) {
+  GIPSI_CHECK(A.rows() == A.cols() && A.isCompressed(), "{}: matrix must be square and compressed",
+              who);
+  GIPSI_CHECK(A.rows() == rows && A.nonZeros() == nonzeros,
+              "{}: matrix ({} rows, {} nonzeros) does not have the analysed pattern ({} rows, {} "
+              "nonzeros); call AnalyzePattern first",
+              who, A.rows(), A.nonZeros(), rows, nonzeros);
+}
+
+std::unique_ptr<LinearSolver> MakeLinearSolver(const LinearSolverOptions& options) {
+  if (auto complaint = CheckChoice("linear solver type", options.type, kTypes))
+    throw InputError(*complaint);
+  if (auto complaint = CheckChoice("preconditioner", options.preconditioner, kPreconditioners))
+    throw InputError(*complaint);
+  if (auto complaint = CholeskyNeedsCg(options)) throw InputError(*complaint);
+  if (!(options.tolerance > 0.0) || !std::isfinite(options.tolerance))
+    throw InputError(fmt::format("linear solver tolerance must be a positive number, got {}",
+                                 options.tolerance));
+  if (options.max_iterations < 1)
+    throw InputError(
+        fmt::format("linear solver max_iterations must be ≥ 1, got {}", options.max_iterations));
+  if (options.refactor_iterations < 0)
+    throw InputError(fmt::format("linear solver refactor_iterations must be ≥ 0, got {}",
+                                 options.refactor_iterations));
+  if (options.type == "ldlt") return MakeLdltSolver(options);
+  if (options.type == "cholmod") return MakeCholmodSolver(options);
+  return MakePcgSolver(options);
+}
+
+LinearSolverOptions ParseLinearSolverOptions(const JsonNode& node) {
+  node.CheckKeys({"type", "preconditioner", "tolerance", "max_iterations", "refactor_iterations"});
+  LinearSolverOptions options;
+  if (auto type = node.Find("type")) options.type = ReadChoice(*type, "linear solver type", kTypes);
+  if (auto preconditioner = node.Find("preconditioner")) {
+    options.preconditioner = ReadChoice(*preconditioner, "preconditioner", kPreconditioners);
+    if (auto complaint = CholeskyNeedsCg(options)) preconditioner->Fail(*complaint);
+  }
+  options.tolerance = node.Positive("tolerance", options.tolerance);
+  if (auto max_iterations = node.Find("max_iterations"))
+    options.max_iterations = ReadInt(*max_iterations, 1);
+  if (auto refactor = node.Find("refactor_iterations"))
+    options.refactor_iterations = ReadInt(*refactor, 0);
+  return options;
+}
+
+}  // namespace gipsi

@@ -1,0 +1,145 @@
+#include <cstring>
+#include <vector>
+
+#include <gtest/gtest.h>
+#include <omp.h>
+
+#include "gipsi/numerics/sparse/linear_solver.h"
+#include "gipsi/numerics/sparse/model_problems.h"
+#include "gipsi/numerics/sparse/vector_ops.h"
+#include "numerics/sparse/sparse_test_util.h"
+
+namespace gipsi {
+namespace {
+
+using testing::RandomVector;
+
+/// True if a and b hold the same bits (not just equal values).
+bool SameBits(const VecX& a, const VecX& b) {
+  return a.size() == b.size() &&
+         std::memcmp(a.data(), b.data(), sizeof(double) * static_cast<std::size_t>(a.size())) == 0;
+}
+
+/// Restores the OpenMP thread count when a test changed it.
+class ThreadCountGuard {
+ public:
+  ThreadCountGuard() : saved_(omp_get_max_threads()) {}
+  ~ThreadCountGuard() { omp_set_num_threads(saved_); }
+  ThreadCountGuard(const ThreadCountGuard&) = delete;
+  ThreadCountGuard& operator=(const ThreadCountGuard&) = delete;
+
+ private:
+  int saved_;
+};
+
+// Both model matrices are large enough (≥ kMinParallelLength rows) to take the parallel path.
+std::vector<SparseMatrix> ParallelSizedMatrices() {
+  std::vector<SparseMatrix> matrices;
+  matrices.push_back(MakeLaplacian3D(21, 0.5));  // 9,261 rows
+  matrices.push_back(MakeSpringLattice3D(14, 1e-2, [](const Vec3& p) { return 1.0 + p.x(); }));
+  for (const SparseMatrix& A : matrices) EXPECT_GE(A.rows(), kMinParallelLength);
+  return matrices;
+}
+
+TEST(SparseModelProblems, AreSymmetricWithTheDocumentedNonzeroCounts) {
+  const SparseMatrix laplacian = MakeLaplacian3D(5, 0.1);
+  EXPECT_EQ(laplacian.rows(), 125);
+  EXPECT_EQ(laplacian.nonZeros(), 7 * 125 - 6 * 25);
+  EXPECT_EQ((SparseMatrix(laplacian.transpose()) - laplacian).norm(), 0.0);
+  EXPECT_DOUBLE_EQ(laplacian.coeff(62, 62), 6.1);
+
+  const SparseMatrix lattice = MakeSpringLattice3D(4, 0.1);
+  EXPECT_EQ(lattice.rows(), 3 * 64);
+  EXPECT_EQ(lattice.nonZeros(), 9 * 10 * 10 * 10);
+  EXPECT_EQ((SparseMatrix(lattice.transpose()) - lattice).norm(), 0.0);
+}
+
+// The lattice without its shift is a stiffness matrix: rigid translations and rotations are in
+// its null space, so A·u = shift·u for them. This pins down the block assembly.
+TEST(SparseModelProblems, LatticeMapsRigidMotionsToShiftTimesMotion) {
+  const int n = 5;
+  const double shift = 0.25;
+  const SparseMatrix A = MakeSpringLattice3D(n, shift, [](const Vec3& p) { return 1.0 + p.y(); });
+  const Vec3 translation(0.3, -1.0, 2.0);
+  const Vec3 omega(0.5, 1.5, -0.7);
+  VecX u(A.rows());
+  for (int z = 0; z < n; ++z)
+    for (int y = 0; y < n; ++y)
+      for (int x = 0; x < n; ++x) {
+        const Vec3 p = Vec3(x, y, z) / (n - 1);
+        u.segment<3>(3 * (x + n * (y + n * z))) = translation + omega.cross(p);
+      }
+  VecX Au(A.rows());
+  SymmetricSpMV(A, u, Au);
+  EXPECT_LT((Au - shift * u).norm(), 1e-12 * u.norm());
+}
+
+TEST(SymmetricSpMV, MatchesEigenProductToRoundOff) {
+  for (const SparseMatrix& A : ParallelSizedMatrices()) {
+    const VecX x = RandomVector(A.cols(), 3);
+    VecX y(A.rows());
+    SymmetricSpMV(A, x, y);
+    const VecX expected = A * x;
+    EXPECT_LE((y - expected).norm(), 1e-14 * expected.norm());
+  }
+}
+
+TEST(SymmetricSpMV, RepeatedRunsGiveIdenticalBits) {
+  for (const SparseMatrix& A : ParallelSizedMatrices()) {
+    const VecX x = RandomVector(A.cols(), 4);
+    VecX first(A.rows());
+    VecX again(A.rows());
+    SymmetricSpMV(A, x, first);
+    for (int run = 0; run < 5; ++run) {
+      again.setConstant(-1.0);
+      SymmetricSpMV(A, x, again);
+      EXPECT_TRUE(SameBits(first, again)) << "run " << run;
+    }
+  }
+}
+
+// Each y[j] is one sequential sum over column j, so even the thread count cannot change it.
+TEST(SymmetricSpMV, BitsDoNotDependOnThreadCount) {
+  ThreadCountGuard guard;
+  for (const SparseMatrix& A : ParallelSizedMatrices()) {
+    const VecX x = RandomVector(A.cols(), 5);
+    omp_set_num_threads(1);
+    VecX serial(A.rows());
+    SymmetricSpMV(A, x, serial);
+    for (int threads : {2, 3}) {
+      omp_set_num_threads(threads);
+      VecX parallel(A.rows());
+      SymmetricSpMV(A, x, parallel);
+      EXPECT_TRUE(SameBits(serial, parallel)) << threads << " threads";
+    }
+  }
+}
+
+TEST(SymmetricSpMV, HandlesEmptyColumnsAndATinyMatrix) {
+  SparseMatrix A(3, 3);  // diag(2, 0, 5) with the middle column empty
+  A.insert(0, 0) = 2.0;
+  A.insert(2, 2) = 5.0;
+  A.makeCompressed();
+  VecX x(3);
+  x << 1.0, 7.0, -1.0;
+  VecX y(3);
+  SymmetricSpMV(A, x, y);
+  EXPECT_EQ(y, VecX((VecX(3) << 2.0, 0.0, -5.0).finished()));
+}
+
+TEST(ParallelDot, MatchesSerialDotAndRepeatsBitForBit) {
+  ThreadCountGuard guard;
+  omp_set_num_threads(3);  // an uneven split of the range
+  const VecX a = RandomVector(100'003, 11);
+  const VecX b = RandomVector(100'003, 12);
+  ReductionScratch scratch;
+  const double first = ParallelDot(a, b, scratch);
+  EXPECT_NEAR(first, a.dot(b), 1e-12 * a.norm() * b.norm());
+  for (int run = 0; run < 5; ++run) {
+    const double again = ParallelDot(a, b, scratch);
+    EXPECT_EQ(std::memcmp(&first, &again, sizeof(double)), 0) << "run " << run;
+  }
+}
+
+}  // namespace
+}  // namespace gipsi
