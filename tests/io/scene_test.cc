@@ -93,7 +93,7 @@ TEST(SceneErrors, UnknownTypeSuggestsTheClosest) {
   text.replace(text.find("\"MassSpring\""), 12, "\"MassSprign\"");
   EXPECT_THAT(LoadError(text),
               HasSubstr("scene.json: objects.cube.type: unknown object type 'MassSprign' (did "
-                        "you mean 'MassSpring'?); known: Aggregate, MassSpring"));
+                        "you mean 'MassSpring'?); known: Aggregate, FemSolid, MassSpring"));
 }
 
 TEST(SceneErrors, WrongParameterTypeNamesThePath) {
@@ -118,7 +118,8 @@ TEST(SceneErrors, NegativeParameterIsRejected) {
 TEST(SceneErrors, UnknownMaterialLawSuggestsTheClosest) {
   EXPECT_THAT(LoadError(SceneText(R"(, "material": {"law": "Exponentail", "b": 5})")),
               HasSubstr("objects.cube.material.law: unknown material law 'Exponentail' (did you "
-                        "mean 'Exponential'?); known: Exponential, Hooke"));
+                        "mean 'Exponential'?); known: Corotational, Exponential, Guccione, Hooke, "
+                        "Linear, NeoHookean, StVenantKirchhoff"));
   EXPECT_THAT(LoadError(SceneText(R"(, "material": {"law": "Exponential"})")),
               HasSubstr("objects.cube.material: missing required key 'b'"));
 }

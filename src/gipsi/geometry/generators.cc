@@ -31,9 +31,15 @@ constexpr int kKuhnTets[6][4] = {
     {0, 4, 7, 6},  // z, y, x (odd; swapped)
 };
 
+/// Five-tet split: the tet on the four corners of even bit-sum (0, 3, 5, 6) and the four corner
+/// tets cut off the odd corners; cells of odd parity use the mirror image (corners XOR 1), so
+/// every face diagonal matches its neighbour's.
+constexpr int kFiveTets[5][4] = {
+    {0, 3, 5, 6}, {1, 0, 3, 5}, {2, 0, 6, 3}, {4, 0, 5, 6}, {7, 3, 6, 5}};
+
 }  // namespace
 
-Mesh MakeTetBox(const Vec3& min, const Vec3& max, const std::array<int, 3>& cells) {
+Mesh MakeTetBox(const Vec3& min, const Vec3& max, const std::array<int, 3>& cells, HexSplit split) {
   if (!min.allFinite() || !max.allFinite() || !(max.array() > min.array()).all())
     ThrowInputError("", "tet box",
                     fmt::format("max ({}, {}, {}) must exceed min ({}, {}, {}) on every axis",
@@ -55,15 +61,29 @@ Mesh MakeTetBox(const Vec3& min, const Vec3& max, const std::array<int, 3>& cell
             Vec3(i == nx ? max.x() : min.x() + i * h.x(), j == ny ? max.y() : min.y() + j * h.y(),
                  k == nz ? max.z() : min.z() + k * h.z());
       }
-  mesh.tets.resize(4, Index(6) * nx * ny * nz);
+  const int per_cell = split == HexSplit::kSix ? 6 : 5;
+  mesh.tets.resize(4, Index(per_cell) * nx * ny * nz);
   Index e = 0;
   for (int k = 0; k < nz; ++k)
     for (int j = 0; j < ny; ++j)
       for (int i = 0; i < nx; ++i) {
         int corner[8];
         for (int c = 0; c < 8; ++c) corner[c] = node(i + (c & 1), j + ((c >> 1) & 1), k + (c >> 2));
-        for (const auto& tet : kKuhnTets) {
-          for (int a = 0; a < 4; ++a) mesh.tets(a, e) = corner[tet[a]];
+        if (split == HexSplit::kSix) {
+          for (const auto& tet : kKuhnTets) {
+            for (int a = 0; a < 4; ++a) mesh.tets(a, e) = corner[tet[a]];
+            ++e;
+          }
+          continue;
+        }
+        const int flip = (i + j + k) % 2;  // odd cells mirror x
+        for (const auto& tet : kFiveTets) {
+          for (int a = 0; a < 4; ++a) mesh.tets(a, e) = corner[tet[a] ^ flip];
+          const Vec3 p0 = mesh.nodes.col(mesh.tets(0, e));
+          const double vol = (mesh.nodes.col(mesh.tets(1, e)) - p0)
+                                 .cross(mesh.nodes.col(mesh.tets(2, e)) - p0)
+                                 .dot(mesh.nodes.col(mesh.tets(3, e)) - p0);
+          if (vol < 0) std::swap(mesh.tets(2, e), mesh.tets(3, e));
           ++e;
         }
       }

@@ -10,11 +10,19 @@
 
 namespace gipsi {
 
-/// A box [min, max] split into cells[0]×cells[1]×cells[2] hexahedra, each cut into 6 positively
-/// oriented tets that conform across cells. Node (i,j,k) has index i + (nx+1)(j + (ny+1)k).
-/// Boundary triangles are included, with groups "xmin", "xmax", "ymin", "ymax", "zmin", "zmax"
-/// (dim 2) and "volume" (dim 3). Throws InputError unless max > min and cells >= 1.
-Mesh MakeTetBox(const Vec3& min, const Vec3& max, const std::array<int, 3>& cells);
+/// How each hexahedral cell of a structured box is cut into tetrahedra.
+enum class HexSplit {
+  kSix,   ///< 6 tets around the main diagonal (Kuhn/Freudenthal)
+  kFive,  ///< 5 tets (a central tet and four corners), alternating by cell parity to conform
+};
+
+/// A box [min, max] split into cells[0]×cells[1]×cells[2] hexahedra, each cut into 6 (or 5)
+/// positively oriented tets that conform across cells. Node (i,j,k) has index
+/// i + (nx+1)(j + (ny+1)k). Boundary triangles are included, with groups "xmin", "xmax", "ymin",
+/// "ymax", "zmin", "zmax" (dim 2) and "volume" (dim 3). Throws InputError unless max > min and
+/// cells >= 1.
+Mesh MakeTetBox(const Vec3& min, const Vec3& max, const std::array<int, 3>& cells,
+                HexSplit split = HexSplit::kSix);
 
 /// A flat sheet of triangles spanned by `origin + s·edge_u + t·edge_v`, s,t in [0,1], with
 /// cells[0]×cells[1] quads each cut into 2 triangles. Node (i,j) has index i + (nu+1)·j. Groups

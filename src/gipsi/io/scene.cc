@@ -192,7 +192,7 @@ std::string ResolvePlugin(const std::string& entry, const std::filesystem::path&
 Mesh BuildMesh(const JsonNode& node, const std::filesystem::path& base_dir) {
   node.CheckKeys({"file", "generate", "scale", "translate", "min", "max", "cells", "origin", "u",
                   "v", "endo", "epi", "base_z", "size", "inner_radius", "outer_radius", "height",
-                  "description"});
+                  "tets_per_cell", "description"});
   Mesh mesh;
   if (node.Has("file") == node.Has("generate"))
     node.Fail("expected exactly one of 'file', 'generate'");
@@ -209,7 +209,14 @@ Mesh BuildMesh(const JsonNode& node, const std::filesystem::path& base_dir) {
     std::string kind = gen.AsChoice({"box", "sheet", "ellipsoid_shell", "cylinder_shell"});
     try {
       if (kind == "box") {
-        mesh = MakeTetBox(node.Vector3("min"), node.Vector3("max"), Cells3(node.At("cells")));
+        HexSplit split = HexSplit::kSix;
+        if (auto per_cell = node.Find("tets_per_cell")) {
+          const std::int64_t n = per_cell->AsInt();
+          if (n != 5 && n != 6) per_cell->Expected("5 or 6");
+          split = n == 5 ? HexSplit::kFive : HexSplit::kSix;
+        }
+        mesh = MakeTetBox(node.Vector3("min"), node.Vector3("max"), Cells3(node.At("cells")),
+                          split);
       } else if (kind == "sheet") {
         auto cells = node.At("cells").AsInts();
         if (cells.size() != 2 || cells[0] < 1 || cells[1] < 1 || cells[0] > 2000 || cells[1] > 2000)

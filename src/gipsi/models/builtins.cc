@@ -3,6 +3,7 @@
 #include "gipsi/core/aggregate.h"
 #include "gipsi/models/connectors/boundary_coupling.h"
 #include "gipsi/models/connectors/field_copy.h"
+#include "gipsi/models/fem/fem_solid.h"
 #include "gipsi/models/mass_spring/mass_spring.h"
 
 namespace gipsi {
@@ -11,6 +12,8 @@ void RegisterBuiltins(TypeRegistry& registry) {
   RegisterIntegrators(registry);
   RegisterSpringLaws(registry);
   RegisterMassSpring(registry);
+  RegisterSolidLaws(registry);
+  RegisterFemSolid(registry);
   RegisterAggregate(registry);
   RegisterFieldCopy(registry);
   RegisterBoundaryCoupling(registry);

@@ -6,9 +6,10 @@
 
 namespace gipsi {
 
-/// Registers the built-in objects ("MassSpring", "Aggregate"), connectors ("FieldCopy",
-/// "BoundaryCoupling"), integrators ("ExplicitEuler", "SymplecticEuler", "RK4") and spring
-/// laws ("Hooke", "Exponential").
+/// Registers the built-in objects ("MassSpring", "FemSolid", "Aggregate"), connectors
+/// ("FieldCopy", "BoundaryCoupling"), integrators ("ExplicitEuler", "SymplecticEuler", "RK4"),
+/// spring laws ("Hooke", "Exponential") and solid laws ("Linear", "Corotational",
+/// "StVenantKirchhoff", "NeoHookean", "Guccione").
 void RegisterBuiltins(TypeRegistry& registry);
 
 }  // namespace gipsi

@@ -1,0 +1,38 @@
+#pragma once
+/// @file
+/// The volume enclosed by an oriented triangle surface and its gradient with respect to the
+/// vertex positions — what couples a deforming cavity (a ventricle) to a lumped blood model.
+/// Closed surfaces use the divergence theorem: V = Σ_t (1/6) x0 · (x1 × x2) (positive when the
+/// triangles are oriented with outward normals). An open surface (an endocardium cut at the
+/// base) is closed by capping each boundary loop with a fan of triangles to the loop's centroid;
+/// the centroid moves with the loop, so its contribution to the gradient is shared equally among
+/// the loop's vertices.
+
+#include <vector>
+
+#include "gipsi/base/math.h"
+
+namespace gipsi {
+
+/// Precomputed capping of one surface. Immutable; copyable.
+class EnclosedVolume {
+ public:
+  /// `triangles` (3 by T) index vertices 0..num_vertices−1 and must be consistently oriented.
+  /// Throws InputError if the boundary is not a set of simple loops (a non-manifold edge or
+  /// vertex, or inconsistent orientation).
+  EnclosedVolume(const Triangles& triangles, Index num_vertices);
+
+  /// Number of boundary loops capped (0 for a closed surface).
+  [[nodiscard]] Index num_loops() const { return static_cast<Index>(loops_.size()); }
+  /// Enclosed volume for vertex positions `x` (3 by num_vertices) [m³ if x in m]. If
+  /// `gradient` is not null it is resized to 3 by num_vertices and receives ∂V/∂x.
+  double Compute(const Points& x, Points* gradient = nullptr) const;
+
+ private:
+  Triangles triangles_;
+  Index num_vertices_;
+  /// Each loop: its boundary half-edges (a → b, as oriented in the surface).
+  std::vector<std::vector<std::pair<int, int>>> loops_;
+};
+
+}  // namespace gipsi

@@ -1,0 +1,651 @@
+#include "gipsi/models/fem/fem_solid.h"
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <limits>
+#include <utility>
+
+#include <fmt/format.h>
+
+#include "gipsi/base/error.h"
+#include "gipsi/base/log.h"
+#include "gipsi/models/fem/surface_loads.h"
+
+namespace gipsi {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double Seconds(Clock::time_point since) {
+  return std::chrono::duration<double>(Clock::now() - since).count();
+}
+
+Mat3 FrameFrom(const Vec3& fibre, const Vec3& sheet) {
+  Mat3 axes;
+  const Vec3 f = fibre.normalized();
+  Vec3 s = sheet - sheet.dot(f) * f;
+  if (s.norm() < 1e-8) s = f.unitOrthogonal();
+  s.normalize();
+  axes.col(0) = f;
+  axes.col(1) = s;
+  axes.col(2) = f.cross(s);
+  return axes;
+}
+
+}  // namespace
+
+FemSolid::FemSolid(std::string name, std::shared_ptr<const Mesh> domain, FemParams params)
+    : SimObject(std::move(name)), params_(std::move(params)), assembly_(*domain) {
+  if (!params_.material)
+    throw InputError(fmt::format("object '{}': FemSolid needs a material", this->name()));
+  if (!(params_.density > 0))
+    throw InputError(fmt::format("object '{}': density must be positive", this->name()));
+  law_ = params_.material.get();
+  SetGeometry(domain, MakeBoundary(*domain));
+  const Index n = domain->num_nodes();
+  const Index ne = assembly_.num_elements();
+
+  active_tension_ = VecX::Zero(ne);
+  nodal_active_tension_ = VecX::Zero(n);
+  if (law_->needs_fibres())
+    axes_.assign(static_cast<std::size_t>(ne), FrameFrom(params_.fibre, params_.sheet));
+  lumped_mass_ = assembly_.LumpedMass(params_.density);
+  for (Index i = 0; i < n; ++i)
+    if (!(lumped_mass_[i] > 0))
+      throw InputError(
+          fmt::format("object '{}': node {} belongs to no tetrahedron (remove unused "
+                      "nodes from the mesh)",
+                      this->name(), i));
+  jac_ = assembly_.MakePattern();
+  if (!params_.lumped_mass) {
+    mass_ = jac_;
+    VecX values;
+    assembly_.AssembleConsistentMass(params_.density, values);
+    std::copy(values.data(), values.data() + values.size(), mass_.valuePtr());
+  }
+  if (params_.rayleigh_stiffness > 0) damping_k_ = jac_;
+
+  rest_ = Eigen::Map<const VecX>(domain->nodes.data(), 3 * n);
+  x_ = rest_;
+  scheme_ = ImplicitScheme(params_.scheme, params_.newmark_beta, params_.newmark_gamma);
+  scheme_.Reset(VecX::Zero(3 * n), VecX::Zero(3 * n), VecX::Zero(3 * n));
+  saved_scheme_ = scheme_;
+  newton_ = std::make_unique<NewtonSolver>(params_.newton, MakeLinearSolver(params_.linear_solver));
+  newton_->Prepare(jac_);
+  positions_ = domain->nodes;
+  external_force_ = Points::Zero(3, n);
+
+  const BoundarySurface& bnd = boundary();
+  const Index nf = bnd.num_triangles();
+  f_nodal_prev_ = f_nodal_new_ = VecX::Zero(3 * n);
+  pressure_prev_ = pressure_new_ = VecX::Zero(nf);
+  traction_prev_ = traction_new_ = Points::Zero(3, nf);
+  constraint_.assign(static_cast<std::size_t>(3 * n), 0);
+  target_ = x_begin_ = VecX::Zero(3 * n);
+  face_local_.resize(static_cast<std::size_t>(nf));
+  for (Index f = 0; f < nf; ++f) {
+    const int tet = bnd.face_to_tet[static_cast<std::size_t>(f)];
+    for (int v = 0; v < 3; ++v) {
+      const int node = bnd.vertex_to_node[static_cast<std::size_t>(bnd.triangles(v, f))];
+      int local = -1;
+      for (int a = 0; a < 4; ++a)
+        if (assembly_.tets()(a, tet) == node) local = a;
+      GIPSI_CHECK(local >= 0);
+      face_local_[static_cast<std::size_t>(f)][static_cast<std::size_t>(v)] = local;
+    }
+  }
+  f_int_ = f_ext_ = work_ = work2_ = d_ = VecX::Zero(3 * n);
+  invalid_.assign(static_cast<std::size_t>(ne), 0);
+  element_force_sum_ = VecX::Zero(ne);
+
+  using L = FieldLocation;
+  using A = FieldAccess;
+  f_position_ =
+      DeclareField({"position", L::kNode, 3, "m", A::kReadWrite, "current node position"});
+  f_velocity_ = DeclareField({"velocity", L::kNode, 3, "m/s", A::kReadWrite, "node velocity"});
+  f_displacement_ =
+      DeclareField({"displacement", L::kNode, 3, "m", A::kRead, "position minus rest position"});
+  f_external_force_ = DeclareField({"external_force", L::kNode, 3, "N", A::kReadWrite,
+                                    "extra nodal force (volume coupling input)"});
+  f_bposition_ = DeclareField({"boundary_position", L::kBoundaryVertex, 3, "m", A::kRead,
+                               "current boundary vertex position"});
+  f_bvelocity_ = DeclareField(
+      {"boundary_velocity", L::kBoundaryVertex, 3, "m/s", A::kRead, "boundary vertex velocity"});
+  f_bdisplacement_ = DeclareField({"boundary_displacement", L::kBoundaryVertex, 3, "m", A::kRead,
+                                   "boundary vertex displacement"});
+  f_reaction_ = DeclareField({"reaction_force", L::kBoundaryVertex, 3, "N", A::kRead,
+                              "force the kinematic constraints exert on constrained vertices"});
+  f_fibre_ = DeclareField({"fibre", L::kElement, 3, "1", A::kReadWrite,
+                           "fibre direction in the reference configuration (unit)"});
+  f_active_ = DeclareField({"active_tension", L::kElement, 1, "Pa", A::kReadWrite,
+                            "active tension along the fibre (2nd Piola-Kirchhoff Ta f x f)"});
+  f_nodal_active_ = DeclareField({"nodal_active_tension", L::kNode, 1, "Pa", A::kReadWrite,
+                                  "active tension per node (elements take the mean of theirs)"});
+  f_von_mises_ = DeclareField(
+      {"von_mises_stress", L::kElement, 1, "Pa", A::kRead, "von Mises equivalent Cauchy stress"});
+  f_jacobian_ = DeclareField(
+      {"volume_ratio", L::kElement, 1, "1", A::kRead, "det F (< 0 for an inverted element)"});
+  f_kinetic_ = DeclareField({"kinetic_energy", L::kGlobal, 1, "J", A::kRead, "1/2 v' M v"});
+  f_strain_energy_ =
+      DeclareField({"strain_energy", L::kGlobal, 1, "J", A::kRead, "stored elastic energy"});
+  f_newton_ = DeclareField(
+      {"newton_iterations", L::kGlobal, 1, "1", A::kRead, "Newton iterations of the last step"});
+  f_inverted_ = DeclareField(
+      {"inverted_elements", L::kGlobal, 1, "1", A::kRead, "number of elements with det F <= 0"});
+}
+
+MaterialPoint FemSolid::PointOf(Index e) const {
+  MaterialPoint mp;
+  if (!axes_.empty()) mp.axes = axes_[static_cast<std::size_t>(e)];
+  if (active_from_nodes_) {
+    double sum = 0;
+    for (int a = 0; a < 4; ++a) sum += nodal_active_tension_[assembly_.tets()(a, e)];
+    mp.active_tension = 0.25 * sum;
+  } else {
+    mp.active_tension = active_tension_[e];
+  }
+  return mp;
+}
+
+bool FemSolid::AssembleElements(const double* u, VecX& f, double* k_values) const {
+  f.setZero(3 * num_nodes());
+  if (k_values) std::fill(k_values, k_values + jac_.nonZeros(), 0.0);
+  std::atomic<bool> any_invalid{false};
+  double* fp = f.data();
+  assembly_.ForEachElementColoured([&](Index e) {
+    const auto g = assembly_.gradients(e);
+    const Mat3 F = assembly_.DeformationGradient(e, u);
+    const MaterialPoint mp = PointOf(e);
+    Mat3 P;
+    Mat9 C;
+    const bool ok = k_values ? law_->StressAndTangent(F, mp, P, C) : law_->Stress(F, mp, P);
+    invalid_[static_cast<std::size_t>(e)] = ok ? 0 : 1;
+    element_force_sum_[e] = 0;
+    if (!ok) {
+      any_invalid.store(true, std::memory_order_relaxed);
+      return;
+    }
+    const double vol = assembly_.volume(e);
+    const Eigen::Matrix<double, 3, 4> fe = vol * P * g;
+    element_force_sum_[e] = fe.cwiseAbs().sum();
+    for (int a = 0; a < 4; ++a) {
+      double* fa = fp + 3 * assembly_.tets()(a, e);
+      fa[0] += fe(0, a);
+      fa[1] += fe(1, a);
+      fa[2] += fe(2, a);
+    }
+    if (!k_values) return;
+    // T_b(:, k) = Σ_l C(:, k + 3l) g_b[l]  (9 by 3 per node b), then
+    // K_ab(i, k) = V Σ_j g_a[j] T_b(i + 3j, k).
+    for (int b = 0; b < 4; ++b) {
+      Eigen::Matrix<double, 9, 3> t;
+      for (int k = 0; k < 3; ++k)
+        t.col(k) = C.col(k) * g(0, b) + C.col(k + 3) * g(1, b) + C.col(k + 6) * g(2, b);
+      for (int a = 0; a < 4; ++a) {
+        const Mat3 block = vol * (g(0, a) * t.block<3, 3>(0, 0) + g(1, a) * t.block<3, 3>(3, 0) +
+                                  g(2, a) * t.block<3, 3>(6, 0));
+        for (int k = 0; k < 3; ++k) {
+          double* col = k_values + assembly_.ValueIndex(e, a, b, 0, k);
+          col[0] += block(0, k);
+          col[1] += block(1, k);
+          col[2] += block(2, k);
+        }
+      }
+    }
+  });
+  // Assembling contributions of magnitude |f| into a residual loses ~ε|f| each, and forces
+  // evaluated at a displacement u carry ~ε ‖K‖ ‖u‖: 100 ε times their sum bounds what any
+  // iterate's residual can be told apart from zero (still ~1e-14 of the element forces).
+  residual_floor_ =
+      100 * std::numeric_limits<double>::epsilon() *
+      (element_force_sum_.sum() + jacobian_norm_ * Eigen::Map<const VecX>(u, f.size()).norm());
+  if (any_invalid.load()) {
+    first_invalid_ = -1;
+    for (Index e = 0; e < num_elements(); ++e)
+      if (invalid_[static_cast<std::size_t>(e)]) {
+        first_invalid_ = e;
+        break;
+      }
+    return false;
+  }
+  return true;
+}
+
+bool FemSolid::CalcInternalForces(const VecX& x, VecX& f) const {
+  GIPSI_CHECK(x.size() == 3 * num_nodes());
+  work_ = x - rest_;
+  return AssembleElements(work_.data(), f, nullptr);
+}
+
+bool FemSolid::CalcStiffness(const VecX& x, SparseMatrix& K) const {
+  GIPSI_CHECK(x.size() == 3 * num_nodes());
+  if (K.nonZeros() != jac_.nonZeros()) K = assembly_.MakePattern();
+  work_ = x - rest_;
+  return AssembleElements(work_.data(), f_int_, K.valuePtr());
+}
+
+void FemSolid::AssembleExternal(const double* u) {
+  const double s = s_;
+  f_ext_ = f_nodal_prev_ + s * (f_nodal_new_ - f_nodal_prev_);
+  const BoundarySurface& bnd = boundary();
+  for (Index f = 0; f < bnd.num_triangles(); ++f) {
+    const double p = pressure_prev_[f] + s * (pressure_new_[f] - pressure_prev_[f]);
+    const Vec3 t = traction_prev_.col(f) + s * (traction_new_.col(f) - traction_prev_.col(f));
+    if (p == 0 && t.squaredNorm() == 0) continue;
+    int node[3];
+    for (int v = 0; v < 3; ++v)
+      node[v] = bnd.vertex_to_node[static_cast<std::size_t>(bnd.triangles(v, f))];
+    Vec3 fl[3] = {Vec3::Zero(), Vec3::Zero(), Vec3::Zero()};
+    Vec3 xf[3];
+    for (int v = 0; v < 3; ++v)
+      xf[v] = rest_.segment<3>(3 * node[v]) + Eigen::Map<const Vec3>(u + 3 * node[v]);
+    FaceLoads(xf[0], xf[1], xf[2], p, t, fl[0], fl[1], fl[2]);
+    for (int v = 0; v < 3; ++v) f_ext_.segment<3>(3 * node[v]) += fl[v];
+  }
+}
+
+void FemSolid::FinishResidual(const VecX& d, VecX& r) {
+  r = f_int_ - f_ext_;
+  if (params_.scheme != ImplicitSchemeKind::kStatic) {
+    // Inertia M a and damping α M v + β K_n v.
+    work_ = scheme_.c_a() * d + scheme_.a_hat();
+    work2_ = scheme_.c_v() * d + scheme_.v_hat();
+    if (params_.rayleigh_mass > 0) work_ += params_.rayleigh_mass * work2_;
+    if (params_.lumped_mass) {
+      for (Index i = 0; i < num_nodes(); ++i)
+        r.segment<3>(3 * i) += lumped_mass_[i] * work_.segment<3>(3 * i);
+    } else {
+      VecX& ma = f_int_;  // f_int_ is consumed above; reuse as a buffer
+      SymmetricSpMV(mass_, work_, ma);
+      r += ma;
+    }
+    if (params_.rayleigh_stiffness > 0) {
+      SymmetricSpMV(damping_k_, work2_, work_);
+      r += params_.rayleigh_stiffness * work_;
+    }
+  }
+  for (int dof : constrained_dofs_) r[dof] = 0;
+}
+
+bool FemSolid::CalcResidual(const VecX& d, VecX& r) {
+  const auto start = Clock::now();
+  work_ = scheme_.x() + d;
+  const bool ok = AssembleElements(work_.data(), f_int_, nullptr);
+  if (ok) {
+    AssembleExternal(work_.data());
+    FinishResidual(d, r);
+  }
+  profile_.assembly_seconds += Seconds(start);
+  return ok;
+}
+
+bool FemSolid::CalcResidualAndJacobian(const VecX& d, VecX& r, SparseMatrix& J) {
+  const auto start = Clock::now();
+  work_ = scheme_.x() + d;
+  if (!AssembleElements(work_.data(), f_int_, J.valuePtr())) {
+    profile_.assembly_seconds += Seconds(start);
+    return false;
+  }
+  AssembleExternal(work_.data());
+  double* jv = J.valuePtr();
+  const Index nnz = J.nonZeros();
+  if (params_.rayleigh_stiffness > 0 && first_iteration_)
+    std::copy(jv, jv + nnz, damping_k_.valuePtr());
+  first_iteration_ = false;
+  // Symmetric part of the follower-load tangent: J −= sym(∂f_ext/∂x).
+  const BoundarySurface& bnd = boundary();
+  for (Index f = 0; f < bnd.num_triangles(); ++f) {
+    const double p = pressure_prev_[f] + s_ * (pressure_new_[f] - pressure_prev_[f]);
+    const Vec3 t = traction_prev_.col(f) + s_ * (traction_new_.col(f) - traction_prev_.col(f));
+    if (p == 0 && t.squaredNorm() == 0) continue;
+    int node[3];
+    for (int v = 0; v < 3; ++v)
+      node[v] = bnd.vertex_to_node[static_cast<std::size_t>(bnd.triangles(v, f))];
+    const Mat99 jf =
+        FaceLoadJacobian(rest_.segment<3>(3 * node[0]) + work_.segment<3>(3 * node[0]),
+                         rest_.segment<3>(3 * node[1]) + work_.segment<3>(3 * node[1]),
+                         rest_.segment<3>(3 * node[2]) + work_.segment<3>(3 * node[2]), p, t);
+    const Mat99 sym = 0.5 * (jf + jf.transpose());
+    const int tet = bnd.face_to_tet[static_cast<std::size_t>(f)];
+    const auto& local = face_local_[static_cast<std::size_t>(f)];
+    for (int a = 0; a < 3; ++a)
+      for (int b = 0; b < 3; ++b)
+        for (int k = 0; k < 3; ++k) {
+          double* col = jv + assembly_.ValueIndex(tet, local[static_cast<std::size_t>(a)],
+                                                  local[static_cast<std::size_t>(b)], 0, k);
+          for (int i = 0; i < 3; ++i) col[i] -= sym(3 * a + i, 3 * b + k);
+        }
+  }
+  // Inertia and damping: J += (c_a + c_v α) M + c_v β K_n.
+  if (params_.scheme != ImplicitSchemeKind::kStatic) {
+    const double cm = scheme_.c_a() + scheme_.c_v() * params_.rayleigh_mass;
+    const double ck = scheme_.c_v() * params_.rayleigh_stiffness;
+    if (params_.lumped_mass) {
+      const auto& diag = assembly_.diagonal_index();
+      for (std::size_t i = 0; i < diag.size(); ++i)
+        jv[diag[i]] += cm * lumped_mass_[static_cast<Index>(i / 3)];
+    } else {
+      const double* mv = mass_.valuePtr();
+      for (Index j = 0; j < nnz; ++j) jv[j] += cm * mv[j];
+    }
+    if (ck > 0) {
+      const double* kv = damping_k_.valuePtr();
+      for (Index j = 0; j < nnz; ++j) jv[j] += ck * kv[j];
+    }
+  }
+  // Constrained dofs: rows and columns of the identity times the mean diagonal (keeps J
+  // symmetric and well scaled; their increment is 0). Also the largest absolute row sum, which
+  // bounds the round-off of any solve with J: a backward-stable solve leaves a residual of
+  // ~ε ‖J‖ ‖Δ‖, which no further Newton step can remove.
+  const int* outer = J.outerIndexPtr();
+  const int* inner = J.innerIndexPtr();
+  const Index ncols = J.cols();
+  double diag_sum = 0;
+  for (int index : assembly_.diagonal_index()) diag_sum += std::abs(jv[index]);
+  const double unit = diag_sum > 0 ? diag_sum / static_cast<double>(ncols) : 1.0;
+  double max_row_sum = 0;
+  for (Index c = 0; c < ncols; ++c) {
+    const bool fixed_col = constraint_[static_cast<std::size_t>(c)] != 0;
+    double row_sum = 0;
+    for (int j = outer[c]; j < outer[c + 1]; ++j) {
+      if (fixed_col || constraint_[static_cast<std::size_t>(inner[j])] != 0)
+        jv[j] = inner[j] == c ? unit : 0.0;
+      row_sum += std::abs(jv[j]);
+    }
+    max_row_sum = std::max(max_row_sum, row_sum);
+  }
+  jacobian_norm_ = max_row_sum;
+  FinishResidual(d, r);
+  profile_.assembly_seconds += Seconds(start);
+  return true;
+}
+
+void FemSolid::GatherTargets() {
+  const Index n = num_nodes();
+  const BoundarySurface& bnd = boundary();
+  const BoundaryConditions& bcs = boundary_conditions();
+  for (Index i = 0; i < n; ++i)
+    f_nodal_new_.segment<3>(3 * i) = lumped_mass_[i] * params_.gravity + external_force_.col(i);
+  for (Index j = 0; j < bnd.num_vertices(); ++j)
+    f_nodal_new_.segment<3>(3 * bnd.vertex_to_node[static_cast<std::size_t>(j)]) += bcs.force(j);
+  for (Index f = 0; f < bnd.num_triangles(); ++f) {
+    pressure_new_[f] = bcs.pressure(f);
+    traction_new_.col(f) = bcs.traction(f);
+  }
+  constrained_dofs_.clear();
+  std::fill(constraint_.begin(), constraint_.end(), 0);
+  for (Index j = 0; j < bnd.num_vertices(); ++j) {
+    const Index node = bnd.vertex_to_node[static_cast<std::size_t>(j)];
+    for (int a = 0; a < 3; ++a) {
+      const Index dof = 3 * node + a;
+      switch (bcs.kind(j, a)) {
+        case ConstraintKind::kFree:
+          continue;
+        case ConstraintKind::kDisplacement:
+          constraint_[static_cast<std::size_t>(dof)] = 1;
+          target_[dof] = bcs.value(j)[a];
+          break;
+        case ConstraintKind::kVelocity:
+          constraint_[static_cast<std::size_t>(dof)] = 2;
+          target_[dof] = bcs.value(j)[a];
+          break;
+      }
+      constrained_dofs_.push_back(static_cast<int>(dof));
+    }
+  }
+  if (!have_prev_loads_) {
+    // Quasi-static analysis starts unloaded and ramps; dynamics starts with its loads applied.
+    if (params_.scheme == ImplicitSchemeKind::kStatic) {
+      f_nodal_prev_.setZero();
+      pressure_prev_.setZero();
+      traction_prev_.setZero();
+    } else {
+      f_nodal_prev_ = f_nodal_new_;
+      pressure_prev_ = pressure_new_;
+      traction_prev_ = traction_new_;
+    }
+    have_prev_loads_ = true;
+  }
+}
+
+void FemSolid::InitialAcceleration() {
+  // Newmark needs a_0 from M a_0 = f_ext − f_int − C v_0 (lumped: nodal division; consistent:
+  // solved with a direct factorisation of M, once).
+  s_ = 0;
+  if (!AssembleElements(scheme_.x().data(), f_int_, nullptr)) return;
+  AssembleExternal(scheme_.x().data());
+  VecX rhs = f_ext_ - f_int_;
+  if (params_.rayleigh_mass > 0) {
+    if (params_.lumped_mass) {
+      for (Index i = 0; i < num_nodes(); ++i)
+        rhs.segment<3>(3 * i) -=
+            params_.rayleigh_mass * lumped_mass_[i] * scheme_.v().segment<3>(3 * i);
+    } else {
+      SymmetricSpMV(mass_, scheme_.v(), work_);
+      rhs -= params_.rayleigh_mass * work_;
+    }
+  }
+  VecX a0 = VecX::Zero(rhs.size());
+  if (params_.lumped_mass) {
+    for (Index i = 0; i < num_nodes(); ++i)
+      a0.segment<3>(3 * i) = rhs.segment<3>(3 * i) / lumped_mass_[i];
+  } else {
+    auto solver = MakeLinearSolver(LinearSolverOptions{.type = "ldlt"});
+    solver->AnalyzePattern(mass_);
+    if (solver->Factorize(mass_)) solver->Solve(rhs, a0);
+  }
+  for (int dof : constrained_dofs_) a0[dof] = 0;
+  scheme_.SetAcceleration(a0);
+}
+
+StepStatus FemSolid::Advance(double s0, double s1, double dt, int depth) {
+  saved_scheme_ = scheme_;
+  scheme_.Begin((s1 - s0) * dt);
+  s_ = s1;
+  first_iteration_ = true;
+  d_.setZero();
+  const VecX& xn = scheme_.x();
+  for (int dof : constrained_dofs_) {
+    if (constraint_[static_cast<std::size_t>(dof)] == 1)
+      d_[dof] = x_begin_[dof] + s1 * (target_[dof] - x_begin_[dof]) - xn[dof];
+    else
+      d_[dof] = scheme_.IncrementForVelocity(dof, target_[dof]);
+  }
+  // The force scale for the convergence test: applied loads and the weight.
+  force_scale_ = (f_nodal_prev_ + s1 * (f_nodal_new_ - f_nodal_prev_)).norm();
+  last_newton_ = newton_->Solve(*this, d_, jac_);
+  profile_.newton_iterations += last_newton_.iterations;
+  profile_.linear_iterations += last_newton_.linear_iterations;
+  if (last_newton_.converged && d_.allFinite()) {
+    scheme_.Commit(d_);
+    return StepStatus::Ok();
+  }
+  scheme_ = saved_scheme_;
+  if (depth < params_.max_bisections) {
+    const double mid = 0.5 * (s0 + s1);
+    StepStatus status = Advance(s0, mid, dt, depth + 1);
+    if (!status.ok()) return status;
+    return Advance(mid, s1, dt, depth + 1);
+  }
+  failure_detail_ = Describe(last_newton_, params_.newton);
+  if (last_newton_.inadmissible && first_invalid_ >= 0)
+    failure_detail_ +=
+        fmt::format("; element {} is outside its law's domain (det F <= 0?)", first_invalid_);
+  if (last_newton_.inadmissible)
+    return StepStatus::Failed("no admissible state: an element inverted; element", first_invalid_);
+  if (last_newton_.linear_failure)
+    return StepStatus::Failed("linear solver failed (tangent not positive definite?)");
+  return StepStatus::Failed("Newton did not converge; final residual", -1,
+                            last_newton_.final_residual);
+}
+
+StepStatus FemSolid::DoStep(double /*t*/, double dt) {
+  GatherTargets();
+  if (params_.scheme == ImplicitSchemeKind::kNewmark && step_count() == 0) InitialAcceleration();
+  x_begin_ = scheme_.x();
+  failure_detail_.clear();
+  const auto start = Clock::now();
+  const double solve_before = profile_.assembly_seconds;
+  StepStatus status = StepStatus::Ok();
+  const int pieces = std::max(1, params_.load_steps);
+  for (int k = 0; k < pieces && status.ok(); ++k)
+    status = Advance(double(k) / pieces, double(k + 1) / pieces, dt, 0);
+  profile_.solve_seconds += Seconds(start) - (profile_.assembly_seconds - solve_before);
+  ++profile_.steps;
+  UpdatePositions();
+  if (!status.ok()) return status;
+  f_nodal_prev_ = f_nodal_new_;
+  pressure_prev_ = pressure_new_;
+  traction_prev_ = traction_new_;
+  if (!scheme_.x().allFinite() || !scheme_.v().allFinite())
+    return StepStatus::Diverged("non-finite position or velocity");
+  return StepStatus::Ok();
+}
+
+void FemSolid::UpdatePositions() {
+  x_ = rest_ + scheme_.x();
+  positions_ = Eigen::Map<const Points>(x_.data(), 3, num_nodes());
+}
+
+double FemSolid::StrainEnergy() const {
+  double energy = 0;
+  for (Index e = 0; e < num_elements(); ++e)
+    energy += assembly_.volume(e) *
+              law_->Energy(assembly_.DeformationGradient(e, u().data()), PointOf(e));
+  return energy;
+}
+
+double FemSolid::KineticEnergy() const {
+  if (params_.lumped_mass) {
+    double e = 0;
+    for (Index i = 0; i < num_nodes(); ++i)
+      e += 0.5 * lumped_mass_[i] * v().segment<3>(3 * i).squaredNorm();
+    return e;
+  }
+  SymmetricSpMV(mass_, v(), work_);
+  return 0.5 * v().dot(work_);
+}
+
+double FemSolid::GravityEnergy() const {
+  double e = 0;
+  for (Index i = 0; i < num_nodes(); ++i)
+    e -= lumped_mass_[i] * params_.gravity.dot(u().segment<3>(3 * i));
+  return e;
+}
+
+Index FemSolid::CountInvertedElements() const {
+  Index count = 0;
+  for (Index e = 0; e < num_elements(); ++e)
+    if (assembly_.DeformationGradient(e, u().data()).determinant() <= 0) ++count;
+  return count;
+}
+
+Mat3 FemSolid::CauchyStress(Index e) const {
+  const Mat3 F = assembly_.DeformationGradient(e, u().data());
+  Mat3 P;
+  const double j = F.determinant();
+  if (j <= 0 || !law_->Stress(F, PointOf(e), P)) return Mat3::Zero();
+  return P * F.transpose() / j;
+}
+
+void FemSolid::DoReadField(FieldId id, Eigen::Ref<Eigen::MatrixXd> out) const {
+  const Index n = num_nodes();
+  const auto& v2n = boundary().vertex_to_node;
+  if (id == f_position_) {
+    out = positions_;
+  } else if (id == f_velocity_) {
+    out = Eigen::Map<const Points>(v().data(), 3, n);
+  } else if (id == f_displacement_) {
+    out = positions_ - domain().nodes;
+  } else if (id == f_external_force_) {
+    out = external_force_;
+  } else if (id == f_bposition_ || id == f_bvelocity_ || id == f_bdisplacement_) {
+    for (std::size_t j = 0; j < v2n.size(); ++j) {
+      const Index node = v2n[j];
+      const auto col = static_cast<Index>(j);
+      if (id == f_bposition_) out.col(col) = positions_.col(node);
+      if (id == f_bvelocity_) out.col(col) = v().segment<3>(3 * node);
+      if (id == f_bdisplacement_) out.col(col) = positions_.col(node) - domain().nodes.col(node);
+    }
+  } else if (id == f_reaction_) {
+    // Reaction = M a + C v + f_int − f_ext on constrained axes, at the current state.
+    out.setZero();
+    if (!AssembleElements(u().data(), f_int_, nullptr)) return;
+    auto* self = const_cast<FemSolid*>(this);  // load buffers only; the state is untouched
+    const double s = self->s_;
+    self->s_ = 1;
+    self->AssembleExternal(u().data());
+    self->s_ = s;
+    work2_ = f_int_ - f_ext_;
+    if (params_.scheme != ImplicitSchemeKind::kStatic) {
+      if (params_.lumped_mass) {
+        for (Index i = 0; i < n; ++i)
+          work2_.segment<3>(3 * i) += lumped_mass_[i] * a().segment<3>(3 * i);
+      } else {
+        SymmetricSpMV(mass_, a(), work_);
+        work2_ += work_;
+      }
+    }
+    const BoundaryConditions& bcs = boundary_conditions();
+    for (std::size_t j = 0; j < v2n.size(); ++j) {
+      const auto col = static_cast<Index>(j);
+      for (int a = 0; a < 3; ++a)
+        if (bcs.kind(col, a) != ConstraintKind::kFree) out(a, col) = work2_[3 * v2n[j] + a];
+    }
+  } else if (id == f_fibre_) {
+    for (Index e = 0; e < num_elements(); ++e)
+      out.col(e) = axes_.empty() ? Vec3(FrameFrom(params_.fibre, params_.sheet).col(0))
+                                 : Vec3(axes_[static_cast<std::size_t>(e)].col(0));
+  } else if (id == f_active_) {
+    for (Index e = 0; e < num_elements(); ++e) out(0, e) = PointOf(e).active_tension;
+  } else if (id == f_nodal_active_) {
+    out = nodal_active_tension_.transpose();
+  } else if (id == f_von_mises_) {
+    for (Index e = 0; e < num_elements(); ++e) {
+      const Mat3 s = CauchyStress(e);
+      const Mat3 dev = s - s.trace() / 3.0 * Mat3::Identity();
+      out(0, e) = std::sqrt(1.5 * dev.squaredNorm());
+    }
+  } else if (id == f_jacobian_) {
+    for (Index e = 0; e < num_elements(); ++e)
+      out(0, e) = assembly_.DeformationGradient(e, u().data()).determinant();
+  } else if (id == f_kinetic_) {
+    out(0, 0) = KineticEnergy();
+  } else if (id == f_strain_energy_) {
+    out(0, 0) = StrainEnergy();
+  } else if (id == f_newton_) {
+    out(0, 0) = last_newton_.iterations;
+  } else if (id == f_inverted_) {
+    out(0, 0) = static_cast<double>(CountInvertedElements());
+  }
+}
+
+void FemSolid::DoWriteField(FieldId id, const Eigen::Ref<const Eigen::MatrixXd>& in) {
+  const Index n = num_nodes();
+  if (id == f_position_) {
+    positions_ = in;
+    scheme_.SetPositions(Eigen::Map<const VecX>(positions_.data(), 3 * n) - rest_);
+    UpdatePositions();
+  } else if (id == f_velocity_) {
+    scheme_.SetVelocity(Eigen::Map<const VecX>(in.data(), 3 * n));
+  } else if (id == f_external_force_) {
+    external_force_ = in;
+  } else if (id == f_fibre_) {
+    if (axes_.empty())
+      axes_.assign(static_cast<std::size_t>(num_elements()),
+                   FrameFrom(params_.fibre, params_.sheet));
+    for (Index e = 0; e < num_elements(); ++e) {
+      Mat3& axes = axes_[static_cast<std::size_t>(e)];
+      const Vec3 fibre = in.col(e);
+      if (fibre.squaredNorm() > 0) axes = FrameFrom(fibre, axes.col(1));
+    }
+  } else if (id == f_active_) {
+    active_tension_ = in.row(0).transpose();
+    active_from_nodes_ = false;
+  } else if (id == f_nodal_active_) {
+    nodal_active_tension_ = in.row(0).transpose();
+    active_from_nodes_ = true;
+  }
+}
+
+}  // namespace gipsi

@@ -1,0 +1,184 @@
+#pragma once
+/// @file
+/// `FemSolid`: nonlinear solid mechanics on a linear (P1) tetrahedral mesh — GiPSi's FEM
+/// modeling tool. Any solid law (solid_material.h): small-strain linear, corotational,
+/// St. Venant–Kirchhoff, neo-Hookean, Guccione myocardium with fibres and active tension.
+///
+/// Equations (x node positions, 3N): M a + C v + f_int(x) = f_ext(x), with
+///   f_int,a = Σ_e V_e P(F_e) ∇N_a          (P the law's first Piola–Kirchhoff stress)
+///   f_ext   = gravity (ρ g per node mass) + nodal forces + external_force field
+///             + follower pressure and traction on boundary triangles (surface_loads.h)
+///   M lumped (ρV/4 per node) or consistent (ρV/20 (1 + δ_ab)), C = α M + β K_n (Rayleigh, K_n
+///   the tangent at the start of the step, so the damping force is linear in v within a step).
+/// Time stepping by any ImplicitScheme (Static, BackwardEuler, BDF2, Newmark) and Newton with
+/// line search; the tangent is consistent (law tangents, symmetric part of the load tangent).
+/// A step whose Newton solve fails is bisected (loads interpolated linearly over the step) up
+/// to `max_bisections` times before the step is reported failed with a diagnostic.
+/// Kinematic boundary conditions (displacement, velocity per axis on boundary vertices) are
+/// imposed exactly; reaction forces are readable as the boundary field "reaction_force".
+/// Units: SI (m, kg, s, N, Pa).
+
+#include <array>
+#include <chrono>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "gipsi/core/registry.h"
+#include "gipsi/core/sim_object.h"
+#include "gipsi/models/fem/solid_material.h"
+#include "gipsi/models/fem/tet_assembly.h"
+#include "gipsi/numerics/implicit_scheme.h"
+#include "gipsi/numerics/newton.h"
+
+namespace gipsi {
+
+/// Parameters. Plain struct with defaults.
+struct FemParams {
+  double density = 1000;                          ///< kg/m³
+  std::shared_ptr<const SolidMaterial> material;  ///< required
+  bool lumped_mass = false;                       ///< else consistent mass
+  double rayleigh_mass = 0;                       ///< α [1/s]
+  double rayleigh_stiffness = 0;                  ///< β [s]
+  Vec3 gravity = Vec3(0, 0, -9.81);               ///< m/s²
+  ImplicitSchemeKind scheme = ImplicitSchemeKind::kBackwardEuler;
+  double newmark_beta = 0.25, newmark_gamma = 0.5;  ///< Newmark parameters
+  NewtonOptions newton;
+  LinearSolverOptions linear_solver;
+  int load_steps = 1;          ///< increments per step (quasi-static load stepping)
+  int max_bisections = 6;      ///< halvings of a failed increment before the step fails
+  Vec3 fibre = Vec3::UnitX();  ///< uniform fibre direction (reference configuration)
+  Vec3 sheet = Vec3::UnitY();  ///< uniform sheet direction (orthogonalised against the fibre)
+};
+
+/// Time spent in one object's steps, for `gipsi run --profile`. Plain struct.
+struct FemProfile {
+  double assembly_seconds = 0;  ///< residual and tangent assembly
+  double solve_seconds = 0;     ///< linear solves (including factorisations)
+  std::int64_t newton_iterations = 0;
+  std::int64_t linear_iterations = 0;
+  std::int64_t steps = 0;
+};
+
+/// Not copyable or movable (a SimObject).
+class FemSolid final : public SimObject, private NonlinearSystem {
+ public:
+  /// Throws InputError for a mesh without tets, inverted/degenerate tets, a missing material,
+  /// or a non-positive density.
+  FemSolid(std::string name, std::shared_ptr<const Mesh> domain, FemParams params);
+
+  [[nodiscard]] std::string_view type_name() const override { return "FemSolid"; }
+  [[nodiscard]] const Points& domain_positions() const override { return positions_; }
+  [[nodiscard]] std::string failure_detail() const override { return failure_detail_; }
+
+  [[nodiscard]] const FemParams& params() const { return params_; }
+  [[nodiscard]] const TetAssembly& assembly() const { return assembly_; }
+  [[nodiscard]] Index num_nodes() const { return domain().num_nodes(); }
+  [[nodiscard]] Index num_elements() const { return assembly_.num_elements(); }
+  /// Positions (3N, node-major), updated after every step and field write.
+  [[nodiscard]] const VecX& x() const { return x_; }
+  /// Displacements from the rest positions (3N): the state the integrator advances.
+  [[nodiscard]] const VecX& u() const { return scheme_.x(); }
+  /// Velocities and accelerations (3N).
+  [[nodiscard]] const VecX& v() const { return scheme_.v(); }
+  [[nodiscard]] const VecX& a() const { return scheme_.a(); }
+  /// Statistics of the last Newton solve.
+  [[nodiscard]] const NewtonStats& last_newton() const { return last_newton_; }
+  [[nodiscard]] const FemProfile& profile() const { return profile_; }
+
+  /// Internal forces f_int(x) (3N) for positions x (3N); false if an element is outside its
+  /// law's domain. For tests and connectors.
+  bool CalcInternalForces(const VecX& x, VecX& f) const;
+  /// The tangent stiffness K = ∂f_int/∂x at positions x, in assembly().MakePattern() layout.
+  bool CalcStiffness(const VecX& x, SparseMatrix& K) const;
+  /// Σ_e V_e W(F_e) [J].
+  [[nodiscard]] double StrainEnergy() const;
+  /// ½ vᵀ M v [J].
+  [[nodiscard]] double KineticEnergy() const;
+  /// Gravitational potential energy relative to the rest configuration, −Σ m g·(x − X) [J].
+  [[nodiscard]] double GravityEnergy() const;
+  /// Number of elements with det F <= 0 at the current state.
+  [[nodiscard]] Index CountInvertedElements() const;
+  /// Cauchy stress of element e at the current state (zero if outside the law's domain).
+  [[nodiscard]] Mat3 CauchyStress(Index e) const;
+
+ protected:
+  StepStatus DoStep(double t, double dt) override;
+  void DoReadField(FieldId id, Eigen::Ref<Eigen::MatrixXd> out) const override;
+  void DoWriteField(FieldId id, const Eigen::Ref<const Eigen::MatrixXd>& in) override;
+
+ private:
+  // NonlinearSystem: residual of the current increment as a function of d = x − x_n.
+  bool CalcResidual(const VecX& d, VecX& r) override;
+  bool CalcResidualAndJacobian(const VecX& d, VecX& r, SparseMatrix& J) override;
+  [[nodiscard]] double force_scale() const override { return force_scale_; }
+  [[nodiscard]] double residual_floor() const override { return residual_floor_; }
+
+  /// f_int (and K values if `k_values` is not null) at displacements u; marks invalid
+  /// elements.
+  bool AssembleElements(const double* u, VecX& f, double* k_values) const;
+  /// External loads at displacements u for the current load fraction into f_ext_.
+  void AssembleExternal(const double* u);
+  /// Refreshes x_ and positions_ from the displacements.
+  void UpdatePositions();
+  /// Residual from f_int_ and f_ext_ plus inertia and damping for increment d.
+  void FinishResidual(const VecX& d, VecX& r);
+  /// Reads the boundary conditions into the step's targets.
+  void GatherTargets();
+  StepStatus Advance(double s0, double s1, double dt, int depth);
+  [[nodiscard]] MaterialPoint PointOf(Index e) const;
+  void InitialAcceleration();
+
+  FemParams params_;
+  TetAssembly assembly_;
+  const SolidMaterial* law_ = nullptr;
+  std::vector<Mat3> axes_;     // per element, empty if the law needs none and none were set
+  VecX active_tension_;        // per element [Pa]
+  VecX nodal_active_tension_;  // per node [Pa], used when active_from_nodes_
+  bool active_from_nodes_ = false;
+  VecX lumped_mass_;        // per node
+  SparseMatrix mass_;       // consistent mass (pattern layout); empty values if lumped
+  SparseMatrix jac_;        // Newton matrix
+  SparseMatrix damping_k_;  // K_n for Rayleigh β
+  ImplicitScheme scheme_, saved_scheme_;
+  std::unique_ptr<NewtonSolver> newton_;
+  NewtonStats last_newton_;
+  FemProfile profile_;
+
+  // Loads: previous step's (s = 0) and this step's (s = 1) values, interpolated at s_.
+  VecX f_nodal_prev_, f_nodal_new_;  // 3N: gravity + nodal forces + external_force
+  VecX pressure_prev_, pressure_new_;
+  Points traction_prev_, traction_new_;
+  bool have_prev_loads_ = false;
+  double s_ = 1;
+  Points external_force_;  // field, 3 by N
+  // Constraints: mask per dof, displacement target (absolute position) or velocity.
+  std::vector<std::uint8_t> constraint_;  // 0 free, 1 displacement, 2 velocity
+  VecX target_, x_begin_;
+  std::vector<int> constrained_dofs_;
+  std::vector<std::array<int, 3>> face_local_;  // local indices of face vertices in its tet
+  bool first_iteration_ = true;
+  double force_scale_ = 0;
+
+  // Work buffers (3N unless noted).
+  mutable VecX f_int_, f_ext_, work_, work2_;
+  mutable std::vector<std::uint8_t> invalid_;  // per element
+  mutable VecX element_force_sum_;             // per element Σ|f_e| (round-off floor)
+  mutable double residual_floor_ = 0;
+  double jacobian_norm_ = 0;  // largest absolute row sum of the last Jacobian
+  mutable Index first_invalid_ = -1;
+  VecX d_;
+  VecX rest_;  // 3N rest positions
+  VecX x_;     // 3N current positions
+  Points positions_;
+  std::string failure_detail_;
+
+  FieldId f_position_, f_velocity_, f_displacement_, f_external_force_, f_bposition_, f_bvelocity_,
+      f_bdisplacement_, f_reaction_, f_fibre_, f_active_, f_nodal_active_, f_von_mises_,
+      f_jacobian_, f_kinetic_, f_strain_energy_, f_newton_, f_inverted_;
+};
+
+/// Registers "FemSolid".
+void RegisterFemSolid(TypeRegistry& registry);
+
+}  // namespace gipsi

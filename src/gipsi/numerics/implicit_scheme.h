@@ -1,0 +1,78 @@
+#pragma once
+/// @file
+/// Implicit time-stepping schemes for second-order (mechanical) systems
+///     M a + C v + f_int(x) = f_ext(x),
+/// written so that any of them reduces a step to one nonlinear solve for the displacement
+/// increment d = x_{n+1} − x_n: every scheme makes the new velocity and acceleration affine in d,
+///     v_{n+1} = c_v d + v̂,   a_{n+1} = c_a d + â,
+/// so the residual is r(d) = M (c_a d + â) + C (c_v d + v̂) + f_int − f_ext and its Jacobian is
+/// c_a M + c_v C + K. Schemes:
+///  - Static:        c_a = c_v = 0 (quasi-static equilibrium; v = a = 0).
+///  - BackwardEuler: v = d/Δt, a = (v − v_n)/Δt. First order, strongly damped (L-stable).
+///  - BDF2:          v = (3 x_{n+1} − 4 x_n + x_{n−1})/(2Δt), a likewise from velocities.
+///                   Second order, L-stable; falls back to backward Euler for the first step and
+///                   whenever the step size changed.
+///  - Newmark:       x_{n+1} = x_n + Δt v_n + Δt²((½ − β) a_n + β a_{n+1}),
+///                   v_{n+1} = v_n + Δt((1 − γ) a_n + γ a_{n+1}); β = ¼, γ = ½ (average
+///                   acceleration) is second order and conserves the energy of linear systems.
+///                   (N. M. Newmark, J. Eng. Mech. Div. ASCE 85(3):67–94, 1959.)
+
+#include <string_view>
+
+#include "gipsi/base/math.h"
+
+namespace gipsi {
+
+enum class ImplicitSchemeKind { kStatic, kBackwardEuler, kBdf2, kNewmark };
+
+/// Name used in scene files: "Static", "BackwardEuler", "BDF2", "Newmark".
+std::string_view ToString(ImplicitSchemeKind kind);
+
+/// Scheme state: the history it needs (x_n, v_n, a_n, x_n − x_{n−1}, v_{n−1}). Copyable (for
+/// rolling back a failed step); allocation-free after `Reset`.
+class ImplicitScheme {
+ public:
+  ImplicitScheme() = default;
+  ImplicitScheme(ImplicitSchemeKind kind, double newmark_beta = 0.25, double newmark_gamma = 0.5);
+
+  [[nodiscard]] ImplicitSchemeKind kind() const { return kind_; }
+  /// Order of accuracy in time (0 for Static).
+  [[nodiscard]] int order() const;
+
+  /// Starts from positions x (3N), velocities v and accelerations a; forgets older history.
+  void Reset(const VecX& x, const VecX& v, const VecX& a);
+  /// Prepares a step of size dt > 0: sets c_a, c_v, â, v̂ (allocation-free).
+  void Begin(double dt);
+  [[nodiscard]] double c_a() const { return c_a_; }
+  [[nodiscard]] double c_v() const { return c_v_; }
+  [[nodiscard]] const VecX& a_hat() const { return a_hat_; }
+  [[nodiscard]] const VecX& v_hat() const { return v_hat_; }
+  /// The increment that gives velocity `v_target` on one degree of freedom (velocity-driven
+  /// boundary conditions); for Static, dt · v_target.
+  [[nodiscard]] double IncrementForVelocity(Index dof, double v_target) const;
+  /// Accepts the step with increment d: updates x_n, v_n, a_n and the history.
+  void Commit(const VecX& d);
+
+  [[nodiscard]] const VecX& x() const { return x_; }
+  [[nodiscard]] const VecX& v() const { return v_; }
+  [[nodiscard]] const VecX& a() const { return a_; }
+  /// Overwrites the current velocities (a field write); drops multistep history.
+  void SetVelocity(const VecX& v);
+  /// Overwrites the current positions (a field write); drops multistep history.
+  void SetPositions(const VecX& x);
+  /// Overwrites the current accelerations (Newmark's initial a_0).
+  void SetAcceleration(const VecX& a) { a_ = a; }
+
+ private:
+  ImplicitSchemeKind kind_ = ImplicitSchemeKind::kBackwardEuler;
+  double beta_ = 0.25, gamma_ = 0.5;
+  VecX x_, v_, a_;
+  VecX dx_prev_, v_prev_;  // x_n − x_{n−1}, v_{n−1}
+  double dt_prev_ = 0;     // 0: no usable history
+  double dt_ = 0;
+  bool bdf2_now_ = false;
+  double c_a_ = 0, c_v_ = 0;
+  VecX a_hat_, v_hat_;
+};
+
+}  // namespace gipsi

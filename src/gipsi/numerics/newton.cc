@@ -1,0 +1,134 @@
+#include "gipsi/numerics/newton.h"
+
+#include <cmath>
+#include <utility>
+
+#include <fmt/format.h>
+
+#include "gipsi/base/error.h"
+
+namespace gipsi {
+
+NewtonSolver::NewtonSolver(NewtonOptions options, std::unique_ptr<LinearSolver> linear)
+    : options_(options), linear_(std::move(linear)) {
+  GIPSI_CHECK(linear_ != nullptr && options_.max_iterations >= 1);
+}
+
+void NewtonSolver::Prepare(const SparseMatrix& pattern) {
+  const Index n = pattern.rows();
+  r_.setZero(n);
+  r_trial_.setZero(n);
+  delta_.setZero(n);
+  d_trial_.setZero(n);
+  rhs_.setZero(n);
+  linear_->AnalyzePattern(pattern);
+}
+
+NewtonStats NewtonSolver::Solve(NonlinearSystem& system, VecX& d, SparseMatrix& J) {
+  NewtonStats stats;
+  if (!system.CalcResidualAndJacobian(d, r_, J)) {
+    stats.inadmissible = true;
+    return stats;
+  }
+  double norm = r_.norm();
+  stats.initial_residual = norm;
+  stats.final_residual = norm;
+  stats.residual_history[0] = norm;
+  const double reference = std::max(norm, system.force_scale());
+  auto done = [&](double residual) {
+    return !options_.fixed_iterations &&
+           residual <= std::max(options_.tolerance * reference, system.residual_floor());
+  };
+  if (!std::isfinite(norm)) return stats;
+  if (done(norm) || reference == 0) {
+    stats.converged = true;
+    return stats;
+  }
+  delta_.setZero();
+  for (int it = 1; it <= options_.max_iterations; ++it) {
+    stats.iterations = it;
+    if (!linear_->Factorize(J)) {
+      stats.linear_failure = true;
+      return stats;
+    }
+    rhs_ = -r_;
+    delta_.setZero();
+    const LinearSolveStats ls = linear_->Solve(rhs_, delta_);
+    stats.linear_iterations += ls.iterations;
+    stats.refactorizations += ls.refactorized ? 1 : 0;
+    if (!ls.converged || !delta_.allFinite()) {
+      stats.linear_failure = true;
+      return stats;
+    }
+    const bool last_fixed = options_.fixed_iterations && it == options_.max_iterations;
+    if (last_fixed && !options_.line_search) {
+      d += delta_;
+      stats.converged = true;  // accepted by definition in interactive mode
+      return stats;
+    }
+    // Backtracking line search on ‖r‖.
+    double alpha = 1;
+    bool accepted = false;
+    double trial_norm = 0;
+    const int tries = options_.line_search ? options_.max_line_search_steps : 1;
+    for (int ls_step = 0; ls_step < tries; ++ls_step, alpha *= 0.5) {
+      d_trial_ = d + alpha * delta_;
+      if (!system.CalcResidual(d_trial_, r_trial_)) continue;
+      trial_norm = r_trial_.norm();
+      if (!std::isfinite(trial_norm)) continue;
+      if (!options_.line_search || trial_norm <= (1 - 1e-4 * alpha) * norm) {
+        accepted = true;
+        break;
+      }
+    }
+    if (!accepted) {
+      // No decrease: take the full step anyway if it is admissible (Newton may need to climb
+      // out of a poor start); otherwise report the failure.
+      d_trial_ = d + delta_;
+      if (!system.CalcResidual(d_trial_, r_trial_) || !r_trial_.allFinite()) {
+        stats.inadmissible = true;
+        return stats;
+      }
+      trial_norm = r_trial_.norm();
+    }
+    d.swap(d_trial_);
+    norm = trial_norm;
+    stats.final_residual = norm;
+    if (it < NewtonStats::kHistory) stats.residual_history[static_cast<std::size_t>(it)] = norm;
+    const double step = delta_.lpNorm<Eigen::Infinity>();  // the full Newton correction
+    const double step_tolerance =
+        std::max(options_.increment_tolerance,
+                 options_.relative_increment_tolerance * d.lpNorm<Eigen::Infinity>());
+    if (done(norm) ||
+        (!options_.fixed_iterations && step_tolerance > 0 && step <= step_tolerance)) {
+      r_.swap(r_trial_);
+      stats.converged = true;
+      return stats;
+    }
+    if (last_fixed) {
+      r_.swap(r_trial_);
+      stats.converged = true;
+      return stats;
+    }
+    if (!system.CalcResidualAndJacobian(d, r_, J)) {
+      stats.inadmissible = true;
+      return stats;
+    }
+  }
+  return stats;
+}
+
+std::string Describe(const NewtonStats& stats, const NewtonOptions& options) {
+  std::string history;
+  for (int i = 0; i <= std::min(stats.iterations, NewtonStats::kHistory - 1); ++i)
+    history +=
+        fmt::format("{}{:.2e}", i ? " " : "", stats.residual_history[static_cast<std::size_t>(i)]);
+  const char* why = stats.inadmissible ? "no admissible state (inverted elements?)"
+                    : stats.linear_failure
+                        ? "the linear solve failed (matrix not positive definite?)"
+                        : "did not converge";
+  return fmt::format("Newton: {} after {} iteration(s) (tolerance {:.1e}); |r|: {}", why,
+                     stats.iterations, options.tolerance, history);
+}
+
+}  // namespace gipsi
