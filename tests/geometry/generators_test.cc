@@ -125,3 +125,26 @@ TEST(TriangleSheet, RejectsParallelEdgesAndZeroCells) {
 
 }  // namespace
 }  // namespace gipsi
+
+namespace gipsi {
+namespace {
+
+TEST(TetBox, FiveTetSplitConformsAndFillsTheBox) {
+  const Mesh box = MakeTetBox(Vec3(0, 0, 0), Vec3(2, 3, 1), {3, 4, 2}, HexSplit::kFive);
+  EXPECT_EQ(box.num_tets(), 5 * 3 * 4 * 2);
+  double volume = 0;
+  for (Index e = 0; e < box.num_tets(); ++e) {
+    const double v = TetSignedVolume(box.nodes.col(box.tets(0, e)), box.nodes.col(box.tets(1, e)),
+                                     box.nodes.col(box.tets(2, e)), box.nodes.col(box.tets(3, e)));
+    ASSERT_GT(v, 0) << "tet " << e;
+    volume += v;
+  }
+  EXPECT_NEAR(volume, 6.0, 1e-12);
+  // Conforming: every boundary face of the tet set lies on the box surface (a mismatched face
+  // diagonal between neighbouring cells would leave interior faces used once).
+  const BoundarySurface b = ExtractTetBoundary(box.nodes, box.tets);
+  EXPECT_EQ(b.num_triangles(), 2 * 2 * (3 * 4 + 3 * 2 + 4 * 2));
+}
+
+}  // namespace
+}  // namespace gipsi

@@ -23,6 +23,10 @@ namespace gipsi {
 /// Precomputed data for one tet mesh. Immutable after construction; copyable and movable.
 class TetAssembly {
  public:
+  /// Loops over fewer elements run on the calling thread: starting a parallel region costs
+  /// more than assembling a few hundred elements (and much more on a loaded machine).
+  static constexpr int kMinParallelElements = 1024;
+
   /// Throws InputError naming the first elements if any tet is degenerate or inverted
   /// (non-positive rest volume), or if the mesh has no tets.
   explicit TetAssembly(const Mesh& mesh);
@@ -70,7 +74,7 @@ class TetAssembly {
     for (int c = 0; c < num_colours(); ++c) {
       const int begin = colour_start_[static_cast<std::size_t>(c)];
       const int end = colour_start_[static_cast<std::size_t>(c) + 1];
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (end - begin >= kMinParallelElements)
       for (int k = begin; k < end; ++k) fn(static_cast<Index>(colour_elements_[k]));
     }
   }
@@ -78,7 +82,7 @@ class TetAssembly {
   template <class Fn>
   void ForEachElement(Fn&& fn) const {
     const int n = static_cast<int>(num_elements());
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (n >= kMinParallelElements)
     for (int e = 0; e < n; ++e) fn(static_cast<Index>(e));
   }
 
