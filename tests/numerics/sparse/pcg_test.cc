@@ -8,6 +8,8 @@
 #include <string>
 
 #include <gtest/gtest.h>
+#include <Eigen/IterativeLinearSolvers>
+#include <Eigen/OrderingMethods>
 
 #include "gipsi/numerics/sparse/linear_solver.h"
 #include "gipsi/numerics/sparse/vector_ops.h"
@@ -116,6 +118,23 @@ TEST(Pcg, NonFiniteInitialGuessStopsWithoutIterating) {
   EXPECT_FALSE(stats.converged);
   EXPECT_EQ(stats.iterations, 0);
   EXPECT_FALSE(std::isfinite(stats.relative_residual));
+}
+
+// The "ic" preconditioner hands Eigen's IncompleteCholesky<Lower> the full symmetric matrix
+// (PCG needs both triangles for its SpMV). It must read only the lower triangle: the result
+// equals that of the lower triangle alone, bit for bit.
+TEST(Pcg, IncompleteCholeskyOfFullMatrixEqualsThatOfItsLowerTriangle) {
+  const SparseMatrix A = testing::TestLattice();
+  const SparseMatrix lower = A.triangularView<Eigen::Lower>();
+  Eigen::IncompleteCholesky<double, Eigen::Lower, Eigen::AMDOrdering<int>> from_full, from_lower;
+  from_full.compute(A);
+  from_lower.compute(lower);
+  ASSERT_EQ(from_full.info(), Eigen::Success);
+  ASSERT_EQ(from_lower.info(), Eigen::Success);
+  const VecX r = testing::RandomVector(A.rows(), 8);
+  const VecX z_full = from_full.solve(r);
+  const VecX z_lower = from_lower.solve(r);
+  EXPECT_EQ(std::memcmp(z_full.data(), z_lower.data(), sizeof(double) * z_full.size()), 0);
 }
 
 // A matrix with a negative diagonal entry is not SPD: Jacobi refuses it at Factorize time.

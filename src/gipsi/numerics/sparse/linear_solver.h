@@ -28,10 +28,10 @@ namespace gipsi {
 using SparseMatrix = Eigen::SparseMatrix<double, Eigen::ColMajor, int>;
 
 /// y = A x for a symmetric A stored in full (both triangles); parallel over rows (OpenMP,
-/// static schedule: the same bits for the same thread count; in fact each y[j] is one sequential
-/// sum, so the bits do not depend on the thread count either). Preconditions (checked): A is
-/// square and compressed, x.size() == y.size() == A.rows() (y is not resized), x and y are
-/// distinct vectors. Allocates nothing.
+/// static schedule: the same bits for the same thread count; in fact each y[j] is summed by one
+/// thread in a fixed order, so the bits do not depend on the thread count either). Preconditions
+/// (checked): A is square and compressed, x.size() == y.size() == A.rows() (y is not resized), x
+/// and y are distinct vectors. Allocates nothing.
 void SymmetricSpMV(const SparseMatrix& A, const VecX& x, VecX& y);
 
 /// Which solver and how hard it works. Plain struct.
