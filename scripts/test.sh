@@ -6,6 +6,9 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/install-deps.sh
 
+# ccache keys on paths relative to the checkout, so fresh clones reuse earlier builds.
+export CCACHE_BASEDIR="$PWD"
+
 # Warnings are errors in CI (CI=true), and only warnings elsewhere.
 export GIPSI_WERROR=OFF
 if [ "${CI:-}" = "true" ]; then export GIPSI_WERROR=ON; fi
