@@ -215,8 +215,8 @@ Mesh BuildMesh(const JsonNode& node, const std::filesystem::path& base_dir) {
           if (n != 5 && n != 6) per_cell->Expected("5 or 6");
           split = n == 5 ? HexSplit::kFive : HexSplit::kSix;
         }
-        mesh = MakeTetBox(node.Vector3("min"), node.Vector3("max"), Cells3(node.At("cells")),
-                          split);
+        mesh =
+            MakeTetBox(node.Vector3("min"), node.Vector3("max"), Cells3(node.At("cells")), split);
       } else if (kind == "sheet") {
         auto cells = node.At("cells").AsInts();
         if (cells.size() != 2 || cells[0] < 1 || cells[1] < 1 || cells[0] > 2000 || cells[1] > 2000)

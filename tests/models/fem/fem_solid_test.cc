@@ -162,10 +162,11 @@ TEST(FemSolid, CantileverDeflectionConvergesToBeamTheory) {
     EXPECT_GT(error[2], -0.02);  // never more flexible than the continuum beyond its 3-D effects
     const double order01 = std::log2(error[0] / error[1]);
     const double order12 = std::log2(error[1] / error[2]);
-    std::printf("cantilever (%s): tip %.5g %.5g %.5g m, exact %.5g m, errors %.1f %.1f %.1f %%, "
-                "observed orders %.2f %.2f\n",
-                gravity ? "gravity" : "tip load", d[0], d[1], d[2], exact, 100 * error[0],
-                100 * error[1], 100 * error[2], order01, order12);
+    std::printf(
+        "cantilever (%s): tip %.5g %.5g %.5g m, exact %.5g m, errors %.1f %.1f %.1f %%, "
+        "observed orders %.2f %.2f\n",
+        gravity ? "gravity" : "tip load", d[0], d[1], d[2], exact, 100 * error[0], 100 * error[1],
+        100 * error[2], order01, order12);
     EXPECT_GT(order01, 1.0);
     EXPECT_GT(order12, order01);
     EXPECT_LT(error[2], 0.10);
