@@ -73,8 +73,36 @@ gipsi::Scene Load(const std::string& file, const std::vector<std::string>& plugi
   return gipsi::LoadScene(file, registry);
 }
 
+/// `gipsi run --profile`: where the wall time went, per object (with the object's own
+/// breakdown), per connector, and in outputs.
+std::string ProfileTable(const gipsi::Kernel& kernel, double wall_seconds) {
+  const auto& coordinator = kernel.coordinator();
+  auto share = [&](double s) { return wall_seconds > 0 ? 100.0 * s / wall_seconds : 0.0; };
+  std::string table = "profile (wall time):\n";
+  for (std::size_t i = 0; i < coordinator.num_objects(); ++i) {
+    const auto& object = coordinator.object(i);
+    const double s = coordinator.object_seconds(i);
+    table += fmt::format("  object {:<20} {:>10.3f} s {:>5.1f} %\n", object.name(), s, share(s));
+    for (const auto& entry : object.ProfileBreakdown()) {
+      if (entry.unit == "s")
+        table += fmt::format("    {:<27} {:>10.3f} s {:>5.1f} %\n", entry.name, entry.value,
+                             share(entry.value));
+      else
+        table += fmt::format("    {:<27} {:>10.0f}\n", entry.name, entry.value);
+    }
+  }
+  for (std::size_t i = 0; i < coordinator.num_connectors(); ++i) {
+    const double s = coordinator.connector_seconds(i);
+    table += fmt::format("  connector {:<17} {:>10.3f} s {:>5.1f} %\n",
+                         coordinator.connector(i).name(), s, share(s));
+  }
+  table += fmt::format("  outputs (probes, VTU)       {:>10.3f} s {:>5.1f} %\n",
+                       kernel.output_seconds(), share(kernel.output_seconds()));
+  return table;
+}
+
 int Run(const std::string& file, const std::string& out_dir, double until, bool quiet, bool no_vtu,
-        const std::vector<std::string>& plugins) {
+        bool profile, const std::vector<std::string>& plugins) {
   gipsi::TypeRegistry registry;
   gipsi::Scene scene = Load(file, plugins, registry);
   if (until > 0) scene.end_time = until;
@@ -116,7 +144,8 @@ int Run(const std::string& file, const std::string& out_dir, double until, bool 
   for (const auto& [t, what] : kernel.fired_events())
     summary += fmt::format("  event at {:.6g} s: {}\n", t, what);
   summary += fmt::format("outputs:          {}\n", out.string());
-  if (!quiet || !result.ok()) std::cout << summary << std::flush;
+  if (profile) summary += ProfileTable(kernel, result.wall_seconds);
+  if (!quiet || !result.ok() || profile) std::cout << summary << std::flush;
 
   switch (result.outcome) {
     case gipsi::RunResult::Outcome::kCompleted:
@@ -196,7 +225,7 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   std::string scene_file, out_dir, mesh_file;
   double until = 0;
-  bool quiet = false, no_vtu = false, verbose = false;
+  bool quiet = false, no_vtu = false, verbose = false, profile = false;
   std::vector<std::string> plugins;
   app.add_flag("-v,--verbose", verbose, "Log more (debug level)");
 
@@ -208,6 +237,9 @@ int main(int argc, char** argv) {
       ->check(CLI::PositiveNumber);
   run->add_flag("-q,--quiet", quiet, "No progress bar and no summary unless the run fails");
   run->add_flag("--no-vtu", no_vtu, "Do not write VTU/PVD series (probes are still written)");
+  run->add_flag("--profile", profile,
+                "Print where the wall time went: per object (and its own breakdown, e.g. "
+                "assembly and linear solves), per connector, and in outputs");
   run->add_option("--plugin", plugins, "Load a plugin shared library (repeatable)");
 
   auto* validate = app.add_subcommand("validate", "Check a scene without running it");
@@ -226,7 +258,7 @@ int main(int argc, char** argv) {
   CLI11_PARSE(app, argc, argv);
   gipsi::Log().set_level(verbose ? spdlog::level::debug : spdlog::level::info);
   try {
-    if (*run) return Run(scene_file, out_dir, until, quiet, no_vtu, plugins);
+    if (*run) return Run(scene_file, out_dir, until, quiet, no_vtu, profile, plugins);
     if (*validate) return Validate(scene_file, plugins);
     if (*info) return Info(mesh_file);
     if (*types) return Types(plugins);

@@ -97,6 +97,18 @@ TEST(GipsiRun, LiverSceneWritesEmbeddedDisplaySurface) {
   EXPECT_EQ(ReadVtu(out / files.back()).num_triangles(), 4384);
 }
 
+TEST(GipsiRun, ProfileShowsWhereTheTimeWent) {
+  fs::path out = TempDir("cantilever");
+  Result r =
+      Gipsi("run -q --profile " + Scene("cantilever.json") + " --until 0.05 --out " + out.string());
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_THAT(r.output, HasSubstr("profile (wall time):"));
+  EXPECT_THAT(r.output, HasSubstr("object beam"));
+  EXPECT_THAT(r.output, HasSubstr("assembly (residual, tangent)"));
+  EXPECT_THAT(r.output, HasSubstr("linear solves"));
+  EXPECT_THAT(r.output, HasSubstr("outputs (probes, VTU)"));
+}
+
 TEST(GipsiRun, DivergingSceneStopsWithDiagnosticAndKeepsOutputs) {
   fs::path dir = TempDir("diverge");
   {

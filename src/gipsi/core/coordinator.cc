@@ -1,5 +1,7 @@
 #include "gipsi/core/coordinator.h"
 
+#include <chrono>
+
 #include <algorithm>
 #include <cmath>
 #include <set>
@@ -10,6 +12,9 @@
 #include "gipsi/base/json_node.h"
 
 namespace gipsi {
+namespace {
+using Clock = std::chrono::steady_clock;
+}  // namespace
 
 SimObject& Coordinator::AddObject(std::unique_ptr<SimObject> object, double dt) {
   GIPSI_CHECK(object != nullptr);
@@ -105,15 +110,22 @@ std::optional<ScheduleFailure> Coordinator::MacroStep(double t, std::int64_t mac
     if (entry.is_connector) {
       ConnectorSlot& slot = connectors_[entry.index];
       if (macro_index % slot.every != 0) continue;
+      const auto start = Clock::now();
       StepStatus status = slot.connector->Fire(t);
+      slot.seconds += std::chrono::duration<double>(Clock::now() - start).count();
       if (!status.ok()) return ScheduleFailure{status, slot.connector->name(), true, t};
     } else {
       ObjectSlot& slot = objects_[entry.index];
       const double dt = macro_dt_ / slot.substeps;
+      const auto start = Clock::now();
       for (int k = 0; k < slot.substeps; ++k) {
         StepStatus status = slot.object->Step(dt);
-        if (!status.ok()) return ScheduleFailure{status, slot.object->name(), false, t + k * dt};
+        if (!status.ok()) {
+          slot.seconds += std::chrono::duration<double>(Clock::now() - start).count();
+          return ScheduleFailure{status, slot.object->name(), false, t + k * dt};
+        }
       }
+      slot.seconds += std::chrono::duration<double>(Clock::now() - start).count();
       slot.object->SetTime(t + macro_dt_);
     }
   }

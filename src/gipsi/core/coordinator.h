@@ -66,6 +66,9 @@ class Coordinator {
   [[nodiscard]] const Connector& connector(std::size_t i) const {
     return *connectors_[i].connector;
   }
+  /// Wall-clock seconds spent stepping object i / firing connector i so far.
+  [[nodiscard]] double object_seconds(std::size_t i) const { return objects_[i].seconds; }
+  [[nodiscard]] double connector_seconds(std::size_t i) const { return connectors_[i].seconds; }
   /// The object called `name` (dotted names reach into aggregates: "heart.muscle"), or nullptr.
   [[nodiscard]] SimObject* FindObject(std::string_view name) const;
   /// Names of every object (for messages).
@@ -76,10 +79,12 @@ class Coordinator {
     std::unique_ptr<SimObject> object;
     double dt = 0;
     int substeps = 1;
+    double seconds = 0;
   };
   struct ConnectorSlot {
     std::unique_ptr<Connector> connector;
     int every = 1;
+    double seconds = 0;
   };
   struct Entry {
     bool is_connector = false;

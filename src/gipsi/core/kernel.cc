@@ -52,7 +52,10 @@ void Kernel::FireDueEvents(double t) {
 }
 
 void Kernel::Notify(double t) {
+  const auto start = std::chrono::steady_clock::now();
   for (auto& observer : observers_) observer->Observe(*this, t);
+  output_seconds_ +=
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
 RunResult Kernel::Run(double end_time, const ProgressFn& progress) {

@@ -85,6 +85,8 @@ class Kernel {
 
   [[nodiscard]] double time() const { return start_time_ + macro_index_ * macro_dt_; }
   [[nodiscard]] std::int64_t macro_steps() const { return macro_index_; }
+  /// Wall-clock seconds spent in observers (probes, output files) so far.
+  [[nodiscard]] double output_seconds() const { return output_seconds_; }
   /// Descriptions and times of the events fired so far.
   [[nodiscard]] const std::vector<std::pair<double, std::string>>& fired_events() const {
     return fired_;
@@ -103,6 +105,7 @@ class Kernel {
   std::vector<std::unique_ptr<Observer>> observers_;
   std::vector<std::pair<double, std::string>> fired_;
   double macro_dt_ = 0;
+  double output_seconds_ = 0;
   double start_time_ = 0;
   std::int64_t macro_index_ = 0;
   bool started_ = false;

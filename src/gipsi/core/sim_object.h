@@ -99,6 +99,14 @@ class SimObject {
   /// After a failed step, extra context for the diagnostic (an aggregate names the failing
   /// part); empty by default.
   [[nodiscard]] virtual std::string failure_detail() const { return {}; }
+  /// Where the object's step time went, for `gipsi run --profile`: named figures such as
+  /// {"assembly", 1.2, "s"} or {"Newton iterations", 340, ""}. Empty by default.
+  struct ProfileEntry {
+    std::string name;
+    double value = 0;
+    std::string unit;
+  };
+  [[nodiscard]] virtual std::vector<ProfileEntry> ProfileBreakdown() const { return {}; }
   /// Called by the kernel at the start of every macro step (aggregates forward it).
   virtual void BeginMacroStep() { bcs_.ClearCouplingLoads(); }
 

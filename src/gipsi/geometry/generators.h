@@ -53,4 +53,12 @@ Mesh MakeEllipsoidShell(const EllipsoidShellSpec& spec);
 /// inner >= outer, a non-positive size, too many tets, or if Gmsh fails.
 Mesh MakeCylinderShell(double inner_radius, double outer_radius, double height, double mesh_size);
 
+/// Tetrahedralises the volume enclosed by a closed triangle surface (`vertices` 3 by V,
+/// `triangles` 3 by T) with Gmsh: the surface is reparametrised (Gmsh's classifySurfaces and
+/// createGeometry, splitting it at creases sharper than 40°) and remeshed at `mesh_size`, then
+/// the volume is meshed with tets no larger than `mesh_size`. Groups: "surface" (dim 2) and
+/// "volume" (dim 3). Throws InputError if the surface is not a closed manifold Gmsh can mesh,
+/// or for a mesh size giving over 2e7 tets. Thread-safe (the Gmsh mutex).
+Mesh MakeTetsInSurface(const Points& vertices, const Triangles& triangles, double mesh_size);
+
 }  // namespace gipsi

@@ -1,7 +1,8 @@
 /// @file
-/// `MakeEllipsoidShell` and `MakeCylinderShell` through the Gmsh C++ API with the OpenCASCADE
-/// kernel (Debian's libgmsh 4.8 is built with it): solids are made by boolean cuts, meshed in
-/// 3-D, and read back as nodes and linear tets. The boundary is then extracted from the tets
+/// `MakeEllipsoidShell`, `MakeCylinderShell` and `MakeTetsInSurface` through the Gmsh C++ API with
+/// the OpenCASCADE kernel (Debian's libgmsh 4.8 is built with it): solids are made by boolean cuts,
+/// meshed in 3-D, and read back as nodes and linear tets. The boundary is then extracted from the
+/// tets
 /// (`ExtractTetBoundary`, so it is closed and outward) and its triangles are grouped by where
 /// they lie (base plane, inner or outer surface) instead of by Gmsh entity tags, which would
 /// depend on the numbering OpenCASCADE gives the faces after the cuts.
@@ -24,6 +25,7 @@
 
 #include "gipsi/base/error.h"
 #include "gipsi/geometry/boundary.h"
+#include "gipsi/geometry/enclosed_volume.h"
 #include "gipsi/geometry/generators.h"
 #include "gipsi/geometry/quality.h"
 
@@ -151,15 +153,17 @@ void AddBoundaryGroups(Mesh& mesh, const std::vector<std::string>& names,
   mesh.groups = std::move(groups);
 }
 
-/// Runs `build` (which creates and synchronises an OpenCASCADE model) in a Gmsh session,
+/// Runs `build` (which creates an OpenCASCADE model, synchronised here unless `occ_kernel` is
+/// false and `build` synchronises its own built-in-kernel model) in a Gmsh session,
 /// meshes it in 3-D with maximal element size `mesh_size` and reads the tets back. Gmsh
 /// failures become InputError naming `what`.
-Mesh MeshWithGmsh(const std::string& what, double mesh_size, const std::function<void()>& build) {
+Mesh MeshWithGmsh(const std::string& what, double mesh_size, const std::function<void()>& build,
+                  bool occ_kernel = true) {
   GmshSession session;
   try {
     gmsh::model::add("gipsi_shell");
     build();
-    gmsh::model::occ::synchronize();
+    if (occ_kernel) gmsh::model::occ::synchronize();
     gmsh::option::setNumber("Mesh.MeshSizeMax", mesh_size);
     gmsh::option::setNumber("Mesh.MeshSizeMin", 0.0);
     gmsh::model::mesh::generate(3);
@@ -296,6 +300,72 @@ Mesh MakeCylinderShell(double inner_radius, double outer_radius, double height, 
         return std::abs(r - inner_radius) < std::abs(r - outer_radius) ? 0 : 1;
       },
       "wall", what);
+  return mesh;
+}
+
+Mesh MakeTetsInSurface(const Points& vertices, const Triangles& triangles, double mesh_size) {
+  const std::string what = "tetrahedralized surface";
+  CheckPositive(what, "size", mesh_size);
+  if (triangles.cols() < 4 || vertices.cols() < 4)
+    ThrowInputError("", what, "the surface needs at least 4 vertices and 4 triangles");
+  for (Index t = 0; t < triangles.cols(); ++t)
+    for (int a = 0; a < 3; ++a)
+      if (triangles(a, t) < 0 || triangles(a, t) >= vertices.cols())
+        ThrowInputError("", what,
+                        fmt::format("triangle {} refers to vertex {} (have {})", t, triangles(a, t),
+                                    vertices.cols()));
+  // Gmsh cannot fill an open or inconsistently oriented surface; say so before calling it.
+  try {
+    const EnclosedVolume check(triangles, vertices.cols());
+    if (check.num_loops() > 0)
+      ThrowInputError("", what,
+                      fmt::format("the surface is not closed ({} boundary loop(s)); only a "
+                                  "closed surface encloses a volume",
+                                  check.num_loops()));
+  } catch (const InputError& e) {
+    std::string message = e.what();
+    if (message.rfind(what, 0) == 0) throw;
+    ThrowInputError("", what, message);
+  }
+  // Enclosed volume (divergence theorem) bounds the tet count; its sign tells the orientation.
+  double volume = 0;
+  for (Index t = 0; t < triangles.cols(); ++t)
+    volume += vertices.col(triangles(0, t))
+                  .dot(vertices.col(triangles(1, t)).cross(vertices.col(triangles(2, t)))) /
+              6.0;
+  CheckMeshCount(what, std::abs(volume), mesh_size);
+
+  Mesh mesh = MeshWithGmsh(
+      what, mesh_size,
+      [&] {
+        const int surface = gmsh::model::addDiscreteEntity(2);
+        std::vector<std::size_t> node_tags(std::size_t(vertices.cols()));
+        std::vector<double> coords(std::size_t(3 * vertices.cols()));
+        for (Index v = 0; v < vertices.cols(); ++v) {
+          node_tags[std::size_t(v)] = std::size_t(v + 1);
+          for (int a = 0; a < 3; ++a) coords[std::size_t(3 * v + a)] = vertices(a, v);
+        }
+        gmsh::model::mesh::addNodes(2, surface, node_tags, coords);
+        std::vector<std::size_t> tri_nodes(std::size_t(3 * triangles.cols()));
+        for (Index t = 0; t < triangles.cols(); ++t)
+          for (int a = 0; a < 3; ++a)
+            tri_nodes[std::size_t(3 * t + a)] = std::size_t(triangles(a, t) + 1);
+        gmsh::model::mesh::addElementsByType(surface, /*triangle*/ 2, {}, tri_nodes);
+        constexpr double kCrease = 40 * std::numbers::pi / 180;
+        gmsh::model::mesh::classifySurfaces(kCrease, /*boundary=*/true,
+                                            /*forReparametrization=*/true, std::numbers::pi);
+        gmsh::model::mesh::createGeometry();
+        gmsh::vectorpair surfaces;
+        gmsh::model::getEntities(surfaces, 2);
+        std::vector<int> tags;
+        for (const auto& [dim, tag] : surfaces) tags.push_back(tag);
+        const int loop = gmsh::model::geo::addSurfaceLoop(tags);
+        gmsh::model::geo::addVolume({loop});
+        gmsh::model::geo::synchronize();
+      },
+      /*occ_kernel=*/false);
+  AddBoundaryGroups(
+      mesh, {"surface"}, [](const Vec3&, const Vec3&, const Vec3&) { return 0; }, "volume", what);
   return mesh;
 }
 

@@ -190,9 +190,10 @@ std::string ResolvePlugin(const std::string& entry, const std::filesystem::path&
 }
 
 Mesh BuildMesh(const JsonNode& node, const std::filesystem::path& base_dir) {
-  node.CheckKeys({"file", "generate", "scale", "translate", "min", "max", "cells", "origin", "u",
-                  "v", "endo", "epi", "base_z", "size", "inner_radius", "outer_radius", "height",
-                  "tets_per_cell", "description"});
+  node.CheckKeys({"file",         "generate", "scale",         "translate", "min",
+                  "max",          "cells",    "origin",        "u",         "v",
+                  "endo",         "epi",      "base_z",        "size",      "inner_radius",
+                  "outer_radius", "height",   "tets_per_cell", "surface",   "description"});
   Mesh mesh;
   if (node.Has("file") == node.Has("generate"))
     node.Fail("expected exactly one of 'file', 'generate'");
@@ -206,7 +207,8 @@ Mesh BuildMesh(const JsonNode& node, const std::filesystem::path& base_dir) {
     }
   } else {
     JsonNode gen = node.At("generate");
-    std::string kind = gen.AsChoice({"box", "sheet", "ellipsoid_shell", "cylinder_shell"});
+    std::string kind =
+        gen.AsChoice({"box", "sheet", "ellipsoid_shell", "cylinder_shell", "tetrahedralize"});
     try {
       if (kind == "box") {
         HexSplit split = HexSplit::kSix;
@@ -236,6 +238,19 @@ Mesh BuildMesh(const JsonNode& node, const std::filesystem::path& base_dir) {
         spec.base_z = node.Number("base_z", spec.base_z);
         spec.mesh_size = node.Positive("size", spec.mesh_size);
         mesh = MakeEllipsoidShell(spec);
+      } else if (kind == "tetrahedralize") {
+        const JsonNode surface_node = node.At("surface");
+        std::filesystem::path path = surface_node.AsString();
+        if (path.is_relative()) path = base_dir / path;
+        Mesh surface;
+        try {
+          surface = ReadMesh(path);
+        } catch (const InputError& e) {
+          surface_node.Fail(e.what());
+        }
+        if (surface.num_triangles() == 0)
+          surface_node.Fail(fmt::format("'{}' has no triangles to fill", path.string()));
+        mesh = MakeTetsInSurface(surface.nodes, surface.triangles, node.Positive("size"));
       } else {
         mesh = MakeCylinderShell(node.Positive("inner_radius"), node.Positive("outer_radius"),
                                  node.Positive("height"), node.Positive("size"));

@@ -19,6 +19,8 @@ void NewtonSolver::Prepare(const SparseMatrix& pattern) {
   r_.setZero(n);
   r_trial_.setZero(n);
   delta_.setZero(n);
+  warm_.setZero(n);
+  warm_valid_ = false;
   d_trial_.setZero(n);
   rhs_.setZero(n);
   linear_->AnalyzePattern(pattern);
@@ -44,7 +46,6 @@ NewtonStats NewtonSolver::Solve(NonlinearSystem& system, VecX& d, SparseMatrix& 
     stats.converged = true;
     return stats;
   }
-  delta_.setZero();
   for (int it = 1; it <= options_.max_iterations; ++it) {
     stats.iterations = it;
     if (!linear_->Factorize(J)) {
@@ -52,8 +53,17 @@ NewtonStats NewtonSolver::Solve(NonlinearSystem& system, VecX& d, SparseMatrix& 
       return stats;
     }
     rhs_ = -r_;
-    delta_.setZero();
+    // Warm start: the first correction of a solve resembles the previous solve's (consecutive
+    // time steps), later ones shrink towards zero.
+    if (it == 1 && options_.warm_start && warm_valid_)
+      delta_ = warm_;
+    else
+      delta_.setZero();
     const LinearSolveStats ls = linear_->Solve(rhs_, delta_);
+    if (it == 1 && ls.converged) {
+      warm_ = delta_;
+      warm_valid_ = true;
+    }
     stats.linear_iterations += ls.iterations;
     stats.refactorizations += ls.refactorized ? 1 : 0;
     if (!ls.converged || !delta_.allFinite()) {

@@ -50,6 +50,9 @@ struct NewtonOptions {
   /// Interactive mode: take exactly max_iterations iterations and accept the result (the usual
   /// one-Newton-step-per-frame practice); the residual is then not recomputed.
   bool fixed_iterations = false;
+  /// Start the first linear solve of each Solve from the previous Solve's first correction
+  /// (iterative solvers converge faster when consecutive steps are alike).
+  bool warm_start = true;
 };
 
 /// Outcome of one solve. Plain struct.
@@ -88,6 +91,8 @@ class NewtonSolver {
   NewtonOptions options_;
   std::unique_ptr<LinearSolver> linear_;
   VecX r_, r_trial_, delta_, d_trial_, rhs_;
+  VecX warm_;  // first correction of the last solve
+  bool warm_valid_ = false;
 };
 
 /// One-line summary of a failed solve for diagnostics ("Newton did not converge in 25

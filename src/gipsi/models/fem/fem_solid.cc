@@ -502,6 +502,13 @@ StepStatus FemSolid::DoStep(double /*t*/, double dt) {
   return StepStatus::Ok();
 }
 
+std::vector<SimObject::ProfileEntry> FemSolid::ProfileBreakdown() const {
+  return {{"assembly (residual, tangent)", profile_.assembly_seconds, "s"},
+          {"linear solves", profile_.solve_seconds, "s"},
+          {"Newton iterations", static_cast<double>(profile_.newton_iterations), ""},
+          {"linear iterations", static_cast<double>(profile_.linear_iterations), ""}};
+}
+
 void FemSolid::UpdatePositions() {
   x_ = rest_ + scheme_.x();
   positions_ = Eigen::Map<const Points>(x_.data(), 3, num_nodes());

@@ -85,6 +85,7 @@ class FemSolid final : public SimObject, private NonlinearSystem {
   /// Statistics of the last Newton solve.
   [[nodiscard]] const NewtonStats& last_newton() const { return last_newton_; }
   [[nodiscard]] const FemProfile& profile() const { return profile_; }
+  [[nodiscard]] std::vector<ProfileEntry> ProfileBreakdown() const override;
 
   /// Internal forces f_int(x) (3N) for positions x (3N); false if an element is outside its
   /// law's domain. For tests and connectors.
