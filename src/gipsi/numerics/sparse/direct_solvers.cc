@@ -125,7 +125,8 @@ class LdltSolver final : public DirectSolver {
 class CholmodSolver final : public DirectSolver {
  public:
   explicit CholmodSolver(const LinearSolverOptions& options) : DirectSolver(options) {
-    // Keep CHOLMOD's "not positive definite" warning off stderr: Factorize returns false.
+    // CHOLMOD prints "matrix not positive definite" at any print level > 0; Factorize reports
+    // it by returning false instead, so keep CHOLMOD quiet.
     llt_.cholmod().print = 0;
   }
   [[nodiscard]] std::string name() const override { return "cholmod"; }

@@ -33,8 +33,8 @@ class PcgSolver final : public LinearSolver {
  public:
   explicit PcgSolver(const LinearSolverOptions& options)
       : options_(options), kind_(PreconditionerFromName(options.preconditioner)) {
-    // CHOLMOD prints warnings such as "not positive definite" at print level ≥ 2 (default 3);
-    // Factorize reports them through its return value instead. Errors still print.
+    // CHOLMOD prints even "matrix not positive definite" as an error at any print level > 0;
+    // Factorize reports failures through its return value instead, so keep CHOLMOD quiet.
     cholesky_.cholmod().print = 0;
   }
 
