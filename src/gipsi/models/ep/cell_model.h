@@ -92,8 +92,9 @@ struct CellStimulus {
 /// movable (use it through `std::shared_ptr<const CellModel>`).
 ///
 /// Public methods check their arguments (always on; a violation aborts as a programmer error)
-/// and call the protected `Do…` hooks. Nothing in a step throws or allocates; a diverging cell
-/// shows as non-finite states, which the owner (a tissue solver) checks.
+/// and call the protected `Do…` hooks. Nothing in a step throws; after `Prepare(dt)` nothing
+/// in a step of that dt allocates. A diverging cell shows as non-finite states, which the owner
+/// (a tissue solver) checks.
 class CellModel {
  public:
   virtual ~CellModel() = default;
@@ -118,6 +119,11 @@ class CellModel {
   [[nodiscard]] int FindState(std::string_view name) const;
   /// The resting initial state (num_states() values), e.g. the published initial values.
   [[nodiscard]] const std::vector<double>& resting_state() const { return resting_; }
+
+  /// Precomputes what steps of `dt` [ms] need (e.g. tables of Rush–Larsen factors), so that
+  /// the first Step with that dt does not have to. Optional: Step prepares on first use. Safe
+  /// to call concurrently; the default does nothing.
+  virtual void Prepare(double dt) const { (void)dt; }
 
   /// Advances nodes [begin, end) of `states` by `dt` [ms] with the model's scheme, the
   /// stimulus `i_stim[i]` [µA/µF] held constant over the step. `i_stim` is indexed like the

@@ -27,23 +27,28 @@ class LookupTable {
   [[nodiscard]] std::size_t num_rows() const { return rows_; }
   [[nodiscard]] int num_columns() const { return columns_; }
 
-  /// Where x falls: `row` points to the grid row at or below x and `frac` in [0, 1] is the
-  /// weight of the next row. x outside [x_min, x_max] is clamped to it; NaN reads row 0.
+  /// Where x falls: `row` is the grid row at or below x and `frac` in [0, 1] the weight of the
+  /// next row. x outside [x_min, x_max] is clamped to it; NaN reads row 0. Tables built on the
+  /// same grid (x_min, dx, rows) can share a Position.
   struct Position {
-    const double* row;
+    std::size_t row;
     double frac;
   };
   [[nodiscard]] Position Locate(double x) const {
     double s = (x - x_min_) * inv_dx_;
     s = s > 0.0 ? s : 0.0;  // also maps NaN to 0
     s = s < last_ ? s : last_;
-    const auto r = static_cast<std::size_t>(s);
-    return {data_.data() + r * static_cast<std::size_t>(columns_), s - static_cast<double>(r)};
+    const auto row = static_cast<std::size_t>(s);
+    return {row, s - static_cast<double>(row)};
   }
   /// Column c interpolated at `position` (c < num_columns()).
   [[nodiscard]] double Interpolate(const Position& position, int c) const {
-    const double lo = position.row[c];
-    return lo + position.frac * (position.row[c + columns_] - lo);
+    const double* lo = data_.data() + position.row * static_cast<std::size_t>(columns_) + c;
+    return *lo + position.frac * (lo[columns_] - *lo);
+  }
+  /// True if `other` has the same grid (its Positions are valid here).
+  [[nodiscard]] bool SameGrid(const LookupTable& other) const {
+    return x_min_ == other.x_min_ && dx_ == other.dx_ && rows_ == other.rows_;
   }
   /// All columns interpolated at x into out[0 .. num_columns()).
   void InterpolateAll(double x, double* out) const;

@@ -114,6 +114,7 @@ SingleCellResult PaceSingleCell(const CellModel& model, const PacingProtocol& pr
                                 num_states, initial.size()));
   CellStates states(model, 1);
   if (!initial.empty()) states.SetNode(0, initial);
+  model.Prepare(protocol.dt);
   const int v_index = model.v_index();
   const double dt = protocol.dt;
   const auto total_steps = static_cast<std::int64_t>(

@@ -84,37 +84,50 @@ enum State : int {
   kNumStates
 };
 
+// Per-node terms of a chunk, each a row of kChunk values in the terms buffer.
 enum Term : int {
+  // The voltage table's columns (CalcVoltageTerms).
   kMInf,
-  kMRate,
   kHJInf,
-  kHRate,
-  kJRate,
   kXr1Inf,
-  kXr1Rate,
   kXr2Inf,
-  kXr2Rate,
   kXsInf,
-  kXsRate,
   kRInf,
-  kRRate,
   kSInf,
-  kSRate,
   kDInf,
-  kDRate,
   kFInf,
-  kFRate,
   kF2Inf,
-  kF2Rate,
   kCaLCaSS,  // ICaL = d f f2 fCass (term · CaSS − kCaLCao term)
   kCaLCao,
   kNaCaNai,  // INaCa = term · Nai³ − kNaCaCai term · Cai
   kNaCaCai,
   kNaK,  // INaK = term · Nai / (Nai + KmNa)
   kPK,   // IpK = term · (V − EK)
+  // Rush–Larsen factors e^(−dt/τ) (CalcGateRates order).
+  kMDecay,
+  kHDecay,
+  kJDecay,
+  kXr1Decay,
+  kXr2Decay,
+  kXsDecay,
+  kRDecay,
+  kSDecay,
+  kDDecay,
+  kFDecay,
+  kF2Decay,
+  // Per node: the K⁺ Nernst potential and the IK1 rectification at V − EK.
+  kEK,
+  kK1Rect,
   kNumTerms
 };
-static_assert(kNumTerms == TenTusscherPanfilov2006::kNumVoltageTerms);
+static_assert(kMDecay == TenTusscherPanfilov2006::kNumVoltageTerms);
+static_assert(kEK - kMDecay == TenTusscherPanfilov2006::kNumVoltageGates);
+
+// IK1 table range over V − EK [mV].
+constexpr double kK1TableMin = -200.0;
+constexpr double kK1TableMax = 300.0;
+// Rush–Larsen tables kept (distinct dt).
+constexpr std::size_t kMaxDecayTables = 8;
 
 std::vector<CellStateInfo> StateInfo() {
   return {{"V", "mV"},  {"Cai", "mM"}, {"CaSR", "mM"}, {"CaSS", "mM"},  {"Nai", "mM"},
@@ -199,9 +212,12 @@ TenTusscherPanfilov2006::TenTusscherPanfilov2006(const Params& params)
   if (params.lookup_tables) {
     GIPSI_CHECK(params.table_step > 0 && params.table_step <= 1.0, "table step {} mV",
                 params.table_step);
-    table_ = std::make_unique<const LookupTable>(
-        kTableVMin, kTableVMax, params.table_step, kNumTerms,
+    voltage_table_ = std::make_unique<const LookupTable>(
+        kTableVMin, kTableVMax, params.table_step, kNumVoltageTerms,
         [this](double v, double* row) { CalcVoltageTerms(v, row); });
+    k1_table_ = std::make_unique<const LookupTable>(
+        kK1TableMin, kK1TableMax, params.table_step, 1,
+        [](double dk, double* row) { row[0] = CalcK1Rectification(dk); });
   }
 }
 
@@ -253,17 +269,47 @@ std::shared_ptr<const CellModel> TenTusscherPanfilov2006::FromJson(const JsonNod
 void TenTusscherPanfilov2006::CalcVoltageTerms(double v, double* terms) const {
   const Params& p = params_;
   const double rtf = kGasConstant * kTemperature / kFaraday;
-  // INa gates (2004 paper, Appendix; unchanged in 2006).
+  // Gate steady states (2004 paper, Appendix; IKs, Ito, ICaL as updated in 2006).
+  const double m_inf = Sigmoid((-56.86 - v) / 9.03);
+  const double hj_inf = Sigmoid((v + 71.55) / 7.43);
+  terms[kMInf] = m_inf * m_inf;
+  terms[kHJInf] = hj_inf * hj_inf;
+  terms[kXr1Inf] = Sigmoid((-26.0 - v) / 7.0);
+  terms[kXr2Inf] = Sigmoid((v + 88.0) / 24.0);
+  terms[kXsInf] = Sigmoid((-5.0 - v) / 14.0);
+  terms[kRInf] = Sigmoid((20.0 - v) / 6.0);
+  // The s gate differs between the endocardium and the other variants.
+  terms[kSInf] = Sigmoid((v + (p.variant == Variant::kEndo ? 28.0 : 20.0)) / 5.0);
+  terms[kDInf] = Sigmoid((-8.0 - v) / 7.5);
+  terms[kFInf] = Sigmoid((v + 20.0) / 7.0);
+  terms[kF2Inf] = 0.67 * Sigmoid((v + 35.0) / 7.0) + 0.33;
+  // ICaL = g d f f2 fCass · 4 (V − 15) F²/(RT) · (0.25 CaSS e^x − Cao)/(e^x − 1),
+  // x = 2 (V − 15) F/(RT); with B(x) = x/(e^x − 1) and x e^x/(e^x − 1) = B(−x):
+  // ICaL = g d f f2 fCass · 2F (0.25 CaSS B(−x) − Cao B(x)).
+  const double x = 2.0 * (v - 15.0) / rtf;
+  terms[kCaLCaSS] = 0.5 * p.g_cal * kFaraday * XOverExpm1(-x);
+  terms[kCaLCao] = 2.0 * p.g_cal * kFaraday * p.cao * XOverExpm1(x);
+  // INaCa.
+  const double e_up = std::exp(kNaCaGamma * v / rtf);
+  const double e_down = std::exp((kNaCaGamma - 1.0) * v / rtf);
+  const double den =
+      (kKmNai * kKmNai * kKmNai + p.nao * p.nao * p.nao) * (kKmCa + p.cao) * (1.0 + kKsat * e_down);
+  terms[kNaCaNai] = p.k_naca * e_up * p.cao / den;
+  terms[kNaCaCai] = p.k_naca * e_down * p.nao * p.nao * p.nao * kNaCaAlpha / den;
+  // INaK and IpK.
+  terms[kNaK] = p.p_nak * p.ko / (p.ko + kKmK) /
+                (1.0 + 0.1245 * std::exp(-0.1 * v / rtf) + 0.0353 * std::exp(-v / rtf));
+  terms[kPK] = p.g_pk * Sigmoid((25.0 - v) / 5.98);
+}
+
+void TenTusscherPanfilov2006::CalcGateRates(double v, double* rates) const {
+  // Indices follow the decay terms: rates[k] belongs to Term kMDecay + k.
   {
     const double alpha = Sigmoid((-60.0 - v) / 5.0);
     const double beta = 0.1 * Sigmoid((v + 35.0) / 5.0) + 0.1 * Sigmoid((v - 50.0) / 200.0);
-    const double inf = Sigmoid((-56.86 - v) / 9.03);
-    terms[kMInf] = inf * inf;
-    terms[kMRate] = 1.0 / (alpha * beta);
+    rates[kMDecay - kMDecay] = 1.0 / (alpha * beta);
   }
   {
-    const double inf = Sigmoid((v + 71.55) / 7.43);
-    terms[kHJInf] = inf * inf;
     double alpha_h = 0.0, beta_h, alpha_j = 0.0, beta_j;
     if (v < -40.0) {
       alpha_h = 0.057 * std::exp(-(v + 80.0) / 6.8);
@@ -275,90 +321,118 @@ void TenTusscherPanfilov2006::CalcVoltageTerms(double v, double* terms) const {
       beta_h = 0.77 / (0.13 * (1.0 + std::exp(-(v + 10.66) / 11.1)));
       beta_j = 0.6 * std::exp(0.057 * v) / (1.0 + std::exp(-0.1 * (v + 32.0)));
     }
-    terms[kHRate] = alpha_h + beta_h;
-    terms[kJRate] = alpha_j + beta_j;
+    rates[kHDecay - kMDecay] = alpha_h + beta_h;
+    rates[kJDecay - kMDecay] = alpha_j + beta_j;
   }
-  // IKr gates.
   {
     const double alpha = 450.0 * Sigmoid((-45.0 - v) / 10.0);
     const double beta = 6.0 * Sigmoid((v + 30.0) / 11.5);
-    terms[kXr1Inf] = Sigmoid((-26.0 - v) / 7.0);
-    terms[kXr1Rate] = 1.0 / (alpha * beta);
+    rates[kXr1Decay - kMDecay] = 1.0 / (alpha * beta);
   }
   {
     const double alpha = 3.0 * Sigmoid((-60.0 - v) / 20.0);
     const double beta = 1.12 * Sigmoid((v - 60.0) / 20.0);
-    terms[kXr2Inf] = Sigmoid((v + 88.0) / 24.0);
-    terms[kXr2Rate] = 1.0 / (alpha * beta);
+    rates[kXr2Decay - kMDecay] = 1.0 / (alpha * beta);
   }
-  // IKs gate (τ + 80 ms in the 2006 model).
   {
     const double alpha = 1400.0 / std::sqrt(1.0 + std::exp((5.0 - v) / 6.0));
     const double beta = Sigmoid((v - 35.0) / 15.0);
-    terms[kXsInf] = Sigmoid((-5.0 - v) / 14.0);
-    terms[kXsRate] = 1.0 / (alpha * beta + 80.0);
+    rates[kXsDecay - kMDecay] = 1.0 / (alpha * beta + 80.0);  // + 80 ms in the 2006 model
   }
-  // Ito gates; the s gate differs between endocardium and the other variants.
-  terms[kRInf] = Sigmoid((20.0 - v) / 6.0);
-  terms[kRRate] = 1.0 / (9.5 * std::exp(-(v + 40.0) * (v + 40.0) / 1800.0) + 0.8);
-  if (p.variant == Variant::kEndo) {
-    terms[kSInf] = Sigmoid((v + 28.0) / 5.0);
-    terms[kSRate] = 1.0 / (1000.0 * std::exp(-(v + 67.0) * (v + 67.0) / 1000.0) + 8.0);
+  rates[kRDecay - kMDecay] = 1.0 / (9.5 * std::exp(-(v + 40.0) * (v + 40.0) / 1800.0) + 0.8);
+  if (params_.variant == Variant::kEndo) {
+    rates[kSDecay - kMDecay] = 1.0 / (1000.0 * std::exp(-(v + 67.0) * (v + 67.0) / 1000.0) + 8.0);
   } else {
-    terms[kSInf] = Sigmoid((v + 20.0) / 5.0);
-    terms[kSRate] = 1.0 / (85.0 * std::exp(-(v + 45.0) * (v + 45.0) / 320.0) +
-                           5.0 * Sigmoid((v - 20.0) / 5.0) + 3.0);
+    rates[kSDecay - kMDecay] = 1.0 / (85.0 * std::exp(-(v + 45.0) * (v + 45.0) / 320.0) +
+                                      5.0 * Sigmoid((v - 20.0) / 5.0) + 3.0);
   }
-  // ICaL gates (2006 formulation).
   {
     const double alpha = 1.4 * Sigmoid((-35.0 - v) / 13.0) + 0.25;
     const double beta = 1.4 * Sigmoid((v + 5.0) / 5.0);
     const double gamma = Sigmoid((50.0 - v) / 20.0);
-    terms[kDInf] = Sigmoid((-8.0 - v) / 7.5);
-    terms[kDRate] = 1.0 / (alpha * beta + gamma);
+    rates[kDDecay - kMDecay] = 1.0 / (alpha * beta + gamma);
   }
-  terms[kFInf] = Sigmoid((v + 20.0) / 7.0);
-  terms[kFRate] =
+  rates[kFDecay - kMDecay] =
       1.0 / (1102.5 * std::exp(-(v + 27.0) * (v + 27.0) / 225.0) +
              200.0 * Sigmoid((13.0 - v) / 10.0) + 180.0 * Sigmoid((v + 30.0) / 10.0) + 20.0);
-  terms[kF2Inf] = 0.67 * Sigmoid((v + 35.0) / 7.0) + 0.33;
-  terms[kF2Rate] = 1.0 / (562.0 * std::exp(-(v + 27.0) * (v + 27.0) / 240.0) +
-                          31.0 * Sigmoid((25.0 - v) / 10.0) + 80.0 * Sigmoid((v + 30.0) / 10.0));
-  // ICaL = g d f f2 fCass · 4 (V − 15) F²/(RT) · (0.25 CaSS e^x − Cao)/(e^x − 1),
-  // x = 2 (V − 15) F/(RT); with B(x) = x/(e^x − 1) and x e^x/(e^x − 1) = B(−x):
-  // ICaL = g d f f2 fCass · 2F (0.25 CaSS B(−x) − Cao B(x)).
-  {
-    const double x = 2.0 * (v - 15.0) / rtf;
-    terms[kCaLCaSS] = 0.5 * p.g_cal * kFaraday * XOverExpm1(-x);
-    terms[kCaLCao] = 2.0 * p.g_cal * kFaraday * p.cao * XOverExpm1(x);
-  }
-  // INaCa.
-  {
-    const double e_up = std::exp(kNaCaGamma * v / rtf);
-    const double e_down = std::exp((kNaCaGamma - 1.0) * v / rtf);
-    const double den = (kKmNai * kKmNai * kKmNai + p.nao * p.nao * p.nao) * (kKmCa + p.cao) *
-                       (1.0 + kKsat * e_down);
-    terms[kNaCaNai] = p.k_naca * e_up * p.cao / den;
-    terms[kNaCaCai] = p.k_naca * e_down * p.nao * p.nao * p.nao * kNaCaAlpha / den;
-  }
-  // INaK and IpK.
-  terms[kNaK] = p.p_nak * p.ko / (p.ko + kKmK) /
-                (1.0 + 0.1245 * std::exp(-0.1 * v / rtf) + 0.0353 * std::exp(-v / rtf));
-  terms[kPK] = p.g_pk * Sigmoid((25.0 - v) / 5.98);
+  rates[kF2Decay - kMDecay] =
+      1.0 / (562.0 * std::exp(-(v + 27.0) * (v + 27.0) / 240.0) +
+             31.0 * Sigmoid((25.0 - v) / 10.0) + 80.0 * Sigmoid((v + 30.0) / 10.0));
 }
 
-void TenTusscherPanfilov2006::FillVoltageTerms(const double* voltage, std::size_t first,
-                                               std::size_t count, double* terms) const {
+double TenTusscherPanfilov2006::CalcK1Rectification(double dk) {
+  const double alpha = 0.1 / (1.0 + std::exp(0.06 * (dk - 200.0)));
+  const double beta = (3.0 * std::exp(0.0002 * (dk + 100.0)) + std::exp(0.1 * (dk - 10.0))) /
+                      (1.0 + std::exp(-0.5 * dk));
+  return alpha / (alpha + beta);
+}
+
+void TenTusscherPanfilov2006::Prepare(double dt) const {
+  GIPSI_CHECK(dt > 0 && std::isfinite(dt), "dt = {}", dt);
+  (void)DecayTable(dt);
+}
+
+const LookupTable* TenTusscherPanfilov2006::DecayTable(double dt) const {
+  if (!voltage_table_) return nullptr;
+  const DecayTableEntry* last = last_decay_.load(std::memory_order_acquire);
+  if (last && last->dt == dt) return &last->table;
+  std::lock_guard<std::mutex> lock(decay_mutex_);
+  for (const auto& entry : decay_tables_) {
+    if (entry->dt == dt) {
+      last_decay_.store(entry.get(), std::memory_order_release);
+      return &entry->table;
+    }
+  }
+  if (decay_tables_.size() >= kMaxDecayTables) return nullptr;
+  decay_tables_.push_back(std::make_unique<const DecayTableEntry>(
+      DecayTableEntry{dt, LookupTable(kTableVMin, kTableVMax, params_.table_step, kNumVoltageGates,
+                                      [this, dt](double v, double* row) {
+                                        CalcGateRates(v, row);
+                                        for (int k = 0; k < kNumVoltageGates; ++k)
+                                          row[k] = std::exp(-dt * row[k]);
+                                      })}));
+  last_decay_.store(decay_tables_.back().get(), std::memory_order_release);
+  return &decay_tables_.back()->table;
+}
+
+void TenTusscherPanfilov2006::FillTerms(const ConstCellStateView& states, std::size_t first,
+                                        std::size_t count, double dt, const LookupTable* decay,
+                                        double* terms) const {
+  const TenTusscherPanfilov2006Constants& c = *constants_;
+  const double* __restrict voltage = states.var(kV) + first;
+  const double* __restrict ki = states.var(kKi) + first;
+  double* __restrict ek = terms + kEK * kChunk;
+  // EK (vectorised), then per node the table lookups (gathers, scalar).
+#pragma omp simd
+  for (std::size_t j = 0; j < count; ++j) ek[j] = c.rtf * (c.log_ko - simd::FastLog(ki[j]));
   double row[kNumTerms];
   for (std::size_t j = 0; j < count; ++j) {
-    if (table_) {
-      const LookupTable::Position position = table_->Locate(voltage[first + j]);
-      for (int t = 0; t < kNumTerms; ++t)
-        terms[static_cast<std::size_t>(t) * kChunk + j] = table_->Interpolate(position, t);
+    const double v = voltage[j];
+    if (voltage_table_) {
+      const LookupTable::Position at = voltage_table_->Locate(v);
+      for (int t = 0; t < kNumVoltageTerms; ++t) row[t] = voltage_table_->Interpolate(at, t);
+      if (dt > 0) {
+        if (decay) {
+          for (int k = 0; k < kNumVoltageGates; ++k) row[kMDecay + k] = decay->Interpolate(at, k);
+        } else {  // more distinct dt than the cache holds
+          CalcGateRates(v, row + kMDecay);
+          for (int k = 0; k < kNumVoltageGates; ++k)
+            row[kMDecay + k] = std::exp(-dt * row[kMDecay + k]);
+        }
+      }
+      row[kK1Rect] = k1_table_->Interpolate(k1_table_->Locate(v - ek[j]), 0);
     } else {
-      CalcVoltageTerms(voltage[first + j], row);
-      for (int t = 0; t < kNumTerms; ++t) terms[static_cast<std::size_t>(t) * kChunk + j] = row[t];
+      CalcVoltageTerms(v, row);
+      if (dt > 0) {
+        CalcGateRates(v, row + kMDecay);
+        for (int k = 0; k < kNumVoltageGates; ++k)
+          row[kMDecay + k] = std::exp(-dt * row[kMDecay + k]);
+      }
+      row[kK1Rect] = CalcK1Rectification(v - ek[j]);
     }
+    const int last = dt > 0 ? kEK : kMDecay;
+    for (int t = 0; t < last; ++t) terms[static_cast<std::size_t>(t) * kChunk + j] = row[t];
+    terms[static_cast<std::size_t>(kK1Rect) * kChunk + j] = row[kK1Rect];
   }
 }
 
@@ -377,23 +451,17 @@ struct Gates {
   double m, h, j, xr1, xr2, xs, r, s, d, f, f2, fcass;
 };
 
-/// The currents of one node from its state and its voltage terms `t` (stride kChunk).
+/// The currents of one node from its state and its terms `t` (stride kChunk).
 /// Branch-free, so that the loops over nodes vectorise.
 [[gnu::always_inline]] inline Currents CalcCurrents(const TenTusscherPanfilov2006Constants& c,
-                                                    const simd::ExpRange& range, double v,
-                                                    double cai, double cass, double nai, double ki,
-                                                    const Gates& g, const double* t) {
+                                                    double v, double cai, double cass, double nai,
+                                                    double ki, const Gates& g, const double* t) {
   const double e_na = c.rtf * (c.log_nao - simd::FastLog(nai));
-  const double e_k = c.rtf * (c.log_ko - simd::FastLog(ki));
+  const double e_k = t[kEK * kChunk];
   const double e_ks = c.rtf * (c.log_eks_num - simd::FastLog(ki + kPKNa * nai));
   const double e_ca = 0.5 * c.rtf * (c.log_cao - simd::FastLog(cai));
-  // IK1: x∞ = α/(α + β) with α = 0.1/A, β = B/C, i.e. x∞ = 0.1 C/(0.1 C + A B).
   const double dk = v - e_k;
-  const double k1_a = 1.0 + simd::FastExp(0.06 * (dk - 200.0), range);
-  const double k1_b =
-      3.0 * simd::FastExp(0.0002 * (dk + 100.0), range) + simd::FastExp(0.1 * (dk - 10.0), range);
-  const double k1_c = 1.0 + simd::FastExp(-0.5 * dk, range);
-  const double x_k1 = 0.1 * k1_c / (0.1 * k1_c + k1_a * k1_b);
+  const double x_k1 = t[kK1Rect * kChunk];
   Currents out;
   out.ina = c.g_na * g.m * g.m * g.m * g.h * g.j * (v - e_na);
   out.ik1 = c.g_k1 * x_k1 * dk;
@@ -410,10 +478,9 @@ struct Gates {
   return out;
 }
 
-/// Rush–Larsen: x∞ + (x − x∞) e^(−dt·rate); `minus_dt` = −dt.
-[[gnu::always_inline]] inline double RushLarsen(double x, double inf, double rate, double minus_dt,
-                                                const simd::ExpRange& range) {
-  return inf + (x - inf) * simd::FastExp(minus_dt * rate, range);
+/// Rush–Larsen: x∞ + (x − x∞) e^(−dt/τ), given the decay factor e^(−dt/τ).
+[[gnu::always_inline]] inline double RushLarsen(double x, double inf, double decay) {
+  return inf + (x - inf) * decay;
 }
 
 }  // namespace
@@ -424,6 +491,7 @@ void TenTusscherPanfilov2006::StepChunk(const CellStateView& states, std::size_t
                                         const double* terms) const {
   const TenTusscherPanfilov2006Constants c = *constants_;
   const simd::ExpRange range = simd::ExpRange::Load();
+  const double minus_dt = -dt;
   double* __restrict pv = states.var(kV) + first;
   double* __restrict pcai = states.var(kCai) + first;
   double* __restrict pcasr = states.var(kCaSR) + first;
@@ -452,7 +520,7 @@ void TenTusscherPanfilov2006::StepChunk(const CellStateView& states, std::size_t
     const Gates g{pm[i], ph[i], pj[i], pxr1[i], pxr2[i], pxs[i],
                   pr[i], ps[i], pd[i], pf[i],   pf2[i],  pfcass[i]};
     const double rp = prp[i];
-    const Currents cur = CalcCurrents(c, range, v, cai, cass, nai, ki, g, t);
+    const Currents cur = CalcCurrents(c, v, cai, cass, nai, ki, g, t);
     const double i_applied = kStimulus ? stim[i] : 0.0;
 
     // Calcium handling (2006 paper: subspace, RyR four-state model reduced to R_prime).
@@ -492,28 +560,28 @@ void TenTusscherPanfilov2006::StepChunk(const CellStateView& states, std::size_t
     pki[i] = ki + dt * dki;
     prp[i] = rp + dt * drp;
     // Rush–Larsen.
-    const double mdt = -dt;
-    pm[i] = RushLarsen(g.m, t[kMInf * kChunk], t[kMRate * kChunk], mdt, range);
-    ph[i] = RushLarsen(g.h, t[kHJInf * kChunk], t[kHRate * kChunk], mdt, range);
-    pj[i] = RushLarsen(g.j, t[kHJInf * kChunk], t[kJRate * kChunk], mdt, range);
-    pxr1[i] = RushLarsen(g.xr1, t[kXr1Inf * kChunk], t[kXr1Rate * kChunk], mdt, range);
-    pxr2[i] = RushLarsen(g.xr2, t[kXr2Inf * kChunk], t[kXr2Rate * kChunk], mdt, range);
-    pxs[i] = RushLarsen(g.xs, t[kXsInf * kChunk], t[kXsRate * kChunk], mdt, range);
-    pr[i] = RushLarsen(g.r, t[kRInf * kChunk], t[kRRate * kChunk], mdt, range);
-    ps[i] = RushLarsen(g.s, t[kSInf * kChunk], t[kSRate * kChunk], mdt, range);
-    pd[i] = RushLarsen(g.d, t[kDInf * kChunk], t[kDRate * kChunk], mdt, range);
-    pf[i] = RushLarsen(g.f, t[kFInf * kChunk], t[kFRate * kChunk], mdt, range);
-    pf2[i] = RushLarsen(g.f2, t[kF2Inf * kChunk], t[kF2Rate * kChunk], mdt, range);
-    pfcass[i] = RushLarsen(g.fcass, fcass_inf, 1.0 / fcass_tau, mdt, range);
+    pm[i] = RushLarsen(g.m, t[kMInf * kChunk], t[kMDecay * kChunk]);
+    ph[i] = RushLarsen(g.h, t[kHJInf * kChunk], t[kHDecay * kChunk]);
+    pj[i] = RushLarsen(g.j, t[kHJInf * kChunk], t[kJDecay * kChunk]);
+    pxr1[i] = RushLarsen(g.xr1, t[kXr1Inf * kChunk], t[kXr1Decay * kChunk]);
+    pxr2[i] = RushLarsen(g.xr2, t[kXr2Inf * kChunk], t[kXr2Decay * kChunk]);
+    pxs[i] = RushLarsen(g.xs, t[kXsInf * kChunk], t[kXsDecay * kChunk]);
+    pr[i] = RushLarsen(g.r, t[kRInf * kChunk], t[kRDecay * kChunk]);
+    ps[i] = RushLarsen(g.s, t[kSInf * kChunk], t[kSDecay * kChunk]);
+    pd[i] = RushLarsen(g.d, t[kDInf * kChunk], t[kDDecay * kChunk]);
+    pf[i] = RushLarsen(g.f, t[kFInf * kChunk], t[kFDecay * kChunk]);
+    pf2[i] = RushLarsen(g.f2, t[kF2Inf * kChunk], t[kF2Decay * kChunk]);
+    pfcass[i] = RushLarsen(g.fcass, fcass_inf, simd::FastExp(minus_dt / fcass_tau, range));
   }
 }
 
 void TenTusscherPanfilov2006::DoStep(const CellStateView& states, std::size_t begin,
                                      std::size_t end, double dt, const double* i_stim) const {
   alignas(64) double terms[kNumTerms * kChunk];
+  const LookupTable* decay = DecayTable(dt);
   for (std::size_t first = begin; first < end; first += kChunk) {
     const std::size_t count = std::min(kChunk, end - first);
-    FillVoltageTerms(states.var(kV), first, count, terms);
+    FillTerms(states, first, count, dt, decay, terms);
     if (i_stim)
       StepChunk<true>(states, first, count, dt, i_stim, terms);
     else
@@ -526,10 +594,9 @@ void TenTusscherPanfilov2006::DoCalcIonicCurrent(const ConstCellStateView& state
                                                  double* i_ion) const {
   alignas(64) double terms[kNumTerms * kChunk];
   const TenTusscherPanfilov2006Constants c = *constants_;
-  const simd::ExpRange range = simd::ExpRange::Load();
   for (std::size_t first = begin; first < end; first += kChunk) {
     const std::size_t count = std::min(kChunk, end - first);
-    FillVoltageTerms(states.var(kV), first, count, terms);
+    FillTerms(states, first, count, 0.0, nullptr, terms);
     const double* __restrict pv = states.var(kV) + first;
     const double* __restrict pcai = states.var(kCai) + first;
     const double* __restrict pcass = states.var(kCaSS) + first;
@@ -553,7 +620,7 @@ void TenTusscherPanfilov2006::DoCalcIonicCurrent(const ConstCellStateView& state
       const double* t = terms + i;
       const Gates g{pm[i], ph[i], pj[i], pxr1[i], pxr2[i], pxs[i],
                     pr[i], ps[i], pd[i], pf[i],   pf2[i],  pfcass[i]};
-      out[i] = CalcCurrents(c, range, pv[i], pcai[i], pcass[i], pnai[i], pki[i], g, t).Total();
+      out[i] = CalcCurrents(c, pv[i], pcai[i], pcass[i], pnai[i], pki[i], g, t).Total();
     }
   }
 }

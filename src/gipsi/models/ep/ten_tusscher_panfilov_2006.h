@@ -23,17 +23,24 @@
 /// Hodgkin–Huxley gates m … fCass, forward Euler for V, the concentrations and R_prime; all
 /// right-hand sides from the state at the start of the step. Production steps: dt 0.01–0.02 ms.
 ///
-/// Speed: the voltage-only terms (the x∞ and 1/τ of eleven gates and the voltage factors of
-/// ICaL, INaCa, INaK and IpK: 27 functions, some 45 exponentials) come from a lookup table over
-/// V in [−150, 150] mV, step 0.05 mV, with linear interpolation (largest relative error per
-/// column 2.1e-5 away from the −40 mV jump of the h and j rates, see docs/electrophysiology.md; V
-/// outside the range reads the end rows). The remaining exponentials and logarithms (Rush–Larsen
-/// factors, IK1, Nernst potentials) use the vectorisable simd::FastExp/FastLog. "lookup_tables":
-/// false evaluates the voltage terms exactly (std::exp) instead, about 4× slower: the reference for
-/// the table error.
+/// Speed (docs/electrophysiology.md): as in CARP/openCARP, what depends on V alone comes from
+/// lookup tables over V in [−150, 150] mV, step 0.05 mV, with linear interpolation: the ten
+/// gate steady states and the voltage factors of ICaL, INaCa, INaK and IpK (16 columns), and the
+/// Rush–Larsen factors e^(−dt/τ) of the eleven voltage-gated gates (11 columns, one table per
+/// dt, built by `Prepare(dt)` or the first Step with that dt; up to 8 dt are kept, further ones
+/// are evaluated exactly). The IK1 rectification, a function of V − EK, has its own table over
+/// [−200, 300] mV. Largest interpolation errors (grid midpoints): 2.1e-5 relative for the
+/// voltage terms, 4.5e-5 for IK1, 3.6e-6 absolute for the Rush–Larsen factors at dt 0.01 ms;
+/// except within 0.05 mV of −40 mV, where the model's own h and j rates jump. V outside a table
+/// reads its end rows. The rest (Nernst potentials, fCass, concentrations) is computed per node
+/// with the vectorisable simd::FastExp/FastLog. "lookup_tables": false evaluates every term
+/// exactly (std::exp) instead, several times slower: the reference for the table error.
 
+#include <atomic>
 #include <memory>
+#include <mutex>
 #include <string>
+#include <vector>
 
 #include "gipsi/base/json_node.h"
 #include "gipsi/models/ep/cell_model.h"
@@ -71,13 +78,16 @@ struct TenTusscherPanfilov2006Params {
   static TenTusscherPanfilov2006Params ForVariant(Variant variant);
 };
 
-/// ten Tusscher–Panfilov 2006 (see the file comment). Immutable; shareable between threads.
+/// ten Tusscher–Panfilov 2006 (see the file comment). Immutable apart from its cache of
+/// Rush–Larsen tables (thread-safe); shareable between threads. Not copyable or movable.
 class TenTusscherPanfilov2006 final : public CellModel {
  public:
   using Params = TenTusscherPanfilov2006Params;
   using Variant = Params::Variant;
-  /// Number of voltage-dependent terms in the table.
-  static constexpr int kNumVoltageTerms = 27;
+  /// Columns of the voltage table (see CalcVoltageTerms).
+  static constexpr int kNumVoltageTerms = 16;
+  /// Voltage-gated gates with a Rush–Larsen factor table (m h j xr1 xr2 xs r s d f f2).
+  static constexpr int kNumVoltageGates = 11;
 
   explicit TenTusscherPanfilov2006(const Params& params = {});
   ~TenTusscherPanfilov2006() override;
@@ -94,11 +104,26 @@ class TenTusscherPanfilov2006 final : public CellModel {
   /// 52 µA/µF for 1 ms, as in the CellML protocol.
   [[nodiscard]] CellStimulus default_stimulus() const override { return {52.0, 1.0}; }
   [[nodiscard]] const Params& params() const { return params_; }
-  /// The voltage table (null when lookup_tables is false).
-  [[nodiscard]] const LookupTable* table() const { return table_.get(); }
+  /// Builds the Rush–Larsen factor table of `dt` (when lookup_tables is on). Thread-safe.
+  void Prepare(double dt) const override;
 
-  /// Evaluates the kNumVoltageTerms voltage-only terms at V [mV] exactly (what the table holds).
+  /// The exact voltage terms at V [mV], kNumVoltageTerms values: the steady states of m, h (= j),
+  /// xr1, xr2, xs, r, s, d, f, f2, then ICaL = d f f2 fCass (t[10] CaSS − t[11]), INaCa =
+  /// t[12] Nai³ − t[13] Cai, INaK = t[14] Nai/(Nai + 40 mM), IpK = t[15] (V − EK).
   void CalcVoltageTerms(double v, double* terms) const;
+  /// The exact rates 1/τ [1/ms] of the kNumVoltageGates gates at V [mV] (m h j xr1 xr2 xs r s
+  /// d f f2; for h and j α + β).
+  void CalcGateRates(double v, double* rates) const;
+  /// The IK1 rectification x∞ = α/(α + β) as a function of V − EK [mV], exactly.
+  static double CalcK1Rectification(double v_minus_ek);
+
+  /// The voltage table (kNumVoltageTerms columns), or null when lookup_tables is off.
+  [[nodiscard]] const LookupTable* voltage_table() const { return voltage_table_.get(); }
+  /// The IK1 rectification table over V − EK, or null when lookup_tables is off.
+  [[nodiscard]] const LookupTable* k1_table() const { return k1_table_.get(); }
+  /// The table of e^(−dt·rate) for the kNumVoltageGates gates, built on first use; null when
+  /// lookup_tables is off or 8 other dt are cached already. Thread-safe.
+  [[nodiscard]] const LookupTable* DecayTable(double dt) const;
 
  protected:
   void DoStep(const CellStateView& states, std::size_t begin, std::size_t end, double dt,
@@ -107,16 +132,29 @@ class TenTusscherPanfilov2006 final : public CellModel {
                           double* i_ion) const override;
 
  private:
-  /// Fills terms[t * kChunk + j] for nodes first … first + count − 1 (count ≤ kChunk).
-  void FillVoltageTerms(const double* voltage, std::size_t first, std::size_t count,
-                        double* terms) const;
+  struct DecayTableEntry {
+    double dt;
+    LookupTable table;
+  };
+  /// Fills the per-node terms of nodes first … first + count − 1 (count ≤ the chunk size): the
+  /// voltage terms, EK, the IK1 rectification and, if dt > 0, the Rush–Larsen factors (from
+  /// `decay`, or exactly when it is null).
+  void FillTerms(const ConstCellStateView& states, std::size_t first, std::size_t count, double dt,
+                 const LookupTable* decay, double* terms) const;
   template <bool kStimulus>
   void StepChunk(const CellStateView& states, std::size_t first, std::size_t count, double dt,
                  const double* i_stim, const double* terms) const;
 
   Params params_;
   std::unique_ptr<const TenTusscherPanfilov2006Constants> constants_;
-  std::unique_ptr<const LookupTable> table_;
+  std::unique_ptr<const LookupTable> voltage_table_;
+  std::unique_ptr<const LookupTable> k1_table_;
+  // Cache of Rush–Larsen factor tables by dt: entries are added under the mutex and never
+  // removed (steps running in other threads may be reading them); `last_decay_` is the most
+  // recently used, checked without locking.
+  mutable std::mutex decay_mutex_;
+  mutable std::vector<std::unique_ptr<const DecayTableEntry>> decay_tables_;
+  mutable std::atomic<const DecayTableEntry*> last_decay_{nullptr};
 };
 
 }  // namespace gipsi
