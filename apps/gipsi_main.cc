@@ -1,15 +1,19 @@
 /// @file
-/// The `gipsi` command-line tool: run, validate and inspect scenes and meshes.
+/// The `gipsi` command-line tool: run, validate and inspect scenes and meshes; pace single
+/// cardiac cells.
 ///
-/// Exit codes: 0 success; 1 bad input (scene, mesh, plugin); 2 bad command line; 3 the run
-/// stopped because an object diverged or failed; 4 writing outputs failed; 130 interrupted.
+/// Exit codes: 0 success; 1 bad input (scene, mesh, plugin, cell model or parameter); 2 bad
+/// command line; 3 the run stopped because an object diverged or failed; 4 writing outputs
+/// failed; 130 interrupted.
 
 #include <unistd.h>
 
 #include <chrono>
 #include <csignal>
 #include <cstdio>
+#include <fstream>
 #include <iostream>
+#include <optional>
 
 #include <fmt/format.h>
 #include <CLI/CLI.hpp>
@@ -21,6 +25,8 @@
 #include "gipsi/io/outputs.h"
 #include "gipsi/io/scene.h"
 #include "gipsi/models/builtins.h"
+#include "gipsi/models/ep/cell_models.h"
+#include "gipsi/models/ep/single_cell.h"
 
 namespace {
 
@@ -217,6 +223,90 @@ int Types(const std::vector<std::string>& plugins) {
   return 0;
 }
 
+/// Options of `gipsi cell`.
+struct CellOptions {
+  std::string model;
+  std::string variant;
+  std::vector<std::string> params;  // key=value (value parsed as JSON, else taken as a string)
+  gipsi::PacingProtocol protocol;
+  std::optional<double> stim_amplitude, stim_duration;
+  std::string out;
+  std::int64_t every = 10;
+};
+
+/// The model's JSON description from the command line: {"model": MODEL, "variant": ..., k: v}.
+nlohmann::ordered_json CellSpec(const CellOptions& options) {
+  nlohmann::ordered_json spec = {{"model", options.model}};
+  if (!options.variant.empty()) spec["variant"] = options.variant;
+  for (const auto& param : options.params) {
+    const auto eq = param.find('=');
+    if (eq == std::string::npos || eq == 0)
+      gipsi::ThrowInputError("command line", "--param",
+                             fmt::format("expected key=value, got '{}'", param));
+    const std::string key = param.substr(0, eq), value = param.substr(eq + 1);
+    nlohmann::ordered_json parsed = nlohmann::ordered_json::parse(value, nullptr, false);
+    spec[key] = parsed.is_discarded() ? nlohmann::ordered_json(value) : parsed;
+  }
+  return spec;
+}
+
+int Cell(CellOptions options, const std::vector<std::string>& plugins) {
+  gipsi::TypeRegistry registry;
+  gipsi::RegisterBuiltins(registry);
+  // Until RegisterBuiltins registers the cell models itself.
+  if (!registry.cell_models.Contains("AlievPanfilov")) gipsi::RegisterCellModels(registry);
+  for (const auto& plugin : plugins) registry.LoadPlugin(plugin);
+  const nlohmann::ordered_json spec = CellSpec(options);
+  auto model = gipsi::CreateCellModel(registry, gipsi::JsonNode(spec, "command line", "cell"));
+  gipsi::PacingProtocol& protocol = options.protocol;
+  protocol.stim_amplitude = options.stim_amplitude.value_or(model->default_stimulus().amplitude);
+  protocol.stim_duration = options.stim_duration.value_or(model->default_stimulus().duration);
+  protocol.record_every = 0;
+
+  std::ofstream csv;
+  gipsi::CellSampleFn sink;
+  if (!options.out.empty()) {
+    csv.open(options.out);
+    if (!csv) {
+      std::cerr << "gipsi: error: cannot create " << options.out << "\n";
+      return 4;
+    }
+    csv << gipsi::CellTraceCsvHeader(*model) << '\n';
+    std::string row;
+    sink = [&csv, row](double t, std::span<const double> state) mutable {
+      row = fmt::format("{:.10g}", t);
+      for (double x : state) row += fmt::format(",{:.10g}", x);
+      row += '\n';
+      csv << row;
+    };
+  }
+  const gipsi::SingleCellResult result =
+      gipsi::PaceSingleCell(*model, protocol, {}, sink, options.out.empty() ? 0 : options.every);
+
+  std::string variant(model->variant());
+  std::cout << fmt::format("model:    {}{}, {} states; {}\n", model->type_name(),
+                           variant.empty() ? "" : " (" + variant + ")", model->num_states(),
+                           model->scheme());
+  std::cout << fmt::format(
+      "pacing:   {} beats at bcl {:g} ms, dt {:g} ms, stimulus {:g} uA/uF for {:g} ms\n",
+      protocol.beats, protocol.bcl, protocol.dt, protocol.stim_amplitude, protocol.stim_duration);
+  const std::string apd = fmt::format("APD{:g}", protocol.apd_percent);
+  std::cout << fmt::format("{:>5} {:>10} {:>9} {:>9} {:>10} {:>10} {:>9}\n", "beat", "start_ms",
+                           "rest_mV", "peak_mV", "dVdt_max", "act_ms", apd + "_ms");
+  for (const auto& b : result.beats)
+    std::cout << fmt::format("{:>5} {:>10.6g} {:>9.3f} {:>9.3f} {:>10.2f} {:>10.3f} {:>9.2f}\n",
+                             b.beat, b.start, b.rest, b.peak, b.dvdt_max, b.activation, b.apd);
+  if (!options.out.empty()) {
+    csv.flush();
+    if (!csv) {
+      std::cerr << "gipsi: error: writing " << options.out << " failed\n";
+      return 4;
+    }
+    std::cout << "trace:    " << options.out << "\n";
+  }
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -255,6 +345,44 @@ int main(int argc, char** argv) {
       "types", "List the registered object, connector, integrator and material types");
   types->add_option("--plugin", plugins, "Load a plugin shared library (repeatable)");
 
+  CellOptions cell_options;
+  auto* cell = app.add_subcommand(
+      "cell", "Pace a single cell of a cardiac cell model; print per-beat biomarkers");
+  cell->add_option("MODEL", cell_options.model,
+                   "Cell model (AlievPanfilov, MitchellSchaeffer, FitzHughNagumo, Nagumo, "
+                   "TenTusscherPanfilov2006)")
+      ->required();
+  cell->add_option("--variant", cell_options.variant, "Model variant (TTP06: epi, endo, M)");
+  cell->add_option("--param", cell_options.params,
+                   "Model parameter key=value, e.g. g_ks=0.2 (repeatable)");
+  cell->add_option("--bcl", cell_options.protocol.bcl, "Basic cycle length [ms]")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  cell->add_option("--beats", cell_options.protocol.beats, "Number of beats")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  cell->add_option("--dt", cell_options.protocol.dt, "Time step [ms]")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  cell->add_option("--stim-amplitude", cell_options.stim_amplitude,
+                   "Stimulus [uA/uF], positive depolarises (default: the model's)");
+  cell->add_option("--stim-duration", cell_options.stim_duration,
+                   "Stimulus duration [ms] (default: the model's)")
+      ->check(CLI::NonNegativeNumber);
+  cell->add_option("--apd", cell_options.protocol.apd_percent,
+                   "Repolarisation level of the APD [%]")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 100.0));
+  cell->add_option("--threshold", cell_options.protocol.activation_threshold,
+                   "Activation threshold [mV]")
+      ->capture_default_str();
+  cell->add_option("-o,--out", cell_options.out,
+                   "Write a CSV trace: t_ms then every state variable");
+  cell->add_option("--every", cell_options.every, "Write every K-th step to the CSV")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  cell->add_option("--plugin", plugins, "Load a plugin shared library (repeatable)");
+
   CLI11_PARSE(app, argc, argv);
   gipsi::Log().set_level(verbose ? spdlog::level::debug : spdlog::level::info);
   try {
@@ -262,6 +390,7 @@ int main(int argc, char** argv) {
     if (*validate) return Validate(scene_file, plugins);
     if (*info) return Info(mesh_file);
     if (*types) return Types(plugins);
+    if (*cell) return Cell(cell_options, plugins);
   } catch (const gipsi::InputError& e) {
     std::cerr << "gipsi: error: " << e.what() << "\n";
     return 1;

@@ -94,6 +94,7 @@ template class FactoryTable<ObjectFactory>;
 template class FactoryTable<ConnectorFactory>;
 template class FactoryTable<IntegratorFactory>;
 template class FactoryTable<MaterialFactory>;
+template class FactoryTable<CellModelFactory>;
 
 std::unique_ptr<SimObject> TypeRegistry::CreateObject(const std::string& name,
                                                       const JsonNode& params,

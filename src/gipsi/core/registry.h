@@ -24,6 +24,7 @@ namespace gipsi {
 
 class TypeRegistry;
 class Coordinator;
+class CellModel;
 
 /// Looks up meshes declared in the scene by name (implemented by the scene loader).
 class MeshProvider {
@@ -83,6 +84,9 @@ using ConnectorFactory = std::function<std::unique_ptr<Connector>(const Connecto
 using IntegratorFactory = std::function<std::unique_ptr<ExplicitIntegrator>()>;
 /// Builds a material from its JSON object (the "law" key is already consumed).
 using MaterialFactory = std::function<std::shared_ptr<const Material>(const JsonNode&)>;
+/// Builds a cardiac cell model from its JSON object ({"model": name, ...parameters}; see
+/// gipsi/models/ep/cell_models.h); throws InputError naming the JSON path of a bad parameter.
+using CellModelFactory = std::function<std::shared_ptr<const CellModel>(const JsonNode& params)>;
 
 /// Factories by type name, for one kind of product. Not copyable; movable.
 template <class Factory>
@@ -119,6 +123,7 @@ class TypeRegistry {
   FactoryTable<ConnectorFactory> connectors{"connector type"};
   FactoryTable<IntegratorFactory> integrators{"integrator"};
   FactoryTable<MaterialFactory> materials{"material law"};
+  FactoryTable<CellModelFactory> cell_models{"cell model"};
 
   /// Builds the object described by `params` (its "type" picks the factory).
   [[nodiscard]] std::unique_ptr<SimObject> CreateObject(const std::string& name,
