@@ -220,6 +220,7 @@ int Types(const std::vector<std::string>& plugins) {
   print("connectors", registry.connectors.List());
   print("integrators", registry.integrators.List());
   print("material laws", registry.materials.List());
+  print("cell models", registry.cell_models.List());
   return 0;
 }
 
@@ -253,8 +254,6 @@ nlohmann::ordered_json CellSpec(const CellOptions& options) {
 int Cell(CellOptions options, const std::vector<std::string>& plugins) {
   gipsi::TypeRegistry registry;
   gipsi::RegisterBuiltins(registry);
-  // Until RegisterBuiltins registers the cell models itself.
-  if (!registry.cell_models.Contains("AlievPanfilov")) gipsi::RegisterCellModels(registry);
   for (const auto& plugin : plugins) registry.LoadPlugin(plugin);
   const nlohmann::ordered_json spec = CellSpec(options);
   auto model = gipsi::CreateCellModel(registry, gipsi::JsonNode(spec, "command line", "cell"));

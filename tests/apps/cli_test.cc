@@ -141,8 +141,9 @@ TEST(GipsiRun, DivergingSceneStopsWithDiagnosticAndKeepsOutputs) {
 }
 
 TEST(GipsiValidate, AcceptsTheDemoScenes) {
-  for (const char* scene : {"hanging_sheet.json", "hanging_liver.json", "plugin_oscillator.json",
-                            "coupled_blocks.json", "cantilever.json", "indentation.json"}) {
+  for (const char* scene :
+       {"hanging_sheet.json", "hanging_liver.json", "plugin_oscillator.json", "coupled_blocks.json",
+        "cantilever.json", "indentation.json", "hanging_liver_fem.json"}) {
     Result r = Gipsi("validate " + Scene(scene));
     EXPECT_EQ(r.code, 0) << scene << "\n" << r.output;
     EXPECT_THAT(r.output, HasSubstr("valid scene"));

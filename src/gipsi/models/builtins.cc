@@ -3,6 +3,7 @@
 #include "gipsi/core/aggregate.h"
 #include "gipsi/models/connectors/boundary_coupling.h"
 #include "gipsi/models/connectors/field_copy.h"
+#include "gipsi/models/ep/cell_models.h"
 #include "gipsi/models/fem/fem_solid.h"
 #include "gipsi/models/mass_spring/mass_spring.h"
 
@@ -14,6 +15,7 @@ void RegisterBuiltins(TypeRegistry& registry) {
   RegisterMassSpring(registry);
   RegisterSolidLaws(registry);
   RegisterFemSolid(registry);
+  RegisterCellModels(registry);
   RegisterAggregate(registry);
   RegisterFieldCopy(registry);
   RegisterBoundaryCoupling(registry);
