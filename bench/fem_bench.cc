@@ -61,10 +61,12 @@ void BM_ImplicitStep(benchmark::State& state, const char* law) {
   state.counters["failed_steps"] = static_cast<double>(failures);
 }
 
+// Preconditioners: 0 Jacobi, 1 incomplete Cholesky, 2 lagged CHOLMOD factorisation. Eigen's
+// incomplete Cholesky refactorises every step and costs more than it saves on the larger meshes.
 void Sizes(benchmark::internal::Benchmark* b) {
-  for (int n : {10, 16, 25})
-    for (int pc : {1, 2}) b->Args({n, pc});
-  b->Args({10, 0});
+  for (int n : {10, 16, 25}) b->Args({n, 2});
+  for (int n : {10, 16}) b->Args({n, 0});
+  b->Args({10, 1});
   b->Unit(benchmark::kMillisecond)->UseRealTime();
 }
 BENCHMARK_CAPTURE(BM_ImplicitStep, corotational, "Corotational")->Apply(Sizes);

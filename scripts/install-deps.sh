@@ -13,7 +13,7 @@ packages=(
   zlib1g-dev             # compressed VTU payloads
   libgmsh-dev gmsh       # Gmsh C++ API: shell (left-ventricle) mesh generation
   libsuitesparse-dev     # CHOLMOD sparse Cholesky
-  libopenblas-openmp-dev # its BLAS: OpenBLAS threaded by the same OpenMP runtime as GiPSi
+  libopenblas-serial-dev # its BLAS: single-threaded OpenBLAS (GiPSi threads above it)
   libgtest-dev libgmock-dev libbenchmark-dev
   clang-format clang-tidy
 )
@@ -32,12 +32,13 @@ else
   DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
 fi
 
-# Use the OpenMP build of OpenBLAS even where the pthread build is installed too: pthread
-# OpenBLAS threads spin against GiPSi's OpenMP threads and made CHOLMOD solves 50x slower.
+# Use the single-threaded OpenBLAS even where a threaded build is installed too: CHOLMOD makes
+# many small BLAS calls, and waking BLAS threads for each (pthread build: spinning against
+# GiPSi's OpenMP threads; OpenMP build: sleeping and waking) made its solves 50x slower.
 arch_dir="/usr/lib/$(dpkg-architecture -qDEB_HOST_MULTIARCH 2>/dev/null || echo x86_64-linux-gnu)"
 for lib in libblas.so.3 liblapack.so.3; do
   name="${lib}-$(basename "$arch_dir")"
-  want="$arch_dir/openblas-openmp/$lib"
+  want="$arch_dir/openblas-serial/$lib"
   if [ -e "$want" ] && [ "$(readlink -f "$arch_dir/$lib")" != "$(readlink -f "$want")" ]; then
     echo "install-deps: selecting $want for $lib"
     $SUDO update-alternatives --quiet --set "$name" "$want"

@@ -121,15 +121,6 @@ TetAssembly::TetAssembly(const Mesh& mesh) : num_nodes_(mesh.num_nodes()), tets_
         static_cast<int>(e);
 }
 
-Mat3 TetAssembly::DeformationGradient(Index e, const double* u) const {
-  const auto g = gradients(e);
-  Mat3 f = Mat3::Identity();
-  for (int a = 0; a < 4; ++a) {
-    f.noalias() += Eigen::Map<const Vec3>(u + 3 * tets_(a, e)) * g.col(a).transpose();
-  }
-  return f;
-}
-
 SparseMatrix TetAssembly::MakePattern() const {
   const Index n = 3 * num_nodes_;
   SparseMatrix m(n, n);

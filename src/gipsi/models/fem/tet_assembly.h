@@ -45,7 +45,13 @@ class TetAssembly {
   /// Deformation gradient F = I + Σ_a u_a ⊗ ∇N_a of element e for node displacements `u`
   /// (3N, node-major). Working with displacements keeps F's round-off proportional to the
   /// deformation, not to the distance from the origin (stiff materials amplify it).
-  [[nodiscard]] Mat3 DeformationGradient(Index e, const double* u) const;
+  [[nodiscard]] Mat3 DeformationGradient(Index e, const double* u) const {
+    const auto g = gradients(e);
+    Mat3 f = Mat3::Identity();
+    for (int a = 0; a < 4; ++a)
+      f.noalias() += Eigen::Map<const Vec3>(u + 3 * tets_(a, e)) * g.col(a).transpose();
+    return f;
+  }
 
   /// A 3N by 3N matrix with the block pattern of node adjacency (both triangles, all nine
   /// entries of each coupled node pair) and zero values. Every node-coupled matrix of this mesh
