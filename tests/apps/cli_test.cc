@@ -9,6 +9,8 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include "apps/cli_test_util.h"
+
 #include "gipsi/io/vtu_reader.h"
 
 namespace gipsi {
@@ -17,30 +19,10 @@ namespace {
 namespace fs = std::filesystem;
 using ::testing::HasSubstr;
 
-struct Result {
-  int code = -1;
-  std::string output;  // stdout and stderr
-};
+using testing::Gipsi;
+using testing::Result;
 
-Result Gipsi(const std::string& args) {
-  std::string command = std::string(GIPSI_BINARY_DIR) + "/bin/gipsi " + args + " 2>&1";
-  Result result;
-  FILE* pipe = popen(command.c_str(), "r");
-  if (!pipe) return result;
-  std::array<char, 4096> buffer{};
-  while (std::size_t n = fread(buffer.data(), 1, buffer.size(), pipe))
-    result.output.append(buffer.data(), n);
-  int status = pclose(pipe);
-  result.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return result;
-}
-
-fs::path TempDir(const std::string& name) {
-  fs::path dir = fs::temp_directory_path() / ("gipsi_cli_" + name);
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  return dir;
-}
+fs::path TempDir(const std::string& name) { return testing::TempDir("gipsi_cli_", name); }
 
 std::string Scene(const std::string& name) {
   return std::string(GIPSI_SOURCE_DIR) + "/scenes/" + name;
