@@ -224,8 +224,7 @@ bool FemSolid::CalcStiffness(const VecX& x, SparseMatrix& K) const {
   return AssembleElements(work_.data(), f_int_, K.valuePtr());
 }
 
-void FemSolid::AssembleExternal(const double* u) {
-  const double s = s_;
+void FemSolid::AssembleExternal(const double* u, double s) const {
   f_ext_ = f_nodal_prev_ + s * (f_nodal_new_ - f_nodal_prev_);
   const BoundarySurface& bnd = boundary();
   for (Index f = 0; f < bnd.num_triangles(); ++f) {
@@ -272,7 +271,7 @@ bool FemSolid::CalcResidual(const VecX& d, VecX& r) {
   work_ = scheme_.x() + d;
   const bool ok = AssembleElements(work_.data(), f_int_, nullptr);
   if (ok) {
-    AssembleExternal(work_.data());
+    AssembleExternal(work_.data(), s_);
     FinishResidual(d, r);
   }
   profile_.assembly_seconds += Seconds(start);
@@ -286,7 +285,7 @@ bool FemSolid::CalcResidualAndJacobian(const VecX& d, VecX& r, SparseMatrix& J) 
     profile_.assembly_seconds += Seconds(start);
     return false;
   }
-  AssembleExternal(work_.data());
+  AssembleExternal(work_.data(), s_);
   double* jv = J.valuePtr();
   const Index nnz = J.nonZeros();
   if (params_.rayleigh_stiffness > 0 && first_iteration_)
@@ -413,7 +412,7 @@ void FemSolid::InitialAcceleration() {
   // solved with a direct factorisation of M, once).
   s_ = 0;
   if (!AssembleElements(scheme_.x().data(), f_int_, nullptr)) return;
-  AssembleExternal(scheme_.x().data());
+  AssembleExternal(scheme_.x().data(), s_);
   VecX rhs = f_ext_ - f_int_;
   if (params_.rayleigh_mass > 0) {
     if (params_.lumped_mass) {
@@ -578,11 +577,7 @@ void FemSolid::DoReadField(FieldId id, Eigen::Ref<Eigen::MatrixXd> out) const {
     // Reaction = M a + C v + f_int − f_ext on constrained axes, at the current state.
     out.setZero();
     if (!AssembleElements(u().data(), f_int_, nullptr)) return;
-    auto* self = const_cast<FemSolid*>(this);  // load buffers only; the state is untouched
-    const double s = self->s_;
-    self->s_ = 1;
-    self->AssembleExternal(u().data());
-    self->s_ = s;
+    AssembleExternal(u().data(), 1.0);  // after a step the previous loads equal the new ones
     work2_ = f_int_ - f_ext_;
     if (params_.scheme != ImplicitSchemeKind::kStatic) {
       if (params_.lumped_mass) {

@@ -118,8 +118,9 @@ class FemSolid final : public SimObject, private NonlinearSystem {
   /// f_int (and K values if `k_values` is not null) at displacements u; marks invalid
   /// elements.
   bool AssembleElements(const double* u, VecX& f, double* k_values) const;
-  /// External loads at displacements u for the current load fraction into f_ext_.
-  void AssembleExternal(const double* u);
+  /// External loads at displacements u and load fraction s (0: the previous step's loads, 1:
+  /// this step's) into f_ext_.
+  void AssembleExternal(const double* u, double s) const;
   /// Refreshes x_ and positions_ from the displacements.
   void UpdatePositions();
   /// Residual from f_int_ and f_ext_ plus inertia and damping for increment d.
