@@ -132,6 +132,36 @@ FemSolid::FemSolid(std::string name, std::shared_ptr<const Mesh> domain, FemPara
       {"newton_iterations", L::kGlobal, 1, "1", A::kRead, "Newton iterations of the last step"});
   f_inverted_ = DeclareField(
       {"inverted_elements", L::kGlobal, 1, "1", A::kRead, "number of elements with det F <= 0"});
+  for (const FemCavitySpec& spec : params_.cavities) {
+    std::vector<int> faces = SelectBoundaryFaces(spec.region, *domain, bnd);
+    if (faces.empty())
+      throw InputError(fmt::format("object '{}': cavity '{}' selects no boundary face",
+                                   this->name(), spec.name));
+    // Local vertices; triangles reversed so that they face out of the cavity (the boundary's
+    // normals point out of the tissue, i.e. into the cavity), which makes its volume positive.
+    std::vector<int> local(static_cast<std::size_t>(bnd.num_vertices()), -1);
+    std::vector<int> nodes;
+    Triangles tris(3, static_cast<Index>(faces.size()));
+    for (std::size_t k = 0; k < faces.size(); ++k)
+      for (int v = 0; v < 3; ++v) {
+        const int bv = bnd.triangles(v, faces[k]);
+        int& id = local[static_cast<std::size_t>(bv)];
+        if (id < 0) {
+          id = static_cast<int>(nodes.size());
+          nodes.push_back(bnd.vertex_to_node[static_cast<std::size_t>(bv)]);
+        }
+        tris(v == 0 ? 0 : 3 - v, static_cast<Index>(k)) = id;
+      }
+    EnclosedVolume volume(tris, static_cast<Index>(nodes.size()));
+    Points positions(3, static_cast<Index>(nodes.size()));
+    const FieldId f_volume = DeclareField({spec.name + "_volume", L::kGlobal, 1, "m^3", A::kRead,
+                                           "volume enclosed by the cavity's faces (rim capped)"});
+    const FieldId f_pressure =
+        DeclareField({spec.name + "_pressure", L::kGlobal, 1, "Pa", A::kReadWrite,
+                      "pressure in the cavity, acting on its faces (follower load)"});
+    cavities_.push_back(Cavity{std::move(faces), std::move(nodes), std::move(volume),
+                               std::move(positions), 0.0, f_volume, f_pressure});
+  }
 }
 
 MaterialPoint FemSolid::PointOf(Index e) const {
@@ -371,6 +401,8 @@ void FemSolid::GatherTargets() {
     pressure_new_[f] = bcs.pressure(f);
     traction_new_.col(f) = bcs.traction(f);
   }
+  for (const Cavity& cavity : cavities_)
+    for (int f : cavity.faces) pressure_new_[f] += cavity.pressure;
   constrained_dofs_.clear();
   std::fill(constraint_.begin(), constraint_.end(), 0);
   for (Index j = 0; j < bnd.num_vertices(); ++j) {
@@ -539,6 +571,14 @@ double FemSolid::GravityEnergy() const {
   return e;
 }
 
+double FemSolid::CavityVolume(std::size_t i) const {
+  GIPSI_CHECK(i < cavities_.size());
+  const Cavity& cavity = cavities_[i];
+  for (std::size_t k = 0; k < cavity.nodes.size(); ++k)
+    cavity.positions.col(static_cast<Index>(k)) = positions_.col(cavity.nodes[k]);
+  return cavity.volume.Compute(cavity.positions);
+}
+
 Index FemSolid::CountInvertedElements() const {
   Index count = 0;
   for (Index e = 0; e < num_elements(); ++e)
@@ -619,6 +659,11 @@ void FemSolid::DoReadField(FieldId id, Eigen::Ref<Eigen::MatrixXd> out) const {
     out(0, 0) = last_newton_.iterations;
   } else if (id == f_inverted_) {
     out(0, 0) = static_cast<double>(CountInvertedElements());
+  } else {
+    for (std::size_t i = 0; i < cavities_.size(); ++i) {
+      if (id == cavities_[i].f_volume) out(0, 0) = CavityVolume(i);
+      if (id == cavities_[i].f_pressure) out(0, 0) = cavities_[i].pressure;
+    }
   }
 }
 
@@ -647,6 +692,9 @@ void FemSolid::DoWriteField(FieldId id, const Eigen::Ref<const Eigen::MatrixXd>&
   } else if (id == f_nodal_active_) {
     nodal_active_tension_ = in.row(0).transpose();
     active_from_nodes_ = true;
+  } else {
+    for (Cavity& cavity : cavities_)
+      if (id == cavity.f_pressure) cavity.pressure = in(0, 0);
   }
 }
 

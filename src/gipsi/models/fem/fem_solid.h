@@ -26,12 +26,21 @@
 
 #include "gipsi/core/registry.h"
 #include "gipsi/core/sim_object.h"
+#include "gipsi/geometry/enclosed_volume.h"
+#include "gipsi/geometry/region.h"
 #include "gipsi/models/fem/solid_material.h"
 #include "gipsi/models/fem/tet_assembly.h"
 #include "gipsi/numerics/implicit_scheme.h"
 #include "gipsi/numerics/newton.h"
 
 namespace gipsi {
+
+/// A cavity bounded by part of the boundary (an endocardium): its volume is a field, and a
+/// pressure written to it acts as follower pressure on its faces. Plain struct.
+struct FemCavitySpec {
+  std::string name;  ///< fields "<name>_volume" [m³] and "<name>_pressure" [Pa]
+  Region region;     ///< selects the boundary faces that bound the cavity
+};
 
 /// Parameters. Plain struct with defaults.
 struct FemParams {
@@ -49,6 +58,7 @@ struct FemParams {
   int max_bisections = 6;      ///< halvings of a failed increment before the step fails
   Vec3 fibre = Vec3::UnitX();  ///< uniform fibre direction (reference configuration)
   Vec3 sheet = Vec3::UnitY();  ///< uniform sheet direction (orthogonalised against the fibre)
+  std::vector<FemCavitySpec> cavities;
 };
 
 /// Time spent in one object's steps, for `gipsi run --profile`. Plain struct.
@@ -102,6 +112,9 @@ class FemSolid final : public SimObject, private NonlinearSystem {
   [[nodiscard]] Index CountInvertedElements() const;
   /// Cauchy stress of element e at the current state (zero if outside the law's domain).
   [[nodiscard]] Mat3 CauchyStress(Index e) const;
+  /// Volume of cavity i (FemParams::cavities order) at the current state [m³]; an open rim is
+  /// capped (EnclosedVolume).
+  [[nodiscard]] double CavityVolume(std::size_t i) const;
 
  protected:
   StepStatus DoStep(double t, double dt) override;
@@ -174,6 +187,16 @@ class FemSolid final : public SimObject, private NonlinearSystem {
   VecX x_;     // 3N current positions
   Points positions_;
   std::string failure_detail_;
+
+  struct Cavity {
+    std::vector<int> faces;    // boundary faces
+    std::vector<int> nodes;    // domain node of each cavity vertex
+    EnclosedVolume volume;     // over the faces, oriented out of the cavity
+    mutable Points positions;  // work buffer, 3 by nodes.size()
+    double pressure = 0;       // Pa, written through the field
+    FieldId f_volume, f_pressure;
+  };
+  std::vector<Cavity> cavities_;
 
   FieldId f_position_, f_velocity_, f_displacement_, f_external_force_, f_bposition_, f_bvelocity_,
       f_bdisplacement_, f_reaction_, f_fibre_, f_active_, f_nodal_active_, f_von_mises_,

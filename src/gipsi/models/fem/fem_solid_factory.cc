@@ -4,6 +4,7 @@
 #include <fmt/format.h>
 
 #include "gipsi/base/error.h"
+#include "gipsi/geometry/region_json.h"
 #include "gipsi/models/fem/fem_solid.h"
 
 namespace gipsi {
@@ -41,7 +42,7 @@ void RegisterFemSolid(TypeRegistry& registry) {
       [](const ObjectBuildContext& ctx) -> std::unique_ptr<SimObject> {
         const JsonNode& p = ctx.params;
         ctx.CheckKeys({"density", "material", "mass", "damping", "gravity", "newmark", "newton",
-                       "linear_solver", "load_steps", "max_bisections", "fibres"});
+                       "linear_solver", "load_steps", "max_bisections", "fibres", "cavities"});
         FemParams params;
         params.density = p.Positive("density", params.density);
         params.material = ctx.registry.CreateMaterialAs<SolidMaterial>(p.At("material"), "solid");
@@ -89,6 +90,9 @@ void RegisterFemSolid(TypeRegistry& registry) {
                   "{{\"direction\": [1, 0, 0]}}",
                   params.material->law()));
         }
+        if (auto cavities = p.Find("cavities"))
+          for (const auto& [name, region] : cavities->Members())
+            params.cavities.push_back(FemCavitySpec{name, ParseRegion(region)});
         try {
           return std::make_unique<FemSolid>(ctx.name, ctx.DomainMesh(), std::move(params));
         } catch (const InputError& e) {
