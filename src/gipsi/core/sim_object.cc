@@ -73,6 +73,46 @@ FieldId SimObject::DeclareField(FieldInfo info) {
   return FieldId(static_cast<std::int64_t>(fields_.size() - 1));
 }
 
+MechanicalFieldIds SimObject::DeclareMechanicalFields() {
+  using L = FieldLocation;
+  using A = FieldAccess;
+  MechanicalFieldIds ids;
+  ids.position =
+      DeclareField({"position", L::kNode, 3, "m", A::kReadWrite, "current node position"});
+  ids.velocity = DeclareField({"velocity", L::kNode, 3, "m/s", A::kReadWrite, "node velocity"});
+  ids.displacement =
+      DeclareField({"displacement", L::kNode, 3, "m", A::kRead, "position minus rest position"});
+  ids.external_force = DeclareField({"external_force", L::kNode, 3, "N", A::kReadWrite,
+                                     "extra nodal force (volume coupling input)"});
+  ids.boundary_position = DeclareField({"boundary_position", L::kBoundaryVertex, 3, "m", A::kRead,
+                                        "current boundary vertex position"});
+  ids.boundary_velocity = DeclareField(
+      {"boundary_velocity", L::kBoundaryVertex, 3, "m/s", A::kRead, "boundary vertex velocity"});
+  ids.boundary_displacement = DeclareField({"boundary_displacement", L::kBoundaryVertex, 3, "m",
+                                            A::kRead, "boundary vertex displacement"});
+  ids.reaction_force =
+      DeclareField({"reaction_force", L::kBoundaryVertex, 3, "N", A::kRead,
+                    "force the kinematic constraints exert on constrained boundary vertices"});
+  return ids;
+}
+
+bool SimObject::ReadBoundaryKinematics(const MechanicalFieldIds& ids, FieldId id,
+                                       const Points& positions, const double* velocities,
+                                       Eigen::Ref<Eigen::MatrixXd> out) const {
+  if (id != ids.boundary_position && id != ids.boundary_velocity && id != ids.boundary_displacement)
+    return false;
+  const auto& v2n = boundary_.vertex_to_node;
+  for (std::size_t j = 0; j < v2n.size(); ++j) {
+    const Index node = v2n[j];
+    const auto col = static_cast<Index>(j);
+    if (id == ids.boundary_position) out.col(col) = positions.col(node);
+    if (id == ids.boundary_velocity) out.col(col) = Eigen::Map<const Vec3>(velocities + 3 * node);
+    if (id == ids.boundary_displacement)
+      out.col(col) = positions.col(node) - domain_->nodes.col(node);
+  }
+  return true;
+}
+
 std::optional<FieldId> SimObject::TryFindField(std::string_view name) const {
   for (std::size_t i = 0; i < fields_.size(); ++i)
     if (fields_[i].name == name) return FieldId(static_cast<std::int64_t>(i));

@@ -31,6 +31,16 @@ struct DisplayGeometry {
   Points positions = Points(3, 0);  ///< 3 by V current display vertex positions
 };
 
+/// Ids of the fields every deformable (mechanical) object declares under the same names, units
+/// and meanings, so connectors, collision response and probes can rely on them: "position",
+/// "velocity", "external_force" (node, read/write), "displacement" (node, read),
+/// "boundary_position", "boundary_velocity", "boundary_displacement", "reaction_force"
+/// (boundary vertex, read). Plain struct.
+struct MechanicalFieldIds {
+  FieldId position, velocity, displacement, external_force;
+  FieldId boundary_position, boundary_velocity, boundary_displacement, reaction_force;
+};
+
 /// Base class of every simulation object. Not copyable or movable (others hold references).
 ///
 /// Subclasses: declare their fields in the constructor (`DeclareField`), set their geometries
@@ -118,6 +128,12 @@ class SimObject {
   void SetGeometry(std::shared_ptr<const Mesh> domain, BoundarySurface boundary);
   /// Declares a field; returns its id. Call from the constructor only.
   FieldId DeclareField(FieldInfo info);
+  /// Declares the mechanical fields (MechanicalFieldIds). Call from the constructor only.
+  MechanicalFieldIds DeclareMechanicalFields();
+  /// Fills `out` (3 by boundary vertices) if `id` is one of the boundary kinematic fields of
+  /// `ids`, from node positions (3 by N) and node-major velocities (3N); returns whether it did.
+  bool ReadBoundaryKinematics(const MechanicalFieldIds& ids, FieldId id, const Points& positions,
+                              const double* velocities, Eigen::Ref<Eigen::MatrixXd> out) const;
 
   virtual StepStatus DoStep(double t, double dt) = 0;
   virtual void DoReadField(FieldId id, Eigen::Ref<Eigen::MatrixXd> out) const = 0;

@@ -100,21 +100,7 @@ FemSolid::FemSolid(std::string name, std::shared_ptr<const Mesh> domain, FemPara
 
   using L = FieldLocation;
   using A = FieldAccess;
-  f_position_ =
-      DeclareField({"position", L::kNode, 3, "m", A::kReadWrite, "current node position"});
-  f_velocity_ = DeclareField({"velocity", L::kNode, 3, "m/s", A::kReadWrite, "node velocity"});
-  f_displacement_ =
-      DeclareField({"displacement", L::kNode, 3, "m", A::kRead, "position minus rest position"});
-  f_external_force_ = DeclareField({"external_force", L::kNode, 3, "N", A::kReadWrite,
-                                    "extra nodal force (volume coupling input)"});
-  f_bposition_ = DeclareField({"boundary_position", L::kBoundaryVertex, 3, "m", A::kRead,
-                               "current boundary vertex position"});
-  f_bvelocity_ = DeclareField(
-      {"boundary_velocity", L::kBoundaryVertex, 3, "m/s", A::kRead, "boundary vertex velocity"});
-  f_bdisplacement_ = DeclareField({"boundary_displacement", L::kBoundaryVertex, 3, "m", A::kRead,
-                                   "boundary vertex displacement"});
-  f_reaction_ = DeclareField({"reaction_force", L::kBoundaryVertex, 3, "N", A::kRead,
-                              "force the kinematic constraints exert on constrained vertices"});
+  mech_ = DeclareMechanicalFields();
   f_fibre_ = DeclareField({"fibre", L::kElement, 3, "1", A::kReadWrite,
                            "fibre direction in the reference configuration (unit)"});
   f_active_ = DeclareField({"active_tension", L::kElement, 1, "Pa", A::kReadWrite,
@@ -597,23 +583,16 @@ Mat3 FemSolid::CauchyStress(Index e) const {
 void FemSolid::DoReadField(FieldId id, Eigen::Ref<Eigen::MatrixXd> out) const {
   const Index n = num_nodes();
   const auto& v2n = boundary().vertex_to_node;
-  if (id == f_position_) {
+  if (ReadBoundaryKinematics(mech_, id, positions_, v().data(), out)) return;
+  if (id == mech_.position) {
     out = positions_;
-  } else if (id == f_velocity_) {
+  } else if (id == mech_.velocity) {
     out = Eigen::Map<const Points>(v().data(), 3, n);
-  } else if (id == f_displacement_) {
+  } else if (id == mech_.displacement) {
     out = positions_ - domain().nodes;
-  } else if (id == f_external_force_) {
+  } else if (id == mech_.external_force) {
     out = external_force_;
-  } else if (id == f_bposition_ || id == f_bvelocity_ || id == f_bdisplacement_) {
-    for (std::size_t j = 0; j < v2n.size(); ++j) {
-      const Index node = v2n[j];
-      const auto col = static_cast<Index>(j);
-      if (id == f_bposition_) out.col(col) = positions_.col(node);
-      if (id == f_bvelocity_) out.col(col) = v().segment<3>(3 * node);
-      if (id == f_bdisplacement_) out.col(col) = positions_.col(node) - domain().nodes.col(node);
-    }
-  } else if (id == f_reaction_) {
+  } else if (id == mech_.reaction_force) {
     // Reaction = M a + C v + f_int − f_ext on constrained axes, at the current state.
     out.setZero();
     if (!AssembleElements(u().data(), f_int_, nullptr)) return;
@@ -669,13 +648,13 @@ void FemSolid::DoReadField(FieldId id, Eigen::Ref<Eigen::MatrixXd> out) const {
 
 void FemSolid::DoWriteField(FieldId id, const Eigen::Ref<const Eigen::MatrixXd>& in) {
   const Index n = num_nodes();
-  if (id == f_position_) {
+  if (id == mech_.position) {
     positions_ = in;
     scheme_.SetPositions(Eigen::Map<const VecX>(positions_.data(), 3 * n) - rest_);
     UpdatePositions();
-  } else if (id == f_velocity_) {
+  } else if (id == mech_.velocity) {
     scheme_.SetVelocity(Eigen::Map<const VecX>(in.data(), 3 * n));
-  } else if (id == f_external_force_) {
+  } else if (id == mech_.external_force) {
     external_force_ = in;
   } else if (id == f_fibre_) {
     if (axes_.empty())

@@ -198,9 +198,9 @@ class FemSolid final : public SimObject, private NonlinearSystem {
   };
   std::vector<Cavity> cavities_;
 
-  FieldId f_position_, f_velocity_, f_displacement_, f_external_force_, f_bposition_, f_bvelocity_,
-      f_bdisplacement_, f_reaction_, f_fibre_, f_active_, f_nodal_active_, f_von_mises_,
-      f_jacobian_, f_kinetic_, f_strain_energy_, f_newton_, f_inverted_;
+  MechanicalFieldIds mech_;
+  FieldId f_fibre_, f_active_, f_nodal_active_, f_von_mises_, f_jacobian_, f_kinetic_,
+      f_strain_energy_, f_newton_, f_inverted_;
 };
 
 /// Registers "FemSolid".

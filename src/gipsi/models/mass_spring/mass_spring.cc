@@ -123,22 +123,8 @@ void MassSpring::Finish() {
 
   using L = FieldLocation;
   using A = FieldAccess;
-  f_position_ =
-      DeclareField({"position", L::kNode, 3, "m", A::kReadWrite, "current node position"});
-  f_velocity_ = DeclareField({"velocity", L::kNode, 3, "m/s", A::kReadWrite, "node velocity"});
-  f_displacement_ =
-      DeclareField({"displacement", L::kNode, 3, "m", A::kRead, "position minus rest position"});
-  f_external_force_ = DeclareField({"external_force", L::kNode, 3, "N", A::kReadWrite,
-                                    "extra nodal force (volume coupling input)"});
+  mech_ = DeclareMechanicalFields();
   f_mass_ = DeclareField({"mass", L::kNode, 1, "kg", A::kRead, "lumped node mass"});
-  f_bposition_ = DeclareField({"boundary_position", L::kBoundaryVertex, 3, "m", A::kRead,
-                               "current boundary vertex position"});
-  f_bvelocity_ = DeclareField(
-      {"boundary_velocity", L::kBoundaryVertex, 3, "m/s", A::kRead, "boundary vertex velocity"});
-  f_bdisplacement_ = DeclareField({"boundary_displacement", L::kBoundaryVertex, 3, "m", A::kRead,
-                                   "boundary vertex displacement"});
-  f_reaction_ = DeclareField({"reaction_force", L::kBoundaryVertex, 3, "N", A::kRead,
-                              "force the constraints exert on constrained boundary vertices"});
   f_kinetic_ = DeclareField({"kinetic_energy", L::kGlobal, 1, "J", A::kRead, "½ Σ m v²"});
   f_potential_ = DeclareField(
       {"potential_energy", L::kGlobal, 1, "J", A::kRead, "spring plus gravitational energy"});
@@ -302,25 +288,18 @@ void MassSpring::DoReadField(FieldId id, Eigen::Ref<Eigen::MatrixXd> out) const 
   auto node_block = [&](Index offset) {  // 3 by N view into x_
     return Eigen::Map<const Points>(x_.data() + offset, 3, n);
   };
-  if (id == f_position_) {
+  if (ReadBoundaryKinematics(mech_, id, positions_, x_.data() + 3 * n, out)) return;
+  if (id == mech_.position) {
     out = positions_;
-  } else if (id == f_velocity_) {
+  } else if (id == mech_.velocity) {
     out = node_block(3 * n);
-  } else if (id == f_displacement_) {
+  } else if (id == mech_.displacement) {
     out = positions_ - domain().nodes;
-  } else if (id == f_external_force_) {
+  } else if (id == mech_.external_force) {
     out = external_force_;
   } else if (id == f_mass_) {
     out = mass_.transpose();
-  } else if (id == f_bposition_ || id == f_bvelocity_ || id == f_bdisplacement_) {
-    for (std::size_t j = 0; j < v2n.size(); ++j) {
-      const Index node = v2n[j];
-      const auto col = static_cast<Index>(j);
-      if (id == f_bposition_) out.col(col) = positions_.col(node);
-      if (id == f_bvelocity_) out.col(col) = x_.segment<3>(3 * n + 3 * node);
-      if (id == f_bdisplacement_) out.col(col) = positions_.col(node) - domain().nodes.col(node);
-    }
-  } else if (id == f_reaction_) {
+  } else if (id == mech_.reaction_force) {
     // Reaction = m·a_prescribed − f = −f on constrained axes (prescribed acceleration is zero).
     CalcForces(time(), x_, force_);
     const BoundaryConditions& bcs = boundary_conditions();
@@ -340,12 +319,12 @@ void MassSpring::DoReadField(FieldId id, Eigen::Ref<Eigen::MatrixXd> out) const 
 
 void MassSpring::DoWriteField(FieldId id, const Eigen::Ref<const Eigen::MatrixXd>& in) {
   const Index n = num_nodes();
-  if (id == f_position_) {
+  if (id == mech_.position) {
     positions_ = in;
     x_.head(3 * n) = Eigen::Map<const VecX>(positions_.data(), 3 * n);
-  } else if (id == f_velocity_) {
+  } else if (id == mech_.velocity) {
     Eigen::Map<Points>(x_.data() + 3 * n, 3, n) = in;
-  } else if (id == f_external_force_) {
+  } else if (id == mech_.external_force) {
     external_force_ = in;
   }
 }

@@ -103,8 +103,8 @@ class MassSpring final : public SimObject {
   Points positions_;       // q as 3 by N (kept in sync)
   Points external_force_;  // volume-coupling input, 3 by N
   mutable VecX force_;     // work buffer, 3N
-  FieldId f_position_, f_velocity_, f_displacement_, f_external_force_, f_mass_;
-  FieldId f_bposition_, f_bvelocity_, f_bdisplacement_, f_reaction_;
+  MechanicalFieldIds mech_;
+  FieldId f_mass_;
   FieldId f_kinetic_, f_potential_, f_momentum_;
 };
 
