@@ -14,6 +14,7 @@ packages=(
   libgmsh-dev gmsh       # Gmsh C++ API: shell (left-ventricle) mesh generation
   libsuitesparse-dev     # CHOLMOD sparse Cholesky
   libopenblas-serial-dev # its BLAS: single-threaded OpenBLAS (GiPSi threads above it)
+  libudunits2-dev        # UDUNITS-2: quantities with units in scene files
   libgtest-dev libgmock-dev libbenchmark-dev
   clang-format clang-tidy
 )

@@ -1,4 +1,5 @@
 #include "gipsi/core/aggregate.h"
+#include "gipsi/base/units.h"
 
 #include <fmt/format.h>
 
@@ -77,7 +78,7 @@ void RegisterAggregate(TypeRegistry& registry) {
         if (auto order = p.Find("order")) parts.SetOrder(order->AsStrings(), order->path());
         JsonNode dt = p.At("dt");
         try {
-          parts.Prepare(dt.AsPositive());
+          parts.Prepare(ReadPositiveQuantity(dt, "s"));
         } catch (const InputError& e) {
           dt.Fail(e.what());
         }

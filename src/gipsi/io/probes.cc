@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 
 #include "gipsi/base/error.h"
+#include "gipsi/base/units.h"
 #include "gipsi/geometry/region_json.h"
 
 namespace gipsi {
@@ -79,7 +80,7 @@ Probe ParseProbe(const std::string& name, const JsonNode& node, const Kernel& ke
   }
   if (names.empty()) node.Fail("missing required key 'fields'");
   if (node.Has("point") && node.Has("region")) node.Fail("give either 'point' or 'region'");
-  probe.every = node.NonNegative("every", 0.0);
+  probe.every = node.Has("every") ? ReadPositiveQuantity(node.At("every"), "s", true) : 0.0;
 
   bool needs_location = false;
   FieldLocation location = FieldLocation::kGlobal;

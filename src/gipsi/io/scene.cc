@@ -8,6 +8,7 @@
 
 #include "gipsi/base/error.h"
 #include "gipsi/base/log.h"
+#include "gipsi/base/units.h"
 #include "gipsi/geometry/generators.h"
 #include "gipsi/io/mesh_io.h"
 
@@ -56,7 +57,7 @@ class ObjectBuilder {
       node.Fail(fmt::format("object name '{}' must be non-empty without '.', '/' or spaces", name));
     auto object = registry_.CreateObject(name, node, meshes_, fn_);
     double dt = default_dt_;
-    if (auto d = node.Find("dt")) dt = d->AsPositive();
+    if (auto d = node.Find("dt")) dt = ReadPositiveQuantity(*d, "s");
     if (!(dt > 0)) node.Fail("missing required key 'dt' (and schedule.dt is not set)");
     if (auto display = node.Find("display")) ApplyDisplay(*object, *display);
     if (auto bcs = node.Find("boundary_conditions")) {
@@ -101,7 +102,7 @@ class ObjectBuilder {
 
 void ParseEvent(const JsonNode& node, Scene& scene) {
   node.CheckKeys({"at", "object", "apply", "remove", "set_field", "description"});
-  const double at = node.At("at").AsNonNegative();
+  const double at = ReadPositiveQuantity(node.At("at"), "s", /*allow_zero=*/true);
   JsonNode object_node = node.At("object");
   std::string object_name = object_node.AsString();
   SimObject* object = nullptr;
@@ -308,8 +309,8 @@ Scene LoadSceneFromString(std::string_view text, const std::string& name,
 
   JsonNode schedule = root.At("schedule");
   schedule.CheckKeys({"end", "dt", "order", "events"});
-  scene.end_time = schedule.At("end").AsPositive();
-  const double macro_dt = schedule.Positive("dt", 0.0);
+  scene.end_time = ReadPositiveQuantity(schedule.At("end"), "s");
+  const double macro_dt = schedule.Has("dt") ? ReadPositiveQuantity(schedule.At("dt"), "s") : 0.0;
 
   ObjectBuilder builder(registry, mesh_provider, scene, macro_dt);
   JsonNode objects = root.At("objects");
@@ -362,7 +363,8 @@ Scene LoadSceneFromString(std::string_view text, const std::string& name,
         scene.vtu.enabled = vtu->AsBool();
       } else {
         vtu->CheckKeys({"every", "objects", "display"});
-        scene.vtu.every = vtu->NonNegative("every", 0.0);
+        scene.vtu.every =
+            vtu->Has("every") ? ReadPositiveQuantity(vtu->At("every"), "s", true) : 0.0;
         scene.vtu.display = vtu->Bool("display", true);
         if (auto names = vtu->Find("objects")) {
           scene.vtu.objects = names->AsStrings();

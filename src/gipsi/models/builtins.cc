@@ -4,6 +4,7 @@
 #include "gipsi/models/connectors/boundary_coupling.h"
 #include "gipsi/models/connectors/field_copy.h"
 #include "gipsi/models/ep/cell_models.h"
+#include "gipsi/models/ep/monodomain.h"
 #include "gipsi/models/fem/fem_solid.h"
 #include "gipsi/models/mass_spring/mass_spring.h"
 
@@ -16,6 +17,7 @@ void RegisterBuiltins(TypeRegistry& registry) {
   RegisterSolidLaws(registry);
   RegisterFemSolid(registry);
   RegisterCellModels(registry);
+  RegisterMonodomain(registry);
   RegisterAggregate(registry);
   RegisterFieldCopy(registry);
   RegisterBoundaryCoupling(registry);

@@ -1,0 +1,171 @@
+#pragma once
+/// @file
+/// `EpTissue`: the part of every monodomain (bioelectricity) simulation object that does not
+/// depend on how space is discretised — cell states, operator splitting, stimulus protocols,
+/// voltage clamps, activation-time and APD maps, fields, divergence checks. A subclass owns the
+/// geometry and supplies the diffusion operator: a mass (lumped vector or consistent matrix) and
+/// a stiffness matrix K_ij = ∫ ∇φ_i · D ∇φ_j with D = σ/(χ Cm) (P1 tets: `Monodomain`; a
+/// regular grid: `GridMonodomain`).
+///
+/// The monodomain equation χ (Cm ∂V/∂t + I_ion(V, s)) = ∇·(σ∇V) + I_vol, divided by χ Cm, is
+///   ∂V/∂t = ∇·(D ∇V) − I_ion(V, s) + I_stim,    I_stim = I_vol / (χ Cm),
+/// with no-flux boundaries. A step of length Δt splits it (Godunov: R(Δt) then D(Δt); Strang:
+/// R(Δt/2) D(Δt) R(Δt/2)) into the reaction R — every node's cell model, `reaction_dt` sub-steps
+/// with the model's own scheme (Rush–Larsen for gates of ionic models) — and the diffusion D:
+///   (M + θ Δt K) V⁺ = (M − (1 − θ) Δt K) V     (θ = 1 backward Euler, ½ Crank–Nicolson),
+/// solved by the configured sparse solver warm-started from V (the matrix is assembled and
+/// factorised once per Δt).
+///
+/// Units: scenes are SI (or quantities with units, base/units.h); inside, lengths are mm, times
+/// ms, V mV, D mm²/ms, currents µA/µF (= mV/ms). Fields report V in mV and times in ms.
+
+#include <chrono>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "gipsi/core/sim_object.h"
+#include "gipsi/geometry/region.h"
+#include "gipsi/models/ep/cell_model.h"
+#include "gipsi/numerics/sparse/linear_solver.h"
+
+namespace gipsi {
+
+/// A train of rectangular pulses (times in ms): pulse k (0 ≤ k < count) is active on
+/// [start + k·period, start + k·period + duration). Plain struct.
+struct PulseTrain {
+  double start = 0;     ///< ms
+  double duration = 1;  ///< ms, > 0
+  double period = 0;    ///< ms; 0 for a single pulse, else ≥ duration
+  int count = 1;        ///< number of pulses (≥ 1)
+
+  /// Total time [ms] during which a pulse is active within [t0, t1].
+  [[nodiscard]] double ActiveTime(double t0, double t1) const;
+  /// Whether a pulse is active at t [ms].
+  [[nodiscard]] bool ActiveAt(double t) const;
+};
+
+/// A stimulus current into the nodes of a region. Plain struct.
+struct StimulusSpec {
+  std::string name;
+  Region region;
+  double amplitude = 0;  ///< applied current per capacitance [µA/µF = mV/ms], > 0 depolarises
+  PulseTrain pulses;
+};
+
+/// Holds V at `voltage` in the nodes of a region while a pulse is active. Plain struct.
+struct ClampSpec {
+  std::string name;
+  Region region;
+  double voltage = 0;  ///< mV
+  PulseTrain pulses;
+};
+
+enum class SplittingScheme { kGodunov, kStrang };
+
+/// Parameters shared by every monodomain object. Plain struct with defaults.
+struct EpTissueParams {
+  std::shared_ptr<const CellModel> cell;  ///< required
+  double sigma_longitudinal = 0;          ///< monodomain conductivity along fibres [S/m]
+  double sigma_transverse = 0;            ///< across fibres [S/m]
+  std::optional<Vec3> fibre;              ///< uniform fibre direction (needed if anisotropic)
+  double surface_to_volume = 1.4e5;       ///< χ [1/m] (1400 /cm)
+  double capacitance = 0.01;              ///< Cm [F/m²] (1 µF/cm²)
+  SplittingScheme splitting = SplittingScheme::kGodunov;
+  double theta = 1.0;          ///< diffusion: 1 backward Euler, 0.5 Crank–Nicolson
+  bool lumped_mass = true;     ///< else consistent mass
+  double reaction_dt = 0;      ///< largest reaction sub-step [s]; 0: the object's step
+  LinearSolverOptions linear;  ///< diffusion solver (default CG + Jacobi, 1e-8)
+  std::vector<StimulusSpec> stimuli;
+  std::vector<ClampSpec> clamps;
+  double activation_threshold = 0;    ///< mV: activation when V rises through it
+  double apd_repolarisation = 0.9;    ///< APD at this fraction of repolarisation
+  std::vector<double> initial_state;  ///< per state variable; empty: the model's rest
+
+  EpTissueParams() {
+    linear.type = "cg";
+    linear.preconditioner = "jacobi";
+    linear.tolerance = 1e-8;
+  }
+  /// D = σ/(χ Cm) [mm²/ms] along (l) and across (t) the fibres.
+  [[nodiscard]] double diffusivity_longitudinal() const;
+  [[nodiscard]] double diffusivity_transverse() const;
+  [[nodiscard]] bool anisotropic() const { return sigma_longitudinal != sigma_transverse; }
+};
+
+/// Base of the monodomain objects (see the file comment). Not copyable or movable.
+class EpTissue : public SimObject {
+ public:
+  [[nodiscard]] const EpTissueParams& params() const { return params_; }
+  [[nodiscard]] const CellModel& cell() const { return *params_.cell; }
+  [[nodiscard]] Index num_nodes() const { return static_cast<Index>(states_->num_nodes()); }
+  /// Transmembrane voltage [mV] of every node (a view of the cell states).
+  [[nodiscard]] Eigen::Map<const VecX> voltage() const;
+  /// First activation time [ms] per node, −1 where not activated yet.
+  [[nodiscard]] const VecX& activation_time() const { return activation_time_; }
+  /// Last completed APD [ms] per node, −1 where none.
+  [[nodiscard]] const VecX& apd() const { return apd_; }
+  /// ∫ V dΩ with the diffusion mass [mV·mm³] (conserved by diffusion alone).
+  [[nodiscard]] double VoltageIntegral() const;
+  /// Nodes driven by each stimulus / clamp (in declaration order).
+  [[nodiscard]] const std::vector<std::vector<int>>& stimulus_nodes() const { return stim_nodes_; }
+  [[nodiscard]] std::vector<ProfileEntry> ProfileBreakdown() const override;
+  [[nodiscard]] std::string failure_detail() const override { return failure_detail_; }
+
+ protected:
+  EpTissue(std::string name, EpTissueParams params);
+
+  /// Call once from the subclass constructor after SetGeometry: sizes the cell states and
+  /// selects the stimulus and clamp nodes on `domain()` (throws InputError for a region that
+  /// selects nothing).
+  void InitTissue();
+  /// Sets the diffusion operator (internal units, see the file comment). `stiffness` is
+  /// symmetric with both triangles stored and rows summing to zero; `mass` is the lumped mass
+  /// per node [mm³] and `consistent_mass`, if the parameters ask for it, has K's pattern.
+  void SetDiffusionOperator(SparseMatrix stiffness, VecX lumped_mass,
+                            SparseMatrix consistent_mass = {});
+  /// Node positions in mm (for diagnostics).
+  [[nodiscard]] virtual Vec3 NodePositionMm(Index node) const;
+
+  StepStatus DoStep(double t, double dt) override;
+  void DoReadField(FieldId id, Eigen::Ref<Eigen::MatrixXd> out) const override;
+  void DoWriteField(FieldId id, const Eigen::Ref<const Eigen::MatrixXd>& in) override;
+
+  EpTissueParams params_;
+
+ private:
+  void ReactionSteps(double t0_ms, double length_ms);
+  [[nodiscard]] bool FillStimulus(double t0, double t1);
+  void ApplyClamps(double t);
+  [[nodiscard]] StepStatus Diffuse(double dt_ms);
+  void TrackActivation(double t0_ms, double dt_ms);
+  [[nodiscard]] StepStatus CheckVoltage();
+  [[nodiscard]] double* v_data() { return states_->var(params_.cell->v_index()); }
+
+  std::unique_ptr<CellStates> states_;
+  std::vector<FieldId> state_fields_;  // one per cell state (V included)
+  FieldId f_activation_, f_last_activation_, f_apd_, f_activated_, f_integral_, f_cg_;
+  std::vector<std::vector<int>> stim_nodes_, clamp_nodes_;
+  VecX i_stim_;
+  std::vector<int> stimulated_;  // nodes with a non-zero i_stim_ entry
+
+  // Diffusion.
+  SparseMatrix stiffness_, consistent_mass_, system_;
+  VecX lumped_mass_, rhs_, solution_, work_;
+  std::unique_ptr<LinearSolver> solver_;
+  double system_dt_ = -1;  // Δt [ms] of system_
+  int last_iterations_ = 0;
+
+  // Activation and APD.
+  VecX v_prev_, activation_time_, last_activation_, apd_, v_min_, v_peak_;
+  std::vector<unsigned char> depolarised_;
+
+  struct Profile {
+    double reaction = 0, diffusion = 0, tracking = 0;
+    std::int64_t cg_iterations = 0, steps = 0;
+  } profile_;
+  std::string failure_detail_;
+};
+
+}  // namespace gipsi

@@ -1,0 +1,21 @@
+#pragma once
+/// @file
+/// Scene keys shared by the monodomain objects ("Monodomain", "GridMonodomain"); documented in
+/// docs/scene-format.md. Quantities are SI numbers or "VALUE UNIT" strings (base/units.h).
+
+#include <string>
+#include <vector>
+
+#include "gipsi/core/registry.h"
+#include "gipsi/models/ep/ep_tissue.h"
+
+namespace gipsi {
+
+/// Checks that the object's keys are the common ones, the EP tissue keys, or `extra`.
+void CheckEpTissueKeys(const ObjectBuildContext& ctx, const std::vector<std::string>& extra = {});
+
+/// Reads cell, conductivity, fibres, surface_to_volume, capacitance, splitting, diffusion,
+/// reaction, stimuli, clamps and activation. Throws InputError naming the JSON path.
+EpTissueParams ParseEpTissueParams(const ObjectBuildContext& ctx);
+
+}  // namespace gipsi
