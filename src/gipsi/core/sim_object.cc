@@ -40,12 +40,16 @@ void SimObject::SetGeometry(std::shared_ptr<const Mesh> domain, BoundarySurface 
   display_.positions.resize(3, boundary_.num_vertices());
 }
 
+PointMap SimObject::MapFromNodes(const Points& targets) const {
+  const Mesh& mesh = *domain_;
+  return mesh.num_tets() > 0
+             ? PointMap::BarycentricInTets(mesh.nodes, mesh.tets, targets)
+             : PointMap::BarycentricOnTriangles(mesh.nodes, mesh.triangles, targets);
+}
+
 void SimObject::EmbedDisplay(const Points& rest_vertices, const Triangles& triangles,
                              double max_distance) {
-  const Mesh& mesh = *domain_;
-  PointMap map = mesh.num_tets() > 0
-                     ? PointMap::BarycentricInTets(mesh.nodes, mesh.tets, rest_vertices)
-                     : PointMap::BarycentricOnTriangles(mesh.nodes, mesh.triangles, rest_vertices);
+  PointMap map = MapFromNodes(rest_vertices);
   if (map.max_distance() > max_distance) {
     ThrowInputError("", fmt::format("objects.{}.display", name_),
                     fmt::format("the display surface lies up to {:.4g} away from the domain "

@@ -72,6 +72,11 @@ class SimObject {
   /// domain barycentrically (tet domains) or by closest point (surface domains). Throws
   /// InputError if a vertex lies farther than `max_distance` from the domain.
   void EmbedDisplay(const Points& rest_vertices, const Triangles& triangles, double max_distance);
+  /// Interpolation of node values at points of the rest domain (probes at points, volume
+  /// connectors, display embedding): by default barycentric in the domain's tets, or on its
+  /// triangles for surface domains; objects on other geometries (e.g. a structured grid)
+  /// override it. Throws InputError as the PointMap builders do.
+  [[nodiscard]] virtual PointMap MapFromNodes(const Points& targets) const;
 
   // --- Boundary conditions ---
   [[nodiscard]] BoundaryConditions& boundary_conditions() { return bcs_; }

@@ -256,4 +256,14 @@ void PointMap::Apply(const Eigen::Ref<const Eigen::MatrixXd>& source,
   }
 }
 
+PointMap PointMap::FromWeights(Eigen::Matrix4Xi indices, Eigen::Matrix4Xd weights,
+                               double max_distance) {
+  GIPSI_CHECK(indices.cols() == weights.cols());
+  PointMap map;
+  map.indices_ = std::move(indices);
+  map.weights_ = std::move(weights);
+  map.max_distance_ = max_distance;
+  return map;
+}
+
 }  // namespace gipsi

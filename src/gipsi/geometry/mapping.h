@@ -31,6 +31,10 @@ class PointMap {
   /// Nearest source point (weight 1). Throws InputError if there are targets but no sources,
   /// or a target is not finite.
   static PointMap Nearest(const Points& sources, const Points& targets);
+  /// Given weights: target j gets Σ_k weights(k, j) · source[indices(k, j)]. `max_distance` as
+  /// max_distance(). Shapes must agree (checked).
+  static PointMap FromWeights(Eigen::Matrix4Xi indices, Eigen::Matrix4Xd weights,
+                              double max_distance);
 
   [[nodiscard]] Index num_targets() const { return indices_.cols(); }
   [[nodiscard]] const Eigen::Matrix4Xi& indices() const { return indices_; }

@@ -107,9 +107,7 @@ Probe ParseProbe(const std::string& name, const JsonNode& node, const Kernel& ke
       p->Fail("point probes interpolate node fields; these fields are not node fields");
     const Mesh& mesh = object.domain();
     Points target = p->AsVec3();
-    probe.point = mesh.num_tets() > 0
-                      ? PointMap::BarycentricInTets(mesh.nodes, mesh.tets, target)
-                      : PointMap::BarycentricOnTriangles(mesh.nodes, mesh.triangles, target);
+    probe.point = object.MapFromNodes(target);
     const double diag = (mesh.nodes.rowwise().maxCoeff() - mesh.nodes.rowwise().minCoeff()).norm();
     if (probe.point->max_distance() > 1e-6 * diag)
       p->Fail(fmt::format("the point lies {:.4g} outside the domain of '{}'",

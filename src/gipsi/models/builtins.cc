@@ -4,6 +4,7 @@
 #include "gipsi/models/connectors/boundary_coupling.h"
 #include "gipsi/models/connectors/field_copy.h"
 #include "gipsi/models/ep/cell_models.h"
+#include "gipsi/models/ep/grid_monodomain.h"
 #include "gipsi/models/ep/monodomain.h"
 #include "gipsi/models/fem/fem_solid.h"
 #include "gipsi/models/mass_spring/mass_spring.h"
@@ -18,6 +19,7 @@ void RegisterBuiltins(TypeRegistry& registry) {
   RegisterFemSolid(registry);
   RegisterCellModels(registry);
   RegisterMonodomain(registry);
+  RegisterGridMonodomain(registry);
   RegisterAggregate(registry);
   RegisterFieldCopy(registry);
   RegisterBoundaryCoupling(registry);

@@ -46,10 +46,7 @@ FieldCopy::FieldCopy(std::string name, SimObject& from, FieldId from_field, SimO
   if (mapping_ == Mapping::kBarycentric) {
     if (src.location != FieldLocation::kNode)
       fail("'barycentric' mapping needs a node field as source");
-    const Mesh& mesh = from.domain();
-    map_ = mesh.num_tets() > 0
-               ? PointMap::BarycentricInTets(mesh.nodes, mesh.tets, dst_pos)
-               : PointMap::BarycentricOnTriangles(mesh.nodes, mesh.triangles, dst_pos);
+    map_ = from.MapFromNodes(dst_pos);
   } else if (mapping_ == Mapping::kNearest) {
     map_ = PointMap::Nearest(src_pos, dst_pos);
   }
