@@ -91,6 +91,17 @@ TEST(GipsiRun, ProfileShowsWhereTheTimeWent) {
   EXPECT_THAT(r.output, HasSubstr("outputs (probes, VTU)"));
 }
 
+TEST(GipsiRun, RunsTheElectrophysiologySlabWithItsProfile) {
+  fs::path out = TempDir("slab_ep");
+  Result r = Gipsi("run -q --profile " + Scene("slab_ep_grid_0.5mm.json") +
+                   " --until 0.004 --out " + out.string());
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_THAT(r.output, HasSubstr("reaction (cell models)"));
+  EXPECT_THAT(r.output, HasSubstr("diffusion (assembly and solves)"));
+  EXPECT_TRUE(fs::exists(out / "probes" / "far_corner.csv"));
+  EXPECT_TRUE(fs::exists(out / "tissue.pvd"));
+}
+
 TEST(GipsiRun, DivergingSceneStopsWithDiagnosticAndKeepsOutputs) {
   fs::path dir = TempDir("diverge");
   {
@@ -125,7 +136,9 @@ TEST(GipsiRun, DivergingSceneStopsWithDiagnosticAndKeepsOutputs) {
 TEST(GipsiValidate, AcceptsTheDemoScenes) {
   for (const char* scene :
        {"hanging_sheet.json", "hanging_liver.json", "plugin_oscillator.json", "coupled_blocks.json",
-        "cantilever.json", "indentation.json", "hanging_liver_fem.json"}) {
+        "cantilever.json", "indentation.json", "hanging_liver_fem.json", "slab_ep_0.5mm.json",
+        "slab_ep_0.2mm.json", "slab_ep_grid_0.5mm.json", "slab_ep_grid_0.2mm.json",
+        "spiral_wave.json"}) {
     Result r = Gipsi("validate " + Scene(scene));
     EXPECT_EQ(r.code, 0) << scene << "\n" << r.output;
     EXPECT_THAT(r.output, HasSubstr("valid scene"));
