@@ -2,6 +2,7 @@
 
 #include "gipsi/core/aggregate.h"
 #include "gipsi/models/connectors/boundary_coupling.h"
+#include "gipsi/models/connectors/excitation_contraction.h"
 #include "gipsi/models/connectors/field_copy.h"
 #include "gipsi/models/ep/cell_models.h"
 #include "gipsi/models/ep/grid_monodomain.h"
@@ -22,6 +23,7 @@ void RegisterBuiltins(TypeRegistry& registry) {
   RegisterGridMonodomain(registry);
   RegisterAggregate(registry);
   RegisterFieldCopy(registry);
+  RegisterExcitationContraction(registry);
   RegisterBoundaryCoupling(registry);
 }
 

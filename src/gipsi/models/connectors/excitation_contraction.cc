@@ -1,0 +1,102 @@
+/// @file
+/// Excitation–contraction coupling (voltage → active tension).
+
+#include "gipsi/models/connectors/excitation_contraction.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "gipsi/base/error.h"
+#include "gipsi/base/units.h"
+#include "gipsi/models/connectors/item_positions.h"
+
+namespace gipsi {
+
+ExcitationContraction::ExcitationContraction(std::string name, const SimObject& ep, FieldId voltage,
+                                             SimObject& muscle, FieldId tension,
+                                             const ExcitationContractionParams& params)
+    : Connector(std::move(name)),
+      ep_(ep),
+      voltage_(voltage),
+      muscle_(muscle),
+      tension_field_(tension),
+      params_(params) {
+  const FieldInfo& v = ep.field_info(voltage);
+  const FieldInfo& ta = muscle.field_info(tension);
+  if (v.location != FieldLocation::kNode || v.components != 1 || !v.readable())
+    throw InputError(
+        fmt::format("'from' must be a readable scalar node field (the voltage); "
+                    "'{}.{}' is not",
+                    ep.name(), v.name));
+  if ((ta.location != FieldLocation::kNode && ta.location != FieldLocation::kElement) ||
+      ta.components != 1 || !ta.writable())
+    throw InputError(
+        fmt::format("'to' must be a writable scalar node or element field (an "
+                    "active tension); '{}.{}' is not",
+                    muscle.name(), ta.name));
+  if (!(params.v_peak > params.v_rest)) throw InputError("v_peak must exceed v_rest");
+  const Points src = ItemRestPositions(ep, FieldLocation::kNode);
+  const Points dst = ItemRestPositions(muscle, ta.location);
+  const bool coincide = src.cols() == dst.cols() && (src - dst).cwiseAbs().maxCoeff() <= 1e-12;
+  if (!coincide) map_ = ep.MapFromNodes(dst);
+  source_.resize(1, src.cols());
+  mapped_.resize(1, dst.cols());
+  tension_ = VecX::Zero(dst.cols());
+}
+
+StepStatus ExcitationContraction::DoFire(double t) {
+  const double dt = fired_ ? t - last_time_ : 0.0;
+  fired_ = true;
+  last_time_ = t;
+  ep_.ReadField(voltage_, source_);
+  if (map_) {
+    map_->Apply(source_, mapped_);
+  } else {
+    mapped_ = source_;
+  }
+  const ExcitationContractionParams& p = params_;
+  for (Index i = 0; i < tension_.size(); ++i) {
+    const double v = mapped_(0, i);
+    if (!std::isfinite(v)) return StepStatus::Diverged("non-finite voltage at item", i, v);
+    const double u = std::clamp((v - p.v_rest) / (p.v_peak - p.v_rest), 0.0, 1.0);
+    const double rate = u >= p.threshold ? p.rise_rate : p.decay_rate;
+    const double target = p.gain * u;
+    tension_[i] = target + (tension_[i] - target) * std::exp(-rate * dt);
+  }
+  muscle_.WriteField(tension_field_, tension_.transpose());
+  return StepStatus::Ok();
+}
+
+void RegisterExcitationContraction(TypeRegistry& registry) {
+  registry.connectors.Register(
+      "ExcitationContraction",
+      [](const ConnectorBuildContext& ctx) -> std::unique_ptr<Connector> {
+        ctx.CheckKeys(
+            {"from", "to", "v_rest", "v_peak", "threshold", "gain", "rise_rate", "decay_rate"});
+        const JsonNode& p = ctx.params;
+        ExcitationContractionParams params;
+        if (auto v = p.Find("v_rest")) params.v_rest = 1e3 * ReadQuantity(*v, "V");
+        if (auto v = p.Find("v_peak")) params.v_peak = 1e3 * ReadQuantity(*v, "V");
+        if (auto th = p.Find("threshold")) {
+          params.threshold = th->AsNumber();
+          if (!(params.threshold > 0 && params.threshold < 1))
+            th->Expected("a fraction of the excitation in (0, 1)");
+        }
+        if (auto k = p.Find("gain")) params.gain = ReadPositiveQuantity(*k, "Pa", true);
+        if (auto r = p.Find("rise_rate")) params.rise_rate = ReadPositiveQuantity(*r, "1/s");
+        if (auto r = p.Find("decay_rate")) params.decay_rate = ReadPositiveQuantity(*r, "1/s");
+        auto [ep, voltage] = ctx.ObjectField("from");
+        auto [muscle, tension] = ctx.ObjectField("to");
+        try {
+          return std::make_unique<ExcitationContraction>(ctx.name, *ep, voltage, *muscle, tension,
+                                                         params);
+        } catch (const InputError& e) {
+          p.Fail(e.what());
+        }
+      },
+      "volume coupling: transmembrane voltage -> active tension (first-order twitch model)");
+}
+
+}  // namespace gipsi

@@ -1,0 +1,71 @@
+#pragma once
+/// @file
+/// `ExcitationContraction`: the bioelectricity → muscle coupling of the GiPSi heart through the
+/// shared volume. It Gets the transmembrane voltage V [mV] of an electrophysiology object,
+/// interpolates it at the items of the muscle's active-tension field (nodes or element
+/// centroids, on another mesh if need be), drives a first-order active-tension model there, and
+/// Sets the tension T_a [Pa] (acting along the fibres) on the muscle.
+///
+/// The model is of the Nash–Panfilov type (Nash & Panfilov, Prog. Biophys. Mol. Biol. 85:501,
+/// 2004): with the normalised excitation u = (V − v_rest)/(v_peak − v_rest) clamped to [0, 1],
+///   dT_a/dt = ε(u) (k u − T_a),   ε = rise_rate while u ≥ threshold, decay_rate below it,
+/// so tension builds up during the action potential and relaxes after repolarisation. V is held
+/// at its value at the firing time over the interval since the previous firing, and the linear
+/// ODE is integrated exactly: T_a ← k u + (T_a − k u) e^{−ε Δt} (stable for any interval).
+/// The state T_a lives in the connector (one value per target item, starting at 0).
+///
+/// Units: V in mV (the EP objects' unit); k in Pa; rates in 1/s; kernel time in s.
+
+#include <optional>
+#include <string>
+
+#include "gipsi/core/connector.h"
+#include "gipsi/core/registry.h"
+#include "gipsi/core/sim_object.h"
+#include "gipsi/geometry/mapping.h"
+
+namespace gipsi {
+
+/// Parameters. Plain struct with defaults (a demonstration twitch: about 40 kPa after 300 ms of
+/// excitation, relaxing with a 33 ms time constant; not fitted to data).
+struct ExcitationContractionParams {
+  double v_rest = -80;       ///< mV: u = 0
+  double v_peak = 20;        ///< mV: u = 1
+  double threshold = 0.05;   ///< u at which the rate switches
+  double gain = 5e4;         ///< k [Pa]: the tension approached under full excitation
+  double rise_rate = 5.0;    ///< 1/s
+  double decay_rate = 30.0;  ///< 1/s
+};
+
+/// Not copyable or movable (a Connector).
+class ExcitationContraction final : public Connector {
+ public:
+  /// `voltage` must be a readable scalar node field of `ep`; `tension` a writable scalar node or
+  /// element field of `muscle`. Throws InputError otherwise, or for bad parameters.
+  ExcitationContraction(std::string name, const SimObject& ep, FieldId voltage, SimObject& muscle,
+                        FieldId tension, const ExcitationContractionParams& params);
+
+  [[nodiscard]] std::string_view type_name() const override { return "ExcitationContraction"; }
+  /// The active tension [Pa] per target item (last value Set).
+  [[nodiscard]] const VecX& tension() const { return tension_; }
+
+ protected:
+  StepStatus DoFire(double t) override;
+
+ private:
+  const SimObject& ep_;
+  FieldId voltage_;
+  SimObject& muscle_;
+  FieldId tension_field_;
+  ExcitationContractionParams params_;
+  std::optional<PointMap> map_;  // empty: the items coincide
+  Eigen::MatrixXd source_, mapped_;
+  VecX tension_;
+  double last_time_ = 0;
+  bool fired_ = false;
+};
+
+/// Registers "ExcitationContraction" (keys in docs/scene-format.md).
+void RegisterExcitationContraction(TypeRegistry& registry);
+
+}  // namespace gipsi
