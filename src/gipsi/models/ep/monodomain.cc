@@ -5,11 +5,10 @@
 
 #include <fmt/format.h>
 
-#include <Eigen/Dense>
-
 #include "gipsi/base/error.h"
 #include "gipsi/geometry/boundary.h"
 #include "gipsi/models/ep/ep_tissue_json.h"
+#include "gipsi/numerics/p1_scalar.h"
 
 namespace gipsi {
 
@@ -32,49 +31,17 @@ Monodomain::Monodomain(std::string name, std::shared_ptr<const Mesh> mesh, EpTis
 
 void Monodomain::Assemble() {
   const Mesh& mesh = domain();
-  const Index num_tets = mesh.tets.cols();
   const double dl = params_.diffusivity_longitudinal();
   const double dt = params_.diffusivity_transverse();
-  std::vector<Eigen::Triplet<double, int>> k_entries, m_entries;
-  k_entries.reserve(static_cast<std::size_t>(16 * num_tets));
-  if (!params_.lumped_mass) m_entries.reserve(static_cast<std::size_t>(16 * num_tets));
-  VecX lumped = VecX::Zero(mesh.num_nodes());
-  for (Index e = 0; e < num_tets; ++e) {
-    Mat3 edges;
-    const Vec3 x0 = 1e3 * mesh.nodes.col(mesh.tets(0, e));  // mm
-    for (int a = 0; a < 3; ++a) edges.col(a) = 1e3 * mesh.nodes.col(mesh.tets(a + 1, e)) - x0;
-    const double volume = edges.determinant() / 6.0;
-    if (!(std::abs(volume) > 1e-300))
-      throw InputError(fmt::format("tet {} of the domain mesh is degenerate (zero volume)", e));
-    // Gradients of the barycentric functions: rows of edges⁻¹ for nodes 1..3; node 0 their
-    // negative sum.
-    const Mat3 inv = edges.inverse();
-    Eigen::Matrix<double, 4, 3> grad;
-    grad.bottomRows<3>() = inv;
-    grad.row(0) = -inv.colwise().sum();
-    const Vec3 f = fibres_.col(e);
-    const Mat3 diffusivity = dt * Mat3::Identity() + (dl - dt) * f * f.transpose();
-    const Eigen::Matrix4d ke = std::abs(volume) * grad * diffusivity * grad.transpose();
-    for (int a = 0; a < 4; ++a) {
-      const int ia = mesh.tets(a, e);
-      lumped[ia] += std::abs(volume) / 4;
-      for (int b = 0; b < 4; ++b) {
-        const int ib = mesh.tets(b, e);
-        k_entries.emplace_back(ia, ib, ke(a, b));
-        if (!params_.lumped_mass)
-          m_entries.emplace_back(ia, ib, std::abs(volume) * (a == b ? 2.0 : 1.0) / 20.0);
-      }
-    }
-  }
-  const auto n = static_cast<int>(mesh.num_nodes());
-  SparseMatrix stiffness(n, n);
-  stiffness.setFromTriplets(k_entries.begin(), k_entries.end());
-  SparseMatrix mass;
-  if (!params_.lumped_mass) {
-    mass.resize(n, n);
-    mass.setFromTriplets(m_entries.begin(), m_entries.end());
-  }
-  SetDiffusionOperator(std::move(stiffness), std::move(lumped), std::move(mass));
+  P1ScalarOperators ops = AssembleP1Scalar(
+      mesh.nodes, mesh.tets, 1e3,  // m → mm
+      [&](Index e) -> Mat3 {
+        const Vec3 f = fibres_.col(e);
+        return dt * Mat3::Identity() + (dl - dt) * f * f.transpose();
+      },
+      !params_.lumped_mass);
+  SetDiffusionOperator(std::move(ops.stiffness), std::move(ops.lumped_mass),
+                       std::move(ops.consistent_mass));
 }
 
 void Monodomain::DoReadField(FieldId id, Eigen::Ref<Eigen::MatrixXd> out) const {
