@@ -28,6 +28,7 @@
 #include "gipsi/core/sim_object.h"
 #include "gipsi/geometry/region.h"
 #include "gipsi/models/ep/cell_model.h"
+#include "gipsi/models/fibres/rule_based_fibres.h"
 #include "gipsi/numerics/sparse/linear_solver.h"
 
 namespace gipsi {
@@ -70,8 +71,10 @@ struct EpTissueParams {
   double sigma_longitudinal = 0;          ///< monodomain conductivity along fibres [S/m]
   double sigma_transverse = 0;            ///< across fibres [S/m]
   std::optional<Vec3> fibre;              ///< uniform fibre direction (needed if anisotropic)
-  double surface_to_volume = 1.4e5;       ///< χ [1/m] (1400 /cm)
-  double capacitance = 0.01;              ///< Cm [F/m²] (1 µF/cm²)
+  /// Per-element fibres from a rule instead (tet objects only).
+  std::optional<TransmuralFibreRule> fibre_rule;
+  double surface_to_volume = 1.4e5;  ///< χ [1/m] (1400 /cm)
+  double capacitance = 0.01;         ///< Cm [F/m²] (1 µF/cm²)
   SplittingScheme splitting = SplittingScheme::kGodunov;
   double theta = 1.0;          ///< diffusion: 1 backward Euler, 0.5 Crank–Nicolson
   bool lumped_mass = true;     ///< else consistent mass

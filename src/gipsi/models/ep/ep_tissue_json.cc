@@ -83,9 +83,13 @@ EpTissueParams ParseEpTissueParams(const ObjectBuildContext& ctx) {
   params.cell = CreateCellModel(ctx.registry, p.At("cell"));
   ReadConductivity(p.At("conductivity"), params);
   if (auto fibres = p.Find("fibres")) {
-    fibres->CheckKeys({"direction"});
-    params.fibre = fibres->Vector3("direction");
-    if (params.fibre->norm() == 0) fibres->At("direction").Expected("a non-zero vector");
+    if (fibres->Has("rule")) {
+      params.fibre_rule = ParseTransmuralFibreRule(*fibres);
+    } else {
+      fibres->CheckKeys({"direction"});
+      params.fibre = fibres->Vector3("direction");
+      if (params.fibre->norm() == 0) fibres->At("direction").Expected("a non-zero vector");
+    }
   } else if (params.anisotropic()) {
     p.At("conductivity")
         .Fail(

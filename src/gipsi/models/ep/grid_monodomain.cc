@@ -32,6 +32,10 @@ GridMonodomain::GridMonodomain(std::string name, const CartesianGrid& grid, EpTi
   if (!params_.lumped_mass)
     throw InputError(
         "GridMonodomain has a diagonal (lumped) mass only: remove \"mass\": \"consistent\"");
+  if (params_.fibre_rule)
+    throw InputError(
+        "GridMonodomain needs fibres along a grid axis (\"fibres\": {\"direction\": [1, 0, "
+        "0]}); rule-based fibres need Monodomain on tets");
   if (params_.anisotropic()) {
     if (!params_.fibre)
       throw InputError(

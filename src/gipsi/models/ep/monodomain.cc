@@ -16,13 +16,14 @@ Monodomain::Monodomain(std::string name, std::shared_ptr<const Mesh> mesh, EpTis
     : EpTissue(std::move(name), std::move(params)) {
   if (mesh->tets.cols() == 0)
     throw InputError("the Monodomain object needs a tetrahedral domain mesh (this one has none)");
-  if (params_.anisotropic() && !params_.fibre)
+  if (params_.anisotropic() && !params_.fibre && !params_.fibre_rule)
     throw InputError(
         "the conductivity is anisotropic (longitudinal != transverse), so the object needs a "
         "fibre direction: add \"fibres\": {\"direction\": [1, 0, 0]}");
   SetGeometry(mesh, MakeBoundary(*mesh));
   const Vec3 fibre = params_.fibre.value_or(Vec3::UnitX()).normalized();
-  fibres_ = fibre.replicate(1, mesh->tets.cols());
+  fibres_ = params_.fibre_rule ? MakeTransmuralFibres(*mesh, *params_.fibre_rule).fibre
+                               : Points(fibre.replicate(1, mesh->tets.cols()));
   f_fibre_ = DeclareField({"fibre", FieldLocation::kElement, 3, "1", FieldAccess::kReadWrite,
                            "fibre direction per element (normalised when written)"});
   InitTissue();

@@ -6,6 +6,7 @@
 #include "gipsi/base/error.h"
 #include "gipsi/geometry/region_json.h"
 #include "gipsi/models/fem/fem_solid.h"
+#include "gipsi/models/fibres/rule_based_fibres.h"
 
 namespace gipsi {
 namespace {
@@ -78,7 +79,10 @@ void RegisterFemSolid(TypeRegistry& registry) {
           if (n < 0 || n > 30) bisections->Expected("an integer in [0, 30]");
           params.max_bisections = static_cast<int>(n);
         }
-        if (auto fibres = p.Find("fibres")) {
+        std::optional<TransmuralFibreRule> fibre_rule;
+        if (auto fibres = p.Find("fibres"); fibres && fibres->Has("rule")) {
+          fibre_rule = ParseTransmuralFibreRule(*fibres);
+        } else if (fibres) {
           fibres->CheckKeys({"direction", "sheet"});
           params.fibre = fibres->Vector3("direction");
           params.sheet = fibres->Vector3("sheet", params.sheet);
@@ -94,7 +98,12 @@ void RegisterFemSolid(TypeRegistry& registry) {
           for (const auto& [name, region] : cavities->Members())
             params.cavities.push_back(FemCavitySpec{name, ParseRegion(region)});
         try {
-          return std::make_unique<FemSolid>(ctx.name, ctx.DomainMesh(), std::move(params));
+          auto mesh = ctx.DomainMesh();
+          auto solid = std::make_unique<FemSolid>(ctx.name, mesh, std::move(params));
+          if (fibre_rule)
+            solid->WriteField(solid->FindField("fibre"),
+                              MakeTransmuralFibres(*mesh, *fibre_rule).fibre);
+          return solid;
         } catch (const InputError& e) {
           p.Fail(e.what());
         }
