@@ -146,5 +146,13 @@ TEST(TetBox, FiveTetSplitConformsAndFillsTheBox) {
   EXPECT_EQ(b.num_triangles(), 2 * 2 * (3 * 4 + 3 * 2 + 4 * 2));
 }
 
+// Absurd sizes are refused before any allocation (a fuzzed scene must not exhaust memory).
+TEST(Generators, RefuseAbsurdSizes) {
+  EXPECT_THROW((void)MakeTetBox(Vec3::Zero(), Vec3::Ones(), {100000, 100000, 100000}), InputError);
+  EXPECT_THROW(
+      (void)MakeTriangleSheet(Vec3::Zero(), Vec3::UnitX(), Vec3::UnitY(), {100000, 100000}),
+      InputError);
+}
+
 }  // namespace
 }  // namespace gipsi

@@ -48,6 +48,11 @@ Mesh MakeTetBox(const Vec3& min, const Vec3& max, const std::array<int, 3>& cell
     ThrowInputError("", "tet box",
                     fmt::format("cells must be >= 1 on every axis, got {} x {} x {}", cells[0],
                                 cells[1], cells[2]));
+  const double num_cells = double(cells[0]) * cells[1] * cells[2];
+  if (num_cells * (split == HexSplit::kSix ? 6 : 5) > kMaxGeneratedElements)
+    ThrowInputError("", "tet box",
+                    fmt::format("{} x {} x {} cells would make more than {:.0e} tets", cells[0],
+                                cells[1], cells[2], kMaxGeneratedElements));
   const int nx = cells[0], ny = cells[1], nz = cells[2];
   auto node = [&](int i, int j, int k) { return i + (nx + 1) * (j + (ny + 1) * k); };
   Mesh mesh;
@@ -132,6 +137,10 @@ Mesh MakeTriangleSheet(const Vec3& origin, const Vec3& edge_u, const Vec3& edge_
     ThrowInputError(
         "", "triangle sheet",
         fmt::format("cells must be >= 1 on both axes, got {} x {}", cells[0], cells[1]));
+  if (2.0 * cells[0] * cells[1] > kMaxGeneratedElements)
+    ThrowInputError("", "triangle sheet",
+                    fmt::format("{} x {} cells would make more than {:.0e} triangles", cells[0],
+                                cells[1], kMaxGeneratedElements));
   if (!origin.allFinite() || !edge_u.allFinite() || !edge_v.allFinite() ||
       !(edge_u.cross(edge_v).norm() > 1e-12 * edge_u.norm() * edge_v.norm()))
     ThrowInputError(

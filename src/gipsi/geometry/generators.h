@@ -11,6 +11,10 @@
 namespace gipsi {
 
 /// How each hexahedral cell of a structured box is cut into tetrahedra.
+/// The most elements a generator makes (a box of 20 million tets needs about 3 GB to build and
+/// assemble): larger requests are refused with an InputError rather than exhausting memory.
+inline constexpr double kMaxGeneratedElements = 2e7;
+
 enum class HexSplit {
   kSix,   ///< 6 tets around the main diagonal (Kuhn/Freudenthal)
   kFive,  ///< 5 tets (a central tet and four corners), alternating by cell parity to conform

@@ -111,7 +111,9 @@ void EpTissue::InitTissue() {
   v_peak_ = v_prev_;
   depolarised_.assign(n, 0);
   solver_ = MakeLinearSolver(params_.linear);
-  model.Prepare(params_.reaction_dt > 0 ? 1e3 * params_.reaction_dt : 0.01);
+  // Tables for the reaction sub-step now, so the first step does not build them (with no
+  // reaction dt the sub-step is the object's dt, known at the first step).
+  if (params_.reaction_dt > 0) model.Prepare(1e3 * params_.reaction_dt);
 }
 
 void EpTissue::SetDiffusionOperator(SparseMatrix stiffness, VecX lumped_mass,

@@ -159,6 +159,9 @@ void RegisterGridMonodomain(TypeRegistry& registry) {
                 std::max(1, static_cast<int>(std::lround(cells)));
           }
         }
+        if (double(grid.num_nodes()) > kMaxGeneratedElements)
+          g.Fail(fmt::format("{} x {} x {} cells would make more than {:.0e} grid nodes",
+                             grid.cells[0], grid.cells[1], grid.cells[2], kMaxGeneratedElements));
         EpTissueParams params = ParseEpTissueParams(ctx);
         try {
           return std::make_unique<GridMonodomain>(ctx.name, grid, std::move(params));
