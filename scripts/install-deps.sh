@@ -16,6 +16,7 @@ packages=(
   libopenblas-serial-dev # its BLAS: single-threaded OpenBLAS (GiPSi threads above it)
   libudunits2-dev        # UDUNITS-2: quantities with units in scene files
   libgtest-dev libgmock-dev libbenchmark-dev
+  clang-14 libclang-rt-14-dev libomp-14-dev  # libFuzzer targets (scripts/fuzz.sh)
   clang-format clang-tidy
 )
 

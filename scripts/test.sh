@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Installs the dependencies, then builds and runs every test: the release build, the same suite
-# under AddressSanitizer + UndefinedBehaviorSanitizer, and a clang-format check.
+# under AddressSanitizer + UndefinedBehaviorSanitizer, a clang-format check, and a bounded
+# libFuzzer run of the scene loader and every mesh reader (scripts/fuzz.sh, 15 s each).
 # Usage: bash scripts/test.sh [--fast]   (--fast: release build and tests only)
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -31,4 +32,7 @@ if [ "${1:-}" != "--fast" ]; then
   cmake --preset asan
   cmake --build --preset asan
   ctest --preset asan
+
+  echo "== fuzz (libFuzzer, clang, ASan + UBSan; 15 s per target)"
+  bash scripts/fuzz.sh 15
 fi

@@ -1,0 +1,10 @@
+// libFuzzer target: the vtk mesh reader (ReadVtkLegacy) on arbitrary bytes.
+
+#include "fuzz/fuzz_util.h"
+#include "gipsi/io/vtk_legacy_reader.h"
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  const auto path = gipsi::fuzz::WriteInput(data, size, ".vtk");
+  gipsi::fuzz::ExpectOnlyInputErrors([&] { (void)gipsi::ReadVtkLegacy(path); });
+  return 0;
+}
