@@ -207,5 +207,15 @@ TEST(Scene, EventReleasesConditionAtItsTime) {
   EXPECT_FALSE(cube.boundary_conditions().any_constraint());
 }
 
+// A probe's name becomes a file name under <out>/probes/: names that would climb out of that
+// folder are refused.
+TEST(Scene, ProbeNamesCannotLeaveTheOutputDirectory) {
+  for (const char* name : {"../escape", "a/b", ".hidden", ""}) {
+    const std::string probes = std::string(R"(, "probes": {")") + name +
+                               R"(": {"object": "cube", "fields": ["kinetic_energy"]}})";
+    EXPECT_THAT(LoadError(SceneText("", probes)), HasSubstr("must be a plain file name")) << name;
+  }
+}
+
 }  // namespace
 }  // namespace gipsi

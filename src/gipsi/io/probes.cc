@@ -63,6 +63,15 @@ void Probe::Sample(std::vector<double>& out) const {
 Probe ParseProbe(const std::string& name, const JsonNode& node, const Kernel& kernel) {
   node.CheckKeys(
       {"object", "point", "region", "fields", "field", "reduce", "every", "description"});
+  // The name becomes <out>/probes/<name>.csv: it must not climb out of that folder.
+  const bool plain = !name.empty() && name.front() != '.' &&
+                     name.find_first_of("/\\") == std::string::npos &&
+                     std::all_of(name.begin(), name.end(), [](unsigned char c) { return c >= 32; });
+  if (!plain)
+    node.Fail(
+        fmt::format("probe name '{}' must be a plain file name (no '/' or '\\', not starting "
+                    "with '.')",
+                    name));
   Probe probe;
   probe.name = name;
   JsonNode object_node = node.At("object");
