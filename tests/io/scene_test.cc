@@ -91,9 +91,12 @@ TEST(SceneErrors, MalformedJsonGivesLineAndColumn) {
 TEST(SceneErrors, UnknownTypeSuggestsTheClosest) {
   std::string text = SceneText();
   text.replace(text.find("\"MassSpring\""), 12, "\"MassSprign\"");
-  EXPECT_THAT(LoadError(text),
-              HasSubstr("scene.json: objects.cube.type: unknown object type 'MassSprign' (did "
-                        "you mean 'MassSpring'?); known: Aggregate, FemSolid, MassSpring"));
+  // The list of known types grows with every model; check its start and a few members.
+  const std::string error = LoadError(text);
+  EXPECT_THAT(error, HasSubstr("scene.json: objects.cube.type: unknown object type 'MassSprign' "
+                               "(did you mean 'MassSpring'?); known: Aggregate, "));
+  for (const char* type : {"FemSolid", "MassSpring", "Monodomain"})
+    EXPECT_THAT(error, HasSubstr(type));
 }
 
 TEST(SceneErrors, WrongParameterTypeNamesThePath) {
