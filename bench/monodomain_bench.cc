@@ -2,8 +2,8 @@
 // harmonic-mean conductivities, fibres along x) at 0.2 mm on P1 tets and on the FD grid, with
 // a wave in flight (the slab is first run for 10 ms after the corner stimulus), reporting the
 // reaction / diffusion split and the diffusion solver's iterations. Run:
-//   OMP_WAIT_POLICY=passive ./build/release/bench/monodomain_bench --benchmark_repetitions=3 \
-//     --benchmark_report_aggregates_only=true
+//   OMP_WAIT_POLICY=passive ./build/release/bench/monodomain_bench
+//     --benchmark_repetitions=3 --benchmark_report_aggregates_only=true
 // The whole 60 ms run is timed by the CLI: gipsi run scenes/slab_ep_0.2mm.json --profile
 
 #include <benchmark/benchmark.h>

@@ -102,7 +102,9 @@ TEST(GridMonodomainTest, AgreesWithTetsOnTheSlabAsBothAreRefined) {
         "%.4f ms\n",
         dx, grid.activation_time().maxCoeff(), tets.activation_time().maxCoeff(), difference);
     differences.push_back(difference);
-    if (dx == 0.125) EXPECT_LT(difference, 0.01 * tets.activation_time().maxCoeff());
+    if (dx == 0.125) {
+      EXPECT_LT(difference, 0.01 * tets.activation_time().maxCoeff());
+    }
   }
   EXPECT_GT(differences[0] / differences[1], 2.5);
   EXPECT_GT(differences[1] / differences[2], 2.5);
