@@ -1,6 +1,7 @@
 #include "gipsi/models/builtins.h"
 
 #include "gipsi/core/aggregate.h"
+#include "gipsi/models/circulation/circulation.h"
 #include "gipsi/models/connectors/boundary_coupling.h"
 #include "gipsi/models/connectors/field_copy.h"
 #include "gipsi/models/ep/cell_models.h"
@@ -20,6 +21,7 @@ void RegisterBuiltins(TypeRegistry& registry) {
   RegisterCellModels(registry);
   RegisterMonodomain(registry);
   RegisterGridMonodomain(registry);
+  RegisterCirculation(registry);
   RegisterAggregate(registry);
   RegisterFieldCopy(registry);
   RegisterBoundaryCoupling(registry);
