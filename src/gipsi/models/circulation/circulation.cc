@@ -115,6 +115,7 @@ void Circulation::UpdateOutputs(double t) {
 }
 
 StepStatus Circulation::DoStep(double t, double dt) {
+  failed_compartment_ = failed_connection_ = -1;
   const double t_end = t + dt;
   double now = t;
   const OdeView view(circuit_);
@@ -154,8 +155,34 @@ StepStatus Circulation::DoStep(double t, double dt) {
   for (Index i = 0; i < x_.size(); ++i)
     if (!std::isfinite(x_[i]))
       return StepStatus::Diverged("circulation state became non-finite", i, x_[i]);
+  // A non-finite input (e.g. a cavity volume) may leave the states finite while a pressure or
+  // flow is not: report it rather than publish NaN.
+  for (Index i = 0; i < pressure_.size(); ++i) {
+    if (!std::isfinite(pressure_[i])) {
+      failed_compartment_ = static_cast<int>(i);
+      return StepStatus::Diverged("compartment pressure is not finite (a non-finite input?)", i,
+                                  pressure_[i]);
+    }
+  }
+  for (Index i = 0; i < flow_.size(); ++i) {
+    if (!std::isfinite(flow_[i])) {
+      failed_connection_ = static_cast<int>(i);
+      return StepStatus::Diverged("connection flow is not finite (a non-finite input?)", i,
+                                  flow_[i]);
+    }
+  }
   if (params_.log_events) LogNewEvents();
   return StepStatus::Ok();
+}
+
+std::string Circulation::failure_detail() const {
+  if (failed_compartment_ >= 0)
+    return fmt::format("compartment '{}'",
+                       circuit_.compartments()[static_cast<std::size_t>(failed_compartment_)].name);
+  if (failed_connection_ >= 0)
+    return fmt::format("connection '{}'",
+                       circuit_.connections()[static_cast<std::size_t>(failed_connection_)].name);
+  return {};
 }
 
 std::vector<std::string> Circulation::DescribeValveEvents() const {

@@ -67,6 +67,8 @@ class Circulation final : public SimObject {
   [[nodiscard]] std::int64_t accepted_steps() const { return accepted_; }
   [[nodiscard]] std::int64_t rejected_steps() const { return rejected_; }
   [[nodiscard]] std::vector<ProfileEntry> ProfileBreakdown() const override;
+  /// After a failed step: the compartment or connection whose value was not finite, if any.
+  [[nodiscard]] std::string failure_detail() const override;
 
  protected:
   StepStatus DoStep(double t, double dt) override;
@@ -102,6 +104,7 @@ class Circulation final : public SimObject {
   VecX pressure_, flow_;
   ValveEventLog events_;
   std::int64_t logged_events_ = 0;
+  int failed_compartment_ = -1, failed_connection_ = -1;  // of the last failed step
   std::int64_t accepted_ = 0, rejected_ = 0, evaluations_ = 0;
   std::vector<FieldTarget> targets_;  // by field id
   Points no_positions_ = Points(3, 0);
