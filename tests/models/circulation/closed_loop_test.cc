@@ -9,6 +9,7 @@
 #include <limits>
 #include <vector>
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include "models/circulation/circulation_test_util.h"
@@ -85,7 +86,7 @@ TEST(ClosedLoop, ConservesBloodVolumeToRoundOff) {
   double drift = 0;
   for (double v : run.total_volume) drift = std::max(drift, std::abs(v - v0));
   EXPECT_LE(drift, bound) << "drift " << drift << " m^3 over " << run.accepted << " steps";
-  RecordProperty("volume_drift_m3", std::to_string(drift));
+  RecordProperty("volume_drift_m3", fmt::format("{:.3g} (bound {:.3g})", drift, bound));
 }
 
 // The state at the start of beat k+1 minus that of beat k shrinks geometrically (the slowest
