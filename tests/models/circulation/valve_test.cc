@@ -114,6 +114,40 @@ TEST(Valves, ValveWithoutInertanceClosesOnPressureCrossover) {
   EXPECT_NEAR(q, dp / (0.05 * kMmHg / kMl), 1e-20);
 }
 
+// A chamber driven by pressure (the multiplier formulation of a 3-D coupling: the pressure is
+// written, the volume integrates the flows) ejecting through a valve into a reservoir:
+// p = 100 mmHg against 80 mmHg through R = 0.1 mmHg·s/mL is q = 200 mL/s, so V falls linearly
+// (exactly, to round-off: the derivative is constant). Writing 70 mmHg makes the open valve's
+// guard positive: it closes at the start of the next step (an event at that time) and the
+// volume stays put.
+TEST(PressureDrivenChamber, VolumeIntegratesTheFlowsAndValvesFollowTheWrittenPressure) {
+  SceneHolder holder(R"({
+    "objects": {"heart": {"type": "Circulation", "dt": "1 ms", "log_events": false,
+      "compartments": {
+        "lv": {"type": "chamber", "driven_by": "pressure", "volume": "120 mL",
+               "pressure": "100 mmHg"},
+        "aorta": {"type": "reservoir", "pressure": "80 mmHg"}},
+      "connections": {
+        "aortic": {"type": "valve", "from": "lv", "to": "aorta",
+                   "resistance": "0.1 mmHg*s/mL"}}}},
+    "schedule": {"end": "0.1 s"}})");
+  Circulation& heart = holder.Object("heart");
+  EXPECT_EQ(heart.valve_state(0), ValveState::kOpen);
+  for (int k = 0; k < 100; ++k) ASSERT_TRUE(heart.Step(1e-3).ok());
+  EXPECT_NEAR(heart.volume(0), 120 * kMl - 200 * kMl * 0.1, 1e-13 * 120 * kMl);
+  EXPECT_NEAR(heart.flow(0), 200 * kMl, 1e-12 * 200 * kMl);
+  heart.WriteField(heart.FindField("lv_pressure_input"),
+                   Eigen::MatrixXd::Constant(1, 1, 70 * kMmHg));
+  EXPECT_DOUBLE_EQ(heart.pressure(0), 70 * kMmHg);
+  const double v = heart.volume(0);
+  ASSERT_TRUE(heart.Step(1e-3).ok());
+  EXPECT_EQ(heart.valve_state(0), ValveState::kClosed);
+  ASSERT_EQ(heart.valve_events().total(), 1);
+  EXPECT_NEAR(heart.valve_events().Events()[0].time, 0.1, 1e-15);
+  EXPECT_EQ(heart.volume(0), v);
+  EXPECT_EQ(heart.flow(0), 0.0);
+}
+
 const char* kSourceScene = R"({
   "objects": {"blood": {"type": "Circulation", "dt": "1 ms", "log_events": false,
     "compartments": {

@@ -55,6 +55,10 @@ Circuit::Circuit(std::vector<CompartmentSpec> compartments, std::vector<Connecti
   for (int i = 0; i < nc; ++i)
     cavity_volume_[static_cast<std::size_t>(i)] =
         compartments_[static_cast<std::size_t>(i)].initial_cavity_volume;
+  chamber_pressure_.assign(static_cast<std::size_t>(nc), 0.0);
+  for (int i = 0; i < nc; ++i)
+    chamber_pressure_[static_cast<std::size_t>(i)] =
+        compartments_[static_cast<std::size_t>(i)].initial_pressure;
   source_value_.assign(connections_.size(), 0.0);
   p_work_.setZero(nc);
   q_work_.setZero(num_connections());
@@ -102,9 +106,17 @@ void Circuit::CalcPressures(double t, Eigen::Ref<const VecX> x, Eigen::Ref<VecX>
     const auto& s = compartments_[static_cast<std::size_t>(i)];
     switch (s.kind) {
       case K::kChamber:
-        p[i] = s.drive == CompartmentSpec::Drive::kElastance
-                   ? Elastance(i, t) * (x[i] - s.unstressed_volume)
-                   : (x[i] - CavityVolume(i, t)) / s.compliance;
+        switch (s.drive) {
+          case CompartmentSpec::Drive::kElastance:
+            p[i] = Elastance(i, t) * (x[i] - s.unstressed_volume);
+            break;
+          case CompartmentSpec::Drive::kVolume:
+            p[i] = (x[i] - CavityVolume(i, t)) / s.compliance;
+            break;
+          case CompartmentSpec::Drive::kPressure:
+            p[i] = chamber_pressure_[static_cast<std::size_t>(i)];
+            break;
+        }
         break;
       case K::kCompliance:
         p[i] = (x[i] - s.unstressed_volume) / s.compliance;

@@ -13,9 +13,10 @@
 /// Pressure laws: chamber p = E(t)(V − V0) with E(t) = E_min + (E_max − E_min) e(t); a chamber
 /// driven by an external cavity volume V_cav(t) is a stiff compliance C_c between the blood
 /// volume and the cavity, p = (V − V_cav(t)) / C_c (the penalty form of the constraint
-/// V = V_cav, whose multiplier is p); compliance p = (V − V0)/C; reservoir p = const (its volume
-/// counts what flowed in, so the total is conserved in every circuit). Every flow leaves one
-/// compartment and enters another, so Σ V is conserved to round-off.
+/// V = V_cav, whose multiplier is p); a chamber driven by pressure takes p as given (written);
+/// compliance p = (V − V0)/C; reservoir p = const (its volume counts what flowed in, so the total
+/// is conserved in every circuit). Every flow leaves one compartment and enters another, so Σ V is
+/// conserved to round-off.
 
 #include <string>
 #include <vector>
@@ -30,8 +31,9 @@ namespace gipsi {
 /// A blood-holding compartment. Plain struct; copyable.
 struct CompartmentSpec {
   enum class Kind { kChamber, kCompliance, kReservoir };
-  /// How a chamber's pressure is found: its own elastance, or an external cavity volume.
-  enum class Drive { kElastance, kVolume };
+  /// How a chamber's pressure is found: its own elastance, an external cavity volume, or an
+  /// external pressure (then only its volume is integrated).
+  enum class Drive { kElastance, kVolume, kPressure };
   std::string name;
   Kind kind = Kind::kCompliance;
   Drive drive = Drive::kElastance;
@@ -42,6 +44,7 @@ struct CompartmentSpec {
   double reservoir_pressure = 0;     ///< reservoir [Pa]
   double initial_volume = 0;         ///< V at t = 0 [m³] (blood volume; reservoirs: 0)
   double initial_cavity_volume = 0;  ///< volume-driven chambers: V_cav at t = 0 [m³]
+  double initial_pressure = 0;       ///< pressure-driven chambers: p at t = 0 [Pa]
 };
 
 /// A prescribed flow q(t) [m³/s]. Plain struct; copyable.
@@ -123,6 +126,11 @@ class Circuit {
   [[nodiscard]] double CavityVolumeRate(int c) const {
     return cavity_rate_[static_cast<std::size_t>(c)];
   }
+  /// Pressure-driven chamber c: p (held until written again).
+  void SetChamberPressure(int c, double p) { chamber_pressure_[static_cast<std::size_t>(c)] = p; }
+  [[nodiscard]] double ChamberPressure(int c) const {
+    return chamber_pressure_[static_cast<std::size_t>(c)];
+  }
   /// Field-driven source connection c.
   void SetSourceFlow(int c, double q) { source_value_[static_cast<std::size_t>(c)] = q; }
 
@@ -141,6 +149,7 @@ class Circuit {
   std::vector<Index> flow_state_;
   std::vector<ValveState> states_;                                 // per valve
   std::vector<double> cavity_volume_, cavity_rate_, cavity_time_;  // per compartment
+  std::vector<double> chamber_pressure_;                           // per compartment
   std::vector<double> source_value_;                               // per connection
   Index size_ = 0;
   Guards guards_{this};

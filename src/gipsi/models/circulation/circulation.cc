@@ -45,6 +45,10 @@ Circulation::Circulation(std::string name, CirculationParams params)
     if (s.drive == CompartmentSpec::Drive::kElastance) {
       Declare({s.name + "_elastance", L::kGlobal, 1, "Pa/m3", A::kRead, "chamber elastance E(t)"},
               Quantity::kElastance, c);
+    } else if (s.drive == CompartmentSpec::Drive::kPressure) {
+      Declare({s.name + "_pressure_input", L::kGlobal, 1, "Pa", A::kReadWrite,
+               "prescribed chamber pressure (input; held until written again)"},
+              Quantity::kPressureInput, c);
     } else {
       Declare({s.name + "_cavity_volume", L::kGlobal, 1, "m3", A::kReadWrite,
                "volume of the driving 3-D cavity (input)"},
@@ -228,6 +232,9 @@ void Circulation::DoReadField(FieldId id, Eigen::Ref<Eigen::MatrixXd> out) const
     case Quantity::kCavityRate:
       value = circuit_.CavityVolumeRate(i);
       break;
+    case Quantity::kPressureInput:
+      value = circuit_.ChamberPressure(i);
+      break;
     case Quantity::kFlow:
       value = flow_[i];
       break;
@@ -264,6 +271,9 @@ void Circulation::DoWriteField(FieldId id, const Eigen::Ref<const Eigen::MatrixX
       break;
     case Quantity::kFlow:
       circuit_.SetSourceFlow(f.index, value);
+      break;
+    case Quantity::kPressureInput:
+      circuit_.SetChamberPressure(f.index, value);
       break;
     default:
       GIPSI_CHECK(false, "field is not writable");

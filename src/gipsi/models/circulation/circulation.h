@@ -77,17 +77,21 @@ class Circulation final : public SimObject {
 
  private:
   enum class Quantity {
+    // compartments
     kPressure,
     kVolume,
     kElastance,
     kCavityVolume,
-    kCavityRate,  // compartments
+    kCavityRate,
+    kPressureInput,
+    // connections
     kFlow,
     kPressureDrop,
-    kValveOpen,  // connections
+    kValveOpen,
+    // global
     kTotalVolume,
     kValveEvents,
-    kSteps  // global
+    kSteps,
   };
   struct FieldTarget {
     Quantity quantity;

@@ -124,8 +124,9 @@ CompartmentSpec ParseCompartment(const std::string& name, const JsonNode& node, 
   node.CheckKeys({"type", "e_max", "e_min", "unstressed_volume", "activation", "volume", "pressure",
                   "driven_by", "coupling_compliance", "description"});
   s.kind = K::kChamber;
-  const std::string drive =
-      node.Has("driven_by") ? node.At("driven_by").AsChoice({"elastance", "volume"}) : "elastance";
+  const std::string drive = node.Has("driven_by")
+                                ? node.At("driven_by").AsChoice({"elastance", "volume", "pressure"})
+                                : "elastance";
   if (drive == "volume") {
     s.drive = CompartmentSpec::Drive::kVolume;
     s.compliance = node.Has("coupling_compliance")
@@ -136,6 +137,14 @@ CompartmentSpec ParseCompartment(const std::string& name, const JsonNode& node, 
     s.initial_cavity_volume = ReadPositiveQuantity(node.At("volume"), kVolume, true);
     const double p0 = node.Has("pressure") ? ReadQuantity(node.At("pressure"), kPressure) : 0.0;
     s.initial_volume = s.initial_cavity_volume + s.compliance * p0;
+    return s;
+  }
+  if (drive == "pressure") {
+    s.drive = CompartmentSpec::Drive::kPressure;
+    if (!node.Has("volume"))
+      node.Fail("a chamber driven by pressure needs its initial \"volume\" (e.g. \"120 mL\")");
+    s.initial_volume = ReadPositiveQuantity(node.At("volume"), kVolume, true);
+    s.initial_pressure = node.Has("pressure") ? ReadQuantity(node.At("pressure"), kPressure) : 0.0;
     return s;
   }
   s.e_max = ReadPositiveQuantity(node.At("e_max"), kElastance);
