@@ -1,6 +1,7 @@
 #include "gipsi/models/builtins.h"
 
 #include "gipsi/core/aggregate.h"
+#include "gipsi/models/circulation/circulation.h"
 #include "gipsi/models/connectors/boundary_coupling.h"
 #include "gipsi/models/connectors/excitation_contraction.h"
 #include "gipsi/models/connectors/field_copy.h"
@@ -21,6 +22,7 @@ void RegisterBuiltins(TypeRegistry& registry) {
   RegisterCellModels(registry);
   RegisterMonodomain(registry);
   RegisterGridMonodomain(registry);
+  RegisterCirculation(registry);
   RegisterAggregate(registry);
   RegisterFieldCopy(registry);
   RegisterExcitationContraction(registry);

@@ -1,0 +1,120 @@
+#pragma once
+/// @file
+/// `Circulation`: the lumped (0D) blood circulation as a GiPSi simulation object — heart
+/// chambers as time-varying elastances (or driven by a 3-D cavity's volume), vessels as
+/// compliances, resistances and inertances, and valves as hybrid systems whose transitions are
+/// located inside the step. See circuit.h for the equations and docs/circulation.md for the
+/// scene keys, default parameters and their sources.
+///
+/// `Step(dt)` integrates with Dormand–Prince 5(4) (AdaptiveOde): as many adaptive sub-steps as
+/// the tolerance needs, stopping at every valve event, switching the valve and restarting there.
+/// It never throws; failures come back as a StepStatus.
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "gipsi/core/registry.h"
+#include "gipsi/core/sim_object.h"
+#include "gipsi/models/circulation/circuit.h"
+
+namespace gipsi {
+
+/// Everything a Circulation is built from. Plain struct; copyable.
+struct CirculationParams {
+  std::vector<CompartmentSpec> compartments;
+  std::vector<ConnectionSpec> connections;
+  double relative_tolerance = 1e-7;
+  /// Absolute tolerance of volumes [m³]; inertial flows use it per second [m³/s].
+  double absolute_tolerance = 1e-12;
+  double max_step = 0.005;                  ///< largest adaptive step [s]
+  double event_tolerance = 1e-9;            ///< valve events located to this width in time [s]
+  int max_events_per_step = 1000;           ///< more transitions in one Step is chattering: fail
+  std::size_t event_log_capacity = 100000;  ///< valve events kept (the most recent)
+  bool log_events = true;  ///< log each valve transition (info level) after the step
+};
+
+/// Not copyable or movable (a SimObject).
+class Circulation final : public SimObject {
+ public:
+  /// Builds the circuit and sets each valve open or closed from the initial pressures.
+  /// Preconditions as Circuit's (the factory checks the scene and throws InputError).
+  Circulation(std::string name, CirculationParams params);
+
+  [[nodiscard]] std::string_view type_name() const override { return "Circulation"; }
+  [[nodiscard]] const Points& domain_positions() const override { return no_positions_; }
+
+  [[nodiscard]] const Circuit& circuit() const { return circuit_; }
+  /// Index of the compartment or connection called `name`, or −1.
+  [[nodiscard]] int FindCompartment(std::string_view name) const;
+  [[nodiscard]] int FindConnection(std::string_view name) const;
+  /// Current pressure [Pa] and volume [m³] of compartment c; flow [m³/s] of connection c.
+  [[nodiscard]] double pressure(int c) const { return pressure_[c]; }
+  [[nodiscard]] double volume(int c) const { return x_[c]; }
+  [[nodiscard]] double flow(int c) const { return flow_[c]; }
+  /// Σ of every compartment's volume [m³] (conserved by the closed loop).
+  [[nodiscard]] double total_volume() const;
+  /// Current state of valve k (index into circuit().valves()) and its name.
+  [[nodiscard]] ValveState valve_state(int k) const { return circuit_.valve_state(k); }
+  [[nodiscard]] const std::string& valve_name(int k) const;
+  /// The record of valve transitions (most recent event_log_capacity kept).
+  [[nodiscard]] const ValveEventLog& valve_events() const { return events_; }
+  /// One line per kept event: "t = 0.123456 s: aortic opens".
+  [[nodiscard]] std::vector<std::string> DescribeValveEvents() const;
+  /// The full ODE state [volumes…, inertial flows…].
+  [[nodiscard]] const VecX& state() const { return x_; }
+  /// Adaptive steps accepted and rejected, derivative evaluations, since construction.
+  [[nodiscard]] std::int64_t accepted_steps() const { return accepted_; }
+  [[nodiscard]] std::int64_t rejected_steps() const { return rejected_; }
+  [[nodiscard]] std::vector<ProfileEntry> ProfileBreakdown() const override;
+  /// After a failed step: the compartment or connection whose value was not finite, if any.
+  [[nodiscard]] std::string failure_detail() const override;
+
+ protected:
+  StepStatus DoStep(double t, double dt) override;
+  void DoReadField(FieldId id, Eigen::Ref<Eigen::MatrixXd> out) const override;
+  void DoWriteField(FieldId id, const Eigen::Ref<const Eigen::MatrixXd>& in) override;
+
+ private:
+  enum class Quantity {
+    // compartments
+    kPressure,
+    kVolume,
+    kElastance,
+    kCavityVolume,
+    kCavityRate,
+    kPressureInput,
+    // connections
+    kFlow,
+    kPressureDrop,
+    kValveOpen,
+    // global
+    kTotalVolume,
+    kValveEvents,
+    kSteps,
+  };
+  struct FieldTarget {
+    Quantity quantity;
+    int index;
+  };
+  void Declare(FieldInfo info, Quantity quantity, int index);
+  void UpdateOutputs(double t);
+  void LogNewEvents();
+
+  CirculationParams params_;
+  Circuit circuit_;
+  AdaptiveOde ode_;
+  VecX x_;
+  VecX pressure_, flow_;
+  ValveEventLog events_;
+  std::int64_t logged_events_ = 0;
+  int failed_compartment_ = -1, failed_connection_ = -1;  // of the last failed step
+  std::int64_t accepted_ = 0, rejected_ = 0, evaluations_ = 0;
+  std::vector<FieldTarget> targets_;  // by field id
+  Points no_positions_ = Points(3, 0);
+};
+
+/// Registers the "Circulation" object type.
+void RegisterCirculation(TypeRegistry& registry);
+
+}  // namespace gipsi

@@ -1,0 +1,63 @@
+#pragma once
+/// @file
+/// Heart valves as hybrid systems (the GiPSi paper's "valves as finite-state machines"): each
+/// valve is open or closed; its guard is a continuous function of the circuit state whose upward
+/// zero crossing, located inside an integration step, fires the one transition out of the
+/// current state:
+///   closed → open   when the pressure difference Δp = p_from − p_to rises through 0;
+///   open → closed   when the flow q falls through 0 (valves with an inertance, where q is a
+///                   state), or when Δp falls through 0 (valves without one, where q = Δp/R).
+/// A closed valve carries no flow at all (not a small leak): the circuit changes its equations.
+
+#include <cstdint>
+#include <string_view>
+#include <vector>
+
+namespace gipsi {
+
+/// The discrete state of a valve.
+enum class ValveState : std::uint8_t { kClosed, kOpen };
+
+/// "open" or "closed".
+std::string_view ToString(ValveState state);
+
+/// The guard of a valve in `state`: the transition fires when it crosses 0 upward.
+/// `dp` = p_from − p_to [Pa], `q` the flow from → to [m³/s] (meaningful for inertial valves).
+[[nodiscard]] constexpr double ValveGuard(ValveState state, bool inertial, double dp, double q) {
+  if (state == ValveState::kClosed) return dp;
+  return inertial ? -q : -dp;
+}
+
+/// The state a transition leads to.
+[[nodiscard]] constexpr ValveState NextValveState(ValveState state) {
+  return state == ValveState::kClosed ? ValveState::kOpen : ValveState::kClosed;
+}
+
+/// One valve transition: when, which valve (index among the circuit's valves), and the new state.
+struct ValveEvent {
+  double time = 0;  ///< [s]
+  int valve = -1;
+  ValveState state = ValveState::kClosed;
+};
+
+/// The record of valve transitions: a preallocated ring keeping the most recent `capacity`
+/// events, and the total count. Recording never allocates. Copyable and movable.
+class ValveEventLog {
+ public:
+  explicit ValveEventLog(std::size_t capacity = 100000);
+  /// Appends an event (dropping the oldest when full).
+  void Record(const ValveEvent& event);
+  /// Events recorded since construction (including dropped ones).
+  [[nodiscard]] std::int64_t total() const { return total_; }
+  /// The kept events, oldest first (allocates the returned vector).
+  [[nodiscard]] std::vector<ValveEvent> Events() const;
+  /// The kept events with index ≥ `first` in the total numbering (for "what is new since").
+  [[nodiscard]] std::vector<ValveEvent> EventsSince(std::int64_t first) const;
+  [[nodiscard]] std::size_t capacity() const { return ring_.size(); }
+
+ private:
+  std::vector<ValveEvent> ring_;
+  std::int64_t total_ = 0;
+};
+
+}  // namespace gipsi
