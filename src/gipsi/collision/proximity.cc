@@ -19,6 +19,13 @@ bool PointNearBox(const Vec3& p, const Box3& b, double gap) {
   return (p.array() >= b.lo.array() - gap).all() && (p.array() <= b.hi.array() + gap).all();
 }
 
+Box3 EdgeBox(const Vec3& p, const Vec3& q) {
+  Box3 b;
+  b.lo = p.cwiseMin(q);
+  b.hi = p.cwiseMax(q);
+  return b;
+}
+
 bool SharesVertex(const Triangles& tris, int t, int v) {
   return tris(0, t) == v || tris(1, t) == v || tris(2, t) == v;
 }
@@ -85,6 +92,7 @@ void ProximityQuery::Query(const CollisionSurface& a, const CollisionSurface& b,
                            bool edge_edge, ProximityResult& out) {
   out.Clear();
   triangle_pairs_ = 0;
+  node_pairs_ = 0;
   Reset(best_a_, touched_a_, a.num_vertices());
   Reset(best_b_, touched_b_, b.num_vertices());
   const AabbTree& ta = a.tree();
@@ -113,13 +121,16 @@ void ProximityQuery::Query(const CollisionSurface& a, const CollisionSurface& b,
     for (int ka = 0; ka < 3; ++ka) {
       const int ea = a.triangle_edges()(ka, i);
       if (a.edge_owner()[static_cast<std::size_t>(ea)] != i) continue;
+      const Vec3 a0 = xa.col(a.edges()(0, ea)), a1 = xa.col(a.edges()(1, ea));
+      const Box3 box_ea = EdgeBox(a0, a1);
+      if (!box_ea.Near(box_j, d)) continue;
       for (int kb = 0; kb < 3; ++kb) {
         const int eb = b.triangle_edges()(kb, j);
         if (b.edge_owner()[static_cast<std::size_t>(eb)] != j) continue;
+        const Vec3 b0 = xb.col(b.edges()(0, eb)), b1 = xb.col(b.edges()(1, eb));
+        if (!box_ea.Near(EdgeBox(b0, b1), d)) continue;
         SegmentSegmentResult r;
-        if (EdgeContact(xa.col(a.edges()(0, ea)), xa.col(a.edges()(1, ea)),
-                        xb.col(b.edges()(0, eb)), xb.col(b.edges()(1, eb)), d, r))
-          out.edges.push_back({ea, eb, r.s, r.t, r.distance});
+        if (EdgeContact(a0, a1, b0, b1, d, r)) out.edges.push_back({ea, eb, r.s, r.t, r.distance});
       }
     }
   };
@@ -133,6 +144,7 @@ void ProximityQuery::Query(const CollisionSurface& a, const CollisionSurface& b,
     stack_.pop_back();
     const AabbTree::Node& ni = na[static_cast<std::size_t>(i)];
     const AabbTree::Node& nj = nb[static_cast<std::size_t>(j)];
+    ++node_pairs_;
     if (!ni.box.Near(nj.box, d)) continue;
     if (ni.is_leaf() && nj.is_leaf()) {
       for (int p = ni.first; p < ni.first + ni.count; ++p)

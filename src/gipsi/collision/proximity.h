@@ -83,6 +83,8 @@ class ProximityQuery {
 
   /// Triangle pairs whose boxes were near in the last query (a cost measure).
   [[nodiscard]] std::int64_t last_triangle_pairs() const { return triangle_pairs_; }
+  /// Node pairs visited in the last two-surface query (a cost measure).
+  [[nodiscard]] std::int64_t last_node_pairs() const { return node_pairs_; }
 
  private:
   struct Best {
@@ -98,6 +100,7 @@ class ProximityQuery {
   std::vector<int> touched_a_, touched_b_;
   std::vector<std::pair<int, int>> stack_;
   std::int64_t triangle_pairs_ = 0;
+  std::int64_t node_pairs_ = 0;
 };
 
 /// Brute-force reference of `ProximityQuery::Query` / `QuerySelf` (every feature pair; for
