@@ -1,5 +1,7 @@
 #include "gipsi/models/builtins.h"
 
+#include "gipsi/collision/contact.h"
+#include "gipsi/collision/rigid_tool.h"
 #include "gipsi/core/aggregate.h"
 #include "gipsi/models/connectors/boundary_coupling.h"
 #include "gipsi/models/connectors/field_copy.h"
@@ -19,6 +21,8 @@ void RegisterBuiltins(TypeRegistry& registry) {
   RegisterAggregate(registry);
   RegisterFieldCopy(registry);
   RegisterBoundaryCoupling(registry);
+  RegisterRigidTool(registry);
+  RegisterContact(registry);
 }
 
 }  // namespace gipsi
