@@ -1,6 +1,7 @@
 #include "gipsi/collision/contact.h"
 
 #include <algorithm>
+#include <optional>
 #include <set>
 
 #include <fmt/format.h>
@@ -18,6 +19,11 @@ struct Contact::Body {
   CollisionSurface surface;
   Points velocities;
   Points forces;
+  // Projection response: the reaction field, its values, and which vertices this connector
+  // holds on a tool (1) or not (0).
+  std::optional<FieldId> reaction;
+  Points reactions;
+  std::vector<char> held;
   Body(SimObject& o, RigidTool* t, FieldId p, FieldId v, CollisionSurface s)
       : object(o), tool(t), position(p), velocity(v), surface(std::move(s)) {
     velocities.setZero(3, surface.num_vertices());
@@ -48,6 +54,11 @@ Contact::Contact(std::string name, const std::vector<SimObject*>& objects,
     const bool closed = !b.face_to_tet.empty() && b.face_to_tet.front() >= 0;
     bodies_.push_back(std::make_unique<Body>(
         *o, tool, p, v, CollisionSurface(b.triangles, b.num_vertices(), closed)));
+    if (!tool && options_.tool_response == ContactOptions::ToolResponse::kProjection) {
+      bodies_.back()->reaction = o->FindField("reaction_force");
+      bodies_.back()->reactions.setZero(3, b.num_vertices());
+      bodies_.back()->held.assign(static_cast<std::size_t>(b.num_vertices()), 0);
+    }
   }
   if (deformables == 0 || (objects.size() < 2 && !options_.self_collision))
     throw InputError(fmt::format(
@@ -151,6 +162,51 @@ void Contact::ToolPair(Body& tool, Body& body) {
   }
 }
 
+void Contact::ToolProjection(Body& tool, Body& body) {
+  const RigidTool& t = *tool.tool;
+  const Vec3 p0 = t.axis_start(), p1 = t.axis_end();
+  const double r = t.spec().radius;
+  query_.QueryCapsule(body.surface, p0, p1, r, material_.thickness, primitive_);
+  stats_.tool_contacts += static_cast<std::int64_t>(primitive_.size());
+  BoundaryConditions& bcs = body.object.boundary_conditions();
+  const auto& v2n = body.object.boundary().vertex_to_node;
+  const Points& rest = body.object.domain().nodes;
+  const Points& tool_x = tool.surface.positions();
+  std::size_t k = 0;  // walks primitive_ (sorted by vertex) alongside the held flags
+  for (Index v = 0; v < body.surface.num_vertices(); ++v) {
+    const PrimitiveContact* c = nullptr;
+    while (k < primitive_.size() && primitive_[k].vertex < v) ++k;
+    if (k < primitive_.size() && primitive_[k].vertex == v) c = &primitive_[k];
+    char& held = body.held[static_cast<std::size_t>(v)];
+    bool keep = false;
+    if (c) {
+      if (held) {
+        // Held: keep while the reaction still pushes the vertex away from the tool.
+        keep = Vec3(body.reactions.col(v)).dot(c->normal) > 0;
+      } else {
+        // Free: take it when it has entered the tool and nothing else constrains it.
+        bool free = true;
+        for (int a = 0; a < 3; ++a) free = free && bcs.kind(v, a) == ConstraintKind::kFree;
+        keep = free && c->gap < 0;
+      }
+    }
+    if (keep) {
+      const Index node = v2n[static_cast<std::size_t>(v)];
+      bcs.PrescribeDisplacement(v, c->on_tool - Vec3(rest.col(node)));
+      if (held) {
+        Index nearest = 0;
+        (tool_x.colwise() - c->on_tool).colwise().squaredNorm().minCoeff(&nearest);
+        tool.forces.col(nearest) -= body.reactions.col(v);
+      }
+      held = 1;
+      ++stats_.projected;
+    } else if (held) {
+      bcs.Release(v);
+      held = 0;
+    }
+  }
+}
+
 StepStatus Contact::DoFire(double /*t*/) {
   stats_ = ContactStats{};
   stats_.min_gap = material_.thickness;
@@ -163,6 +219,11 @@ StepStatus Contact::DoFire(double /*t*/) {
                                   static_cast<Index>(i));
     b.surface.Update(options_.rebuild_ratio, options_.self_collision && b.tool == nullptr);
     b.forces.setZero();
+    if (b.reaction) {
+      b.object.ReadField(*b.reaction, b.reactions);
+      if (!b.reactions.allFinite())
+        return StepStatus::Diverged("non-finite reaction force in object", static_cast<Index>(i));
+    }
   }
   const double d = material_.thickness;
   for (std::size_t i = 0; i < bodies_.size(); ++i) {
@@ -171,10 +232,11 @@ StepStatus Contact::DoFire(double /*t*/) {
       Body& b = *bodies_[j];
       if (a.tool && b.tool) continue;
       if (!a.surface.bounds().Near(b.surface.bounds(), d)) continue;  // broad phase
+      const bool project = options_.tool_response == ContactOptions::ToolResponse::kProjection;
       if (a.primitive()) {
-        ToolPair(a, b);
+        project ? ToolProjection(a, b) : ToolPair(a, b);
       } else if (b.primitive()) {
-        ToolPair(b, a);
+        project ? ToolProjection(b, a) : ToolPair(b, a);
       } else {
         MeshPair(a, b, false);
       }
@@ -196,7 +258,7 @@ void RegisterContact(TypeRegistry& registry) {
       [](const ConnectorBuildContext& ctx) -> std::unique_ptr<Connector> {
         const JsonNode& p = ctx.params;
         ctx.CheckKeys({"objects", "thickness", "stiffness", "damping", "friction", "slip_velocity",
-                       "self_collision", "edge_edge", "rebuild_ratio"});
+                       "self_collision", "edge_edge", "rebuild_ratio", "tool_response"});
         const JsonNode list = p.At("objects");
         if (!list.is_array() || list.size() == 0) list.Expected("an array of object names");
         std::vector<SimObject*> objects;
@@ -215,6 +277,10 @@ void RegisterContact(TypeRegistry& registry) {
         m.friction = p.NonNegative("friction", 0.0);
         m.slip_velocity = p.Positive("slip_velocity", m.slip_velocity);
         ContactOptions o;
+        if (auto r = p.Find("tool_response"))
+          o.tool_response = r->AsChoice({"penalty", "projection"}) == "projection"
+                                ? ContactOptions::ToolResponse::kProjection
+                                : ContactOptions::ToolResponse::kPenalty;
         o.self_collision = p.Bool("self_collision", false);
         o.edge_edge = p.Bool("edge_edge", true);
         o.rebuild_ratio = p.Number("rebuild_ratio", o.rebuild_ratio);

@@ -13,6 +13,7 @@
 ///
 /// Scene (under "connectors"): {"type": "Contact", "objects": ["a", "b", "probe"],
 ///   "thickness": 0.002, "stiffness": 500, "damping": 0.5, "friction": 0.3,
+///   "tool_response": "penalty" | "projection",
 ///   "slip_velocity": 0.001, "self_collision": false, "edge_edge": true, "rebuild_ratio": 1.5}
 /// Objects need the fields "boundary_position" and "boundary_velocity" and boundary triangles.
 /// Forces are applied explicitly (held over the macro step): fire it at the objects' step
@@ -33,6 +34,14 @@ class RigidTool;
 
 /// Options besides the contact material. Plain struct with defaults.
 struct ContactOptions {
+  /// How sphere/capsule tools act on objects: penalty forces, or position projection (a
+  /// vertex that enters the tool is prescribed onto the tool's surface, and released when its
+  /// reaction stops pushing it away from the tool; the tool receives minus the reactions). Use
+  /// projection for stiff or quasi-static (implicit) objects, where an explicit penalty would
+  /// need a stiffness above the tissue's and then oscillates. Object–object contact is always
+  /// penalty.
+  enum class ToolResponse { kPenalty, kProjection };
+  ToolResponse tool_response = ToolResponse::kPenalty;
   bool self_collision = false;  ///< also self-contacts of each deformable object
   bool edge_edge = true;        ///< edge–edge contacts between meshes
   double rebuild_ratio = 1.5;   ///< AabbTree rebuild threshold (> 1)
@@ -41,6 +50,8 @@ struct ContactOptions {
 /// Counts from the last firing. Plain struct.
 struct ContactStats {
   std::int64_t vertex_contacts = 0, edge_contacts = 0, tool_contacts = 0, self_contacts = 0;
+  /// Vertices held on a tool's surface (projection response).
+  std::int64_t projected = 0;
   /// Largest penetration into the contact layer, thickness − gap [m] (0 without contact).
   double max_penetration = 0;
   /// Smallest signed gap over all contacts [m] (thickness without contact); negative means the
@@ -70,6 +81,7 @@ class Contact final : public Connector {
   struct Body;
   void MeshPair(Body& a, Body& b, bool self);
   void ToolPair(Body& tool, Body& body);
+  void ToolProjection(Body& tool, Body& body);
   void AddVertexTriangle(Body& a, Body& b, const VertexTriangleContact& c);
 
   ContactMaterial material_;
