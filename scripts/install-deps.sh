@@ -15,6 +15,7 @@ packages=(
   libsuitesparse-dev     # CHOLMOD sparse Cholesky
   libopenblas-serial-dev # its BLAS: single-threaded OpenBLAS (GiPSi threads above it)
   libgtest-dev libgmock-dev libbenchmark-dev
+  libfcl-dev             # FCL 0.7: the collision benchmark's baseline (bench/collision_bench.cc)
   clang-format clang-tidy
 )
 
