@@ -27,7 +27,9 @@ struct Box3 {
   /// True if the boxes are within `gap` of each other along every axis (so points of the two
   /// boxes closer than `gap` in Euclidean distance are never missed).
   [[nodiscard]] bool Near(const Box3& b, double gap) const {
-    return (lo.array() - gap <= b.hi.array()).all() && (b.lo.array() - gap <= hi.array()).all();
+    // Scalar comparisons: cheaper than Eigen array expressions on 3-vectors in the hot loops.
+    return lo[0] - gap <= b.hi[0] && b.lo[0] - gap <= hi[0] && lo[1] - gap <= b.hi[1] &&
+           b.lo[1] - gap <= hi[1] && lo[2] - gap <= b.hi[2] && b.lo[2] - gap <= hi[2];
   }
   [[nodiscard]] double SurfaceArea() const {
     const Vec3 e = (hi - lo).cwiseMax(0.0);

@@ -16,7 +16,8 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr double kInterior = 1e-9;
 
 bool PointNearBox(const Vec3& p, const Box3& b, double gap) {
-  return (p.array() >= b.lo.array() - gap).all() && (p.array() <= b.hi.array() + gap).all();
+  return p[0] >= b.lo[0] - gap && p[0] <= b.hi[0] + gap && p[1] >= b.lo[1] - gap &&
+         p[1] <= b.hi[1] + gap && p[2] >= b.lo[2] - gap && p[2] <= b.hi[2] + gap;
 }
 
 Box3 EdgeBox(const Vec3& p, const Vec3& q) {
