@@ -1,4 +1,6 @@
 #include <atomic>
+#include <chrono>
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -10,6 +12,7 @@
 
 #include "gipsi/base/error.h"
 #include "gipsi/haptics/force_safety.h"
+#include "gipsi/haptics/haptic_loop.h"
 #include "gipsi/haptics/haptic_tick.h"
 #include "gipsi/haptics/latest_value.h"
 #include "gipsi/haptics/virtual_device.h"
@@ -238,6 +241,38 @@ TEST(HapticTick, RendersThroughTheSafetyStageWithoutAllocating) {
   // 0.4 N at the device.
   EXPECT_NEAR(force.z(), 0.4, 1e-12);
   EXPECT_EQ(device.num_commands(), 10001);
+}
+
+}  // namespace
+}  // namespace gipsi
+
+namespace gipsi {
+namespace {
+
+TEST(HapticLoop, TicksOnItsOwnThreadAndReportsPeriodPercentiles) {
+  // No timing assertion (the machine is shared): the loop must tick, command the device every
+  // tick, and report ordered percentiles. The figures are printed for the record.
+  VirtualDevice device({{0.0, Vec3(0, 0, -0.001), 0}});
+  LatestValue<PlaneLocalModel> models;
+  PlaneLocalModel& m = models.back();
+  m.stiffness = 300;
+  m.active = true;
+  m.published_at = 1e300;  // never stale in this test
+  models.Publish();
+  HapticTick tick(device, DeviceWorkspace{}, models, ForceSafetyParams{});
+  HapticLoop loop(tick, 1000);
+  loop.Start();
+  std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  loop.Stop();
+  const HapticLoopStats s = loop.Stats();
+  EXPECT_GT(s.ticks, 10);
+  EXPECT_EQ(device.num_commands(), s.ticks);
+  EXPECT_LE(s.p50, s.p99);
+  EXPECT_LE(s.p99, s.p999);
+  EXPECT_LE(s.p999, s.max);
+  EXPECT_NEAR(device.last_force().z(), 0.3, 1e-12);  // 300 N/m × 1 mm, after the ramp
+  std::printf("haptic loop: %lld ticks, period p50 %.1f us, p99 %.1f us, max %.1f us\n",
+              static_cast<long long>(s.ticks), 1e6 * s.p50, 1e6 * s.p99, 1e6 * s.max);
 }
 
 }  // namespace
