@@ -218,6 +218,28 @@ TEST(Contact, ProjectionHoldsVerticesOnTheToolAndBalancesTheBase) {
   EXPECT_LT((tool_force - base_reaction).norm(), 1e-3 * tool_force.norm());
 }
 
+TEST(Contact, MeshToolForcesAreEqualAndOpposite) {
+  // A rigid plate (a triangle-mesh tool) 3 mm above a block's top face, thickness 5 mm: the
+  // block's top vertices touch the plate and the plate's vertices touch the block; the tool
+  // receives exactly the opposite of what the block receives.
+  auto block = Block("block", Vec3(0, 0, 0), Vec3(1, 1, 1), 4);
+  auto plate = std::make_shared<const Mesh>(
+      MakeTriangleSheet(Vec3(0.13, 0.21, 0), Vec3(0.6, 0, 0), Vec3(0, 0.5, 0), {5, 4}));
+  RigidToolSpec spec;
+  spec.shape = RigidToolSpec::Shape::kMesh;
+  spec.position = Vec3(0, 0, 1.003);
+  RigidTool tool("plate", spec, plate);
+  ContactMaterial m;
+  m.thickness = 0.005;
+  m.stiffness = 100;
+  Contact contact("c", {block.get(), &tool}, m, {});
+  ASSERT_TRUE(contact.Fire(0).ok());
+  EXPECT_GT(contact.stats().vertex_contacts, 20);
+  const Vec3 f_block = TotalBoundaryForce(*block);
+  EXPECT_LT(f_block.z(), -1.0);  // pushed down
+  EXPECT_LT((tool.ContactForce() + f_block).norm(), 1e-12 * f_block.norm());
+}
+
 TEST(RigidTool, FollowsItsPathAndReportsItsVelocity) {
   RigidToolSpec spec;
   spec.shape = RigidToolSpec::Shape::kCapsule;

@@ -1,5 +1,6 @@
 #include "gipsi/collision/proximity.h"
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <random>
@@ -67,6 +68,32 @@ TEST(ProximityQuery, SphereOnAPlaneTouchesTheKnownVertexSet) {
   EXPECT_EQ(contacts[2].vertex, node(5, 5));
   EXPECT_NEAR(contacts[2].gap, 0, 1e-15);
   EXPECT_LT((contacts[2].normal - Vec3(0, 0, -1)).norm(), 1e-15);
+}
+
+TEST(ProximityQuery, CapsuleContactsMatchTheExactDistance) {
+  // A horizontal capsule (axis from x = 0.2 to 0.8 at y = 0.5, z = 0.1, radius 0.095) above a
+  // plane: the contact set is every vertex whose distance to the axis segment minus the radius
+  // is below the thickness, computed here independently per vertex.
+  CollisionSurface plane = Sheet(20, 1.0, Vec3::Zero());
+  plane.Update(2.0, false);
+  const Vec3 p0(0.2, 0.5, 0.1), p1(0.8, 0.5, 0.1);
+  const double radius = 0.095, thickness = 0.02;
+  ProximityQuery query;
+  std::vector<PrimitiveContact> contacts;
+  query.QueryCapsule(plane, p0, p1, radius, thickness, contacts);
+  std::vector<int> want;
+  for (Index v = 0; v < plane.num_vertices(); ++v) {
+    const Vec3 x = plane.positions().col(v);
+    const double s = std::clamp(x.x(), 0.2, 0.8);
+    const double gap = (x - Vec3(s, 0.5, 0.1)).norm() - radius;
+    if (gap < thickness) want.push_back(int(v));
+  }
+  ASSERT_EQ(contacts.size(), want.size());
+  for (std::size_t i = 0; i < want.size(); ++i) EXPECT_EQ(contacts[i].vertex, want[i]);
+  // Along the axis: x = 0.2 … 0.8 (13 columns) at y = 0.45, 0.5, 0.55 (gap sqrt(0.05² + 0.1²)
+  // − 0.095 = 0.017 off the axis line); beyond the ends only (0.15, 0.5) and (0.85, 0.5) (gap
+  // 0.017 too; with y = 0.45 it is 0.027).
+  EXPECT_EQ(want.size(), 13u * 3u + 2u);
 }
 
 TEST(ProximityQuery, BoxesAtAKnownGapTouchOnTheOverlapOfTheirFaces) {
