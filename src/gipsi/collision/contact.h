@@ -18,6 +18,9 @@
 /// Objects need the fields "boundary_position" and "boundary_velocity" and boundary triangles.
 /// Forces are applied explicitly (held over the macro step): fire it at the objects' step
 /// (schedule.dt = object dt) when the penalty stiffness is high.
+/// Allocation: contact lists keep their capacity between firings, so a firing allocates only
+/// when it finds more contacts than any earlier one (the Connector contract's "nothing" holds
+/// after that warm-up).
 
 #include <memory>
 #include <vector>
