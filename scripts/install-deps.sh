@@ -17,6 +17,7 @@ packages=(
   libudunits2-dev        # UDUNITS-2: quantities with units in scene files
   libgtest-dev libgmock-dev libbenchmark-dev
   clang-14 libclang-rt-14-dev libomp-14-dev  # libFuzzer targets (scripts/fuzz.sh)
+  libfcl-dev             # FCL 0.7: the collision benchmark's baseline (bench/collision_bench.cc)
   clang-format clang-tidy
 )
 

@@ -1,5 +1,7 @@
 #include "gipsi/models/builtins.h"
 
+#include "gipsi/collision/contact.h"
+#include "gipsi/collision/rigid_tool.h"
 #include "gipsi/core/aggregate.h"
 #include "gipsi/models/circulation/circulation.h"
 #include "gipsi/models/connectors/boundary_coupling.h"
@@ -27,6 +29,8 @@ void RegisterBuiltins(TypeRegistry& registry) {
   RegisterFieldCopy(registry);
   RegisterExcitationContraction(registry);
   RegisterBoundaryCoupling(registry);
+  RegisterRigidTool(registry);
+  RegisterContact(registry);
 }
 
 }  // namespace gipsi

@@ -1,0 +1,112 @@
+#pragma once
+/// @file
+/// `AabbTree`: a bounding-volume hierarchy of axis-aligned boxes over the triangles of a
+/// deforming surface. Built once by median split of triangle centroids along the longest axis;
+/// refitted bottom-up every step (O(T)); rebuilt when refitting has let the boxes grow too much
+/// (the summed surface area of the inner boxes exceeds `rebuild_ratio` times its value right
+/// after the last build). Optionally keeps a normal cone per node for self-collision culling.
+
+#include <cstdint>
+#include <vector>
+
+#include "gipsi/base/math.h"
+
+namespace gipsi {
+
+/// A box, min and max corners. Plain struct.
+struct Box3 {
+  Vec3 lo = Vec3::Constant(1e300), hi = Vec3::Constant(-1e300);
+  void Add(const Vec3& p) {
+    lo = lo.cwiseMin(p);
+    hi = hi.cwiseMax(p);
+  }
+  void Add(const Box3& b) {
+    lo = lo.cwiseMin(b.lo);
+    hi = hi.cwiseMax(b.hi);
+  }
+  /// True if the boxes are within `gap` of each other along every axis (so points of the two
+  /// boxes closer than `gap` in Euclidean distance are never missed).
+  [[nodiscard]] bool Near(const Box3& b, double gap) const {
+    // Scalar comparisons: cheaper than Eigen array expressions on 3-vectors in the hot loops.
+    return lo[0] - gap <= b.hi[0] && b.lo[0] - gap <= hi[0] && lo[1] - gap <= b.hi[1] &&
+           b.lo[1] - gap <= hi[1] && lo[2] - gap <= b.hi[2] && b.lo[2] - gap <= hi[2];
+  }
+  [[nodiscard]] double SurfaceArea() const {
+    const Vec3 e = (hi - lo).cwiseMax(0.0);
+    return 2 * (e.x() * e.y() + e.y() * e.z() + e.z() * e.x());
+  }
+};
+
+/// A cone of unit directions: every direction n in it has n · axis >= cos(half_angle).
+/// Plain struct.
+struct NormalCone {
+  Vec3 axis = Vec3::UnitZ();
+  double half_angle = 0;  ///< radians, in [0, π]
+};
+
+/// Not copyable (large); movable.
+class AabbTree {
+ public:
+  /// One node: a box, and either two children (`first` and `first + 1`) or a range of
+  /// triangles [first, first + count) of `order()` (a leaf has count > 0).
+  struct Node {
+    Box3 box;
+    int first = 0;
+    int count = 0;
+    [[nodiscard]] bool is_leaf() const { return count > 0; }
+  };
+
+  AabbTree() = default;
+  AabbTree(AabbTree&&) = default;
+  AabbTree& operator=(AabbTree&&) = default;
+  AabbTree(const AabbTree&) = delete;
+  AabbTree& operator=(const AabbTree&) = delete;
+
+  /// Builds over `triangles` (3 by T) with vertices `positions` (3 by V). Leaves hold at most
+  /// `leaf_size` triangles.
+  void Build(const Points& positions, const Triangles& triangles, int leaf_size = 4);
+  /// Recomputes every box from `positions` bottom-up, keeping the topology. Allocation-free.
+  /// `triangles` must be those of the last Build (the tree keeps no reference to them).
+  void Refit(const Points& positions, const Triangles& triangles);
+  /// Refit, then rebuild if the inner boxes' summed area exceeds `rebuild_ratio` (> 1) times its
+  /// value after the last build. Returns true if it rebuilt.
+  bool Update(const Points& positions, const Triangles& triangles, double rebuild_ratio);
+  /// Recomputes the normal cones bottom-up from per-triangle cones (`triangle_cones`, size T:
+  /// each cone must contain every normal the caller associates with that triangle).
+  void RefitCones(const std::vector<NormalCone>& triangle_cones);
+
+  [[nodiscard]] const std::vector<Node>& nodes() const { return nodes_; }
+  /// Triangle ids in leaf order.
+  [[nodiscard]] const std::vector<int>& order() const { return order_; }
+  /// Box of triangle t at the last refit.
+  [[nodiscard]] const Box3& triangle_box(int t) const {
+    return tri_box_[static_cast<std::size_t>(t)];
+  }
+  [[nodiscard]] const NormalCone& cone(int node) const {
+    return cones_[static_cast<std::size_t>(node)];
+  }
+  [[nodiscard]] bool has_cones() const { return !cones_.empty(); }
+  [[nodiscard]] int num_builds() const { return num_builds_; }
+  [[nodiscard]] bool empty() const { return nodes_.empty(); }
+  /// Summed surface area of inner boxes now / right after the last build (1 after a build).
+  [[nodiscard]] double quality_ratio() const;
+
+ private:
+  void ComputeTriangleBoxes(const Points& positions, const Triangles& triangles);
+  void BuildRange(int self, int begin, int end);
+  double InnerArea() const;
+
+  std::vector<Node> nodes_;
+  std::vector<int> order_;
+  std::vector<Box3> tri_box_;
+  std::vector<Vec3> centroid_;
+  std::vector<NormalCone> cones_;
+  double built_area_ = 0;
+  int num_builds_ = 0;
+  int leaf_size_ = 4;
+};
+
+/// The smallest cone (approximately: axis = normalised mean) containing cones a and b.
+NormalCone MergeCones(const NormalCone& a, const NormalCone& b);
+
+}  // namespace gipsi

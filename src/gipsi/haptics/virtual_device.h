@@ -1,0 +1,47 @@
+#pragma once
+/// @file
+/// `VirtualDevice`: a haptic device that replays a scripted trajectory, for headless runs and
+/// tests. Positions are interpolated linearly between keyframes and held outside them; the
+/// commanded forces are kept for inspection.
+
+#include <filesystem>
+#include <vector>
+
+#include "gipsi/haptics/device.h"
+
+namespace gipsi {
+
+/// One keyframe of a trajectory. Plain struct.
+struct DeviceKeyframe {
+  double time = 0;  ///< s
+  Vec3 position = Vec3::Zero();
+  std::uint32_t buttons = 0;
+};
+
+/// Not copyable or movable (a HapticDevice).
+class VirtualDevice final : public HapticDevice {
+ public:
+  /// Keyframe times must increase strictly; throws InputError otherwise or when empty.
+  explicit VirtualDevice(std::vector<DeviceKeyframe> path);
+  /// Reads a trajectory file: one keyframe per line, `t, x, y, z` or `t, x, y, z, buttons`
+  /// (commas or spaces); blank lines, lines starting with '#' and a first line that is not
+  /// numeric (a header) are skipped. Throws InputError naming the file and line.
+  static std::vector<DeviceKeyframe> ReadTrajectory(const std::filesystem::path& file);
+
+  DevicePose Read(double t) noexcept override;
+  void Command(const Vec3& force, const Vec3& torque) noexcept override;
+
+  /// Simulates a disconnection (Read then reports connected = false) or a reconnection.
+  void SetConnected(bool connected) { connected_ = connected; }
+  [[nodiscard]] const Vec3& last_force() const { return force_; }
+  [[nodiscard]] const Vec3& last_torque() const { return torque_; }
+  [[nodiscard]] std::int64_t num_commands() const { return commands_; }
+
+ private:
+  std::vector<DeviceKeyframe> path_;
+  bool connected_ = true;
+  Vec3 force_ = Vec3::Zero(), torque_ = Vec3::Zero();
+  std::int64_t commands_ = 0;
+};
+
+}  // namespace gipsi
