@@ -27,6 +27,7 @@
 #include "gipsi/models/builtins.h"
 #include "gipsi/models/ep/cell_models.h"
 #include "gipsi/models/ep/single_cell.h"
+#include "viz_commands.h"
 
 /// LeakSanitizer (sanitizer builds only; never called otherwise): libgmsh 4.8 leaks small
 /// allocations while meshing (`meshGFace`, `discreteFace::_createGeometryFromSTL`) that
@@ -390,6 +391,8 @@ int main(int argc, char** argv) {
       ->check(CLI::PositiveNumber);
   cell->add_option("--plugin", plugins, "Load a plugin shared library (repeatable)");
 
+  gipsi::apps::VizCommands viz_commands(app);
+
   CLI11_PARSE(app, argc, argv);
   gipsi::Log().set_level(verbose ? spdlog::level::debug : spdlog::level::info);
   try {
@@ -398,6 +401,7 @@ int main(int argc, char** argv) {
     if (*info) return Info(mesh_file);
     if (*types) return Types(plugins);
     if (*cell) return Cell(cell_options, plugins);
+    if (auto code = viz_commands.Dispatch()) return *code;
   } catch (const gipsi::InputError& e) {
     std::cerr << "gipsi: error: " << e.what() << "\n";
     return 1;

@@ -14,6 +14,9 @@ packages=(
   libgmsh-dev gmsh       # Gmsh C++ API: shell (left-ventricle) mesh generation
   libsuitesparse-dev     # CHOLMOD sparse Cholesky
   libopenblas-serial-dev # its BLAS: single-threaded OpenBLAS (GiPSi threads above it)
+  libosmesa6-dev         # off-screen OpenGL (software) for gipsi snapshot
+  libstb-dev             # PNG files and font rasterisation (stb_image_write, stb_truetype)
+  fonts-dejavu-core      # the font of image labels
   libgtest-dev libgmock-dev libbenchmark-dev
   clang-format clang-tidy
 )

@@ -195,6 +195,28 @@ TEST(ParseColorSpec, ReadsEveryKeyAndNamesThePathOfBadValues) {
   EXPECT_THAT(message("d"), HasSubstr("colour"));
 }
 
+TEST(ParseColorOption, SplitsObjectFieldAndComponent) {
+  auto [object, spec] = ParseColorOption("liver:displacement.z", "cool-warm", std::nullopt, "--c");
+  EXPECT_EQ(object, "liver");
+  EXPECT_EQ(spec.field, "displacement");
+  EXPECT_EQ(spec.component, 2);
+  EXPECT_EQ(spec.color_map, "cool-warm");
+  std::tie(object, spec) =
+      ParseColorOption("heart.muscle:von_mises_stress", "viridis", std::pair{0.0, 5e3}, "--c");
+  EXPECT_EQ(object, "heart.muscle");
+  EXPECT_EQ(spec.field, "von_mises_stress");
+  EXPECT_EQ(spec.component, -1);
+  EXPECT_EQ(spec.range, std::pair(0.0, 5e3));
+  for (const char* bad : {"liver", ":x", "liver:", "liver:displacement.w"}) {
+    try {
+      (void)ParseColorOption(bad, "viridis", std::nullopt, "--c");
+      ADD_FAILURE() << bad << " was accepted";
+    } catch (const InputError& e) {
+      EXPECT_THAT(e.what(), HasSubstr("command line: --c: ")) << bad;
+    }
+  }
+}
+
 TEST(DisplayPublisher, PublishesAFrameAfterEveryMacroStep) {
   TypeRegistry registry;
   Scene scene = LoadBlock(false, registry);

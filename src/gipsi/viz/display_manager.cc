@@ -21,7 +21,7 @@ constexpr Rgb kPalette[] = {{0.80f, 0.45f, 0.40f},
 
 std::string FieldLabel(const FieldInfo& info, int component) {
   if (info.components == 1) return info.name;
-  if (component < 0) return info.name + " |.|";
+  if (component < 0) return "|" + info.name + "|";
   static constexpr const char* kAxes[] = {"x", "y", "z"};
   if (info.components == 3) return info.name + " " + kAxes[component];
   return fmt::format("{} [{}]", info.name, component);
@@ -62,6 +62,36 @@ ColorSpec ParseColorSpec(const JsonNode& node) {
     spec.solid = {static_cast<float>(v[0]), static_cast<float>(v[1]), static_cast<float>(v[2])};
   }
   return spec;
+}
+
+std::pair<std::string, ColorSpec> ParseColorOption(std::string_view text, std::string_view map,
+                                                   std::optional<std::pair<double, double>> range,
+                                                   std::string_view option) {
+  const std::size_t colon = text.find(':');
+  if (colon == std::string_view::npos || colon == 0 || colon + 1 == text.size())
+    ThrowInputError("command line", option,
+                    fmt::format("expected OBJECT:FIELD[.COMPONENT], got '{}'", text));
+  ColorSpec spec;
+  spec.field = std::string(text.substr(colon + 1));
+  const std::size_t dot = spec.field.rfind('.');
+  if (dot != std::string::npos && dot + 2 == spec.field.size()) {
+    const char c = spec.field.back();
+    if (c >= 'x' && c <= 'z')
+      spec.component = c - 'x';
+    else if (c >= '0' && c <= '8')
+      spec.component = c - '0';
+    else
+      ThrowInputError("command line", option,
+                      fmt::format("component '{}' of '{}' is not x, y, z or 0 ... 8", c, text));
+    spec.field.resize(dot);
+  }
+  try {
+    spec.color_map = ColorMap::Named(map).name();
+  } catch (const InputError& e) {
+    ThrowInputError("command line", "--map", e.what());
+  }
+  spec.range = range;
+  return {std::string(text.substr(0, colon)), spec};
 }
 
 DisplayManager::DisplayManager(const SimObject& object, ColorSpec spec)

@@ -34,6 +34,13 @@ struct ColorSpec {
 /// "map": "viridis", "range": [lo, hi], "color": [r, g, b]}; throws InputError naming the path.
 ColorSpec ParseColorSpec(const JsonNode& node);
 
+/// Parses a command-line colour choice "OBJECT:FIELD" where FIELD may end in ".x", ".y", ".z"
+/// (or ".0" ... ".8") for one component (else the magnitude), with colour map `map` and
+/// optional fixed `range`. Throws InputError naming `option` (e.g. "--color").
+std::pair<std::string, ColorSpec> ParseColorOption(std::string_view text, std::string_view map,
+                                                   std::optional<std::pair<double, double>> range,
+                                                   std::string_view option);
+
 /// Fills one object's `SurfaceBuffers` from its display geometry. Built once (it resolves the
 /// field and precomputes the mapping to display vertices); `Fill` allocates nothing after the
 /// first call on the same buffers. Not copyable (holds a reference); movable.

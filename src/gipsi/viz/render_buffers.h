@@ -19,10 +19,11 @@ struct SurfaceBuffers {
   std::vector<float> colors;           ///< 3V, sRGB in [0, 1]
   std::vector<float> values;           ///< V field values behind the colours (empty if solid)
   std::vector<std::uint32_t> indices;  ///< 3T, counter-clockwise seen from outside
-  std::string field;                   ///< colour field label, e.g. "displacement |.|" or ""
-  std::string units;                   ///< its units
-  std::string color_map;               ///< colour map name ("" if solid)
-  double range_lo = 0, range_hi = 0;   ///< the value range the colours span
+  /// Colour field label, e.g. "|displacement|", "position x"; "" for a solid colour.
+  std::string field;
+  std::string units;                  ///< its units
+  std::string color_map;              ///< colour map name ("" if solid)
+  double range_lo = 0, range_hi = 0;  ///< the value range the colours span
 
   [[nodiscard]] std::size_t num_vertices() const { return positions.size() / 3; }
   [[nodiscard]] std::size_t num_triangles() const { return indices.size() / 3; }
