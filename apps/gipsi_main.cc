@@ -27,6 +27,7 @@
 #include "gipsi/models/builtins.h"
 #include "gipsi/models/ep/cell_models.h"
 #include "gipsi/models/ep/single_cell.h"
+#include "gipsi/viz/render/plot.h"
 #include "viz_commands.h"
 
 /// LeakSanitizer (sanitizer builds only; never called otherwise): libgmsh 4.8 leaks small
@@ -159,9 +160,20 @@ int Run(const std::string& file, const std::string& out_dir, double until, bool 
   for (const auto& [t, what] : kernel.fired_events())
     summary += fmt::format("  event at {:.6g} s: {}\n", t, what);
   summary += fmt::format("outputs:          {}\n", out.string());
+  std::string plot_error;  // plots of a run that stopped early still show what was recorded
+  try {
+    for (const auto& plot : gipsi::viz::WritePlots(scene.plots, out))
+      summary += fmt::format("plot:             {}\n", plot.string());
+  } catch (const std::exception& e) {
+    plot_error = e.what();
+  }
   if (profile) summary += ProfileTable(kernel, result.wall_seconds);
   if (!quiet || !result.ok() || profile) std::cout << summary << std::flush;
 
+  if (!plot_error.empty() && result.ok()) {
+    std::cerr << "gipsi: error: writing plots failed: " << plot_error << "\n";
+    return 4;
+  }
   switch (result.outcome) {
     case gipsi::RunResult::Outcome::kCompleted:
       return 0;

@@ -17,6 +17,9 @@ packages=(
   libosmesa6-dev         # off-screen OpenGL (software) for gipsi snapshot
   libstb-dev             # PNG files and font rasterisation (stb_image_write, stb_truetype)
   fonts-dejavu-core      # the font of image labels
+  libplplot-dev plplot-driver-cairo  # plots (PNG and SVG through cairo)
+  libglfw3-dev libimgui-dev  # the gipsi view window and its panels
+  xvfb xauth             # a virtual display for testing the viewer
   libgtest-dev libgmock-dev libbenchmark-dev
   clang-format clang-tidy
 )

@@ -64,6 +64,26 @@ TEST(Camera, FitToKeepsEveryCornerInViewWithOneNearTheEdge) {
   EXPECT_NEAR(widest, 1 / 1.1, 1e-5);
 }
 
+TEST(Camera, RayThroughAProjectedPointMeetsIt) {
+  Camera camera;
+  camera.target = Eigen::Vector3d(0.2, 0.1, -0.3);
+  camera.distance = 3;
+  camera.azimuth = 35;
+  camera.elevation = -20;
+  const double aspect = 1.5;
+  const Eigen::Vector3d point(0.5, -0.4, 0.2);
+  const Eigen::Vector4f clip =
+      camera.Projection(aspect) * camera.View() * Eigen::Vector4f(0.5f, -0.4f, 0.2f, 1.0f);
+  const auto [origin, dir] = camera.Ray(clip.x() / clip.w(), clip.y() / clip.w(), aspect);
+  EXPECT_NEAR(dir.norm(), 1, 1e-12);
+  // Distance from the point to the ray: float matrices, a few units of scene size.
+  EXPECT_LT((point - origin).cross(dir).norm(), 1e-5);
+  // The centre of the screen looks at the target.
+  const auto [o, d] = camera.Ray(0, 0, aspect);
+  EXPECT_LT((camera.target - o).cross(d).norm(), 1e-5);
+  EXPECT_GT((camera.target - o).dot(d), 0);
+}
+
 TEST(ParseCamera, ReadsTwoOrThreeNumbersAndRejectsTheRest) {
   Camera camera;
   ParseCamera("30,-10", "--camera", camera);

@@ -92,6 +92,17 @@ void Camera::FitTo(const FrameBuffers& frame, double aspect) {
   distance = std::max({needed, nearest + 0.1 * (hi - lo).norm(), 1e-9});
 }
 
+std::pair<Eigen::Vector3d, Eigen::Vector3d> Camera::Ray(double ndc_x, double ndc_y,
+                                                        double aspect) const {
+  const Eigen::Matrix4d inverse = (Projection(aspect) * View()).cast<double>().inverse();
+  auto unproject = [&](double z) {
+    const Eigen::Vector4d p = inverse * Eigen::Vector4d(ndc_x, ndc_y, z, 1);
+    return Eigen::Vector3d(p.head<3>() / p.w());
+  };
+  const Eigen::Vector3d near = unproject(-1), far = unproject(1);
+  return {near, (far - near).normalized()};
+}
+
 void Camera::Orbit(double d_azimuth, double d_elevation) {
   azimuth = std::fmod(azimuth + d_azimuth, 360.0);
   elevation = std::clamp(elevation + d_elevation, -89.0, 89.0);

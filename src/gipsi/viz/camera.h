@@ -32,6 +32,10 @@ struct Camera {
   /// Aims at the centre of the bounding box of every surface in `frame` and (unless
   /// distance_given) backs off until the whole box is in view, with a 10 % margin.
   void FitTo(const FrameBuffers& frame, double aspect);
+  /// The ray (origin on the near plane, unit direction) through the point (ndc_x, ndc_y) of
+  /// normalised device coordinates (-1 to 1, y up) of a view with width/height `aspect`.
+  [[nodiscard]] std::pair<Eigen::Vector3d, Eigen::Vector3d> Ray(double ndc_x, double ndc_y,
+                                                                double aspect) const;
   /// Orbit by mouse-like deltas (degrees); elevation is clamped to ±89°.
   void Orbit(double d_azimuth, double d_elevation);
 };

@@ -29,11 +29,20 @@ struct SurfaceBuffers {
   [[nodiscard]] std::size_t num_triangles() const { return indices.size() / 3; }
 };
 
+/// Recent samples of one probe, for live plots. Copyable and movable.
+struct ProbeTrace {
+  std::string name;                        ///< probe name
+  std::vector<std::string> columns;        ///< CSV columns after time
+  std::vector<float> time;                 ///< sample times [s], oldest first
+  std::vector<std::vector<float>> values;  ///< values[c][k]: column c at time[k]
+};
+
 /// Everything drawn in one frame. Copyable and movable.
 struct FrameBuffers {
   double time = 0;          ///< simulated time [s]
   std::int64_t frame = -1;  ///< publication counter (-1: nothing published yet)
   std::vector<SurfaceBuffers> surfaces;
+  std::vector<ProbeTrace> traces;  ///< filled by viewers that plot probes live
 };
 
 }  // namespace gipsi::viz

@@ -146,7 +146,7 @@ void SurfaceRenderer::Draw(const FrameBuffers& frame, const Camera& camera, int 
   gl_.Viewport(0, 0, width, height);
   gl_.ClearColor(options.background.r, options.background.g, options.background.b, 1.0f);
   gl_.Clear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
-  gl_.Viewport(0, 0, scene_width, height);
+  gl_.Viewport(options.viewport_x, 0, scene_width, height);
   gl_.Enable(GL_DEPTH_TEST);
   gl_.DepthFunc(GL_LESS);
   gl_.UseProgram(program_);
@@ -180,7 +180,7 @@ void SurfaceRenderer::Draw(const FrameBuffers& frame, const Camera& camera, int 
     }
   }
   if (legend) {
-    gl_.Viewport(0, 0, width, height);
+    gl_.Viewport(options.viewport_x, 0, width, height);
     DrawColorBar(*legend, width, height);
   }
   gl_.BindVertexArray(0);

@@ -22,6 +22,7 @@ struct RenderOptions {
   bool color_bar = true;     ///< a vertical colour bar at the right edge for the first surface
                              ///< coloured by a field
   std::vector<bool> hidden;  ///< surface i is not drawn if hidden[i] (shorter = visible)
+  int viewport_x = 0;        ///< left edge of the drawing area in the framebuffer (pixels)
 };
 
 /// The surface whose colours the colour bar explains: the first visible one coloured by a
