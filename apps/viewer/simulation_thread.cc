@@ -48,7 +48,9 @@ void SimulationThread::Load() {
     s.end_time = scene_->end_time;
     s.macro_dt = scene_->kernel->macro_dt();
     s.objects.clear();
+    s.colors.clear();
     for (std::size_t i = 0; i < display_->size(); ++i) {
+      s.colors.push_back(display_->manager(i).spec());
       const SimObject& object = display_->manager(i).object();
       std::vector<std::string> fields;
       for (const FieldInfo& f : object.fields())
@@ -190,6 +192,7 @@ void SimulationThread::Loop() {
       if (surface >= display_->size()) continue;
       try {
         display_->manager(surface) = DisplayManager(display_->manager(surface).object(), spec);
+        UpdateStatus([&](SimulationStatus& s) { s.colors[surface] = spec; });
       } catch (const std::exception& e) {
         UpdateStatus([&](SimulationStatus& s) { s.message = e.what(); });
       }

@@ -31,6 +31,8 @@ struct SimulationStatus {
   std::string message;  ///< why it stopped (divergence, reload error), or ""
   /// Per display surface (in frame order): object name and the fields it can be coloured by.
   std::vector<std::pair<std::string, std::vector<std::string>>> objects;
+  /// Per display surface: how it is coloured now.
+  std::vector<ColorSpec> colors;
 };
 
 /// Owns the scene while it runs. Not copyable or movable.

@@ -8,6 +8,7 @@
 #include <imgui_impl_glfw.h>
 #include <imgui_impl_opengl3.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <iostream>
@@ -116,8 +117,9 @@ int RunViewer(const ViewerOptions& options) {
     Camera camera = options.camera;
     bool fitted = false;
     RenderOptions render;
-    std::vector<SurfaceUi> ui;
+    render.color_bar = !options.show_ui;  // the panel has the legend, with its numbers
     const std::vector<std::string> maps = ColorMap::Names();
+    std::vector<SurfaceUi> ui;
     float speed = static_cast<float>(options.speed > 0 ? options.speed : 1.0);
     bool as_fast_as_possible = options.speed <= 0;
     bool dragging_tool = false;
@@ -142,7 +144,18 @@ int RunViewer(const ViewerOptions& options) {
       const double scale = win_width > 0 ? double(fb_width) / win_width : 1.0;
       const int panel = options.show_ui ? std::min(340, fb_width / 3) : 0;
       const int scene_width = fb_width - panel;
-      if (ui.size() != frame.surfaces.size()) ui.assign(frame.surfaces.size(), SurfaceUi{});
+      if (ui.size() != status.colors.size()) {  // (re)loaded: start from the scene's colours
+        ui.assign(status.colors.size(), SurfaceUi{});
+        for (std::size_t i = 0; i < ui.size() && i < status.objects.size(); ++i) {
+          const ColorSpec& spec = status.colors[i];
+          const auto& fields = status.objects[i].second;
+          const auto f = std::find(fields.begin(), fields.end(), spec.field);
+          ui[i].field = f == fields.end() ? 0 : static_cast<int>(f - fields.begin()) + 1;
+          ui[i].component = spec.component + 1;
+          const auto m = std::find(maps.begin(), maps.end(), spec.color_map);
+          ui[i].map = m == maps.end() ? 0 : static_cast<int>(m - maps.begin());
+        }
+      }
       render.hidden.resize(ui.size());
       for (std::size_t i = 0; i < ui.size(); ++i) render.hidden[i] = !ui[i].visible;
       if (!fitted && frame.frame >= 0) {
