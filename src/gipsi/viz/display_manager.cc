@@ -150,6 +150,7 @@ DisplayManager::DisplayManager(const SimObject& object, ColorSpec spec)
                       "field",
                       info.name, ToString(location_)));
   }
+  label_ = FieldLabel(info, spec_.component);
   raw_.resize(info.components, object.FieldCount(*field_));
   item_.resize(raw_.cols());
 }
@@ -239,8 +240,7 @@ void DisplayManager::Fill(SurfaceBuffers& out) {
     out.colors[3 * v + 2] = c.b;
   }
   const FieldInfo& info = object.field_info(*field_);
-  const std::string label = FieldLabel(info, spec_.component);
-  if (out.field != label) out.field = label;
+  if (out.field != label_) out.field = label_;
   if (out.units != info.units) out.units = info.units;
   if (out.color_map != map_.name()) out.color_map = map_.name();
   out.range_lo = lo;

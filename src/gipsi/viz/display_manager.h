@@ -63,6 +63,7 @@ class DisplayManager {
   ColorSpec spec_;
   ColorMap map_;
   std::optional<FieldId> field_;
+  std::string label_;  // e.g. "|displacement|"
   FieldLocation location_ = FieldLocation::kNode;
   // Element -> node averaging (CSR over nodes), when the field lives on elements.
   std::vector<int> node_elem_start_, node_elems_;
