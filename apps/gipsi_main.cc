@@ -34,14 +34,14 @@
 /// allocations while meshing (`meshGFace`, `discreteFace::_createGeometryFromSTL`) that
 /// `gmsh::finalize` does not free. Scenes that generate meshes through Gmsh would otherwise make
 /// the tool fail its leak check. The system graphics and plotting libraries (Mesa and its LLVM,
-/// X11/GLX, GLFW, PLplot with cairo, fontconfig and pango) keep one-time allocations they never
-/// free either. Weak, so LSAN_OPTIONS suppressions still take precedence.
+/// X11/GLX, GLFW, PLplot with libltdl, cairo, fontconfig and pango) keep one-time allocations they
+/// never free either. Weak, so LSAN_OPTIONS suppressions still take precedence.
 extern "C" __attribute__((weak)) const char* __lsan_default_suppressions() {
   return "leak:libgmsh.so\n"
          "leak:libOSMesa.so\nleak:libgallium\nleak:libLLVM\nleak:libglapi.so\n"
          "leak:_dri.so\nleak:libGLX_mesa.so\nleak:libGLdispatch.so\nleak:libX11.so\n"
          "leak:libxcb\nleak:libglfw.so\nleak:libplplot.so\nleak:libcairo.so\n"
-         "leak:libfontconfig.so\nleak:libpango\nleak:libfreetype.so\n";
+         "leak:libfontconfig.so\nleak:libpango\nleak:libfreetype.so\nleak:libltdl.so\n";
 }
 
 namespace {
