@@ -27,13 +27,21 @@
 #include "gipsi/models/builtins.h"
 #include "gipsi/models/ep/cell_models.h"
 #include "gipsi/models/ep/single_cell.h"
+#include "gipsi/viz/render/plot.h"
+#include "viz_commands.h"
 
 /// LeakSanitizer (sanitizer builds only; never called otherwise): libgmsh 4.8 leaks small
 /// allocations while meshing (`meshGFace`, `discreteFace::_createGeometryFromSTL`) that
 /// `gmsh::finalize` does not free. Scenes that generate meshes through Gmsh would otherwise make
-/// the tool fail its leak check. Weak, so LSAN_OPTIONS suppressions still take precedence.
+/// the tool fail its leak check. The system graphics and plotting libraries (Mesa and its LLVM,
+/// X11/GLX, GLFW, PLplot with libltdl, cairo, fontconfig and pango) keep one-time allocations they
+/// never free either. Weak, so LSAN_OPTIONS suppressions still take precedence.
 extern "C" __attribute__((weak)) const char* __lsan_default_suppressions() {
-  return "leak:libgmsh.so\n";
+  return "leak:libgmsh.so\n"
+         "leak:libOSMesa.so\nleak:libgallium\nleak:libLLVM\nleak:libglapi.so\n"
+         "leak:_dri.so\nleak:libGLX_mesa.so\nleak:libGLdispatch.so\nleak:libX11.so\n"
+         "leak:libxcb\nleak:libglfw.so\nleak:libplplot.so\nleak:libcairo.so\n"
+         "leak:libfontconfig.so\nleak:libpango\nleak:libfreetype.so\nleak:libltdl.so\n";
 }
 
 namespace {
@@ -158,9 +166,20 @@ int Run(const std::string& file, const std::string& out_dir, double until, bool 
   for (const auto& [t, what] : kernel.fired_events())
     summary += fmt::format("  event at {:.6g} s: {}\n", t, what);
   summary += fmt::format("outputs:          {}\n", out.string());
+  std::string plot_error;  // plots of a run that stopped early still show what was recorded
+  try {
+    for (const auto& plot : gipsi::viz::WritePlots(scene.plots, out))
+      summary += fmt::format("plot:             {}\n", plot.string());
+  } catch (const std::exception& e) {
+    plot_error = e.what();
+  }
   if (profile) summary += ProfileTable(kernel, result.wall_seconds);
   if (!quiet || !result.ok() || profile) std::cout << summary << std::flush;
 
+  if (!plot_error.empty() && result.ok()) {
+    std::cerr << "gipsi: error: writing plots failed: " << plot_error << "\n";
+    return 4;
+  }
   switch (result.outcome) {
     case gipsi::RunResult::Outcome::kCompleted:
       return 0;
@@ -390,6 +409,8 @@ int main(int argc, char** argv) {
       ->check(CLI::PositiveNumber);
   cell->add_option("--plugin", plugins, "Load a plugin shared library (repeatable)");
 
+  gipsi::apps::VizCommands viz_commands(app);
+
   CLI11_PARSE(app, argc, argv);
   gipsi::Log().set_level(verbose ? spdlog::level::debug : spdlog::level::info);
   try {
@@ -398,6 +419,7 @@ int main(int argc, char** argv) {
     if (*info) return Info(mesh_file);
     if (*types) return Types(plugins);
     if (*cell) return Cell(cell_options, plugins);
+    if (auto code = viz_commands.Dispatch()) return *code;
   } catch (const gipsi::InputError& e) {
     std::cerr << "gipsi: error: " << e.what() << "\n";
     return 1;

@@ -13,7 +13,8 @@ export GIPSI_WERROR=OFF
 seconds="${1:-30}"
 
 cmake --preset fuzz >/dev/null
-cmake --build --preset fuzz
+targets=(scene gmsh obj stl vtu vtk tetgen)
+cmake --build --preset fuzz --target "${targets[@]/#/fuzz_}"
 
 work="build/fuzz/corpus"
 findings="build/fuzz/findings"
@@ -40,7 +41,7 @@ seed tetgen
 export ASAN_OPTIONS="detect_leaks=1:allocator_may_return_null=1"
 export UBSAN_OPTIONS="print_stacktrace=1"
 status=0
-for target in scene gmsh obj stl vtu vtk tetgen; do
+for target in "${targets[@]}"; do
   echo "== fuzz_$target for ${seconds} s"
   if ! ./build/fuzz/fuzz/fuzz_"$target" "$work/$target" -max_total_time="$seconds" -timeout=10 \
       -rss_limit_mb=2048 -malloc_limit_mb=1024 -print_final_stats=1 \

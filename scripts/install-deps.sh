@@ -15,6 +15,12 @@ packages=(
   libsuitesparse-dev     # CHOLMOD sparse Cholesky
   libopenblas-serial-dev # its BLAS: single-threaded OpenBLAS (GiPSi threads above it)
   libudunits2-dev        # UDUNITS-2: quantities with units in scene files
+  libosmesa6-dev         # off-screen OpenGL (software) for gipsi snapshot
+  libstb-dev             # PNG files and font rasterisation (stb_image_write, stb_truetype)
+  fonts-dejavu-core      # the font of image labels
+  libplplot-dev plplot-driver-cairo  # plots (PNG and SVG through cairo)
+  libglfw3-dev libimgui-dev  # the gipsi view window and its panels
+  xvfb xauth             # a virtual display for testing the viewer
   libgtest-dev libgmock-dev libbenchmark-dev
   clang-14 libclang-rt-14-dev libomp-14-dev  # libFuzzer targets (scripts/fuzz.sh)
   libfcl-dev             # FCL 0.7: the collision benchmark's baseline (bench/collision_bench.cc)

@@ -356,7 +356,10 @@ Scene LoadSceneFromString(std::string_view text, const std::string& name,
 
   scene.output_directory = std::filesystem::path("out") / std::filesystem::path(name).stem();
   if (auto outputs = root.Find("outputs")) {
-    outputs->CheckKeys({"directory", "vtu"});
+    outputs->CheckKeys({"directory", "vtu", "plots"});
+    if (auto plots = outputs->Find("plots"))
+      for (const auto& plot : plots->Items())
+        scene.plots.push_back(viz::ParsePlotSpec(plot, scene.probes));
     if (auto dir = outputs->Find("directory")) scene.output_directory = dir->AsString();
     if (auto vtu = outputs->Find("vtu")) {
       if (vtu->raw().is_boolean()) {

@@ -15,6 +15,7 @@
 #include "gipsi/core/registry.h"
 #include "gipsi/io/boundary_condition_spec.h"
 #include "gipsi/io/probes.h"
+#include "gipsi/viz/plot_spec.h"
 
 namespace gipsi {
 
@@ -34,6 +35,8 @@ struct Scene {
   std::filesystem::path output_directory;  ///< from the scene (relative to the working dir)
   std::vector<Probe> probes;
   VtuOutputSpec vtu;
+  /// Plots to draw from the probe CSVs when a run ends ("outputs": {"plots": [...]}).
+  std::vector<viz::PlotSpec> plots;
   std::map<std::string, std::shared_ptr<const Mesh>> meshes;
   /// Boundary conditions by "object/name", for events and `gipsi validate`.
   std::map<std::string, BoundaryConditionSpec> boundary_conditions;

@@ -1,0 +1,264 @@
+#include "viewer/simulation_thread.h"
+
+#include <chrono>
+
+#include "gipsi/base/log.h"
+
+namespace gipsi::viz {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+constexpr std::size_t kMaxTraceSamples = 2000;
+
+}  // namespace
+
+SimulationThread::SimulationThread(LoadFn load,
+                                   std::vector<std::pair<std::string, ColorSpec>> colors,
+                                   TripleBuffer<FrameBuffers>& frames)
+    : load_(std::move(load)), initial_colors_(std::move(colors)), frames_(frames) {
+  Load();  // throws on bad input, before any thread exists
+  Publish();
+  thread_ = std::thread([this] { Loop(); });
+}
+
+SimulationThread::~SimulationThread() {
+  quit_.store(true);
+  wake_.notify_all();
+  thread_.join();
+  tool_.Release();
+}
+
+void SimulationThread::Load() {
+  tool_.Release();
+  auto scene = std::make_unique<Scene>(load_());
+  auto display = std::make_unique<SceneDisplay>(*scene->kernel, initial_colors_);
+  scene_ = std::move(scene);
+  display_ = std::move(display);
+  traces_.clear();
+  for (const Probe& probe : scene_->probes) {
+    ProbeTrace trace;
+    trace.name = probe.name;
+    const auto columns = ProbeColumns(probe);
+    trace.columns.assign(columns.begin() + 1, columns.end());  // after "time"
+    trace.values.resize(trace.columns.size());
+    traces_.push_back(std::move(trace));
+  }
+  UpdateStatus([&](SimulationStatus& s) {
+    s.time = scene_->kernel->time();
+    s.end_time = scene_->end_time;
+    s.macro_dt = scene_->kernel->macro_dt();
+    s.objects.clear();
+    s.colors.clear();
+    for (std::size_t i = 0; i < display_->size(); ++i) {
+      s.colors.push_back(display_->manager(i).spec());
+      const SimObject& object = display_->manager(i).object();
+      std::vector<std::string> fields;
+      for (const FieldInfo& f : object.fields())
+        if (f.readable() &&
+            (f.location == FieldLocation::kNode || f.location == FieldLocation::kElement ||
+             (f.location == FieldLocation::kBoundaryVertex && !object.display().map)))
+          fields.push_back(f.name);
+      s.objects.emplace_back(object.name(), std::move(fields));
+    }
+  });
+}
+
+void SimulationThread::Publish() {
+  FrameBuffers& frame = frames_.back();
+  display_->Fill(scene_->kernel->time(), frame);
+  // Probe samples: appended here, at most kMaxTraceSamples kept (the oldest half dropped).
+  for (std::size_t p = 0; p < traces_.size(); ++p) {
+    ProbeTrace& trace = traces_[p];
+    if (!trace.time.empty() && float(scene_->kernel->time()) <= trace.time.back()) continue;
+    scene_->probes[p].Sample(sample_);
+    if (trace.time.size() >= kMaxTraceSamples) {
+      const auto half = static_cast<std::ptrdiff_t>(kMaxTraceSamples / 2);
+      trace.time.erase(trace.time.begin(), trace.time.begin() + half);
+      for (auto& v : trace.values) v.erase(v.begin(), v.begin() + half);
+    }
+    trace.time.push_back(float(scene_->kernel->time()));
+    for (std::size_t c = 0; c < trace.values.size() && c < sample_.size(); ++c)
+      trace.values[c].push_back(float(sample_[c]));
+  }
+  frame.traces = traces_;
+  frames_.Publish();
+}
+
+void SimulationThread::UpdateStatus(const std::function<void(SimulationStatus&)>& change) {
+  std::lock_guard lock(mutex_);
+  change(status_);
+}
+
+SimulationStatus SimulationThread::status() const {
+  std::lock_guard lock(mutex_);
+  return status_;
+}
+
+void SimulationThread::SetPlaying(bool playing) {
+  std::lock_guard lock(mutex_);
+  commands_.playing = playing;
+  commands_.run_until = -1;
+  wake_.notify_all();
+}
+void SimulationThread::Step() {
+  std::lock_guard lock(mutex_);
+  commands_.playing = false;
+  ++commands_.steps;
+  wake_.notify_all();
+}
+void SimulationThread::Reset() {
+  std::lock_guard lock(mutex_);
+  commands_.playing = false;
+  commands_.steps = 0;
+  commands_.reset = true;
+  wake_.notify_all();
+}
+void SimulationThread::SetSpeed(double real_time_factor) {
+  std::lock_guard lock(mutex_);
+  commands_.speed = real_time_factor;
+}
+void SimulationThread::SetColor(std::size_t surface, ColorSpec spec) {
+  std::lock_guard lock(mutex_);
+  commands_.colors.emplace_back(surface, std::move(spec));
+  wake_.notify_all();
+}
+void SimulationThread::Grab(std::size_t surface, const Vec3& point) {
+  std::lock_guard lock(mutex_);
+  commands_.tool = 1;
+  commands_.tool_surface = surface;
+  commands_.tool_point = point;
+  commands_.tool_target = point;
+  commands_.tool_target_new = false;
+  wake_.notify_all();
+}
+void SimulationThread::Drag(const Vec3& target) {
+  std::lock_guard lock(mutex_);
+  commands_.tool_target = target;
+  commands_.tool_target_new = true;
+  wake_.notify_all();
+}
+void SimulationThread::ReleaseTool() {
+  std::lock_guard lock(mutex_);
+  commands_.tool = 2;
+  wake_.notify_all();
+}
+void SimulationThread::RunUntil(double time) {
+  std::lock_guard lock(mutex_);
+  commands_.playing = true;
+  commands_.run_until = time;
+  wake_.notify_all();
+}
+
+void SimulationThread::Loop() {
+  Clock::time_point wall_anchor = Clock::now();
+  double sim_anchor = 0;
+  bool was_playing = false;
+  double last_speed = -1;
+  // Real-time factor measured over windows of about a second.
+  Clock::time_point rate_wall = Clock::now();
+  double rate_sim = 0;
+  while (!quit_.load()) {
+    Commands c;
+    {
+      std::unique_lock lock(mutex_);
+      wake_.wait_for(lock, std::chrono::milliseconds(20), [&] {
+        return quit_.load() || commands_.playing || commands_.steps > 0 || commands_.reset ||
+               !commands_.colors.empty() || commands_.tool != 0 || commands_.tool_target_new;
+      });
+      c = commands_;
+      commands_.steps = 0;
+      commands_.reset = false;
+      commands_.colors.clear();
+      commands_.tool = 0;
+      commands_.tool_target_new = false;
+      status_.playing = commands_.playing;
+    }
+    if (quit_.load()) break;
+    bool republish = false;
+    if (c.reset) {
+      try {
+        Load();
+        UpdateStatus([](SimulationStatus& s) {
+          s.failed = false;
+          s.message.clear();
+        });
+      } catch (const std::exception& e) {
+        UpdateStatus([&](SimulationStatus& s) { s.message = e.what(); });
+      }
+      republish = true;
+      was_playing = false;
+    }
+    for (auto& [surface, spec] : c.colors) {
+      if (surface >= display_->size()) continue;
+      try {
+        display_->manager(surface) = DisplayManager(display_->manager(surface).object(), spec);
+        UpdateStatus([&](SimulationStatus& s) { s.colors[surface] = spec; });
+      } catch (const std::exception& e) {
+        UpdateStatus([&](SimulationStatus& s) { s.message = e.what(); });
+      }
+      republish = true;
+    }
+    if (c.tool == 1 && c.tool_surface < display_->size()) {
+      // The viewer owns the scene (non-const); the display manager only holds it for reading.
+      auto& object = const_cast<SimObject&>(display_->manager(c.tool_surface).object());
+      if (!tool_.Grab(object, c.tool_point))
+        UpdateStatus([](SimulationStatus& s) { s.message = "every boundary vertex is held"; });
+    } else if (c.tool == 2) {
+      tool_.Release();
+    }
+    if (c.tool_target_new) tool_.MoveTo(c.tool_target);
+
+    Kernel& kernel = *scene_->kernel;
+    const bool failed = status().failed;
+    int steps = failed ? 0 : c.steps;
+    const bool playing = c.playing && !failed;
+    if (playing && (!was_playing || c.speed != last_speed)) {
+      wall_anchor = Clock::now();
+      sim_anchor = kernel.time();
+    }
+    was_playing = playing;
+    last_speed = c.speed;
+    if (playing) {
+      if (c.speed > 0) {  // real-time pacing: do not get ahead of the wall clock
+        const double wall = std::chrono::duration<double>(Clock::now() - wall_anchor).count();
+        const double ahead = (kernel.time() - sim_anchor) / c.speed - wall;
+        if (ahead > 0) {
+          std::this_thread::sleep_for(std::chrono::duration<double>(std::min(ahead, 0.01)));
+          if (republish) Publish();
+          continue;
+        }
+      }
+      steps = 1;
+    }
+    for (int k = 0; k < steps; ++k) {
+      const RunResult result = kernel.Run(kernel.time() + kernel.macro_dt());
+      if (!result.ok()) {
+        UpdateStatus([&](SimulationStatus& s) {
+          s.failed = true;
+          s.message = result.diagnostic;
+        });
+        std::lock_guard lock(mutex_);
+        commands_.playing = false;
+        break;
+      }
+    }
+    if (steps > 0) republish = true;
+    if (c.run_until >= 0 && kernel.time() >= c.run_until - 1e-12) {
+      std::lock_guard lock(mutex_);
+      commands_.playing = false;
+      commands_.run_until = -1;
+    }
+    const auto now = Clock::now();
+    const double window = std::chrono::duration<double>(now - rate_wall).count();
+    if (window > 1.0 || !playing) {
+      const double rtf = playing && window > 0 ? (kernel.time() - rate_sim) / window : 0;
+      rate_wall = now;
+      rate_sim = kernel.time();
+      UpdateStatus([&](SimulationStatus& s) { s.real_time_factor = rtf; });
+    }
+    UpdateStatus([&](SimulationStatus& s) { s.time = kernel.time(); });
+    if (republish) Publish();
+  }
+}
+
+}  // namespace gipsi::viz

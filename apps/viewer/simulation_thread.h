@@ -1,0 +1,105 @@
+#pragma once
+/// @file
+/// `SimulationThread`: runs a scene's kernel on its own thread for the viewer — play, pause,
+/// single step, reset (reload), real-time pacing — and publishes display frames (and recent
+/// probe samples) through a triple buffer after every macro step. The window thread only sends
+/// commands and reads published frames; neither waits for the other except for a short mutex
+/// around the command and status structs.
+
+#include <atomic>
+#include <condition_variable>
+#include <functional>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "gipsi/io/scene.h"
+#include "gipsi/viz/display_manager.h"
+#include "gipsi/viz/mouse_tool.h"
+#include "gipsi/viz/triple_buffer.h"
+
+namespace gipsi::viz {
+
+/// What the window shows about the simulation. Plain struct.
+struct SimulationStatus {
+  double time = 0, end_time = 0, macro_dt = 0;
+  double real_time_factor = 0;  ///< simulated / wall seconds over the last second of play
+  bool playing = false;
+  bool failed = false;
+  std::string message;  ///< why it stopped (divergence, reload error), or ""
+  /// Per display surface (in frame order): object name and the fields it can be coloured by.
+  std::vector<std::pair<std::string, std::vector<std::string>>> objects;
+  /// Per display surface: how it is coloured now.
+  std::vector<ColorSpec> colors;
+};
+
+/// Owns the scene while it runs. Not copyable or movable.
+class SimulationThread {
+ public:
+  using LoadFn = std::function<Scene()>;
+  /// Loads the scene with `load` on the calling thread (so load errors reach the caller as
+  /// exceptions), publishes the initial frame and starts the thread, paused.
+  SimulationThread(LoadFn load, std::vector<std::pair<std::string, ColorSpec>> colors,
+                   TripleBuffer<FrameBuffers>& frames);
+  ~SimulationThread();
+  SimulationThread(const SimulationThread&) = delete;
+  SimulationThread& operator=(const SimulationThread&) = delete;
+
+  void SetPlaying(bool playing);
+  /// One macro step (pauses).
+  void Step();
+  /// Reloads the scene (back to its start), paused.
+  void Reset();
+  /// Target simulated seconds per wall second while playing; 0 = as fast as possible.
+  void SetSpeed(double real_time_factor);
+  /// Recolours display surface `surface` (applied between steps, then republished).
+  void SetColor(std::size_t surface, ColorSpec spec);
+  /// Mouse tool: grab the nearest free boundary vertex of surface `surface`'s object at
+  /// `point`, move it to `target`, release.
+  void Grab(std::size_t surface, const Vec3& point);
+  void Drag(const Vec3& target);
+  void ReleaseTool();
+  /// Runs (playing) until the simulated time reaches `time`, then pauses.
+  void RunUntil(double time);
+
+  [[nodiscard]] SimulationStatus status() const;
+
+ private:
+  struct Commands {
+    bool playing = false;
+    int steps = 0;
+    bool reset = false;
+    double speed = 1.0;
+    double run_until = -1;
+    std::vector<std::pair<std::size_t, ColorSpec>> colors;
+    // mouse tool
+    int tool = 0;  // 0 nothing, 1 grab, 2 release
+    std::size_t tool_surface = 0;
+    Vec3 tool_point = Vec3::Zero(), tool_target = Vec3::Zero();
+    bool tool_target_new = false;
+  };
+  void Loop();
+  void Load();
+  void Publish();
+  void UpdateStatus(const std::function<void(SimulationStatus&)>& change);
+
+  LoadFn load_;
+  std::vector<std::pair<std::string, ColorSpec>> initial_colors_;
+  TripleBuffer<FrameBuffers>& frames_;
+  std::unique_ptr<Scene> scene_;
+  std::unique_ptr<SceneDisplay> display_;
+  std::vector<ProbeTrace> traces_;
+  std::vector<double> sample_;
+  DragTool tool_;
+
+  mutable std::mutex mutex_;
+  std::condition_variable wake_;
+  Commands commands_;
+  SimulationStatus status_;
+  std::atomic<bool> quit_{false};
+  std::thread thread_;
+};
+
+}  // namespace gipsi::viz

@@ -1,0 +1,62 @@
+#pragma once
+/// @file
+/// Plots a scene asks for at the end of a run (`"outputs": {"plots": [...]}`), e.g. a trace over
+/// time or a pressure-volume loop, from the probes' CSV columns:
+///
+///   "plots": [
+///     {"file": "tip.png", "y": ["tip.displacement_z"]},
+///     {"file": "pv.svg", "x": "lv.volume", "y": "lv.pressure", "title": "PV loop"}
+///   ]
+/// A column is named `PROBE.COLUMN` with the probe's CSV column (`time`, `displacement_x`, ...);
+/// `x` defaults to `time` (each trace against its own probe's time); any other `x` must come
+/// from the same probe as every `y`.
+
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "gipsi/base/json_node.h"
+#include "gipsi/io/probes.h"
+
+namespace gipsi::viz {
+
+/// One probe column. Plain struct.
+struct ColumnRef {
+  std::string probe;   ///< probe name
+  std::string column;  ///< CSV column, e.g. "displacement_z"
+};
+
+/// One plot. Plain struct.
+struct PlotSpec {
+  std::string file;  ///< output file, .png or .svg, relative to the run's output directory
+  std::string title;
+  std::optional<ColumnRef> x;  ///< absent: time
+  std::vector<ColumnRef> y;    ///< at least one
+  int width = 800, height = 500;
+};
+
+/// Parses and checks one plot against the scene's probes (their names and CSV columns); throws
+/// InputError naming the JSON path for an unknown probe or column, a bad file extension, or
+/// an `x` from another probe than a `y`.
+PlotSpec ParsePlotSpec(const JsonNode& node, const std::vector<Probe>& probes);
+
+/// A plot's data, ready to draw. Plain struct.
+struct PlotData {
+  struct Series {
+    std::string label;
+    std::vector<double> x, y;  ///< same length; non-finite points break the line
+  };
+  std::string title, x_label, y_label;
+  std::vector<Series> series;
+  int width = 800, height = 500;
+};
+
+/// Reads the columns of `spec` from `<probe_dir>/<probe>.csv`; throws InputError naming the
+/// file for a missing file or column.
+PlotData LoadPlotData(const PlotSpec& spec, const std::filesystem::path& probe_dir);
+
+/// The CSV columns a probe writes (its header split at commas).
+std::vector<std::string> ProbeColumns(const Probe& probe);
+
+}  // namespace gipsi::viz

@@ -1,0 +1,48 @@
+#pragma once
+/// @file
+/// The standard format the visualization tool draws: per object, vertex positions, normals,
+/// colours and triangle indices (GiPSi's display-manager output). Plain data, filled by display
+/// managers on the simulation thread and published to renderers through a `TripleBuffer`.
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace gipsi::viz {
+
+/// One object's display surface. Vectors are flat, vertex-major (x0 y0 z0 x1 ...), ready for
+/// OpenGL vertex buffers. Copyable and movable; refilling keeps the capacity.
+struct SurfaceBuffers {
+  std::string object;                  ///< leaf object name
+  std::vector<float> positions;        ///< 3V, scene units
+  std::vector<float> normals;          ///< 3V, unit (zero at vertices of degenerate triangles)
+  std::vector<float> colors;           ///< 3V, sRGB in [0, 1]
+  std::vector<float> values;           ///< V field values behind the colours (empty if solid)
+  std::vector<std::uint32_t> indices;  ///< 3T, counter-clockwise seen from outside
+  /// Colour field label, e.g. "|displacement|", "position x"; "" for a solid colour.
+  std::string field;
+  std::string units;                  ///< its units
+  std::string color_map;              ///< colour map name ("" if solid)
+  double range_lo = 0, range_hi = 0;  ///< the value range the colours span
+
+  [[nodiscard]] std::size_t num_vertices() const { return positions.size() / 3; }
+  [[nodiscard]] std::size_t num_triangles() const { return indices.size() / 3; }
+};
+
+/// Recent samples of one probe, for live plots. Copyable and movable.
+struct ProbeTrace {
+  std::string name;                        ///< probe name
+  std::vector<std::string> columns;        ///< CSV columns after time
+  std::vector<float> time;                 ///< sample times [s], oldest first
+  std::vector<std::vector<float>> values;  ///< values[c][k]: column c at time[k]
+};
+
+/// Everything drawn in one frame. Copyable and movable.
+struct FrameBuffers {
+  double time = 0;          ///< simulated time [s]
+  std::int64_t frame = -1;  ///< publication counter (-1: nothing published yet)
+  std::vector<SurfaceBuffers> surfaces;
+  std::vector<ProbeTrace> traces;  ///< filled by viewers that plot probes live
+};
+
+}  // namespace gipsi::viz

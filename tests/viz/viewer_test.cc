@@ -1,0 +1,145 @@
+// The interactive viewer for real: `gipsi view` under Xvfb (Mesa's software OpenGL through
+// GLX) runs a known scene on its simulation thread, draws it with its panel, takes a screenshot
+// (glReadPixels of the window) and the test checks what it shows.
+
+#include <sys/wait.h>
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+
+#include <fmt/format.h>
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "apps/cli_test_util.h"
+#include "gipsi/viz/render/image.h"
+
+namespace gipsi::viz {
+namespace {
+
+using ::testing::HasSubstr;
+
+bool InCi() {
+  const char* ci = std::getenv("CI");
+  return ci != nullptr && std::string(ci) == "true";
+}
+
+bool HaveXvfbRun() { return std::system("command -v xvfb-run > /dev/null 2>&1") == 0; }
+
+bool IsBackground(const Rgb& c) { return c.r == 1.0f && c.g == 1.0f && c.b == 1.0f; }
+
+constexpr const char* kBlock = R"({
+    "meshes": {"block": {"generate": "box", "min": [0, 0, 0], "max": [1, 1, 1], "cells": [2, 2, 2]}},
+    "objects": {"block": {"type": "FemSolid", "domain": "block", "dt": 0.01, "density": 1000,
+      "material": {"law": "Corotational", "youngs_modulus": 1e5, "poisson_ratio": 0.3},
+      "integrator": "BackwardEuler", "gravity": [0, 0, 0],
+      "boundary_conditions": [{"name": "back", "region": {"group": "ymax"}, "fix": true}]}},
+    "schedule": {"end": 1},
+    "probes": {"energy": {"object": "block", "fields": ["kinetic_energy"]}}
+  })";
+
+/// Result of one viewer run under Xvfb: `skip` says why it could not run (no xvfb-run, or no
+/// window even under Xvfb).
+struct ViewRun {
+  int code = -1;
+  std::string output, skip;
+  Image image;
+};
+
+/// Runs `gipsi view block.json --camera 0,0 --size 640x480 --screenshot shot.png ARGS` under
+/// xvfb-run (a virtual X display; OpenGL from Mesa's software rasteriser through GLX).
+ViewRun ViewUnderXvfb(const std::string& name, const std::string& args) {
+  ViewRun run;
+  if (!HaveXvfbRun()) {
+    run.skip = "xvfb-run is not installed (Debian package xvfb)";
+    return run;
+  }
+  const auto dir = gipsi::testing::TempDir("gipsi_view_", name);
+  std::ofstream(dir / "block.json") << kBlock;
+  const std::string command = fmt::format(
+      "xvfb-run -a -s '-screen 0 1024x768x24' {}/bin/gipsi view {} --camera 0,0 --size 640x480 "
+      "--screenshot {} {} 2>&1",
+      GIPSI_BINARY_DIR, (dir / "block.json").string(), (dir / "shot.png").string(), args);
+  FILE* pipe = popen(command.c_str(), "r");
+  if (pipe == nullptr) return run;
+  char buffer[4096];
+  while (std::size_t n = fread(buffer, 1, sizeof buffer, pipe)) run.output.append(buffer, n);
+  const int status = pclose(pipe);
+  run.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  if (run.code == 5) run.skip = "the viewer cannot create a window under Xvfb: " + run.output;
+  if (run.code == 0) run.image = ReadPng(dir / "shot.png");
+  return run;
+}
+
+/// Skips the test (fails it in CI, where the viewer must be tested) when the run could not
+/// happen.
+#define SKIP_WITHOUT_DISPLAY(run)                          \
+  if (!(run).skip.empty()) {                               \
+    if (InCi()) FAIL() << (run).skip;                      \
+    GTEST_SKIP() << (run).skip << ": viewer test skipped"; \
+  }
+
+TEST(Viewer, DrawsAKnownSceneUnderXvfbAndTakesAScreenshot) {
+  const ViewRun run = ViewUnderXvfb("screenshot", "--screenshot-time 0.05");
+  SKIP_WITHOUT_DISPLAY(run);
+  ASSERT_EQ(run.code, 0) << run.output;
+  EXPECT_THAT(run.output, HasSubstr("640 x 480 at t = 0.05 s"));  // the simulation thread ran
+  const Image& image = run.image;
+
+  ASSERT_EQ(image.width, 640);
+  ASSERT_EQ(image.height, 480);
+  // The scene part: background at its corners, the block's face head-on in its middle with its
+  // exact solid colour (headlight along the face normal), to 8-bit rounding.
+  const int panel = 640 / 3, centre = panel + (640 - panel) / 2;
+  for (auto [x, y] : {std::pair{panel + 3, 3}, {636, 3}, {panel + 3, 476}, {636, 476}})
+    EXPECT_TRUE(IsBackground(image.At(x, y))) << x << ", " << y;
+  // Above the face's top edge (where the mouse-tool test pulls the surface to): background.
+  for (int y = 30; y < 40; ++y) EXPECT_TRUE(IsBackground(image.At(centre, y))) << y;
+  const Rgb face = image.At(centre, 240);
+  EXPECT_NEAR(face.r, 0.80, 1.0 / 255);
+  EXPECT_NEAR(face.g, 0.45, 1.0 / 255);
+  EXPECT_NEAR(face.b, 0.40, 1.0 / 255);
+  // The panel: mostly ImGui's light window grey (0.94), with dark text in it.
+  int panel_grey = 0, dark = 0;
+  for (int y = 0; y < 480; ++y)
+    for (int x = 0; x < panel; ++x) {
+      const Rgb c = image.At(x, y);
+      panel_grey += c.r == c.g && c.g == c.b && std::abs(c.r * 255 - 240) <= 1;
+      dark += c.r < 0.3f;
+    }
+  EXPECT_GT(panel_grey, panel * 480 / 2);
+  EXPECT_GT(dark, 200);
+}
+
+TEST(Viewer, TheMouseToolPullsTheSurface) {
+  // Ctrl + drag from the face's centre (a mesh vertex) to 210 px above it, held for 0.3 s: the
+  // pulled vertex sits exactly under the mouse (a prescribed displacement in the plane facing
+  // the camera), so the block now covers pixels above its original top edge (y = 45).
+  const int panel = 640 / 3, centre = panel + (640 - panel) / 2;
+  const ViewRun run = ViewUnderXvfb(
+      "drag", fmt::format("--screenshot-time 0.3 --drag {},240,{},30", centre, centre));
+  SKIP_WITHOUT_DISPLAY(run);
+  ASSERT_EQ(run.code, 0) << run.output;
+  const Image& image = run.image;
+  int object_above = 0;
+  for (int y = 30; y < 40; ++y)
+    for (int x = centre - 3; x <= centre + 3; ++x) object_above += !IsBackground(image.At(x, y));
+  EXPECT_GT(object_above, 20);
+  // Far from the pulled vertex, above the old top edge, stays background.
+  EXPECT_TRUE(IsBackground(image.At(panel + 20, 30)));
+}
+
+TEST(Viewer, SaysSoWhenThereIsNoDisplay) {
+  const auto result = gipsi::testing::Gipsi("view " + std::string(GIPSI_SOURCE_DIR) +
+                                            "/scenes/cantilever.json --screenshot /dev/null");
+  if (std::getenv("DISPLAY") != nullptr || std::getenv("WAYLAND_DISPLAY") != nullptr)
+    GTEST_SKIP() << "a display is available here";
+  EXPECT_EQ(result.code, 5) << result.output;
+  EXPECT_THAT(result.output, HasSubstr("cannot open a window"));
+  EXPECT_THAT(result.output, HasSubstr("xvfb-run"));
+}
+
+}  // namespace
+}  // namespace gipsi::viz
