@@ -56,7 +56,7 @@ TEST(FemAmg, StepsMatchTheDirectSolver) {
 // CG iterations per step at 1e-6 as the cube is refined from 6³ to 12³ cells (1,080 to 8,640
 // tets; 2 and 3 levels). Jacobi-CG needs ~1.7× more per doubling of the cells per side
 // (measured 83 at 10³ and 144 at 16³ in the benchmark); the multigrid counts stay flat:
-// measured 12.75, 13 and 14 per step (and about 15, 18, 19 at 10³, 16³, 25³ in the benchmark).
+// measured 12, 13 and 14 per step (and about 15, 18, 19 at 10³, 16³, 25³ in the benchmark).
 // The bound of 25 leaves slack for the lagged hierarchy, not for a count growing like Jacobi's.
 TEST(FemAmg, CgIterationsStayBoundedUnderRefinement) {
   LinearSolverOptions amg{.type = "cg", .preconditioner = "amg", .tolerance = 1e-6};

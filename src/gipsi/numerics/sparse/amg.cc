@@ -7,6 +7,7 @@
 #include <cmath>
 #include <utility>
 
+#include <Eigen/Cholesky>
 #include <Eigen/CholmodSupport>
 
 #include "gipsi/base/error.h"
@@ -199,6 +200,35 @@ double SpectralRadiusEstimate(const SparseMatrix& A, const VecX& inverse_diagona
   return rho;
 }
 
+/// s_a −= Σ_{t ∈ [begin, end)} v_a[t] x[rows[t]] for the three columns a of one node, with two
+/// partial sums per column (shorter floating-point add chains, as in SymmetricSpMV).
+inline void SubtractBlockRow(const double* __restrict v0, const double* __restrict v1,
+                             const double* __restrict v2, const int* __restrict rows,
+                             const double* __restrict x, int begin, int end, double& s0, double& s1,
+                             double& s2) {
+  double a0 = 0.0, a1 = 0.0, a2 = 0.0, b0 = 0.0, b1 = 0.0, b2 = 0.0;
+  int t = begin;
+  for (; t + 2 <= end; t += 2) {
+    const double xa = x[rows[t]];
+    const double xb = x[rows[t + 1]];
+    a0 += v0[t] * xa;
+    a1 += v1[t] * xa;
+    a2 += v2[t] * xa;
+    b0 += v0[t + 1] * xb;
+    b1 += v1[t + 1] * xb;
+    b2 += v2[t + 1] * xb;
+  }
+  if (t < end) {
+    const double xa = x[rows[t]];
+    a0 += v0[t] * xa;
+    a1 += v1[t] * xa;
+    a2 += v2[t] * xa;
+  }
+  s0 -= a0 + b0;
+  s1 -= a1 + b1;
+  s2 -= a2 + b2;
+}
+
 /// y = M x for a row-major M (each row summed by one thread).
 void RowSpMV(const Eigen::SparseMatrix<double, Eigen::RowMajor, int>& M, const VecX& x, VecX& y,
              bool accumulate) {
@@ -241,9 +271,59 @@ double SmoothedAggregationAmg::operator_complexity() const {
   return sum / static_cast<double>(levels_.front()->a->nonZeros());
 }
 
+void SmoothedAggregationAmg::DetectBlocks(Level& level) {
+  const SparseMatrix& A = *level.a;
+  level.blocked = false;
+  if (!level.sorted || A.rows() % 3 != 0) return;
+  const int* outer = A.outerIndexPtr();
+  const int* inner = A.innerIndexPtr();
+  const int nodes = static_cast<int>(A.rows() / 3);
+  std::vector<int> offsets(static_cast<std::size_t>(nodes), -1);
+  for (int node = 0; node < nodes; ++node) {
+    const int c0 = outer[3 * node];
+    const int length = outer[3 * node + 1] - c0;
+    if (length % 3 != 0) return;
+    for (int a = 1; a < 3; ++a) {
+      const int ca = outer[3 * node + a];
+      if (outer[3 * node + a + 1] - ca != length ||
+          !std::equal(inner + c0, inner + c0 + length, inner + ca))
+        return;
+    }
+    for (int t = 0; t < length; t += 3) {
+      const int row = inner[c0 + t];
+      if (row % 3 != 0 || inner[c0 + t + 1] != row + 1 || inner[c0 + t + 2] != row + 2) return;
+      if (row == 3 * node) offsets[static_cast<std::size_t>(node)] = t;
+    }
+    if (offsets[static_cast<std::size_t>(node)] < 0) return;  // no diagonal block
+  }
+  level.block_diagonal = std::move(offsets);
+  level.block_inverse.assign(static_cast<std::size_t>(9 * nodes), 0.0);
+  level.blocked = true;
+}
+
 bool SmoothedAggregationAmg::UpdateDiagonal(Level& level) const {
   const SparseMatrix& A = *level.a;
   const double* values = A.valuePtr();
+  if (level.blocked) {
+    const int* outer = A.outerIndexPtr();
+    const int nodes = static_cast<int>(level.block_diagonal.size());
+    bool positive = true;
+    for (int node = 0; node < nodes; ++node) {
+      Mat3 block;
+      for (int a = 0; a < 3; ++a)
+        for (int i = 0; i < 3; ++i)
+          block(i, a) = values[outer[3 * node + a] +
+                               level.block_diagonal[static_cast<std::size_t>(node)] + i];
+      // An SPD matrix has SPD diagonal blocks; the Cholesky test rejects anything else.
+      const Eigen::LLT<Mat3> llt(block);
+      const bool ok = llt.info() == Eigen::Success && block.allFinite();
+      positive = positive && ok;
+      Eigen::Map<Mat3> inverse(level.block_inverse.data() + 9 * node);
+      inverse = ok ? Mat3(llt.solve(Mat3::Identity())) : Mat3::Zero();
+      inverse = 0.5 * (inverse + inverse.transpose()).eval();  // exactly symmetric
+    }
+    return positive;
+  }
   bool positive = true;
   for (std::size_t i = 0; i < level.diagonal.size(); ++i) {
     const double d = level.diagonal[i] >= 0 ? values[level.diagonal[i]] : 0.0;
@@ -293,6 +373,7 @@ bool SmoothedAggregationAmg::Setup(const SparseMatrix& A) {
           level.sorted = false;
       }
     level.inverse_diagonal.resize(rows);
+    if (levels_.size() == 1) DetectBlocks(level);  // coarse nodes have ≤ 6 DOFs: point GS
     if (!UpdateDiagonal(level)) return false;
     for (VecX* v : {&level.x, &level.b, &level.residual}) v->setZero(rows);
     if (rows <= kMaxCoarseRows || static_cast<int>(levels_.size()) >= kMaxLevels) break;
@@ -304,6 +385,12 @@ bool SmoothedAggregationAmg::Setup(const SparseMatrix& A) {
     const Index coarse_rows = tentative.t.cols();
     if (coarse_rows == 0 || 10 * coarse_rows >= 9 * rows) break;  // coarsening stagnates
 
+    if (level.blocked) {  // the prolongator smoother uses the point diagonal
+      for (Index i = 0; i < rows; ++i) {
+        const double d = current.valuePtr()[level.diagonal[static_cast<std::size_t>(i)]];
+        level.inverse_diagonal[i] = 1.0 / d;  // > 0: the diagonal blocks are SPD
+      }
+    }
     const double rho = SpectralRadiusEstimate(current, level.inverse_diagonal);
     const double omega = rho > 0.0 ? 4.0 / (3.0 * rho) : 0.0;
     const SparseMatrix at = current * tentative.t;
@@ -353,6 +440,72 @@ void SmoothedAggregationAmg::Apply(const VecX& r, VecX& z) {
   z = fine.x;
 }
 
+void SmoothedAggregationAmg::BlockForwardFromZero(Level& level) {
+  // (D_B + L_B) x = b by node blocks, then r = b − A x = −U_B x (U_B the blocks right of the
+  // diagonal), as in the point-wise sweep; a node's three columns share one row pattern, so
+  // each row index and x entry is read once for three sums.
+  const SparseMatrix& A = *level.a;
+  const int nodes = static_cast<int>(A.rows() / 3);
+  const int* __restrict outer = A.outerIndexPtr();
+  const int* __restrict inner = A.innerIndexPtr();
+  const double* __restrict values = A.valuePtr();
+  const double* __restrict b = level.b.data();
+  const double* __restrict inverse = level.block_inverse.data();
+  const int* __restrict offset = level.block_diagonal.data();
+  double* __restrict x = level.x.data();
+  double* __restrict res = level.residual.data();
+  for (int node = 0; node < nodes; ++node) {
+    const double* v0 = values + outer[3 * node];
+    const double* v1 = values + outer[3 * node + 1];
+    const double* v2 = values + outer[3 * node + 2];
+    const int* rows = inner + outer[3 * node];
+    double s0 = b[3 * node], s1 = b[3 * node + 1], s2 = b[3 * node + 2];
+    SubtractBlockRow(v0, v1, v2, rows, x, 0, offset[node], s0, s1, s2);
+    const double* m = inverse + 9 * node;
+    x[3 * node] = m[0] * s0 + m[3] * s1 + m[6] * s2;
+    x[3 * node + 1] = m[1] * s0 + m[4] * s1 + m[7] * s2;
+    x[3 * node + 2] = m[2] * s0 + m[5] * s1 + m[8] * s2;
+  }
+#pragma omp parallel for schedule(static) if (3 * nodes >= kMinParallelLength)
+  for (int node = 0; node < nodes; ++node) {
+    const double* v0 = values + outer[3 * node];
+    const double* v1 = values + outer[3 * node + 1];
+    const double* v2 = values + outer[3 * node + 2];
+    const int* rows = inner + outer[3 * node];
+    const int length = outer[3 * node + 1] - outer[3 * node];
+    double s0 = 0.0, s1 = 0.0, s2 = 0.0;
+    SubtractBlockRow(v0, v1, v2, rows, x, offset[node] + 3, length, s0, s1, s2);
+    res[3 * node] = s0;
+    res[3 * node + 1] = s1;
+    res[3 * node + 2] = s2;
+  }
+}
+
+void SmoothedAggregationAmg::BlockBackward(Level& level) {
+  // x_I += D_II⁻¹ (b_I − Σ_J A_IJ x_J), nodes in decreasing order: (D_B + U_B) δ = b − A x.
+  const SparseMatrix& A = *level.a;
+  const int nodes = static_cast<int>(A.rows() / 3);
+  const int* __restrict outer = A.outerIndexPtr();
+  const int* __restrict inner = A.innerIndexPtr();
+  const double* __restrict values = A.valuePtr();
+  const double* __restrict b = level.b.data();
+  const double* __restrict inverse = level.block_inverse.data();
+  double* __restrict x = level.x.data();
+  for (int node = nodes - 1; node >= 0; --node) {
+    const double* v0 = values + outer[3 * node];
+    const double* v1 = values + outer[3 * node + 1];
+    const double* v2 = values + outer[3 * node + 2];
+    const int* rows = inner + outer[3 * node];
+    const int length = outer[3 * node + 1] - outer[3 * node];
+    double s0 = b[3 * node], s1 = b[3 * node + 1], s2 = b[3 * node + 2];
+    SubtractBlockRow(v0, v1, v2, rows, x, 0, length, s0, s1, s2);
+    const double* m = inverse + 9 * node;
+    x[3 * node] += m[0] * s0 + m[3] * s1 + m[6] * s2;
+    x[3 * node + 1] += m[1] * s0 + m[4] * s1 + m[7] * s2;
+    x[3 * node + 2] += m[2] * s0 + m[5] * s1 + m[8] * s2;
+  }
+}
+
 void SmoothedAggregationAmg::Cycle(std::size_t l) {
   Level& level = *levels_[l];
   if (l + 1 == levels_.size()) {
@@ -372,7 +525,9 @@ void SmoothedAggregationAmg::Cycle(std::size_t l) {
   // strictly upper part), which the backward pass over each row below collects; so the
   // sweep and the residual together read the matrix once.
   double* __restrict res = level.residual.data();
-  if (level.sorted) {
+  if (level.blocked) {
+    BlockForwardFromZero(level);
+  } else if (level.sorted) {
     for (int j = 0; j < n; ++j) {
       double s = b[j];
       int k = outer[j];
@@ -403,6 +558,10 @@ void SmoothedAggregationAmg::Cycle(std::size_t l) {
   Cycle(l + 1);
   RowSpMV(level.p, coarse.x, level.x, true);
   // Backward Gauss–Seidel (the adjoint of the forward sweep: the cycle stays symmetric).
+  if (level.blocked) {
+    BlockBackward(level);
+    return;
+  }
   for (int j = n - 1; j >= 0; --j) {
     double s = b[j];
     for (int k = outer[j]; k < outer[j + 1]; ++k) s -= values[k] * x[inner[k]];

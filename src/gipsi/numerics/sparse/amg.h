@@ -22,7 +22,9 @@
 ///  - Galerkin coarse matrix Pᵀ A P (symmetrised to remove product round-off), until at most
 ///    `kMaxCoarseRows` rows remain, which CHOLMOD factorises.
 /// Cycle: a V-cycle with one forward Gauss–Seidel sweep before and one backward sweep after the
-/// coarse correction on every level, so the preconditioner is symmetric; it is positive
+/// coarse correction on every level (by 3×3 node blocks where the matrix has that block
+/// pattern, e.g. the finest level of an FEM tangent; point-wise elsewhere), so the
+/// preconditioner is symmetric; it is positive
 /// definite whenever each level's matrix is SPD (Gauss–Seidel then converges in the energy
 /// norm), also when the coarse levels were built from an earlier matrix (see Refresh).
 /// Everything is serial except the sparse products, whose rows are each summed by one thread:
@@ -79,12 +81,20 @@ class SmoothedAggregationAmg {
     std::vector<int> diagonal;        ///< value index of each diagonal entry
     VecX inverse_diagonal;            ///< 1 / A_ii
     bool sorted = true;               ///< row indices increase within each column
-    RowMatrix p;                      ///< prolongator to this level from the next coarser one
-    RowMatrix r;                      ///< restriction pᵀ
-    VecX x, b, residual;              ///< cycle work vectors
+    /// Node-block Gauss–Seidel (3×3 blocks) on this level: set when every node's three columns
+    /// share one sorted row pattern made of whole node blocks (FEM tangents on level 0).
+    bool blocked = false;
+    std::vector<int> block_diagonal;    ///< per node: offset of its diagonal block in its columns
+    std::vector<double> block_inverse;  ///< per node: the inverse of its diagonal block (9)
+    RowMatrix p;                        ///< prolongator to this level from the next coarser one
+    RowMatrix r;                        ///< restriction pᵀ
+    VecX x, b, residual;                ///< cycle work vectors
   };
 
   bool UpdateDiagonal(Level& level) const;
+  static void DetectBlocks(Level& level);
+  static void BlockForwardFromZero(Level& level);
+  static void BlockBackward(Level& level);
   void Cycle(std::size_t l);
 
   std::vector<std::unique_ptr<Level>> levels_;
