@@ -200,35 +200,6 @@ double SpectralRadiusEstimate(const SparseMatrix& A, const VecX& inverse_diagona
   return rho;
 }
 
-/// s_a −= Σ_{t ∈ [begin, end)} v_a[t] x[rows[t]] for the three columns a of one node, with two
-/// partial sums per column (shorter floating-point add chains, as in SymmetricSpMV).
-inline void SubtractBlockRow(const double* __restrict v0, const double* __restrict v1,
-                             const double* __restrict v2, const int* __restrict rows,
-                             const double* __restrict x, int begin, int end, double& s0, double& s1,
-                             double& s2) {
-  double a0 = 0.0, a1 = 0.0, a2 = 0.0, b0 = 0.0, b1 = 0.0, b2 = 0.0;
-  int t = begin;
-  for (; t + 2 <= end; t += 2) {
-    const double xa = x[rows[t]];
-    const double xb = x[rows[t + 1]];
-    a0 += v0[t] * xa;
-    a1 += v1[t] * xa;
-    a2 += v2[t] * xa;
-    b0 += v0[t + 1] * xb;
-    b1 += v1[t + 1] * xb;
-    b2 += v2[t + 1] * xb;
-  }
-  if (t < end) {
-    const double xa = x[rows[t]];
-    a0 += v0[t] * xa;
-    a1 += v1[t] * xa;
-    a2 += v2[t] * xa;
-  }
-  s0 -= a0 + b0;
-  s1 -= a1 + b1;
-  s2 -= a2 + b2;
-}
-
 /// y = M x for a row-major M (each row summed by one thread).
 void RowSpMV(const Eigen::SparseMatrix<double, Eigen::RowMajor, int>& M, const VecX& x, VecX& y,
              bool accumulate) {
@@ -298,6 +269,15 @@ void SmoothedAggregationAmg::DetectBlocks(Level& level) {
   }
   level.block_diagonal = std::move(offsets);
   level.block_inverse.assign(static_cast<std::size_t>(9 * nodes), 0.0);
+  level.block_start.assign(static_cast<std::size_t>(nodes) + 1, 0);
+  level.block_column.clear();
+  for (int node = 0; node < nodes; ++node) {
+    for (int k = outer[3 * node]; k < outer[3 * node + 1]; k += 3)
+      level.block_column.push_back(inner[k] / 3);
+    level.block_start[static_cast<std::size_t>(node) + 1] =
+        static_cast<int>(level.block_column.size());
+  }
+  level.block_values.assign(static_cast<std::size_t>(A.nonZeros()), 0.0);
   level.blocked = true;
 }
 
@@ -307,6 +287,18 @@ bool SmoothedAggregationAmg::UpdateDiagonal(Level& level) const {
   if (level.blocked) {
     const int* outer = A.outerIndexPtr();
     const int nodes = static_cast<int>(level.block_diagonal.size());
+    // The block (BSR) copy: block m of node I holds B(i, a) = A(3J + i, 3I + a) at 9m + i + 3a.
+    const int* start = level.block_start.data();
+    double* blocks = level.block_values.data();
+#pragma omp parallel for schedule(static) if (3 * nodes >= kMinParallelLength)
+    for (int node = 0; node < nodes; ++node)
+      for (int a = 0; a < 3; ++a) {
+        const double* column = values + outer[3 * node + a];
+        double* out = blocks + 9 * start[node] + 3 * a;
+        const int count = start[node + 1] - start[node];
+        for (int m = 0; m < count; ++m)
+          for (int i = 0; i < 3; ++i) out[9 * m + i] = column[3 * m + i];
+      }
     bool positive = true;
     for (int node = 0; node < nodes; ++node) {
       Mat3 block;
@@ -440,70 +432,112 @@ void SmoothedAggregationAmg::Apply(const VecX& r, VecX& z) {
   z = fine.x;
 }
 
+namespace {
+
+/// s −= Σ_{m ∈ [begin, end)} B_mᵀ x_{J_m} over the 3×3 blocks B_m (column-major, 9 doubles)
+/// of one block row, with two partial sums per component (shorter add chains).
+inline void SubtractBlocks(const double* __restrict blocks, const int* __restrict columns,
+                           const double* __restrict x, int begin, int end, double s[3]) {
+  double a0 = 0.0, a1 = 0.0, a2 = 0.0, b0 = 0.0, b1 = 0.0, b2 = 0.0;
+  for (int m = begin; m < end; ++m) {
+    const double* B = blocks + 9 * m;
+    const double* xj = x + 3 * columns[m];
+    const double x0 = xj[0], x1 = xj[1], x2 = xj[2];
+    a0 += B[0] * x0 + B[1] * x1;
+    a1 += B[3] * x0 + B[4] * x1;
+    a2 += B[6] * x0 + B[7] * x1;
+    b0 += B[2] * x2;
+    b1 += B[5] * x2;
+    b2 += B[8] * x2;
+  }
+  s[0] -= a0 + b0;
+  s[1] -= a1 + b1;
+  s[2] -= a2 + b2;
+}
+
+/// x_I = M s for the symmetric 3×3 M (column-major); `add` accumulates instead.
+inline void ApplyInverse(const double* __restrict m, const double s[3], double* __restrict x,
+                         bool add) {
+  const double y0 = m[0] * s[0] + m[3] * s[1] + m[6] * s[2];
+  const double y1 = m[1] * s[0] + m[4] * s[1] + m[7] * s[2];
+  const double y2 = m[2] * s[0] + m[5] * s[1] + m[8] * s[2];
+  if (add) {
+    x[0] += y0;
+    x[1] += y1;
+    x[2] += y2;
+  } else {
+    x[0] = y0;
+    x[1] = y1;
+    x[2] = y2;
+  }
+}
+
+}  // namespace
+
 void SmoothedAggregationAmg::BlockForwardFromZero(Level& level) {
   // (D_B + L_B) x = b by node blocks, then r = b − A x = −U_B x (U_B the blocks right of the
-  // diagonal), as in the point-wise sweep; a node's three columns share one row pattern, so
-  // each row index and x entry is read once for three sums.
-  const SparseMatrix& A = *level.a;
-  const int nodes = static_cast<int>(A.rows() / 3);
-  const int* __restrict outer = A.outerIndexPtr();
-  const int* __restrict inner = A.innerIndexPtr();
-  const double* __restrict values = A.valuePtr();
+  // diagonal), as in the point-wise sweep, on the block copy: one column index per 3×3 block
+  // and the block's nine values adjacent.
+  const int nodes = static_cast<int>(level.block_diagonal.size());
+  const int* __restrict start = level.block_start.data();
+  const int* __restrict columns = level.block_column.data();
+  const double* __restrict blocks = level.block_values.data();
   const double* __restrict b = level.b.data();
   const double* __restrict inverse = level.block_inverse.data();
   const int* __restrict offset = level.block_diagonal.data();
   double* __restrict x = level.x.data();
   double* __restrict res = level.residual.data();
   for (int node = 0; node < nodes; ++node) {
-    const double* v0 = values + outer[3 * node];
-    const double* v1 = values + outer[3 * node + 1];
-    const double* v2 = values + outer[3 * node + 2];
-    const int* rows = inner + outer[3 * node];
-    double s0 = b[3 * node], s1 = b[3 * node + 1], s2 = b[3 * node + 2];
-    SubtractBlockRow(v0, v1, v2, rows, x, 0, offset[node], s0, s1, s2);
-    const double* m = inverse + 9 * node;
-    x[3 * node] = m[0] * s0 + m[3] * s1 + m[6] * s2;
-    x[3 * node + 1] = m[1] * s0 + m[4] * s1 + m[7] * s2;
-    x[3 * node + 2] = m[2] * s0 + m[5] * s1 + m[8] * s2;
+    double s[3] = {b[3 * node], b[3 * node + 1], b[3 * node + 2]};
+    SubtractBlocks(blocks, columns, x, start[node], start[node] + offset[node] / 3, s);
+    ApplyInverse(inverse + 9 * node, s, x + 3 * node, false);
   }
 #pragma omp parallel for schedule(static) if (3 * nodes >= kMinParallelLength)
   for (int node = 0; node < nodes; ++node) {
-    const double* v0 = values + outer[3 * node];
-    const double* v1 = values + outer[3 * node + 1];
-    const double* v2 = values + outer[3 * node + 2];
-    const int* rows = inner + outer[3 * node];
-    const int length = outer[3 * node + 1] - outer[3 * node];
-    double s0 = 0.0, s1 = 0.0, s2 = 0.0;
-    SubtractBlockRow(v0, v1, v2, rows, x, offset[node] + 3, length, s0, s1, s2);
-    res[3 * node] = s0;
-    res[3 * node + 1] = s1;
-    res[3 * node + 2] = s2;
+    double s[3] = {0.0, 0.0, 0.0};
+    SubtractBlocks(blocks, columns, x, start[node] + offset[node] / 3 + 1, start[node + 1], s);
+    res[3 * node] = s[0];
+    res[3 * node + 1] = s[1];
+    res[3 * node + 2] = s[2];
   }
 }
 
 void SmoothedAggregationAmg::BlockBackward(Level& level) {
   // x_I += D_II⁻¹ (b_I − Σ_J A_IJ x_J), nodes in decreasing order: (D_B + U_B) δ = b − A x.
-  const SparseMatrix& A = *level.a;
-  const int nodes = static_cast<int>(A.rows() / 3);
-  const int* __restrict outer = A.outerIndexPtr();
-  const int* __restrict inner = A.innerIndexPtr();
-  const double* __restrict values = A.valuePtr();
+  const int nodes = static_cast<int>(level.block_diagonal.size());
+  const int* __restrict start = level.block_start.data();
+  const int* __restrict columns = level.block_column.data();
+  const double* __restrict blocks = level.block_values.data();
   const double* __restrict b = level.b.data();
   const double* __restrict inverse = level.block_inverse.data();
   double* __restrict x = level.x.data();
   for (int node = nodes - 1; node >= 0; --node) {
-    const double* v0 = values + outer[3 * node];
-    const double* v1 = values + outer[3 * node + 1];
-    const double* v2 = values + outer[3 * node + 2];
-    const int* rows = inner + outer[3 * node];
-    const int length = outer[3 * node + 1] - outer[3 * node];
-    double s0 = b[3 * node], s1 = b[3 * node + 1], s2 = b[3 * node + 2];
-    SubtractBlockRow(v0, v1, v2, rows, x, 0, length, s0, s1, s2);
-    const double* m = inverse + 9 * node;
-    x[3 * node] += m[0] * s0 + m[3] * s1 + m[6] * s2;
-    x[3 * node + 1] += m[1] * s0 + m[4] * s1 + m[7] * s2;
-    x[3 * node + 2] += m[2] * s0 + m[5] * s1 + m[8] * s2;
+    double s[3] = {b[3 * node], b[3 * node + 1], b[3 * node + 2]};
+    SubtractBlocks(blocks, columns, x, start[node], start[node + 1], s);
+    ApplyInverse(inverse + 9 * node, s, x + 3 * node, true);
   }
+}
+
+bool SmoothedAggregationAmg::Multiply(const VecX& x, VecX& y) const {
+  if (levels_.empty() || !levels_.front()->blocked) return false;
+  const Level& level = *levels_.front();
+  GIPSI_CHECK(x.size() == level.a->rows() && y.size() == x.size() && x.data() != y.data(),
+              "AMG Multiply: sizes do not match or x and y alias");
+  const int nodes = static_cast<int>(level.block_diagonal.size());
+  const int* __restrict start = level.block_start.data();
+  const int* __restrict columns = level.block_column.data();
+  const double* __restrict blocks = level.block_values.data();
+  const double* __restrict px = x.data();
+  double* __restrict py = y.data();
+#pragma omp parallel for schedule(static) if (3 * nodes >= kMinParallelLength)
+  for (int node = 0; node < nodes; ++node) {
+    double s[3] = {0.0, 0.0, 0.0};
+    SubtractBlocks(blocks, columns, px, start[node], start[node + 1], s);
+    py[3 * node] = -s[0];
+    py[3 * node + 1] = -s[1];
+    py[3 * node + 2] = -s[2];
+  }
+  return true;
 }
 
 void SmoothedAggregationAmg::Cycle(std::size_t l) {

@@ -182,9 +182,16 @@ class PcgSolver final : public LinearSolver {
     return positive;
   }
 
+  /// y = A x, from the AMG hierarchy's block copy of A when it has one (same matrix, fewer
+  /// index loads), else SymmetricSpMV.
+  void Multiply(const VecX& x, VecX& y) {
+    if (kind_ == Preconditioner::kAmg && amg_.Multiply(x, y)) return;
+    SymmetricSpMV(*matrix_, x, y);
+  }
+
   /// r_ = b − A x; returns ‖r_‖.
   double TrueResidual(const VecX& b, const VecX& x) {
-    SymmetricSpMV(*matrix_, x, q_);
+    Multiply(x, q_);
     const double* __restrict pb = b.data();
     const double* __restrict pq = q_.data();
     double* __restrict pr = r_.data();
@@ -244,7 +251,7 @@ class PcgSolver final : public LinearSolver {
     if (!(rz > 0.0) || !std::isfinite(rz)) return false;
     p_ = z_;
     while (iterations < options_.max_iterations) {
-      SymmetricSpMV(*matrix_, p_, q_);
+      Multiply(p_, q_);
       const double pq = ParallelDot(p_, q_, scratch_);
       if (!(pq > 0.0) || !std::isfinite(pq)) return false;  // A not SPD, or NaN
       const double alpha = rz / pq;
