@@ -55,9 +55,9 @@ TEST(FemAmg, StepsMatchTheDirectSolver) {
 
 // CG iterations per step at 1e-6 as the cube is refined from 6³ to 12³ cells (1,080 to 8,640
 // tets; 2 and 3 levels). Jacobi-CG needs ~1.7× more per doubling of the cells per side
-// (measured 83 at 10³ and 144 at 16³ in the benchmark); the multigrid counts stay flat:
-// measured 12, 13 and 14 per step (and about 15, 18, 19 at 10³, 16³, 25³ in the benchmark).
-// The bound of 25 leaves slack for the lagged hierarchy, not for a count growing like Jacobi's.
+// (84 at 10³ and 143 at 16³ in the benchmark); the multigrid counts grow slowly: measured
+// 18.25, 19.5 and 21.25 per step here (22, 25, 29 at 10³, 16³, 25³ in the benchmark). The bound
+// of 30 leaves slack for the lagged hierarchy, not for a count growing like Jacobi's.
 TEST(FemAmg, CgIterationsStayBoundedUnderRefinement) {
   LinearSolverOptions amg{.type = "cg", .preconditioner = "amg", .tolerance = 1e-6};
   for (int cells : {6, 9, 12}) {
@@ -65,7 +65,7 @@ TEST(FemAmg, CgIterationsStayBoundedUnderRefinement) {
     for (int step = 0; step < 4; ++step) ASSERT_TRUE(fem->Step(0.01).ok()) << cells;
     const double per_step = static_cast<double>(fem->profile().linear_iterations) /
                             static_cast<double>(fem->profile().steps);
-    EXPECT_LE(per_step, 25.0) << cells;
+    EXPECT_LE(per_step, 30.0) << cells;
     EXPECT_GT(per_step, 0.0) << cells;
   }
 }

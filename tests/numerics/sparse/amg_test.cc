@@ -118,7 +118,7 @@ TEST(Amg, HandlesDecoupledIdentityRows) {
   VecX x = VecX::Zero(A.rows());
   const LinearSolveStats stats = solver->Solve(problem.b, x);
   ASSERT_TRUE(stats.converged);
-  EXPECT_LE(stats.iterations, 20);  // measured 9, as without the fixed face
+  EXPECT_LE(stats.iterations, 20);  // measured 12, as without the fixed face
   EXPECT_LE(IndependentRelativeResidual(A, problem.b, x), 1e-6);
 }
 
@@ -151,7 +151,7 @@ TEST(Amg, LaggedHierarchyIsReusedAndRebuiltWhenWeak) {
   const LinearSolveStats reused = solver->Solve(near_problem.b, x);
   ASSERT_TRUE(reused.converged);
   EXPECT_FALSE(reused.refactorized);
-  EXPECT_LE(reused.iterations, first.iterations + 3);  // measured: equal (8)
+  EXPECT_LE(reused.iterations, first.iterations + 3);  // measured: equal (12)
   EXPECT_LE(IndependentRelativeResidual(near, near_problem.b, x), 1e-6);
 
   ASSERT_TRUE(solver->Factorize(far));
@@ -200,9 +200,9 @@ TEST(Amg, RigidBodyModesAreAnnihilatedByAFreeLattice) {
 
 // Iterations to 1e-6 from x = 0 as the lattice is refined (648 to 41,472 rows, 2 to 3 levels).
 // Jacobi-CG needs O(n) iterations (175 at n = 12, more on finer lattices); a working multigrid
-// hierarchy keeps the count flat. Measured: 8-9 at every size (operator complexity 1.06-1.15).
-// The bound of 20 leaves twice that, yet a hierarchy that stops scaling (e.g. with the
-// translations only as near-null space, 40 iterations to 1e-10 at n = 12 instead of 14) or an
+// hierarchy keeps the count flat. Measured: 12-13 at every size (operator complexity 1.06-1.15).
+// The bound of 20 leaves 50 % slack, yet a hierarchy that stops scaling (e.g. with the
+// translations only as near-null space, 55 iterations to 1e-10 at n = 12 instead of 20) or an
 // asymmetric cycle (CG breaks down) fails it.
 TEST(Amg, IterationsStayBoundedUnderRefinement) {
   for (int n : {6, 12, 18, 24}) {

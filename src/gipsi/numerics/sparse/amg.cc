@@ -1,5 +1,5 @@
 // Smoothed-aggregation AMG: hierarchy set-up (strength graph, aggregation, tentative and
-// smoothed prolongators, Galerkin products) and the symmetric V-cycle.
+// smoothed prolongators, Galerkin products) and the symmetric damped-Jacobi V-cycle.
 
 #include "gipsi/numerics/sparse/amg.h"
 
@@ -365,7 +365,7 @@ bool SmoothedAggregationAmg::Setup(const SparseMatrix& A) {
           level.sorted = false;
       }
     level.inverse_diagonal.resize(rows);
-    if (levels_.size() == 1) DetectBlocks(level);  // coarse nodes have ≤ 6 DOFs: point GS
+    if (levels_.size() == 1) DetectBlocks(level);  // coarse nodes have ≤ 6 DOFs: point-wise
     if (!UpdateDiagonal(level)) return false;
     for (VecX* v : {&level.x, &level.b, &level.residual}) v->setZero(rows);
     if (rows <= kMaxCoarseRows || static_cast<int>(levels_.size()) >= kMaxLevels) break;
@@ -385,6 +385,7 @@ bool SmoothedAggregationAmg::Setup(const SparseMatrix& A) {
     }
     const double rho = SpectralRadiusEstimate(current, level.inverse_diagonal);
     const double omega = rho > 0.0 ? 4.0 / (3.0 * rho) : 0.0;
+    level.jacobi_weight = JacobiWeight(level, rho);
     const SparseMatrix at = current * tentative.t;
     SparseMatrix p = tentative.t - SparseMatrix((omega * level.inverse_diagonal).asDiagonal() * at);
     p.makeCompressed();
@@ -474,70 +475,77 @@ inline void ApplyInverse(const double* __restrict m, const double s[3], double* 
 
 }  // namespace
 
-void SmoothedAggregationAmg::BlockForwardFromZero(Level& level) {
-  // (D_B + L_B) x = b by node blocks, then r = b − A x = −U_B x (U_B the blocks right of the
-  // diagonal), as in the point-wise sweep, on the block copy: one column index per 3×3 block
-  // and the block's nine values adjacent.
-  const int nodes = static_cast<int>(level.block_diagonal.size());
-  const int* __restrict start = level.block_start.data();
-  const int* __restrict columns = level.block_column.data();
-  const double* __restrict blocks = level.block_values.data();
-  const double* __restrict b = level.b.data();
-  const double* __restrict inverse = level.block_inverse.data();
-  const int* __restrict offset = level.block_diagonal.data();
-  double* __restrict x = level.x.data();
-  double* __restrict res = level.residual.data();
-  for (int node = 0; node < nodes; ++node) {
-    double s[3] = {b[3 * node], b[3 * node + 1], b[3 * node + 2]};
-    SubtractBlocks(blocks, columns, x, start[node], start[node] + offset[node] / 3, s);
-    ApplyInverse(inverse + 9 * node, s, x + 3 * node, false);
-  }
-#pragma omp parallel for schedule(static) if (3 * nodes >= kMinParallelLength)
-  for (int node = 0; node < nodes; ++node) {
-    double s[3] = {0.0, 0.0, 0.0};
-    SubtractBlocks(blocks, columns, x, start[node] + offset[node] / 3 + 1, start[node + 1], s);
-    res[3 * node] = s[0];
-    res[3 * node + 1] = s[1];
-    res[3 * node + 2] = s[2];
-  }
-}
-
-void SmoothedAggregationAmg::BlockBackward(Level& level) {
-  // x_I += D_II⁻¹ (b_I − Σ_J A_IJ x_J), nodes in decreasing order: (D_B + U_B) δ = b − A x.
-  const int nodes = static_cast<int>(level.block_diagonal.size());
-  const int* __restrict start = level.block_start.data();
-  const int* __restrict columns = level.block_column.data();
-  const double* __restrict blocks = level.block_values.data();
-  const double* __restrict b = level.b.data();
-  const double* __restrict inverse = level.block_inverse.data();
-  double* __restrict x = level.x.data();
-  for (int node = nodes - 1; node >= 0; --node) {
-    double s[3] = {b[3 * node], b[3 * node + 1], b[3 * node + 2]};
-    SubtractBlocks(blocks, columns, x, start[node], start[node + 1], s);
-    ApplyInverse(inverse + 9 * node, s, x + 3 * node, true);
-  }
-}
-
 bool SmoothedAggregationAmg::Multiply(const VecX& x, VecX& y) const {
   if (levels_.empty() || !levels_.front()->blocked) return false;
   const Level& level = *levels_.front();
   GIPSI_CHECK(x.size() == level.a->rows() && y.size() == x.size() && x.data() != y.data(),
               "AMG Multiply: sizes do not match or x and y alias");
-  const int nodes = static_cast<int>(level.block_diagonal.size());
-  const int* __restrict start = level.block_start.data();
-  const int* __restrict columns = level.block_column.data();
-  const double* __restrict blocks = level.block_values.data();
-  const double* __restrict px = x.data();
-  double* __restrict py = y.data();
-#pragma omp parallel for schedule(static) if (3 * nodes >= kMinParallelLength)
-  for (int node = 0; node < nodes; ++node) {
-    double s[3] = {0.0, 0.0, 0.0};
-    SubtractBlocks(blocks, columns, px, start[node], start[node + 1], s);
-    py[3 * node] = -s[0];
-    py[3 * node + 1] = -s[1];
-    py[3 * node + 2] = -s[2];
-  }
+  LevelMultiply(level, x, y);
   return true;
+}
+
+double SmoothedAggregationAmg::JacobiWeight(Level& level, double point_rho) {
+  // ω = 4 / (3 λ), λ ≈ λ_max(D⁻¹A) for the smoother's D (3×3 blocks or the point diagonal),
+  // raised by 10 % over the power iteration's estimate (which approaches it from below) so
+  // that ω λ_max < 2 (damped Jacobi converges, the cycle stays SPD) even after the finest
+  // matrix drifts by a few per cent under a lagged hierarchy.
+  double rho = point_rho;
+  if (level.blocked) {
+    const Index n = level.a->rows();
+    VecX v(n), w(n), z(n);
+    for (Index i = 0; i < n; ++i) v[i] = 1.0 + 0.5 * std::sin(0.7 * static_cast<double>(i));
+    v.normalize();
+    for (int it = 0; it < 20; ++it) {
+      SymmetricSpMV(*level.a, v, w);
+      ApplyBlockInverse(level, w, z, 1.0, false);
+      rho = z.norm();
+      if (!(rho > 0.0)) break;
+      v = z / rho;
+    }
+  }
+  return rho > 0.0 ? 4.0 / (3.0 * 1.1 * rho) : 0.0;
+}
+
+void SmoothedAggregationAmg::ApplyBlockInverse(const Level& level, const VecX& r, VecX& z,
+                                               double weight, bool add) {
+  const Index n = r.size();
+  const double* __restrict pr = r.data();
+  double* __restrict pz = z.data();
+  if (level.blocked) {
+    const int nodes = static_cast<int>(n / 3);
+    const double* __restrict inverse = level.block_inverse.data();
+#pragma omp parallel for schedule(static) if (n >= kMinParallelLength)
+    for (int node = 0; node < nodes; ++node) {
+      const double s[3] = {weight * pr[3 * node], weight * pr[3 * node + 1],
+                           weight * pr[3 * node + 2]};
+      ApplyInverse(inverse + 9 * node, s, pz + 3 * node, add);
+    }
+    return;
+  }
+  const double* __restrict inv = level.inverse_diagonal.data();
+#pragma omp parallel for schedule(static) if (n >= kMinParallelLength)
+  for (Index i = 0; i < n; ++i) pz[i] = (add ? pz[i] : 0.0) + weight * inv[i] * pr[i];
+}
+
+void SmoothedAggregationAmg::LevelMultiply(const Level& level, const VecX& x, VecX& y) {
+  if (level.blocked) {
+    const int nodes = static_cast<int>(level.block_diagonal.size());
+    const int* __restrict start = level.block_start.data();
+    const int* __restrict columns = level.block_column.data();
+    const double* __restrict blocks = level.block_values.data();
+    const double* __restrict px = x.data();
+    double* __restrict py = y.data();
+#pragma omp parallel for schedule(static) if (3 * nodes >= kMinParallelLength)
+    for (int node = 0; node < nodes; ++node) {
+      double s[3] = {0.0, 0.0, 0.0};
+      SubtractBlocks(blocks, columns, px, start[node], start[node + 1], s);
+      py[3 * node] = -s[0];
+      py[3 * node + 1] = -s[1];
+      py[3 * node + 2] = -s[2];
+    }
+    return;
+  }
+  SymmetricSpMV(*level.a, x, y);
 }
 
 void SmoothedAggregationAmg::Cycle(std::size_t l) {
@@ -546,61 +554,20 @@ void SmoothedAggregationAmg::Cycle(std::size_t l) {
     level.x = coarse_->llt.solve(level.b);
     return;
   }
-  const SparseMatrix& A = *level.a;
-  const int n = static_cast<int>(A.rows());
-  const int* __restrict outer = A.outerIndexPtr();
-  const int* __restrict inner = A.innerIndexPtr();
-  const double* __restrict values = A.valuePtr();
-  const double* __restrict inv = level.inverse_diagonal.data();
-  const double* __restrict b = level.b.data();
-  double* __restrict x = level.x.data();
-  // Forward Gauss–Seidel from x = 0, x = (D + L)⁻¹ b: column j of the symmetric matrix is row
-  // j, and only rows < j have a nonzero x yet. The residual is then b − A x = −U x (U the
-  // strictly upper part), which the backward pass over each row below collects; so the
-  // sweep and the residual together read the matrix once.
-  double* __restrict res = level.residual.data();
-  if (level.blocked) {
-    BlockForwardFromZero(level);
-  } else if (level.sorted) {
-    for (int j = 0; j < n; ++j) {
-      double s = b[j];
-      int k = outer[j];
-      for (; k < outer[j + 1] && inner[k] < j; ++k) s -= values[k] * x[inner[k]];
-      x[j] = s * inv[j];
-    }
-    // r_j = −Σ_{i > j} A_ji x_i, now that all of x is known (a separate, parallel pass).
-    const int* diag = level.diagonal.data();
-#pragma omp parallel for schedule(static) if (n >= kMinParallelLength)
-    for (int j = 0; j < n; ++j) {
-      double s = 0.0;
-      for (int k = diag[j] + 1; k < outer[j + 1]; ++k) s -= values[k] * x[inner[k]];
-      res[j] = s;
-    }
-  } else {
-    level.x.setZero();
-    for (int j = 0; j < n; ++j) {
-      double s = b[j];
-      for (int k = outer[j]; k < outer[j + 1]; ++k)
-        if (inner[k] != j) s -= values[k] * x[inner[k]];
-      x[j] = s * inv[j];
-    }
-    SymmetricSpMV(A, level.x, level.residual);
-    level.residual = level.b - level.residual;
-  }
+  // Damped (block) Jacobi before and after the coarse correction: the same symmetric smoother
+  // on both sides, so the cycle is symmetric; every step is an SpMV or a diagonal scaling
+  // (parallel, rows summed by one thread each).
   Level& coarse = *levels_[l + 1];
+  const double w = level.jacobi_weight;
+  ApplyBlockInverse(level, level.b, level.x, w, false);  // x = ω D⁻¹ b (from x = 0)
+  LevelMultiply(level, level.x, level.residual);
+  level.residual = level.b - level.residual;
   RowSpMV(level.r, level.residual, coarse.b, false);
   Cycle(l + 1);
   RowSpMV(level.p, coarse.x, level.x, true);
-  // Backward Gauss–Seidel (the adjoint of the forward sweep: the cycle stays symmetric).
-  if (level.blocked) {
-    BlockBackward(level);
-    return;
-  }
-  for (int j = n - 1; j >= 0; --j) {
-    double s = b[j];
-    for (int k = outer[j]; k < outer[j + 1]; ++k) s -= values[k] * x[inner[k]];
-    x[j] += s * inv[j];
-  }
+  LevelMultiply(level, level.x, level.residual);
+  level.residual = level.b - level.residual;
+  ApplyBlockInverse(level, level.residual, level.x, w, true);  // x += ω D⁻¹ (b − A x)
 }
 
 }  // namespace gipsi

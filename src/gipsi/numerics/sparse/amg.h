@@ -21,14 +21,18 @@
 ///  - prolongator smoothing P = (I − ω D⁻¹A) T with ω = 4 / (3 ρ(D⁻¹A)), ρ by power iteration;
 ///  - Galerkin coarse matrix Pᵀ A P (symmetrised to remove product round-off), until at most
 ///    `kMaxCoarseRows` rows remain, which CHOLMOD factorises.
-/// Cycle: a V-cycle with one forward Gauss–Seidel sweep before and one backward sweep after the
-/// coarse correction on every level (by 3×3 node blocks where the matrix has that block
-/// pattern, e.g. the finest level of an FEM tangent; point-wise elsewhere), so the
-/// preconditioner is symmetric; it is positive
-/// definite whenever each level's matrix is SPD (Gauss–Seidel then converges in the energy
-/// norm), also when the coarse levels were built from an earlier matrix (see Refresh).
-/// Everything is serial except the sparse products, whose rows are each summed by one thread:
-/// the same bits for any thread count.
+/// Cycle: a V-cycle with one damped Jacobi step before and one after the coarse correction on
+/// every level, x ← x + ω D⁻¹ (b − A x), with D the 3×3 diagonal blocks where the matrix has
+/// that block pattern (the finest level of an FEM tangent) and the diagonal elsewhere, and
+/// ω = 4 / (3 · 1.1 λ), λ the power-iteration estimate of λ_max(D⁻¹A) at set-up. The same
+/// smoother before and after makes the preconditioner symmetric; it is positive definite
+/// when every level's matrix is SPD and ω λ_max(D⁻¹A) < 2 (the smoother converges in the
+/// energy norm), which the 10 % margin keeps for the estimate's error and for a finest matrix
+/// that drifts from the one the hierarchy was built for (see Refresh). Symmetric Gauss–Seidel
+/// was tried first: ~35 % fewer CG iterations, but a serial sweep that ran at under half the
+/// speed of an SpMV, for a slower step overall (docs/performance.md).
+/// Set-up is serial; the cycle's products and scalings are parallel with every row summed by
+/// one thread: the same bits for any thread count.
 
 #include <memory>
 #include <vector>
@@ -60,8 +64,9 @@ class SmoothedAggregationAmg {
   /// factorisation fails; Apply must not be called then.
   [[nodiscard]] bool Setup(const SparseMatrix& A);
   /// Makes A (same pattern as the last Setup's matrix) the finest-level operator and keeps the
-  /// coarse levels: the V-cycle stays symmetric positive definite for SPD A and is a good
-  /// preconditioner while A stays close to the matrix of the last Setup. False as for Setup.
+  /// coarse levels and the smoother weights: the V-cycle stays symmetric, and positive
+  /// definite for SPD A near the last Setup's matrix (see the file comment); it is a good
+  /// preconditioner while A stays close to that matrix. False as for Setup.
   [[nodiscard]] bool Refresh(const SparseMatrix& A);
   /// z = B r, one V-cycle from a zero initial guess. r and z must have A's size.
   void Apply(const VecX& r, VecX& z);
@@ -87,14 +92,16 @@ class SmoothedAggregationAmg {
     std::vector<int> diagonal;        ///< value index of each diagonal entry
     VecX inverse_diagonal;            ///< 1 / A_ii
     bool sorted = true;               ///< row indices increase within each column
-    /// Node-block Gauss–Seidel (3×3 blocks) on this level: set when every node's three columns
-    /// share one sorted row pattern made of whole node blocks (FEM tangents on level 0).
+    /// 3×3 node blocks on this level (block Jacobi, block copy of A): set when every node's
+    /// three columns share one sorted row pattern made of whole node blocks (level 0 of an
+    /// FEM tangent).
     bool blocked = false;
     std::vector<int> block_diagonal;    ///< per node: offset of its diagonal block in its columns
     std::vector<double> block_inverse;  ///< per node: the inverse of its diagonal block (9)
     std::vector<int> block_start;       ///< block copy: first block of each node
     std::vector<int> block_column;      ///< block copy: neighbour node of each block
     std::vector<double> block_values;   ///< block copy: 9 values per block (see UpdateDiagonal)
+    double jacobi_weight = 0.0;         ///< ω of the damped-Jacobi smoother
     RowMatrix p;                        ///< prolongator to this level from the next coarser one
     RowMatrix r;                        ///< restriction pᵀ
     VecX x, b, residual;                ///< cycle work vectors
@@ -102,8 +109,10 @@ class SmoothedAggregationAmg {
 
   bool UpdateDiagonal(Level& level) const;
   static void DetectBlocks(Level& level);
-  static void BlockForwardFromZero(Level& level);
-  static void BlockBackward(Level& level);
+  static double JacobiWeight(Level& level, double point_rho);
+  static void ApplyBlockInverse(const Level& level, const VecX& r, VecX& z, double weight,
+                                bool add);
+  static void LevelMultiply(const Level& level, const VecX& x, VecX& y);
   void Cycle(std::size_t l);
 
   std::vector<std::unique_ptr<Level>> levels_;

@@ -43,7 +43,7 @@ struct LinearSolverOptions {
   /// For "cg": "none", "jacobi", "ic" (incomplete Cholesky), "cholesky" (a CHOLMOD
   /// factorisation of an earlier matrix, refreshed only when CG needs more than
   /// `refactor_iterations` iterations with it) or "amg" (smoothed-aggregation algebraic
-  /// multigrid on 3×3 node blocks, one symmetric Gauss–Seidel V-cycle per CG iteration; its
+  /// multigrid on 3×3 node blocks, one damped-Jacobi V-cycle per CG iteration; its
   /// coarse levels are built from an earlier matrix and rebuilt under the same rule as
   /// "cholesky", the finest level always uses the current matrix).
   std::string preconditioner = "ic";
