@@ -98,7 +98,7 @@ TEST(Amg, CgConvergesToTheCholmodSolution) {
 }
 
 // Identity rows and columns (Dirichlet DOFs as FemSolid writes them) are nodes without
-// neighbours: in no aggregate, solved exactly by the smoother; CG still converges fast.
+// neighbours: in no aggregate, only smoothed; CG still converges fast.
 TEST(Amg, HandlesDecoupledIdentityRows) {
   const int n = 12;
   SparseMatrix A = Lattice(n);

@@ -10,7 +10,7 @@
 ///    a multiple of 3, else 1), aggregates on coarser levels;
 ///  - strength: nodes I ≠ J are coupled if their block A_IJ has a nonzero entry; nodes with no
 ///    coupling (e.g. Dirichlet rows replaced by the identity) belong to no aggregate and are
-///    left to the smoother, which solves them exactly;
+///    left to the smoother (a fixed positive scaling of their residual there);
 ///  - aggregation: the usual three greedy passes in node order (a node whose neighbours are all
 ///    free seeds an aggregate with them; leftovers join a neighbouring aggregate; what remains
 ///    forms aggregates with its free neighbours), so the hierarchy is deterministic;
