@@ -279,8 +279,8 @@ namespace gipsi {
 namespace {
 
 TEST(FemSolid, AssemblyGivesTheSameBitsForAnyThreadCount) {
-  // Elements of one colour share no node and each entry sums its contributions colour by
-  // colour, so the result cannot depend on how a colour is split among threads.
+  // Element chunks of one colour share no node and each entry sums its contributions colour by
+  // colour, chunk by chunk, so the result cannot depend on how a colour is split among threads.
   auto mesh = std::make_shared<const Mesh>(
       MakeTetBox(Vec3::Zero(), Vec3::Ones(), {20, 20, 20}));  // 48,000 tets: parallel loops
   FemSolid fem(

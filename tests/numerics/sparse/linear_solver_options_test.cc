@@ -55,11 +55,11 @@ TEST(LinearSolverOptions, UnknownTypeNamesPathAndListsChoices) {
 }
 
 TEST(LinearSolverOptions, UnknownPreconditionerNamesPathSuggestsAndListsChoices) {
-  EXPECT_THAT(
-      [] { Parse(R"({"preconditioner": "jacoby"})"); },
-      ThrowsMessage<InputError>(AllOf(
-          HasSubstr("solver.preconditioner: unknown preconditioner 'jacoby'"),
-          HasSubstr("did you mean 'jacobi'"), HasSubstr("'none', 'jacobi', 'ic', 'cholesky'"))));
+  EXPECT_THAT([] { Parse(R"({"preconditioner": "jacoby"})"); },
+              ThrowsMessage<InputError>(
+                  AllOf(HasSubstr("solver.preconditioner: unknown preconditioner 'jacoby'"),
+                        HasSubstr("did you mean 'jacobi'"),
+                        HasSubstr("'none', 'jacobi', 'ic', 'cholesky', 'amg'"))));
 }
 
 TEST(LinearSolverOptions, CholeskyPreconditionerOnlyWithCg) {
@@ -68,6 +68,18 @@ TEST(LinearSolverOptions, CholeskyPreconditionerOnlyWithCg) {
                   AllOf(HasSubstr("scene.json: solver.preconditioner: "),
                         HasSubstr("'cholesky' applies to type 'cg' only (type is 'ldlt')"))));
   EXPECT_NO_THROW(Parse(R"({"type": "ldlt", "preconditioner": "ic"})"));
+}
+
+TEST(LinearSolverOptions, AmgPreconditionerOnlyWithCg) {
+  EXPECT_EQ(Parse(R"({"type": "cg", "preconditioner": "amg"})").preconditioner, "amg");
+  EXPECT_THAT([] { Parse(R"({"type": "cholmod", "preconditioner": "amg"})"); },
+              ThrowsMessage<InputError>(
+                  AllOf(HasSubstr("scene.json: solver.preconditioner: "),
+                        HasSubstr("'amg' applies to type 'cg' only (type is 'cholmod')"))));
+  LinearSolverOptions options;
+  options.type = "ldlt";
+  options.preconditioner = "amg";
+  EXPECT_THROW((void)MakeLinearSolver(options), InputError);
 }
 
 TEST(LinearSolverOptions, BadNumbersNameTheirPath) {

@@ -131,12 +131,14 @@ TEST_P(SparseLinearSolver, ReanalysingMovesTheSolverToANewPattern) {
 INSTANTIATE_TEST_SUITE_P(AllSolvers, SparseLinearSolver,
                          ::testing::Values(SolverCase{"cg", "none"}, SolverCase{"cg", "jacobi"},
                                            SolverCase{"cg", "ic"}, SolverCase{"cg", "cholesky"},
-                                           SolverCase{"ldlt", "ic"}, SolverCase{"cholmod", "ic"}),
+                                           SolverCase{"cg", "amg"}, SolverCase{"ldlt", "ic"},
+                                           SolverCase{"cholmod", "ic"}),
                          CaseName);
 
 TEST(SparseLinearSolver, NamesSayWhichSolverAndPreconditioner) {
   EXPECT_EQ(MakeLinearSolver(OptionsFor({"cg", "ic"}))->name(), "cg+ic");
   EXPECT_EQ(MakeLinearSolver(OptionsFor({"cg", "cholesky"}))->name(), "cg+cholesky");
+  EXPECT_EQ(MakeLinearSolver(OptionsFor({"cg", "amg"}))->name(), "cg+amg");
   EXPECT_EQ(MakeLinearSolver(OptionsFor({"ldlt", "ic"}))->name(), "ldlt");
   EXPECT_EQ(MakeLinearSolver(OptionsFor({"cholmod", "none"}))->name(), "cholmod");
 }

@@ -168,7 +168,7 @@ TEST(Pcg, RepeatedSolvesGiveIdenticalBits) {
   const SparseMatrix A = MakeLaplacian3D(21, 1e-2);
   ASSERT_GE(A.rows(), kMinParallelLength);
   const auto problem = Manufacture(A);
-  for (const char* preconditioner : {"jacobi", "ic"}) {
+  for (const char* preconditioner : {"jacobi", "ic", "amg"}) {
     LinearSolverOptions options = Cg(preconditioner);
     options.max_iterations = 10;
     auto solver = ReadySolver(options, A);

@@ -71,6 +71,8 @@ FemSolid::FemSolid(std::string name, std::shared_ptr<const Mesh> domain, FemPara
   scheme_.Reset(VecX::Zero(3 * n), VecX::Zero(3 * n), VecX::Zero(3 * n));
   saved_scheme_ = scheme_;
   newton_ = std::make_unique<NewtonSolver>(params_.newton, MakeLinearSolver(params_.linear_solver));
+  // Rigid-body modes of the rest shape: what an AMG preconditioner coarsens (others ignore it).
+  newton_->linear_solver().SetNearNullSpace(RigidBodyModes(rest_));
   newton_->Prepare(jac_);
   positions_ = domain->nodes;
   external_force_ = Points::Zero(3, n);

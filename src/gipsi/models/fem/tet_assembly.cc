@@ -1,7 +1,6 @@
 #include "gipsi/models/fem/tet_assembly.h"
 
 #include <algorithm>
-#include <bitset>
 #include <cmath>
 #include <string>
 
@@ -11,12 +10,6 @@
 #include "gipsi/geometry/quality.h"
 
 namespace gipsi {
-namespace {
-
-constexpr int kMaxColours = 512;
-
-}  // namespace
-
 TetAssembly::TetAssembly(const Mesh& mesh) : num_nodes_(mesh.num_nodes()), tets_(mesh.tets) {
   const Index ne = tets_.cols();
   if (ne == 0) throw InputError("FEM domain has no tetrahedra");
@@ -90,35 +83,42 @@ TetAssembly::TetAssembly(const Mesh& mesh) : num_nodes_(mesh.num_nodes()), tets_
             std::lower_bound(list.begin(), list.end(), tets_(a, e)) - list.begin());
     }
 
-  // Greedy colouring: smallest colour not used by any element sharing a node.
-  std::vector<std::bitset<kMaxColours>> used(static_cast<std::size_t>(num_nodes_));
-  std::vector<int> colour(static_cast<std::size_t>(ne));
+  // Greedy colouring of chunks: the smallest colour not used by a chunk sharing a node.
+  const int chunks = static_cast<int>((ne + kChunkElements - 1) / kChunkElements);
+  std::vector<std::vector<int>> node_chunks(static_cast<std::size_t>(num_nodes_));
+  for (Index e = 0; e < ne; ++e)
+    for (int a = 0; a < 4; ++a) {
+      auto& list = node_chunks[static_cast<std::size_t>(tets_(a, e))];
+      const int chunk = static_cast<int>(e / kChunkElements);
+      if (list.empty() || list.back() != chunk) list.push_back(chunk);  // e increases
+    }
+  std::vector<int> colour(static_cast<std::size_t>(chunks), -1);
+  std::vector<char> taken;
   int num_colours = 0;
-  for (Index e = 0; e < ne; ++e) {
-    std::bitset<kMaxColours> taken;
-    for (int a = 0; a < 4; ++a) taken |= used[static_cast<std::size_t>(tets_(a, e))];
+  for (int k = 0; k < chunks; ++k) {
+    taken.assign(static_cast<std::size_t>(num_colours) + 1, 0);
+    const Index first = Index{k} * kChunkElements;
+    const Index last = std::min<Index>(first + kChunkElements, ne);
+    for (Index e = first; e < last; ++e)
+      for (int a = 0; a < 4; ++a)
+        for (int other : node_chunks[static_cast<std::size_t>(tets_(a, e))]) {
+          const int c = colour[static_cast<std::size_t>(other)];
+          if (c >= 0) taken[static_cast<std::size_t>(c)] = 1;
+        }
     int c = 0;
-    while (c < kMaxColours && taken[static_cast<std::size_t>(c)]) ++c;
-    if (c == kMaxColours)
-      throw InputError(fmt::format(
-          "FEM domain: node valence too high to colour element {} (over {} elements share "
-          "nodes with it); check the mesh",
-          e, kMaxColours));
-    colour[static_cast<std::size_t>(e)] = c;
+    while (taken[static_cast<std::size_t>(c)]) ++c;
+    colour[static_cast<std::size_t>(k)] = c;
     num_colours = std::max(num_colours, c + 1);
-    for (int a = 0; a < 4; ++a)
-      used[static_cast<std::size_t>(tets_(a, e))].set(static_cast<std::size_t>(c));
   }
   colour_start_.assign(static_cast<std::size_t>(num_colours + 1), 0);
   for (int c : colour) ++colour_start_[static_cast<std::size_t>(c + 1)];
   for (int c = 0; c < num_colours; ++c)
     colour_start_[static_cast<std::size_t>(c + 1)] += colour_start_[static_cast<std::size_t>(c)];
-  colour_elements_.resize(static_cast<std::size_t>(ne));
+  colour_chunks_.resize(static_cast<std::size_t>(chunks));
   std::vector<int> fill(colour_start_.begin(), colour_start_.end() - 1);
-  for (Index e = 0; e < ne; ++e)
-    colour_elements_[static_cast<std::size_t>(
-        fill[static_cast<std::size_t>(colour[static_cast<std::size_t>(e)])]++)] =
-        static_cast<int>(e);
+  for (int k = 0; k < chunks; ++k)
+    colour_chunks_[static_cast<std::size_t>(
+        fill[static_cast<std::size_t>(colour[static_cast<std::size_t>(k)])]++)] = k;
 }
 
 SparseMatrix TetAssembly::MakePattern() const {

@@ -2,16 +2,19 @@
 /// @file
 /// Rest-geometry data and parallel assembly machinery for linear (P1) tetrahedra: shape-function
 /// gradients and volumes, the 3×3-block sparsity pattern of node-coupled matrices (stiffness,
-/// consistent mass), the value offsets each element scatters into, and an element colouring so
-/// that elements of one colour share no node and can be assembled in parallel without locks.
-/// Results are bit-identical for any thread count: every matrix or vector entry receives its
-/// element contributions in the same order (colour by colour, element order within a colour).
+/// consistent mass), the value offsets each element scatters into, and a colouring of element
+/// chunks (runs of consecutive elements) so that chunks of one colour share no node and can be
+/// assembled in parallel without locks. Results are bit-identical for any thread count: every
+/// matrix or vector entry receives its element contributions in the same order (colour by
+/// colour, chunk by chunk within a colour, element order within a chunk), which depends on the
+/// mesh only.
 ///
 /// P1 tetrahedron: N_a(X) linear, ∇N_a constant; with Dm = [X1−X0, X2−X0, X3−X0],
 /// rows 1..3 of Dm⁻¹ are ∇N_1..3 and ∇N_0 = −(∇N_1 + ∇N_2 + ∇N_3). The deformation gradient is
 /// F = Σ_a x_a ⊗ ∇N_a, and nodal forces from a first Piola–Kirchhoff stress P are
 /// f_a = −V P ∇N_a (V the rest volume).
 
+#include <algorithm>
 #include <vector>
 
 #include "gipsi/base/math.h"
@@ -67,21 +70,33 @@ class TetAssembly {
   /// Value indices of the diagonal entries (3N).
   [[nodiscard]] const std::vector<int>& diagonal_index() const { return diag_index_; }
 
-  /// Elements grouped by colour: colour c holds colour_elements()[colour_start()[c] ..
+  /// Consecutive elements per chunk (the last chunk may be shorter). Chunks keep the mesh's
+  /// element order, so an element's scatter lands near its predecessor's (for a mesh numbered
+  /// with locality); colouring single elements instead made every colour sweep the whole
+  /// matrix, measured 3-5× slower assembly at 20k-80k tets.
+  static constexpr int kChunkElements = 512;
+  /// Chunks grouped by colour: colour c holds chunks colour_chunks()[colour_start()[c] ..
   /// colour_start()[c+1]), and no two of them share a node.
   [[nodiscard]] const std::vector<int>& colour_start() const { return colour_start_; }
-  [[nodiscard]] const std::vector<int>& colour_elements() const { return colour_elements_; }
+  [[nodiscard]] const std::vector<int>& colour_chunks() const { return colour_chunks_; }
   [[nodiscard]] int num_colours() const { return static_cast<int>(colour_start_.size()) - 1; }
 
-  /// Runs `fn(e)` for every element, colour by colour, the elements of a colour in parallel
-  /// (OpenMP, static schedule). `fn` may scatter into node-indexed storage without locks.
+  /// Runs `fn(e)` for every element: colour by colour, the chunks of a colour in parallel
+  /// (OpenMP, static schedule, if the colour has at least kMinParallelElements elements), the
+  /// elements of a chunk in order. `fn` may scatter into node-indexed storage without locks.
   template <class Fn>
   void ForEachElementColoured(Fn&& fn) const {
+    const int ne = static_cast<int>(num_elements());
     for (int c = 0; c < num_colours(); ++c) {
       const int begin = colour_start_[static_cast<std::size_t>(c)];
       const int end = colour_start_[static_cast<std::size_t>(c) + 1];
-#pragma omp parallel for schedule(static) if (end - begin >= kMinParallelElements)
-      for (int k = begin; k < end; ++k) fn(static_cast<Index>(colour_elements_[k]));
+      const int elements = (end - begin) * kChunkElements;  // an upper bound
+#pragma omp parallel for schedule(static) if (end - begin >= 2 && elements >= kMinParallelElements)
+      for (int k = begin; k < end; ++k) {
+        const int first = colour_chunks_[static_cast<std::size_t>(k)] * kChunkElements;
+        const int last = std::min(first + kChunkElements, ne);
+        for (int e = first; e < last; ++e) fn(static_cast<Index>(e));
+      }
     }
   }
   /// Runs `fn(e)` for every element in parallel (no scatter allowed: write per-element data).
@@ -108,7 +123,7 @@ class TetAssembly {
   std::vector<int> block_pos_;   // 16 per element: position of node a in node b's neighbours
   std::vector<int> diag_index_;  // 3N
   std::vector<int> colour_start_;
-  std::vector<int> colour_elements_;
+  std::vector<int> colour_chunks_;
 };
 
 }  // namespace gipsi

@@ -19,7 +19,8 @@ namespace gipsi {
 namespace {
 
 constexpr std::array<std::string_view, 3> kTypes = {"cg", "ldlt", "cholmod"};
-constexpr std::array<std::string_view, 4> kPreconditioners = {"none", "jacobi", "ic", "cholesky"};
+constexpr std::array<std::string_view, 5> kPreconditioners = {"none", "jacobi", "ic", "cholesky",
+                                                              "amg"};
 
 /// Empty if `value` is one of `choices`, else e.g. "unknown linear solver type 'gmres';
 /// choices: 'cg', 'ldlt', 'cholmod'" (with a "did you mean" for a near miss).
@@ -35,10 +36,12 @@ std::optional<std::string> CheckChoice(std::string_view what, std::string_view v
                      list);
 }
 
+/// The lagged preconditioners ("cholesky", "amg") make sense only inside CG.
 std::optional<std::string> CholeskyNeedsCg(const LinearSolverOptions& options) {
-  if (options.preconditioner == "cholesky" && options.type != "cg")
-    return fmt::format("preconditioner 'cholesky' applies to type 'cg' only (type is '{}')",
-                       options.type);
+  if ((options.preconditioner == "cholesky" || options.preconditioner == "amg") &&
+      options.type != "cg")
+    return fmt::format("preconditioner '{}' applies to type 'cg' only (type is '{}')",
+                       options.preconditioner, options.type);
   return std::nullopt;
 }
 
@@ -62,6 +65,28 @@ int ReadInt(const JsonNode& node, int minimum) {
 }
 
 }  // namespace
+
+Eigen::MatrixXd RigidBodyModes(const VecX& positions) {
+  GIPSI_CHECK(positions.size() % 3 == 0, "RigidBodyModes: {} coordinates is not a multiple of 3",
+              positions.size());
+  const Index nodes = positions.size() / 3;
+  Vec3 centre = Vec3::Zero();
+  for (Index i = 0; i < nodes; ++i) centre += positions.segment<3>(3 * i);
+  if (nodes > 0) centre /= static_cast<double>(nodes);
+  Eigen::MatrixXd modes = Eigen::MatrixXd::Zero(positions.size(), 6);
+  for (Index i = 0; i < nodes; ++i) {
+    const Vec3 p = positions.segment<3>(3 * i) - centre;
+    for (int a = 0; a < 3; ++a) modes(3 * i + a, a) = 1.0;
+    // Rotations about x, y, z: ω × p.
+    modes(3 * i + 1, 3) = -p.z();
+    modes(3 * i + 2, 3) = p.y();
+    modes(3 * i + 0, 4) = p.z();
+    modes(3 * i + 2, 4) = -p.x();
+    modes(3 * i + 0, 5) = -p.y();
+    modes(3 * i + 1, 5) = p.x();
+  }
+  return modes;
+}
 
 bool AllValuesFinite(const SparseMatrix& A) {
   return Eigen::Map<const VecX>(A.valuePtr(), A.nonZeros()).allFinite();

@@ -16,6 +16,7 @@
 #include <string>
 #include <string_view>
 
+#include <Eigen/Core>
 #include <Eigen/SparseCore>
 
 #include "gipsi/base/json_node.h"
@@ -39,9 +40,12 @@ struct LinearSolverOptions {
   /// "cg" (preconditioned conjugate gradients), "ldlt" (Eigen SimplicialLDLT) or "cholmod"
   /// (SuiteSparse CHOLMOD supernodal LLᵀ).
   std::string type = "cg";
-  /// For "cg": "none", "jacobi", "ic" (incomplete Cholesky) or "cholesky" (a CHOLMOD
+  /// For "cg": "none", "jacobi", "ic" (incomplete Cholesky), "cholesky" (a CHOLMOD
   /// factorisation of an earlier matrix, refreshed only when CG needs more than
-  /// `refactor_iterations` iterations with it).
+  /// `refactor_iterations` iterations with it) or "amg" (smoothed-aggregation algebraic
+  /// multigrid on 3×3 node blocks, one damped-Jacobi V-cycle per CG iteration; its
+  /// coarse levels are built from an earlier matrix and rebuilt under the same rule as
+  /// "cholesky", the finest level always uses the current matrix).
   std::string preconditioner = "ic";
   /// CG stops when ‖b − A x‖ ≤ tolerance · ‖b‖ (the true residual, checked with an SpMV; the
   /// initial residual counts, so a good warm start can take 0 iterations). Direct solvers
@@ -49,8 +53,9 @@ struct LinearSolverOptions {
   double tolerance = 1e-6;
   /// CG iteration budget per Solve (≥ 1).
   int max_iterations = 2000;
-  /// For preconditioner "cholesky": a Solve needing more CG iterations than this (or not
-  /// converging) makes the next Factorize refactorise numerically (≥ 0).
+  /// For preconditioners "cholesky" and "amg": a Solve needing more CG iterations than this
+  /// (or not converging) makes the next Factorize refactorise numerically / rebuild the
+  /// multigrid hierarchy (≥ 0).
   int refactor_iterations = 30;
 };
 
@@ -63,7 +68,8 @@ struct LinearSolveStats {
   double relative_residual = 0;
   /// A numeric factorisation ran (successfully or not) in the last Factorize: always for
   /// "ldlt", "cholmod" and "cg+ic", never for "cg+none"/"cg+jacobi", and for "cg+cholesky"
-  /// on the first Factorize and when the previous Solve asked for a refresh.
+  /// and "cg+amg" (hierarchy set-up) on the first Factorize and when the previous Solve asked
+  /// for a refresh.
   bool refactorized = false;
 };
 
@@ -77,6 +83,11 @@ class LinearSolver {
 
   /// E.g. "cg+ic", "cholmod".
   [[nodiscard]] virtual std::string name() const = 0;
+  /// Vectors that the matrices to come nearly annihilate (rows = matrix rows, at most 12
+  /// columns; e.g. RigidBodyModes for elasticity). Only "cg+amg" uses them (from the next
+  /// hierarchy set-up; without them it assumes 3 DOFs per node and the 3 translations); the
+  /// others ignore the call.
+  virtual void SetNearNullSpace(const Eigen::MatrixXd& /*modes*/) {}
   /// Symbolic analysis (ordering, elimination tree) for matrices with A's pattern. Call again
   /// only when the pattern changes (it also drops any factorisation). A must be square and
   /// compressed (checked).
@@ -97,16 +108,21 @@ class LinearSolver {
   virtual LinearSolveStats Solve(const VecX& b, VecX& x) = 0;
 };
 
+/// The 6 rigid-body modes (3 translations, 3 rotations about the centroid) of nodes at
+/// `positions` (3N, node-major): a 3N by 6 matrix, the near-null space of an elasticity
+/// stiffness matrix with 3 DOFs per node.
+Eigen::MatrixXd RigidBodyModes(const VecX& positions);
+
 /// Builds the solver `options` describe (names as in LinearSolver::name()). Throws InputError
 /// for an unknown type or preconditioner (listing the choices), for preconditioner "cholesky"
-/// with a type other than "cg", and for tolerance ≤ 0, max_iterations < 1 or
+/// or "amg" with a type other than "cg", and for tolerance ≤ 0, max_iterations < 1 or
 /// refactor_iterations < 0. The preconditioner is ignored by the direct types.
 std::unique_ptr<LinearSolver> MakeLinearSolver(const LinearSolverOptions& options);
 
 /// Reads {"type", "preconditioner", "tolerance", "max_iterations", "refactor_iterations"} (all
 /// optional, defaults as in LinearSolverOptions); throws InputError naming the JSON path for an
-/// unknown key, an unknown type/preconditioner (listing the choices), "cholesky" with a type
-/// other than "cg", a non-positive tolerance or an out-of-range iteration count.
+/// unknown key, an unknown type/preconditioner (listing the choices), "cholesky" or "amg" with
+/// a type other than "cg", a non-positive tolerance or an out-of-range iteration count.
 LinearSolverOptions ParseLinearSolverOptions(const JsonNode& node);
 
 }  // namespace gipsi

@@ -76,7 +76,6 @@ SparseMatrix MakeSpringLattice3D(int n, double shift, const StiffnessField& stif
     for (int y = 0; y < n; ++y) {
       for (int x = 0; x < n; ++x) {
         const int c = x + n * (y + n * z);
-        const Vec3 p = h * Vec3(x, y, z);
         // Neighbours in ascending node order (z slowest), so rows come out sorted.
         int count = 0;
         int self = -1;
@@ -94,7 +93,10 @@ SparseMatrix MakeSpringLattice3D(int n, double shift, const StiffnessField& stif
               }
               const Vec3 offset(dx, dy, dz);
               const Vec3 d = offset.normalized();
-              const double kspring = stiffness ? stiffness(p + 0.5 * h * offset) : 1.0;
+              // The midpoint from integer coordinates: the same bits from either end, so the
+              // matrix is exactly symmetric even where `stiffness` jumps at a midpoint.
+              const Vec3 mid = (0.5 * h) * Vec3(x + qx, y + qy, z + qz);
+              const double kspring = stiffness ? stiffness(mid) : 1.0;
               b.value = -kspring * d * d.transpose();
               diagonal -= b.value;
               ++count;

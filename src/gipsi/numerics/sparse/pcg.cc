@@ -1,5 +1,6 @@
 // Preconditioned conjugate gradients with a warm start, a stopping rule on the true residual,
-// and four preconditioners (none, Jacobi, incomplete Cholesky, lagged CHOLMOD Cholesky).
+// and five preconditioners (none, Jacobi, incomplete Cholesky, lagged CHOLMOD Cholesky,
+// smoothed-aggregation AMG with a lagged hierarchy).
 
 #include <cmath>
 #include <limits>
@@ -10,18 +11,20 @@
 #include <Eigen/OrderingMethods>
 
 #include "gipsi/base/error.h"
+#include "gipsi/numerics/sparse/amg.h"
 #include "gipsi/numerics/sparse/solvers.h"
 #include "gipsi/numerics/sparse/vector_ops.h"
 
 namespace gipsi {
 namespace {
 
-enum class Preconditioner { kNone, kJacobi, kIncompleteCholesky, kLaggedCholesky };
+enum class Preconditioner { kNone, kJacobi, kIncompleteCholesky, kLaggedCholesky, kAmg };
 
 Preconditioner PreconditionerFromName(const std::string& name) {
   if (name == "none") return Preconditioner::kNone;
   if (name == "jacobi") return Preconditioner::kJacobi;
   if (name == "ic") return Preconditioner::kIncompleteCholesky;
+  if (name == "amg") return Preconditioner::kAmg;
   GIPSI_CHECK(name == "cholesky", "MakePcgSolver: unvalidated preconditioner '{}'", name);
   return Preconditioner::kLaggedCholesky;
 }
@@ -39,6 +42,10 @@ class PcgSolver final : public LinearSolver {
   }
 
   [[nodiscard]] std::string name() const override { return "cg+" + options_.preconditioner; }
+
+  void SetNearNullSpace(const Eigen::MatrixXd& modes) override {
+    if (kind_ == Preconditioner::kAmg) amg_.SetNearNullSpace(modes);
+  }
 
   void AnalyzePattern(const SparseMatrix& A) override {
     GIPSI_CHECK(A.rows() == A.cols() && A.isCompressed(),
@@ -62,6 +69,8 @@ class PcgSolver final : public LinearSolver {
       case Preconditioner::kLaggedCholesky:
         cholesky_.analyzePattern(A);
         break;
+      case Preconditioner::kAmg:
+        break;  // the hierarchy depends on the values: built by the first Factorize
     }
   }
 
@@ -89,6 +98,17 @@ class PcgSolver final : public LinearSolver {
           refactor_pending_ = false;
           has_factor_ = cholesky_.info() == Eigen::Success;
           if (!has_factor_) return false;
+        }
+        break;
+      case Preconditioner::kAmg:
+        if (!has_factor_ || refactor_pending_) {
+          refactorized_ = true;
+          refactor_pending_ = false;
+          has_factor_ = amg_.Setup(A);
+          if (!has_factor_) return false;
+        } else if (!amg_.Refresh(A)) {
+          has_factor_ = false;  // rebuild from the next matrix
+          return false;
         }
         break;
     }
@@ -131,6 +151,14 @@ class PcgSolver final : public LinearSolver {
     if (kind_ == Preconditioner::kLaggedCholesky &&
         (!stats.converged || stats.iterations > options_.refactor_iterations))
       refactor_pending_ = true;
+    if (kind_ == Preconditioner::kAmg) {
+      // A fresh hierarchy sets the baseline; the lagged one is rebuilt once CG needs both more
+      // than refactor_iterations and more than 1.5 times (plus 2) that baseline.
+      if (refactorized_) baseline_iterations_ = stats.iterations;
+      if (!stats.converged || (stats.iterations > options_.refactor_iterations &&
+                               2 * stats.iterations > 3 * baseline_iterations_ + 4))
+        refactor_pending_ = true;
+    }
     return stats;
   }
 
@@ -154,9 +182,16 @@ class PcgSolver final : public LinearSolver {
     return positive;
   }
 
+  /// y = A x, from the AMG hierarchy's block copy of A when it has one (same matrix, fewer
+  /// index loads), else SymmetricSpMV.
+  void Multiply(const VecX& x, VecX& y) {
+    if (kind_ == Preconditioner::kAmg && amg_.Multiply(x, y)) return;
+    SymmetricSpMV(*matrix_, x, y);
+  }
+
   /// r_ = b − A x; returns ‖r_‖.
   double TrueResidual(const VecX& b, const VecX& x) {
-    SymmetricSpMV(*matrix_, x, q_);
+    Multiply(x, q_);
     const double* __restrict pb = b.data();
     const double* __restrict pq = q_.data();
     double* __restrict pr = r_.data();
@@ -202,6 +237,9 @@ class PcgSolver final : public LinearSolver {
         z_ = cholesky_.solve(r_);
         if (cholesky_.info() != Eigen::Success) return std::numeric_limits<double>::quiet_NaN();
         break;
+      case Preconditioner::kAmg:
+        amg_.Apply(r_, z_);
+        break;
     }
     return ParallelDot(r_, z_, scratch_);
   }
@@ -213,7 +251,7 @@ class PcgSolver final : public LinearSolver {
     if (!(rz > 0.0) || !std::isfinite(rz)) return false;
     p_ = z_;
     while (iterations < options_.max_iterations) {
-      SymmetricSpMV(*matrix_, p_, q_);
+      Multiply(p_, q_);
       const double pq = ParallelDot(p_, q_, scratch_);
       if (!(pq > 0.0) || !std::isfinite(pq)) return false;  // A not SPD, or NaN
       const double alpha = rz / pq;
@@ -248,13 +286,15 @@ class PcgSolver final : public LinearSolver {
   bool analysed_ = false;
   const SparseMatrix* matrix_ = nullptr;  ///< the last successfully factorised A
   bool refactorized_ = false;
-  bool has_factor_ = false;        ///< cholesky_ holds a valid numeric factorisation
+  bool has_factor_ = false;        ///< cholesky_ / amg_ holds a valid factorisation / hierarchy
   bool refactor_pending_ = false;  ///< the last Solve found the lagged factor too weak
+  int baseline_iterations_ = 0;    ///< CG iterations of the first Solve after an AMG set-up
   VecX r_, z_, p_, q_;             ///< residual, preconditioned residual, direction, A p
   VecX inverse_diagonal_;
   ReductionScratch scratch_;
   Eigen::IncompleteCholesky<double, Eigen::Lower, Eigen::AMDOrdering<int>> incomplete_;
   Eigen::CholmodSupernodalLLT<SparseMatrix, Eigen::Lower> cholesky_;
+  SmoothedAggregationAmg amg_;
 };
 
 }  // namespace
