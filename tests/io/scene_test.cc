@@ -9,6 +9,7 @@
 #include "gipsi/base/error.h"
 #include "gipsi/models/builtins.h"
 #include "gipsi/models/mass_spring/mass_spring.h"
+#include "io/scene_test_util.h"
 
 namespace gipsi {
 namespace {
@@ -28,16 +29,7 @@ std::string SceneText(const std::string& object_extra = "", const std::string& t
          top_extra + "\n}";
 }
 
-std::string LoadError(const std::string& text) {
-  TypeRegistry registry;
-  RegisterBuiltins(registry);
-  try {
-    (void)LoadSceneFromString(text, "scene.json", ".", registry);
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "(no error)";
-}
+std::string LoadError(const std::string& text) { return testing::SceneLoadError(text); }
 
 Scene Load(const std::string& text) {
   static TypeRegistry* registry = [] {

@@ -8,6 +8,7 @@
 #include "gipsi/io/scene.h"
 #include "gipsi/models/builtins.h"
 #include "gipsi/models/circulation/circulation.h"
+#include "io/scene_test_util.h"
 
 namespace gipsi {
 
@@ -33,15 +34,6 @@ class SceneHolder {
 };
 
 /// The InputError message of loading `text`, or "(no error)".
-inline std::string SceneError(const std::string& text) {
-  TypeRegistry registry;
-  RegisterBuiltins(registry);
-  try {
-    (void)LoadSceneFromString(text, "scene.json", ".", registry);
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "(no error)";
-}
+inline std::string SceneError(const std::string& text) { return testing::SceneLoadError(text); }
 
 }  // namespace gipsi

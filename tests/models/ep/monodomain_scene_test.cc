@@ -9,6 +9,7 @@
 #include "gipsi/io/scene.h"
 #include "gipsi/models/builtins.h"
 #include "gipsi/models/ep/monodomain.h"
+#include "io/scene_test_util.h"
 
 namespace gipsi {
 namespace {
@@ -29,16 +30,7 @@ std::string SceneText(const std::string& tissue) {
 
 const std::string kCell = R"("cell": {"model": "AlievPanfilov"}, )";
 
-std::string LoadError(const std::string& text) {
-  TypeRegistry registry;
-  RegisterBuiltins(registry);
-  try {
-    (void)LoadSceneFromString(text, "scene.json", ".", registry);
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "(no error)";
-}
+std::string LoadError(const std::string& text) { return testing::SceneLoadError(text); }
 
 TEST(Units, ConvertsQuantitiesToSi) {
   EXPECT_DOUBLE_EQ(UnitFactor("mS/cm", "S/m"), 0.1);
