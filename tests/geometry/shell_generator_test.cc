@@ -17,7 +17,7 @@
 /// LeakSanitizer: libgmsh 4.8 leaks a few small allocations while meshing surfaces
 /// (`meshGFace`), which `gmsh::finalize` does not free. Weak, so that another definition in the
 /// test binary (or a suppressions file in LSAN_OPTIONS) takes precedence without a clash.
-extern "C" __attribute__((weak)) const char* __lsan_default_suppressions() {
+extern "C" __attribute__((weak, visibility("default"))) const char* __lsan_default_suppressions() {
   return "leak:libgmsh.so\n";
 }
 

@@ -5,7 +5,7 @@
 // loader libltdl, cairo, fontconfig, pango) in this process; those system libraries keep one-time
 // allocations they never free.
 
-extern "C" const char* __lsan_default_suppressions() {
+extern "C" __attribute__((visibility("default"))) const char* __lsan_default_suppressions() {
   return "leak:libgmsh.so\n"
          "leak:libOSMesa.so\nleak:libgallium\nleak:libLLVM\nleak:libglapi.so\n"
          "leak:libplplot.so\nleak:libcairo.so\nleak:libfontconfig.so\nleak:libpango\n"
