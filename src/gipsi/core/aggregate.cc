@@ -52,37 +52,40 @@ void AggregateObject::DoWriteField(FieldId id, const Eigen::Ref<const Eigen::Mat
   p.part->WriteField(p.field, in);
 }
 
+Coordinator BuildAggregateParts(const ObjectBuildContext& ctx, const JsonNode& p) {
+  Coordinator parts;
+  JsonNode part_nodes = p.At("parts");
+  if (part_nodes.size() == 0) part_nodes.Expected("at least one part");
+  for (const auto& [name, node] : part_nodes.Members()) {
+    BuiltObject built = ctx.build_object(name, node);
+    try {
+      parts.AddObject(std::move(built.object), built.dt);
+    } catch (const InputError& e) {
+      node.Fail(e.what());
+    }
+  }
+  if (auto connectors = p.Find("connectors")) {
+    for (const auto& [name, node] : connectors->Members()) {
+      auto connector = ctx.registry.CreateConnector(name, node, parts);
+      parts.AddConnector(std::move(connector), static_cast<int>(node.Int("every", 1)));
+    }
+  }
+  if (auto order = p.Find("order")) parts.SetOrder(order->AsStrings(), order->path());
+  JsonNode dt = p.At("dt");
+  try {
+    parts.Prepare(ReadPositiveQuantity(dt, "s"));
+  } catch (const InputError& e) {
+    dt.Fail(e.what());
+  }
+  return parts;
+}
+
 void RegisterAggregate(TypeRegistry& registry) {
   registry.objects.Register(
       "Aggregate",
       [](const ObjectBuildContext& ctx) -> std::unique_ptr<SimObject> {
-        const JsonNode& p = ctx.params;
         ctx.CheckKeys({"parts", "connectors", "order"});
-        Coordinator parts;
-        JsonNode part_nodes = p.At("parts");
-        if (part_nodes.size() == 0) part_nodes.Expected("at least one part");
-        for (const auto& [name, node] : part_nodes.Members()) {
-          BuiltObject built = ctx.build_object(name, node);
-          try {
-            parts.AddObject(std::move(built.object), built.dt);
-          } catch (const InputError& e) {
-            node.Fail(e.what());
-          }
-        }
-        if (auto connectors = p.Find("connectors")) {
-          for (const auto& [name, node] : connectors->Members()) {
-            auto connector = ctx.registry.CreateConnector(name, node, parts);
-            parts.AddConnector(std::move(connector), static_cast<int>(node.Int("every", 1)));
-          }
-        }
-        if (auto order = p.Find("order")) parts.SetOrder(order->AsStrings(), order->path());
-        JsonNode dt = p.At("dt");
-        try {
-          parts.Prepare(ReadPositiveQuantity(dt, "s"));
-        } catch (const InputError& e) {
-          dt.Fail(e.what());
-        }
-        return std::make_unique<AggregateObject>(ctx.name, std::move(parts));
+        return std::make_unique<AggregateObject>(ctx.name, BuildAggregateParts(ctx, ctx.params));
       },
       "an object made of parts and the connectors between them");
 }

@@ -15,7 +15,7 @@
 namespace gipsi {
 
 /// Not copyable or movable.
-class AggregateObject final : public SimObject {
+class AggregateObject : public SimObject {
  public:
   /// Takes a prepared coordinator (parts, connectors, order; `Prepare(dt)` called with this
   /// aggregate's dt) and exposes its parts' fields.
@@ -30,6 +30,8 @@ class AggregateObject final : public SimObject {
   [[nodiscard]] std::string failure_detail() const override { return failure_detail_; }
 
  protected:
+  /// Number of fields that forward to parts (ids 0 … n−1); a subclass declares its own after.
+  [[nodiscard]] std::size_t num_part_fields() const { return proxies_.size(); }
   StepStatus DoStep(double t, double dt) override;
   void DoReadField(FieldId id, Eigen::Ref<Eigen::MatrixXd> out) const override;
   void DoWriteField(FieldId id, const Eigen::Ref<const Eigen::MatrixXd>& in) override;
@@ -44,6 +46,10 @@ class AggregateObject final : public SimObject {
   Points empty_ = Points(3, 0);
   std::string failure_detail_;  // set only when a part fails
 };
+
+/// Builds the parts, connectors and order of an aggregate from `p` ({"dt", "parts",
+/// "connectors", "order"}) and prepares them with its dt; throws InputError naming the path.
+Coordinator BuildAggregateParts(const ObjectBuildContext& ctx, const JsonNode& p);
 
 /// Registers "Aggregate": {"type": "Aggregate", "dt": macro step, "parts": {name: object...},
 /// "connectors": {name: connector...}, "order": [names...]}.

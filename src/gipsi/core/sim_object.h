@@ -12,6 +12,7 @@
 
 #include "gipsi/base/math.h"
 #include "gipsi/core/boundary_conditions.h"
+#include "gipsi/core/cavity_law.h"
 #include "gipsi/core/field.h"
 #include "gipsi/core/step_status.h"
 #include "gipsi/geometry/boundary.h"
@@ -122,6 +123,11 @@ class SimObject {
     std::string unit;
   };
   [[nodiscard]] virtual std::vector<ProfileEntry> ProfileBreakdown() const { return {}; }
+  /// Couples the cavity called `cavity` (e.g. an endocardium declared by the object) to a
+  /// blood model: from now on each step solves for the cavity pressure that makes the wall's
+  /// enclosed volume equal `law`'s end volume (cavity_law.h). `law` must outlive the object's
+  /// steps. Throws InputError if the object has no such cavity (the default: no cavities).
+  virtual void AttachCavityLaw(std::string_view cavity, CavityLaw* law);
   /// Called by the kernel at the start of every macro step (aggregates forward it).
   virtual void BeginMacroStep() { bcs_.ClearCouplingLoads(); }
 

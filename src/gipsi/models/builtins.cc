@@ -5,12 +5,14 @@
 #include "gipsi/core/aggregate.h"
 #include "gipsi/models/circulation/circulation.h"
 #include "gipsi/models/connectors/boundary_coupling.h"
+#include "gipsi/models/connectors/cavity_coupling.h"
 #include "gipsi/models/connectors/excitation_contraction.h"
 #include "gipsi/models/connectors/field_copy.h"
 #include "gipsi/models/ep/cell_models.h"
 #include "gipsi/models/ep/grid_monodomain.h"
 #include "gipsi/models/ep/monodomain.h"
 #include "gipsi/models/fem/fem_solid.h"
+#include "gipsi/models/heart/heart.h"
 #include "gipsi/models/mass_spring/mass_spring.h"
 
 namespace gipsi {
@@ -26,8 +28,10 @@ void RegisterBuiltins(TypeRegistry& registry) {
   RegisterGridMonodomain(registry);
   RegisterCirculation(registry);
   RegisterAggregate(registry);
+  RegisterHeart(registry);
   RegisterFieldCopy(registry);
   RegisterExcitationContraction(registry);
+  RegisterCavityCoupling(registry);
   RegisterBoundaryCoupling(registry);
   RegisterRigidTool(registry);
   RegisterContact(registry);

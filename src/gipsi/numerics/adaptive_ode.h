@@ -110,6 +110,9 @@ class AdaptiveOde {
   [[nodiscard]] double next_step() const { return h_; }
   /// Forgets the step-size guess (e.g. after a discontinuity in the model).
   void ResetStepSize() { h_ = 0; }
+  /// Sets the step-size guess (0: choose one): a second integrator started like this one
+  /// repeats its steps exactly (trial integrations).
+  void SetStepSize(double h) { h_ = h; }
 
  private:
   double InitialStep(const OdeView& system, double t, double t_end, const VecX& x);

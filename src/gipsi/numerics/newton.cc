@@ -66,7 +66,7 @@ NewtonStats NewtonSolver::Solve(NonlinearSystem& system, VecX& d, SparseMatrix& 
     }
     stats.linear_iterations += ls.iterations;
     stats.refactorizations += ls.refactorized ? 1 : 0;
-    if (!ls.converged || !delta_.allFinite()) {
+    if (!ls.converged || !delta_.allFinite() || !ApplyLowRank(system, stats)) {
       stats.linear_failure = true;
       return stats;
     }
@@ -126,6 +126,47 @@ NewtonStats NewtonSolver::Solve(NonlinearSystem& system, VecX& d, SparseMatrix& 
     }
   }
   return stats;
+}
+
+bool NewtonSolver::ApplyLowRank(NonlinearSystem& system, NewtonStats& stats) {
+  const int k = system.num_low_rank_terms();
+  if (k == 0) return true;
+  GIPSI_CHECK(k <= kMaxLowRankTerms);
+  // (J + B W Bᵀ)⁻¹ r = y − Z (W⁻¹ + Bᵀ Z)⁻¹ Bᵀ y with y = J⁻¹ r (in delta_) and Z = J⁻¹ B.
+  // Terms with w = 0 drop out and are skipped.
+  if (static_cast<int>(low_rank_z_.size()) < k) low_rank_z_.resize(static_cast<std::size_t>(k));
+  std::array<const VecX*, kMaxLowRankTerms> b{};
+  std::array<double, kMaxLowRankTerms> w{};
+  std::array<int, kMaxLowRankTerms> active{};
+  int m = 0;
+  for (int i = 0; i < k; ++i) {
+    const auto ui = static_cast<std::size_t>(i);
+    system.LowRankTerm(i, b[ui], w[ui]);
+    if (!(w[ui] > 0)) continue;
+    VecX& z = low_rank_z_[ui];
+    if (z.size() != b[ui]->size()) z.setZero(b[ui]->size());
+    const LinearSolveStats ls = linear_->Solve(*b[ui], z);  // warm-started from the last z
+    stats.linear_iterations += ls.iterations;
+    if (!ls.converged || !z.allFinite()) return false;
+    active[static_cast<std::size_t>(m++)] = i;
+  }
+  if (m == 0) return true;
+  using Small = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxLowRankTerms,
+                              kMaxLowRankTerms>;
+  using SmallVec = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxLowRankTerms, 1>;
+  Small s(m, m);
+  SmallVec c(m);
+  for (int i = 0; i < m; ++i) {
+    const auto ai = static_cast<std::size_t>(active[static_cast<std::size_t>(i)]);
+    c[i] = b[ai]->dot(delta_);
+    for (int j = 0; j < m; ++j)
+      s(i, j) = b[ai]->dot(low_rank_z_[static_cast<std::size_t>(active[static_cast<std::size_t>(j)])]);
+    s(i, i) += 1 / w[ai];
+  }
+  const SmallVec coef = s.ldlt().solve(c);
+  for (int j = 0; j < m; ++j)
+    delta_ -= coef[j] * low_rank_z_[static_cast<std::size_t>(active[static_cast<std::size_t>(j)])];
+  return delta_.allFinite();
 }
 
 std::string Describe(const NewtonStats& stats, const NewtonOptions& options) {

@@ -14,6 +14,7 @@
 #include <array>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "gipsi/base/math.h"
 #include "gipsi/numerics/sparse/linear_solver.h"
@@ -34,6 +35,14 @@ class NonlinearSystem {
   /// epsilon times the sum of the magnitudes of the terms assembled into it), ≥ 0: no iterate
   /// can be told apart from the solution below it, so Newton accepts a residual under it.
   [[nodiscard]] virtual double residual_floor() const { return 0; }
+  /// Optional low-rank part of the Jacobian kept out of the sparse matrix because it is dense
+  /// (e.g. a cavity's volume gradient times its pressure–volume stiffness): the full Jacobian
+  /// is J + Σ_k w_k b_k b_kᵀ with w_k ≥ 0, valid after the last CalcResidualAndJacobian.
+  /// Newton solves with it by the Sherman–Morrison–Woodbury formula (one extra solve with J per
+  /// term). Default: none.
+  [[nodiscard]] virtual int num_low_rank_terms() const { return 0; }
+  /// Term k (k < 8): sets `b` (size of the system, zero on constrained unknowns) and `w`.
+  virtual void LowRankTerm(int /*k*/, const VecX*& /*b*/, double& /*w*/) const {}
 };
 
 /// Options. Plain struct.
@@ -93,6 +102,11 @@ class NewtonSolver {
   VecX r_, r_trial_, delta_, d_trial_, rhs_;
   VecX warm_;  // first correction of the last solve
   bool warm_valid_ = false;
+  static constexpr int kMaxLowRankTerms = 8;
+  std::vector<VecX> low_rank_z_;  // J⁻¹ b_k of the low-rank terms (sized on first use)
+
+  /// Applies the low-rank correction to delta_ = J⁻¹ rhs (Woodbury); false if a solve fails.
+  bool ApplyLowRank(NonlinearSystem& system, NewtonStats& stats);
 };
 
 /// One-line summary of a failed solve for diagnostics ("Newton did not converge in 25

@@ -110,6 +110,9 @@ class Circuit {
 
   // --- Valves (the hybrid part) ---
   [[nodiscard]] ValveState valve_state(int k) const { return states_[static_cast<std::size_t>(k)]; }
+  /// Every valve's state (valve order), e.g. to undo a trial integration.
+  [[nodiscard]] const std::vector<ValveState>& valve_states() const { return states_; }
+  void SetValveStates(const std::vector<ValveState>& states) { states_ = states; }
   /// Switches valve k to its next state; a closing inertial valve's flow state is set to 0.
   void SwitchValve(int k, Eigen::Ref<VecX> x);
   /// Sets every valve's state from the pressures at (t, x) without events: open where the

@@ -118,36 +118,37 @@ void Circulation::UpdateOutputs(double t) {
   circuit_.CalcFlows(t, x_, pressure_, flow_);
 }
 
-StepStatus Circulation::DoStep(double t, double dt) {
-  failed_compartment_ = failed_connection_ = -1;
+StepStatus Circulation::Integrate(AdaptiveOde& ode, double t, double dt, VecX& x, bool record) {
   const double t_end = t + dt;
   double now = t;
   const OdeView view(circuit_);
   int switches = 0;
-  auto record = [&](int k) {
-    circuit_.SwitchValve(k, x_);
-    events_.Record({now, k, circuit_.valve_state(k)});
+  auto log_switch = [&](int k) {
+    circuit_.SwitchValve(k, x);
+    if (record) events_.Record({now, k, circuit_.valve_state(k)});
     return ++switches <= params_.max_events_per_step;
   };
   while (true) {
     // Transitions pending at the current point (after an external input changed a pressure,
     // or two valves switching at the same instant).
-    for (int k; (k = ode_.FirstPositive(circuit_.guards(), now, x_)) >= 0;)
-      if (!record(k))
+    for (int k; (k = ode.FirstPositive(circuit_.guards(), now, x)) >= 0;)
+      if (!log_switch(k))
         return StepStatus::Failed("valves switch without end within one step (chattering)", k, now);
-    const AdaptiveOdeResult result = ode_.Integrate(view, now, t_end, x_, &circuit_.guards());
-    accepted_ += result.accepted;
-    rejected_ += result.rejected;
-    evaluations_ += result.evaluations;
+    const AdaptiveOdeResult result = ode.Integrate(view, now, t_end, x, &circuit_.guards());
+    if (record) {
+      accepted_ += result.accepted;
+      rejected_ += result.rejected;
+      evaluations_ += result.evaluations;
+    }
     using Outcome = AdaptiveOdeResult::Outcome;
     if (result.outcome == Outcome::kEvent) {
-      if (!record(result.event))
+      if (!log_switch(result.event))
         return StepStatus::Failed("valves switch without end within one step (chattering)",
                                   result.event, now);
       continue;
     }
-    if (result.outcome == Outcome::kReachedEnd) break;
-    UpdateOutputs(now);
+    if (result.outcome == Outcome::kReachedEnd) return StepStatus::Ok();
+    if (record) UpdateOutputs(now);
     if (result.outcome == Outcome::kNonFinite)
       return StepStatus::Diverged("circulation state became non-finite (at this time)", -1, now);
     if (result.outcome == Outcome::kStepTooSmall)
@@ -155,6 +156,38 @@ StepStatus Circulation::DoStep(double t, double dt) {
           "adaptive step fell below its minimum at this time (stiff or singular circuit)", -1, now);
     return StepStatus::Failed("too many adaptive steps in one object step", -1, now);
   }
+}
+
+bool Circulation::PredictChamberVolume(int c, double dt, double p, double& volume) {
+  GIPSI_CHECK(c >= 0 && c < circuit_.num_compartments() &&
+              circuit_.compartments()[static_cast<std::size_t>(c)].drive ==
+                  CompartmentSpec::Drive::kPressure);
+  if (trial_x_.size() != x_.size())
+    trial_ode_.Prepare(circuit_.ode_size(), static_cast<int>(circuit_.valves().size()),
+                       OdeOptions(params_, circuit_));
+  trial_x_ = x_;
+  trial_valves_ = circuit_.valve_states();
+  const double saved_pressure = circuit_.ChamberPressure(c);
+  circuit_.SetChamberPressure(c, p);
+  trial_ode_.SetStepSize(ode_.next_step());
+  const StepStatus status = Integrate(trial_ode_, time(), dt, trial_x_, false);
+  circuit_.SetValveStates(trial_valves_);
+  circuit_.SetChamberPressure(c, saved_pressure);
+  volume = trial_x_[c];
+  return status.ok() && std::isfinite(volume);
+}
+
+void Circulation::SetVolume(int c, double volume) {
+  GIPSI_CHECK(c >= 0 && c < circuit_.num_compartments());
+  x_[c] = volume;
+  circuit_.InitialiseValves(time(), x_);
+  UpdateOutputs(time());
+}
+
+StepStatus Circulation::DoStep(double t, double dt) {
+  failed_compartment_ = failed_connection_ = -1;
+  const double t_end = t + dt;
+  if (StepStatus status = Integrate(ode_, t, dt, x_, true); !status.ok()) return status;
   UpdateOutputs(t_end);
   for (Index i = 0; i < x_.size(); ++i)
     if (!std::isfinite(x_[i]))

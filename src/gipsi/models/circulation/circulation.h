@@ -67,6 +67,14 @@ class Circulation final : public SimObject {
   [[nodiscard]] std::int64_t accepted_steps() const { return accepted_; }
   [[nodiscard]] std::int64_t rejected_steps() const { return rejected_; }
   [[nodiscard]] std::vector<ProfileEntry> ProfileBreakdown() const override;
+  /// For monolithic cavity coupling (cavity_law.h): the blood volume [m³] of pressure-driven
+  /// chamber `c` at time() + dt if its pressure is held at p [Pa] over the step, integrated
+  /// exactly as Step would (same steps, events located the same way), leaving this object
+  /// unchanged. False if the integration fails. Allocation-free after the first call.
+  bool PredictChamberVolume(int c, double dt, double p, double& volume);
+  /// Sets the blood volume of compartment `c` [m³] (before the first step: a 3-D cavity's
+  /// volume), and re-initialises the valves from the new pressures.
+  void SetVolume(int c, double volume);
   /// After a failed step: the compartment or connection whose value was not finite, if any.
   [[nodiscard]] std::string failure_detail() const override;
 
@@ -98,13 +106,17 @@ class Circulation final : public SimObject {
     int index;
   };
   void Declare(FieldInfo info, Quantity quantity, int index);
+  /// Integrates x over [t, t + dt] with `ode`, switching valves at located events (recorded
+  /// in events_ if `record`); the status says why it stopped early.
+  StepStatus Integrate(AdaptiveOde& ode, double t, double dt, VecX& x, bool record);
   void UpdateOutputs(double t);
   void LogNewEvents();
 
   CirculationParams params_;
   Circuit circuit_;
-  AdaptiveOde ode_;
-  VecX x_;
+  AdaptiveOde ode_, trial_ode_;
+  VecX x_, trial_x_;
+  std::vector<ValveState> trial_valves_;
   VecX pressure_, flow_;
   ValveEventLog events_;
   std::int64_t logged_events_ = 0;

@@ -147,8 +147,13 @@ FemSolid::FemSolid(std::string name, std::shared_ptr<const Mesh> domain, FemPara
     const FieldId f_pressure =
         DeclareField({spec.name + "_pressure", L::kGlobal, 1, "Pa", A::kReadWrite,
                       "pressure in the cavity, acting on its faces (follower load)"});
-    cavities_.push_back(Cavity{std::move(faces), std::move(nodes), std::move(volume),
-                               std::move(positions), 0.0, f_volume, f_pressure});
+    Cavity& cavity = cavities_.emplace_back(Cavity{.faces = std::move(faces),
+                                                   .nodes = std::move(nodes),
+                                                   .volume = std::move(volume),
+                                                   .positions = std::move(positions),
+                                                   .f_volume = f_volume,
+                                                   .f_pressure = f_pressure});
+    cavity.gradient = VecX::Zero(3 * n);
   }
 }
 
@@ -287,10 +292,11 @@ void FemSolid::FinishResidual(const VecX& d, VecX& r) {
 bool FemSolid::CalcResidual(const VecX& d, VecX& r) {
   const auto start = Clock::now();
   work_ = scheme_.x() + d;
-  const bool ok = AssembleElements(work_.data(), f_int_, nullptr);
+  bool ok = AssembleElements(work_.data(), f_int_, nullptr);
   if (ok) {
     AssembleExternal(work_.data(), s_);
-    FinishResidual(d, r);
+    ok = AddCoupledCavityLoads(work_.data());
+    if (ok) FinishResidual(d, r);
   }
   profile_.assembly_seconds += Seconds(start);
   return ok;
@@ -304,6 +310,10 @@ bool FemSolid::CalcResidualAndJacobian(const VecX& d, VecX& r, SparseMatrix& J) 
     return false;
   }
   AssembleExternal(work_.data(), s_);
+  if (!AddCoupledCavityLoads(work_.data())) {
+    profile_.assembly_seconds += Seconds(start);
+    return false;
+  }
   double* jv = J.valuePtr();
   const Index nnz = J.nonZeros();
   if (params_.rayleigh_stiffness > 0 && first_iteration_)
@@ -315,24 +325,9 @@ bool FemSolid::CalcResidualAndJacobian(const VecX& d, VecX& r, SparseMatrix& J) 
     const double p = pressure_prev_[f] + s_ * (pressure_new_[f] - pressure_prev_[f]);
     const Vec3 t = traction_prev_.col(f) + s_ * (traction_new_.col(f) - traction_prev_.col(f));
     if (p == 0 && t.squaredNorm() == 0) continue;
-    int node[3];
-    for (int v = 0; v < 3; ++v)
-      node[v] = bnd.vertex_to_node[static_cast<std::size_t>(bnd.triangles(v, f))];
-    const Mat99 jf =
-        FaceLoadJacobian(rest_.segment<3>(3 * node[0]) + work_.segment<3>(3 * node[0]),
-                         rest_.segment<3>(3 * node[1]) + work_.segment<3>(3 * node[1]),
-                         rest_.segment<3>(3 * node[2]) + work_.segment<3>(3 * node[2]), p, t);
-    const Mat99 sym = 0.5 * (jf + jf.transpose());
-    const int tet = bnd.face_to_tet[static_cast<std::size_t>(f)];
-    const auto& local = face_local_[static_cast<std::size_t>(f)];
-    for (int a = 0; a < 3; ++a)
-      for (int b = 0; b < 3; ++b)
-        for (int k = 0; k < 3; ++k) {
-          double* col = jv + assembly_.ValueIndex(tet, local[static_cast<std::size_t>(a)],
-                                                  local[static_cast<std::size_t>(b)], 0, k);
-          for (int i = 0; i < 3; ++i) col[i] -= sym(3 * a + i, 3 * b + k);
-        }
+    AddFaceLoadTangent(f, work_.data(), p, t, jv);
   }
+  AddCoupledCavityTangent(work_.data(), jv);
   // Inertia and damping: J += (c_a + c_v α) M + c_v β K_n.
   if (params_.scheme != ImplicitSchemeKind::kStatic) {
     const double cm = scheme_.c_a() + scheme_.c_v() * params_.rayleigh_mass;
@@ -377,6 +372,28 @@ bool FemSolid::CalcResidualAndJacobian(const VecX& d, VecX& r, SparseMatrix& J) 
   return true;
 }
 
+void FemSolid::AddFaceLoadTangent(Index f, const double* u, double p, const Vec3& t,
+                                  double* jv) const {
+  const BoundarySurface& bnd = boundary();
+  int node[3];
+  for (int v = 0; v < 3; ++v)
+    node[v] = bnd.vertex_to_node[static_cast<std::size_t>(bnd.triangles(v, f))];
+  Vec3 xf[3];
+  for (int v = 0; v < 3; ++v)
+    xf[v] = rest_.segment<3>(3 * node[v]) + Eigen::Map<const Vec3>(u + 3 * node[v]);
+  const Mat99 jf = FaceLoadJacobian(xf[0], xf[1], xf[2], p, t);
+  const Mat99 sym = 0.5 * (jf + jf.transpose());
+  const int tet = bnd.face_to_tet[static_cast<std::size_t>(f)];
+  const auto& local = face_local_[static_cast<std::size_t>(f)];
+  for (int a = 0; a < 3; ++a)
+    for (int b = 0; b < 3; ++b)
+      for (int k = 0; k < 3; ++k) {
+        double* col = jv + assembly_.ValueIndex(tet, local[static_cast<std::size_t>(a)],
+                                                local[static_cast<std::size_t>(b)], 0, k);
+        for (int i = 0; i < 3; ++i) col[i] -= sym(3 * a + i, 3 * b + k);
+      }
+}
+
 void FemSolid::GatherTargets() {
   const Index n = num_nodes();
   const BoundarySurface& bnd = boundary();
@@ -390,7 +407,8 @@ void FemSolid::GatherTargets() {
     traction_new_.col(f) = bcs.traction(f);
   }
   for (const Cavity& cavity : cavities_)
-    for (int f : cavity.faces) pressure_new_[f] += cavity.pressure;
+    if (cavity.law == nullptr)
+      for (int f : cavity.faces) pressure_new_[f] += cavity.pressure;
   constrained_dofs_.clear();
   std::fill(constraint_.begin(), constraint_.end(), 0);
   for (Index j = 0; j < bnd.num_vertices(); ++j) {
@@ -480,6 +498,7 @@ StepStatus FemSolid::Advance(double s0, double s1, double dt, int depth) {
     return StepStatus::Ok();
   }
   scheme_ = saved_scheme_;
+  RestoreCavityPressures();
   if (depth < params_.max_bisections) {
     const double mid = 0.5 * (s0 + s1);
     StepStatus status = Advance(s0, mid, dt, depth + 1);
@@ -487,9 +506,17 @@ StepStatus FemSolid::Advance(double s0, double s1, double dt, int depth) {
     return Advance(mid, s1, dt, depth + 1);
   }
   failure_detail_ = Describe(last_newton_, params_.newton);
+  if (failed_cavity_ >= 0)
+    failure_detail_ += fmt::format(
+        "; the blood coupled to cavity '{}' found no pressure for the wall's volume (is the blood "
+        "object stepped right after this one?)",
+        params_.cavities[static_cast<std::size_t>(failed_cavity_)].name);
   if (last_newton_.inadmissible && first_invalid_ >= 0)
     failure_detail_ +=
         fmt::format("; element {} is outside its law's domain (det F <= 0?)", first_invalid_);
+  if (last_newton_.inadmissible && failed_cavity_ >= 0)
+    return StepStatus::Failed("the blood coupled to a cavity could not answer; cavity",
+                              failed_cavity_);
   if (last_newton_.inadmissible)
     return StepStatus::Failed("no admissible state: an element inverted; element", first_invalid_);
   if (last_newton_.linear_failure)
@@ -498,7 +525,11 @@ StepStatus FemSolid::Advance(double s0, double s1, double dt, int depth) {
                             last_newton_.final_residual);
 }
 
-StepStatus FemSolid::DoStep(double /*t*/, double dt) {
+StepStatus FemSolid::DoStep(double t, double dt) {
+  step_time_ = t;
+  step_dt_ = dt;
+  failed_cavity_ = -1;
+  for (Cavity& cavity : cavities_) cavity.pressure_begin = cavity.pressure;
   GatherTargets();
   if (params_.scheme == ImplicitSchemeKind::kNewmark && step_count() == 0) InitialAcceleration();
   x_begin_ = scheme_.x();
@@ -675,7 +706,7 @@ void FemSolid::DoWriteField(FieldId id, const Eigen::Ref<const Eigen::MatrixXd>&
     active_from_nodes_ = true;
   } else {
     for (Cavity& cavity : cavities_)
-      if (id == cavity.f_pressure) cavity.pressure = in(0, 0);
+      if (id == cavity.f_pressure && cavity.law == nullptr) cavity.pressure = in(0, 0);
   }
 }
 

@@ -115,6 +115,13 @@ class FemSolid final : public SimObject, private NonlinearSystem {
   /// Volume of cavity i (FemParams::cavities order) at the current state [m³]; an open rim is
   /// capped (EnclosedVolume).
   [[nodiscard]] double CavityVolume(std::size_t i) const;
+  /// Couples cavity `cavity` to blood (cavity_law.h): each step then solves for the cavity
+  /// pressure p with the displacements so that the enclosed volume equals the law's end volume
+  /// at p (monolithic; the pressure's dependence on the wall enters the Newton tangent as a
+  /// rank-one term). Its pressure field becomes read-only in effect (writes are ignored).
+  void AttachCavityLaw(std::string_view cavity, CavityLaw* law) override;
+  /// The cavity's pressure [Pa]: written (pressure mode) or solved (coupled to a CavityLaw).
+  [[nodiscard]] double CavityPressure(std::size_t i) const;
 
  protected:
   StepStatus DoStep(double t, double dt) override;
@@ -127,6 +134,8 @@ class FemSolid final : public SimObject, private NonlinearSystem {
   bool CalcResidualAndJacobian(const VecX& d, VecX& r, SparseMatrix& J) override;
   [[nodiscard]] double force_scale() const override { return force_scale_; }
   [[nodiscard]] double residual_floor() const override { return residual_floor_; }
+  [[nodiscard]] int num_low_rank_terms() const override;
+  void LowRankTerm(int k, const VecX*& b, double& w) const override;
 
   /// f_int (and K values if `k_values` is not null) at displacements u; marks invalid
   /// elements.
@@ -142,6 +151,15 @@ class FemSolid final : public SimObject, private NonlinearSystem {
   void GatherTargets();
   StepStatus Advance(double s0, double s1, double dt, int depth);
   [[nodiscard]] MaterialPoint PointOf(Index e) const;
+  /// J −= sym(∂f/∂x) of face f's follower pressure p and traction t at displacements u.
+  void AddFaceLoadTangent(Index f, const double* u, double p, const Vec3& t, double* jv) const;
+  /// Coupled cavities (fem_cavity.cc): solves each one's pressure for displacements u, adds
+  /// p ∂V/∂x to f_ext_ and stores ∂V/∂x (zero on constrained dofs); false if a law fails.
+  bool AddCoupledCavityLoads(const double* u);
+  /// Their follower tangent and the weight of the rank-one term −∂p/∂V ∂V/∂x ⊗ ∂V/∂x.
+  void AddCoupledCavityTangent(const double* u, double* jv);
+  /// Back to the pressures at the start of the step (after a failed Newton solve).
+  void RestoreCavityPressures();
   void InitialAcceleration();
 
   FemParams params_;
@@ -193,10 +211,17 @@ class FemSolid final : public SimObject, private NonlinearSystem {
     std::vector<int> nodes;    // domain node of each cavity vertex
     EnclosedVolume volume;     // over the faces, oriented out of the cavity
     mutable Points positions;  // work buffer, 3 by nodes.size()
-    double pressure = 0;       // Pa, written through the field
+    double pressure = 0;       // Pa, written through the field, or solved when coupled
     FieldId f_volume, f_pressure;
+    CavityLaw* law = nullptr;  // coupled to blood when set
+    double pressure_begin = 0;  // at the start of the step
+    VecX gradient{};            // 3N: ∂V/∂x, zero on constrained dofs (coupled)
+    double stiffness = 0;       // −∂p/∂V of the law at the current pressure [Pa/m³]
+    mutable Points local_gradient{};
   };
   std::vector<Cavity> cavities_;
+  double step_time_ = 0, step_dt_ = 0;  // of the step in progress (the laws' interval)
+  int failed_cavity_ = -1;              // whose law could not answer in the last solve
 
   MechanicalFieldIds mech_;
   FieldId f_fibre_, f_active_, f_nodal_active_, f_von_mises_, f_jacobian_, f_kinetic_,

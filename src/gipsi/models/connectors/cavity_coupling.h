@@ -1,0 +1,64 @@
+#pragma once
+/// @file
+/// `CavityCoupling`: the muscle ↔ blood coupling of the GiPSi heart through their shared
+/// boundary, the endocardium. The wall object (e.g. a FemSolid with a declared cavity) solves
+/// its step together with "enclosed volume = blood volume", with the cavity pressure as the
+/// unknown (cavity_law.h); this connector answers the wall's question "how much volume does the
+/// blood fill at the end of the step if the pressure is p?" by a trial integration of the lumped
+/// circulation whose chamber is pressure-driven, and after the wall's step hands the solved
+/// pressure to that chamber, so the blood's real step ends with exactly the volume the wall
+/// encloses. Isovolumetric phases (both valves closed) need no special treatment: the blood
+/// volume is then fixed and the pressure is its multiplier.
+///
+/// Semantics and units:
+///   Gets   wall  "<cavity>_volume" [m³] (once, at build: the chamber starts with it)
+///          wall  "<cavity>_pressure" [Pa] (each firing: the pressure the wall solved)
+///   Sets   blood "<chamber>_pressure_input" [Pa] (each firing)
+///   Law    V_cavity(p) = V_blood(p) (1 − p / K), V_blood from the circulation's trial step and
+///          K the blood's bulk modulus (2.2 GPa by default): blood is slightly compressible,
+///          which keeps the pressure a well-defined function of the wall's volume when both
+///          valves are closed (a 100 mL cavity at 16 kPa is compressed by 0.7 µL).
+/// Order: the blood must step right after the wall with the same time step, and the connector
+/// fires between the two; a wrong order is reported as a failed step, not silently accepted.
+
+#include <string>
+
+#include "gipsi/core/cavity_law.h"
+#include "gipsi/core/connector.h"
+#include "gipsi/core/registry.h"
+#include "gipsi/core/sim_object.h"
+
+namespace gipsi {
+
+class Circulation;
+
+/// Not copyable or movable (a Connector).
+class CavityCoupling final : public Connector, public CavityLaw {
+ public:
+  /// Attaches itself to `wall`'s cavity `cavity` and sets `blood`'s chamber `chamber` (which
+  /// must be pressure-driven) to the cavity's current volume. Throws InputError for a missing
+  /// cavity or chamber, a chamber that is not pressure-driven, or a bulk modulus ≤ 0.
+  CavityCoupling(std::string name, SimObject& wall, const std::string& cavity, Circulation& blood,
+                 const std::string& chamber, double bulk_modulus);
+
+  [[nodiscard]] std::string_view type_name() const override { return "CavityCoupling"; }
+  bool EndVolume(double t, double dt, double p, double& volume) override;
+  /// Trial integrations of the blood so far (what the coupling costs the circulation).
+  [[nodiscard]] std::int64_t trials() const { return trials_; }
+
+ protected:
+  StepStatus DoFire(double t) override;
+
+ private:
+  SimObject& wall_;
+  Circulation& blood_;
+  int chamber_ = -1;
+  FieldId wall_pressure_, blood_pressure_;
+  double bulk_modulus_;
+  std::int64_t trials_ = 0;
+};
+
+/// Registers "CavityCoupling" (keys in docs/scene-format.md).
+void RegisterCavityCoupling(TypeRegistry& registry);
+
+}  // namespace gipsi

@@ -1,0 +1,172 @@
+// FemSolid's cavities coupled to blood through a CavityLaw (cavity_law.h).
+//
+// For each coupled cavity the step's unknowns are the displacements u and the pressure p, with
+//   f_int(u) − p ∂V/∂x(u) − … = 0     (the pressure acts as a follower load, p ∂V/∂x)
+//   V(u) = V_b(p)                      (the wall encloses what the blood fills at the end)
+// where V_b is the law's end volume, non-increasing in p. For given u the second equation has
+// one root p(u) (V − V_b is increasing in p), found here by a bracketed secant iteration, so
+// Newton sees a residual in u alone. Differentiating p(u): ∂p/∂u = ∂V/∂x / C with
+// C = −dV_b/dp > 0 (the blood's compressibility keeps it positive when the valves are closed),
+// which adds the rank-one term (1/C) ∂V/∂x ⊗ ∂V/∂x to the tangent, solved by Newton with the
+// Sherman–Morrison–Woodbury formula instead of filling the sparse matrix.
+
+#include <algorithm>
+#include <cmath>
+
+#include <fmt/format.h>
+
+#include "gipsi/base/error.h"
+#include "gipsi/models/fem/fem_solid.h"
+
+namespace gipsi {
+namespace {
+
+/// Root of h(p) = v − law(p) (increasing in p) near `guess`; false if the law fails or no root
+/// is bracketed. `stiffness` estimates −dp/dV_b [Pa/m³] (0: unknown) for the first step.
+bool SolvePressure(CavityLaw& law, double t, double dt, double v, double guess, double stiffness,
+                   double& p) {
+  auto h = [&](double q, double& out) {
+    double vb = 0;
+    if (!law.EndVolume(t, dt, q, vb) || !std::isfinite(vb)) return false;
+    out = v - vb;
+    return true;
+  };
+  double a = guess, ha = 0;
+  if (!h(a, ha)) return false;
+  const double tolerance = 1e-13 * std::abs(v);
+  if (std::abs(ha) <= tolerance) {
+    p = a;
+    return true;
+  }
+  // Bracket: step away from the guess in the direction that reduces |h|, doubling the step.
+  const double first =
+      stiffness > 0 ? std::max(2 * std::abs(ha) * stiffness, 1e-3) : std::max(1.0, 0.01 * std::abs(a));
+  double step = ha > 0 ? -first : first;
+  double b = a, hb = ha;
+  for (int k = 0; k < 80; ++k) {
+    b = a + step;
+    if (!h(b, hb)) return false;
+    if ((hb > 0) != (ha > 0) || hb == 0) break;
+    a = b;
+    ha = hb;
+    step *= 2;
+  }
+  if ((hb > 0) == (ha > 0) && hb != 0) return false;
+  // Illinois (modified regula falsi): superlinear, and never leaves the bracket.
+  int side = 0;
+  for (int k = 0; k < 200; ++k) {
+    const double c = (a * hb - b * ha) / (hb - ha);
+    double hc = 0;
+    if (!h(c, hc)) return false;
+    if (std::abs(hc) <= tolerance || std::abs(b - a) <= 1e-10 * (std::abs(c) + 1.0)) {
+      p = c;
+      return true;
+    }
+    if ((hc > 0) == (hb > 0)) {
+      b = c;
+      hb = hc;
+      if (side == -1) ha *= 0.5;
+      side = -1;
+    } else {
+      a = c;
+      ha = hc;
+      if (side == 1) hb *= 0.5;
+      side = 1;
+    }
+  }
+  p = 0.5 * (a + b);
+  return true;
+}
+
+}  // namespace
+
+void FemSolid::AttachCavityLaw(std::string_view cavity, CavityLaw* law) {
+  GIPSI_CHECK(law != nullptr);
+  for (std::size_t i = 0; i < cavities_.size(); ++i) {
+    if (params_.cavities[i].name != cavity) continue;
+    if (cavities_[i].law != nullptr)
+      throw InputError(fmt::format("object '{}': cavity '{}' is already coupled to blood", name(),
+                                   cavity));
+    cavities_[i].law = law;
+    return;
+  }
+  std::string names;
+  for (const FemCavitySpec& spec : params_.cavities)
+    names += (names.empty() ? "" : ", ") + spec.name;
+  throw InputError(fmt::format("object '{}' (FemSolid) has no cavity '{}'; its cavities: {}",
+                               name(), cavity, names.empty() ? "none" : names));
+}
+
+double FemSolid::CavityPressure(std::size_t i) const {
+  GIPSI_CHECK(i < cavities_.size());
+  return cavities_[i].pressure;
+}
+
+bool FemSolid::AddCoupledCavityLoads(const double* u) {
+  for (Cavity& cavity : cavities_) {
+    if (cavity.law == nullptr) continue;
+    for (std::size_t k = 0; k < cavity.nodes.size(); ++k) {
+      const auto node = static_cast<Index>(cavity.nodes[k]);
+      cavity.positions.col(static_cast<Index>(k)) =
+          rest_.segment<3>(3 * node) + Eigen::Map<const Vec3>(u + 3 * node);
+    }
+    const double v = cavity.volume.Compute(cavity.positions, &cavity.local_gradient);
+    double p = cavity.pressure;
+    if (!SolvePressure(*cavity.law, step_time_, step_dt_, v, cavity.pressure, cavity.stiffness,
+                       p)) {
+      failed_cavity_ = static_cast<int>(&cavity - cavities_.data());
+      return false;
+    }
+    cavity.pressure = p;
+    cavity.gradient.setZero();
+    for (std::size_t k = 0; k < cavity.nodes.size(); ++k) {
+      const auto node = static_cast<Index>(cavity.nodes[k]);
+      cavity.gradient.segment<3>(3 * node) += cavity.local_gradient.col(static_cast<Index>(k));
+    }
+    for (int dof : constrained_dofs_) cavity.gradient[dof] = 0;
+    f_ext_ += p * cavity.gradient;
+  }
+  return true;
+}
+
+void FemSolid::AddCoupledCavityTangent(const double* u, double* jv) {
+  for (Cavity& cavity : cavities_) {
+    if (cavity.law == nullptr) continue;
+    // The follower part p ∂²V/∂x² is the faces' pressure tangent (the cap of an open rim moves
+    // only with the rim; its curvature terms are left out, exact when the rim is held).
+    for (int f : cavity.faces) AddFaceLoadTangent(f, u, cavity.pressure, Vec3::Zero(), jv);
+    // C = −dV_b/dp by a one-sided difference of 1e-6 of the pressure (at least 1 mPa).
+    const double p = cavity.pressure;
+    const double dp = std::max(1e-3, 1e-6 * std::abs(p));
+    double v0 = 0, v1 = 0;
+    cavity.stiffness = 0;
+    if (cavity.law->EndVolume(step_time_, step_dt_, p, v0) &&
+        cavity.law->EndVolume(step_time_, step_dt_, p + dp, v1) && v0 > v1)
+      cavity.stiffness = dp / (v0 - v1);
+  }
+}
+
+void FemSolid::RestoreCavityPressures() {
+  for (Cavity& cavity : cavities_)
+    if (cavity.law != nullptr) cavity.pressure = cavity.pressure_begin;
+}
+
+int FemSolid::num_low_rank_terms() const {
+  int count = 0;
+  for (const Cavity& cavity : cavities_) count += cavity.law != nullptr ? 1 : 0;
+  return count;
+}
+
+void FemSolid::LowRankTerm(int k, const VecX*& b, double& w) const {
+  for (const Cavity& cavity : cavities_) {
+    if (cavity.law == nullptr) continue;
+    if (k-- == 0) {
+      b = &cavity.gradient;
+      w = cavity.stiffness;
+      return;
+    }
+  }
+  GIPSI_CHECK(false);
+}
+
+}  // namespace gipsi

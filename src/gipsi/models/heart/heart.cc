@@ -1,0 +1,211 @@
+#include "gipsi/models/heart/heart.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <fmt/format.h>
+
+#include "gipsi/base/error.h"
+#include "gipsi/base/log.h"
+#include "gipsi/base/units.h"
+
+namespace gipsi {
+namespace {
+
+/// The default heart: a left ventricle on the scene's mesh "lv" (an "ellipsoid_shell" with
+/// groups endo, epi and base), Mitchell–Schaeffer cells stimulated at the apex every 0.8 s,
+/// Guccione myocardium with rule-based fibres (+60° endocardium to −60° epicardium) and its base
+/// held, and the closed-loop circulation with the LV as the 3-D cavity. docs/heart.md lists the
+/// parameters and why they are what they are.
+constexpr const char* kHeartDefaults = R"({
+  "dt": "5 ms",
+  "parts": {
+    "bioelectricity": {
+      "type": "Monodomain", "domain": "lv", "dt": "0.1 ms",
+      "cell": {"model": "MitchellSchaeffer"},
+      "conductivity": {"longitudinal": "3 S/m", "transverse": "0.75 S/m"},
+      "fibres": {"rule": "transmural", "endo": {"group": "endo"}, "epi": {"group": "epi"},
+                 "axis": [0, 0, 1], "endo_angle": 60, "epi_angle": -60},
+      "stimuli": {"apex": {"region": {"sphere": {"center": [0, 0, -0.05], "radius": 0.01}},
+                           "amplitude": "50 uA/uF", "duration": "2 ms", "period": "0.8 s"}},
+      "activation": {"threshold": "-40 mV"}
+    },
+    "muscle": {
+      "type": "FemSolid", "domain": "lv", "dt": "5 ms",
+      "material": {"law": "Guccione", "C": 1000, "bf": 8, "bt": 2, "bfs": 4,
+                   "bulk_modulus": 50000},
+      "fibres": {"rule": "transmural", "endo": {"group": "endo"}, "epi": {"group": "epi"},
+                 "axis": [0, 0, 1], "endo_angle": 60, "epi_angle": -60},
+      "integrator": "Static", "gravity": [0, 0, 0],
+      "linear_solver": {"type": "cholmod"},
+      "newton": {"tolerance": 1e-8, "max_iterations": 30},
+      "cavities": {"lumen": {"group": "endo"}},
+      "boundary_conditions": [{"name": "base", "region": {"group": "base"}, "fix": true}]
+    },
+    "blood": {
+      "type": "Circulation", "preset": "closed_loop", "dt": "5 ms",
+      "compartments": {"lv": {"driven_by": "pressure", "volume": "60 mL", "pressure": "0 mmHg"}}
+    }
+  },
+  "connectors": {
+    "excitation_contraction": {"type": "ExcitationContraction", "from": "bioelectricity.V",
+                               "to": "muscle.nodal_active_tension", "gain": "60 kPa"},
+    "cavity_coupling": {"type": "CavityCoupling", "wall": "muscle", "cavity": "lumen",
+                        "blood": "blood", "chamber": "lv"}
+  },
+  "order": ["bioelectricity", "excitation_contraction", "muscle", "cavity_coupling", "blood"],
+  "monitor": {"blood": "blood", "chamber": "lv", "artery": "aorta", "period": "0.8 s"}
+})";
+
+}  // namespace
+
+Heart::Heart(std::string name, Coordinator parts, HeartMonitorSpec monitor)
+    : AggregateObject(std::move(name), std::move(parts)), monitor_(std::move(monitor)) {
+  blood_ = FindPart(monitor_.blood);
+  if (blood_ == nullptr)
+    throw InputError(fmt::format("heart '{}': no part '{}' to monitor", this->name(),
+                                 monitor_.blood));
+  chamber_volume_ = blood_->FindField(monitor_.chamber + "_volume");
+  chamber_pressure_ = blood_->FindField(monitor_.chamber + "_pressure");
+  artery_pressure_ = blood_->FindField(monitor_.artery + "_pressure");
+  if (!(monitor_.period > 0))
+    throw InputError(fmt::format("heart '{}': the beat period must be positive", this->name()));
+  first_own_field_ = num_part_fields();
+  using L = FieldLocation;
+  using A = FieldAccess;
+  const FieldInfo own[] = {
+      {"beats", L::kGlobal, 1, "1", A::kRead, "completed beats"},
+      {"end_diastolic_volume", L::kGlobal, 1, "m3", A::kRead, "EDV of the last completed beat"},
+      {"end_systolic_volume", L::kGlobal, 1, "m3", A::kRead, "ESV of the last completed beat"},
+      {"stroke_volume", L::kGlobal, 1, "m3", A::kRead, "EDV - ESV of the last completed beat"},
+      {"ejection_fraction", L::kGlobal, 1, "1", A::kRead, "SV / EDV of the last completed beat"},
+      {"peak_chamber_pressure", L::kGlobal, 1, "Pa", A::kRead, "of the last completed beat"},
+      {"arterial_systolic_pressure", L::kGlobal, 1, "Pa", A::kRead, "of the last completed beat"},
+      {"arterial_diastolic_pressure", L::kGlobal, 1, "Pa", A::kRead,
+       "of the last completed beat"},
+      {"cycle_change", L::kGlobal, 1, "1", A::kRead,
+       "largest relative change of the beat's figures from the previous beat (1: first beat)"},
+  };
+  for (const FieldInfo& info : own) DeclareField(info);
+}
+
+StepStatus Heart::DoStep(double t, double dt) {
+  StepStatus status = AggregateObject::DoStep(t, dt);
+  if (status.ok()) Track(t + dt);
+  return status;
+}
+
+void Heart::Track(double t) {
+  Eigen::Matrix<double, 1, 1> v, p, a;
+  blood_->ReadField(chamber_volume_, v);
+  blood_->ReadField(chamber_pressure_, p);
+  blood_->ReadField(artery_pressure_, a);
+  if (!beat_started_) {
+    v_max_ = v_min_ = v(0, 0);
+    p_max_ = p(0, 0);
+    a_max_ = a_min_ = a(0, 0);
+    beat_started_ = true;
+  } else {
+    v_max_ = std::max(v_max_, v(0, 0));
+    v_min_ = std::min(v_min_, v(0, 0));
+    p_max_ = std::max(p_max_, p(0, 0));
+    a_max_ = std::max(a_max_, a(0, 0));
+    a_min_ = std::min(a_min_, a(0, 0));
+  }
+  if (t >= (beat_index_ + 1) * monitor_.period - 1e-9 * monitor_.period) {
+    FinishBeat(t);
+    // The beat's last sample opens the next one (it is both end-diastolic and first).
+    v_max_ = v_min_ = v(0, 0);
+    p_max_ = p(0, 0);
+    a_max_ = a_min_ = a(0, 0);
+  }
+}
+
+void Heart::FinishBeat(double t) {
+  BeatSummary beat;
+  beat.beat = ++beat_index_;
+  beat.end_time = t;
+  beat.edv = v_max_;
+  beat.esv = v_min_;
+  beat.peak_pressure = p_max_;
+  beat.arterial_systolic = a_max_;
+  beat.arterial_diastolic = a_min_;
+  if (!beats_.empty()) {
+    const BeatSummary& prev = beats_.back();
+    auto rel = [](double x, double y) { return std::abs(x - y) / std::max(std::abs(x), 1e-300); };
+    beat.change = std::max({rel(beat.edv, prev.edv), rel(beat.esv, prev.esv),
+                            rel(beat.peak_pressure, prev.peak_pressure),
+                            rel(beat.arterial_systolic, prev.arterial_systolic),
+                            rel(beat.arterial_diastolic, prev.arterial_diastolic)});
+  }
+  beats_.push_back(beat);
+  constexpr double kMl = 1e6, kMmHg = 1.0 / 133.322387415;
+  Log().info(
+      "{}: beat {} ({:.3f} s): EDV {:.1f} mL, ESV {:.1f} mL, SV {:.1f} mL, EF {:.1f} %, peak {} "
+      "pressure {:.1f} mmHg, {} {:.1f}/{:.1f} mmHg, change from the previous beat {:.2f} %",
+      name(), beat.beat, t, kMl * beat.edv, kMl * beat.esv, kMl * beat.stroke_volume(),
+      100 * beat.ejection_fraction(), monitor_.chamber, kMmHg * beat.peak_pressure,
+      monitor_.artery, kMmHg * beat.arterial_systolic, kMmHg * beat.arterial_diastolic,
+      100 * beat.change);
+}
+
+void Heart::DoReadField(FieldId id, Eigen::Ref<Eigen::MatrixXd> out) const {
+  const auto index = static_cast<std::size_t>(id.value());
+  if (index < first_own_field_) {
+    AggregateObject::DoReadField(id, out);
+    return;
+  }
+  const BeatSummary last = beats_.empty() ? BeatSummary{} : beats_.back();
+  switch (index - first_own_field_) {
+    case 0: out(0, 0) = static_cast<double>(beats_.size()); break;
+    case 1: out(0, 0) = last.edv; break;
+    case 2: out(0, 0) = last.esv; break;
+    case 3: out(0, 0) = last.stroke_volume(); break;
+    case 4: out(0, 0) = last.ejection_fraction(); break;
+    case 5: out(0, 0) = last.peak_pressure; break;
+    case 6: out(0, 0) = last.arterial_systolic; break;
+    case 7: out(0, 0) = last.arterial_diastolic; break;
+    default: out(0, 0) = last.change; break;
+  }
+}
+
+void Heart::DoWriteField(FieldId id, const Eigen::Ref<const Eigen::MatrixXd>& in) {
+  // Only the parts' writable fields reach here (the monitor's are read-only).
+  AggregateObject::DoWriteField(id, in);
+}
+
+void RegisterHeart(TypeRegistry& registry) {
+  registry.objects.Register(
+      "Heart",
+      [](const ObjectBuildContext& ctx) -> std::unique_ptr<SimObject> {
+        ctx.CheckKeys({"parts", "connectors", "order", "monitor"});
+        // The scene patches the defaults (RFC 7386): change one parameter
+        // ("parts": {"muscle": {"material": {"C": 800}}}), replace a part, or drop one with null.
+        auto merged = nlohmann::ordered_json::parse(kHeartDefaults);
+        nlohmann::ordered_json patch = ctx.params.raw();
+        for (const std::string& key : ObjectBuildContext::CommonKeys())
+          if (key != "dt") patch.erase(key);
+        merged.merge_patch(patch);
+        const JsonNode root(merged,
+                            fmt::format("{} (heart defaults patched by the scene)",
+                                        ctx.params.file()),
+                            ctx.params.path());
+        HeartMonitorSpec monitor;
+        const JsonNode m = root.At("monitor");
+        m.CheckKeys({"blood", "chamber", "artery", "period"});
+        monitor.blood = m.At("blood").AsString();
+        monitor.chamber = m.At("chamber").AsString();
+        monitor.artery = m.At("artery").AsString();
+        monitor.period = ReadPositiveQuantity(m.At("period"), "s");
+        Coordinator parts = BuildAggregateParts(ctx, root);
+        try {
+          return std::make_unique<Heart>(ctx.name, std::move(parts), monitor);
+        } catch (const InputError& e) {
+          m.Fail(e.what());
+        }
+      },
+      "the GiPSi heart: bioelectricity + muscle + blood with their connectors (defaults: a left "
+      "ventricle), and a beat monitor (EDV, ESV, EF, pressures)");
+}
+
+}  // namespace gipsi

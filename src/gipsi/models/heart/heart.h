@@ -1,0 +1,81 @@
+#pragma once
+/// @file
+/// `Heart`: the GiPSi paper's test-bed as one reusable object type — an aggregate of
+/// bioelectricity (Monodomain), muscle (FemSolid, Guccione myocardium with active tension) and
+/// blood (lumped closed-loop Circulation), coupled by an ExcitationContraction connector
+/// (voltage → active tension, through the shared volume) and a CavityCoupling connector
+/// (endocardial volume ↔ cavity pressure, through the shared boundary). Its parts and connectors
+/// come from a default document (`kHeartDefaults` in heart.cc: a left ventricle on the mesh
+/// named "lv") that the scene patches key by key (RFC 7386), like the circulation's presets.
+///
+/// On top of the aggregate it monitors the beats: per beat of `monitor.period` seconds, the
+/// end-diastolic and end-systolic volumes (the beat's largest and smallest chamber volume),
+/// stroke volume, ejection fraction, peak chamber pressure, arterial systolic and diastolic
+/// pressure, and the largest relative change of these from the previous beat (how close the
+/// run is to its periodic state). They are global fields (of the last completed beat) and a
+/// line in the log per beat.
+
+#include <string>
+#include <vector>
+
+#include "gipsi/core/aggregate.h"
+#include "gipsi/core/registry.h"
+
+namespace gipsi {
+
+/// Which blood fields the monitor reads. Plain struct.
+struct HeartMonitorSpec {
+  std::string blood = "blood";   ///< the blood part
+  std::string chamber = "lv";    ///< its chamber compartment (volume and pressure)
+  std::string artery = "aorta";  ///< its arterial compartment (pressure)
+  double period = 0.8;           ///< beat length [s]; beats start at t = 0
+};
+
+/// One completed beat. Plain struct (SI units).
+struct BeatSummary {
+  int beat = 0;           ///< 1, 2, …
+  double end_time = 0;    ///< [s]
+  double edv = 0;         ///< end-diastolic volume [m³]
+  double esv = 0;         ///< end-systolic volume [m³]
+  double peak_pressure = 0;     ///< chamber [Pa]
+  double arterial_systolic = 0;   ///< [Pa]
+  double arterial_diastolic = 0;  ///< [Pa]
+  double change = 1;  ///< largest relative change of the above from the previous beat (1: first)
+  [[nodiscard]] double stroke_volume() const { return edv - esv; }
+  [[nodiscard]] double ejection_fraction() const { return edv > 0 ? (edv - esv) / edv : 0; }
+};
+
+/// Not copyable or movable (a SimObject).
+class Heart final : public AggregateObject {
+ public:
+  /// Throws InputError if the monitored blood part, chamber or artery does not exist.
+  Heart(std::string name, Coordinator parts, HeartMonitorSpec monitor);
+
+  [[nodiscard]] std::string_view type_name() const override { return "Heart"; }
+  /// Every completed beat so far.
+  [[nodiscard]] const std::vector<BeatSummary>& beats() const { return beats_; }
+
+ protected:
+  StepStatus DoStep(double t, double dt) override;
+  void DoReadField(FieldId id, Eigen::Ref<Eigen::MatrixXd> out) const override;
+  void DoWriteField(FieldId id, const Eigen::Ref<const Eigen::MatrixXd>& in) override;
+
+ private:
+  void Track(double t);
+  void FinishBeat(double t);
+
+  HeartMonitorSpec monitor_;
+  SimObject* blood_ = nullptr;
+  FieldId chamber_volume_, chamber_pressure_, artery_pressure_;
+  std::vector<BeatSummary> beats_;
+  // Running extremes of the beat in progress.
+  double v_max_ = 0, v_min_ = 0, p_max_ = 0, a_max_ = 0, a_min_ = 0;
+  bool beat_started_ = false;
+  int beat_index_ = 0;  // of the beat in progress
+  std::size_t first_own_field_ = 0;
+};
+
+/// Registers "Heart" (keys in docs/scene-format.md and docs/heart.md).
+void RegisterHeart(TypeRegistry& registry);
+
+}  // namespace gipsi
