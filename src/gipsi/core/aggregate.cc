@@ -42,6 +42,19 @@ StepStatus AggregateObject::DoStep(double t, double /*dt*/) {
   return StepStatus::Ok();
 }
 
+std::vector<SimObject::ProfileEntry> AggregateObject::ProfileBreakdown() const {
+  std::vector<ProfileEntry> entries;
+  for (std::size_t i = 0; i < parts_.num_objects(); ++i)
+    entries.push_back({"part " + parts_.object(i).name(), parts_.object_seconds(i), "s"});
+  for (std::size_t i = 0; i < parts_.num_connectors(); ++i)
+    entries.push_back(
+        {"connector " + parts_.connector(i).name(), parts_.connector_seconds(i), "s"});
+  for (std::size_t i = 0; i < parts_.num_objects(); ++i)
+    for (ProfileEntry& e : parts_.object(i).ProfileBreakdown())
+      entries.push_back({parts_.object(i).name() + ": " + e.name, e.value, e.unit});
+  return entries;
+}
+
 void AggregateObject::DoReadField(FieldId id, Eigen::Ref<Eigen::MatrixXd> out) const {
   const Proxy& p = proxies_[static_cast<std::size_t>(id.value())];
   p.part->ReadField(p.field, out);

@@ -21,6 +21,7 @@ void NewtonSolver::Prepare(const SparseMatrix& pattern) {
   delta_.setZero(n);
   warm_.setZero(n);
   warm_valid_ = false;
+  factor_valid_ = false;
   d_trial_.setZero(n);
   rhs_.setZero(n);
   linear_->AnalyzePattern(pattern);
@@ -28,7 +29,12 @@ void NewtonSolver::Prepare(const SparseMatrix& pattern) {
 
 NewtonStats NewtonSolver::Solve(NonlinearSystem& system, VecX& d, SparseMatrix& J) {
   NewtonStats stats;
-  if (!system.CalcResidualAndJacobian(d, r_, J)) {
+  const bool reuse = options_.reuse_factorization && !options_.fixed_iterations;
+  // With reuse, the previous Solve's factorisation is tried first (only the residual is new).
+  bool need_factor = !(reuse && factor_valid_);
+  const bool first_ok =
+      need_factor ? system.CalcResidualAndJacobian(d, r_, J) : system.CalcResidual(d, r_);
+  if (!first_ok) {
     stats.inadmissible = true;
     return stats;
   }
@@ -46,11 +52,24 @@ NewtonStats NewtonSolver::Solve(NonlinearSystem& system, VecX& d, SparseMatrix& 
     stats.converged = true;
     return stats;
   }
+  // A stale factorisation that fails is replaced by a fresh Jacobian once per iteration.
+  auto refresh = [&]() {
+    if (!system.CalcResidualAndJacobian(d, r_, J)) return false;
+    norm = r_.norm();
+    need_factor = true;
+    return true;
+  };
   for (int it = 1; it <= options_.max_iterations; ++it) {
     stats.iterations = it;
-    if (!linear_->Factorize(J)) {
-      stats.linear_failure = true;
-      return stats;
+    bool fresh = need_factor;
+    if (need_factor) {
+      factor_valid_ = false;
+      if (!linear_->Factorize(J)) {
+        stats.linear_failure = true;
+        return stats;
+      }
+      factor_valid_ = true;
+      need_factor = false;
     }
     rhs_ = -r_;
     // Warm start: the first correction of a solve resembles the previous solve's (consecutive
@@ -60,15 +79,24 @@ NewtonStats NewtonSolver::Solve(NonlinearSystem& system, VecX& d, SparseMatrix& 
     else
       delta_.setZero();
     const LinearSolveStats ls = linear_->Solve(rhs_, delta_);
-    if (it == 1 && ls.converged) {
-      warm_ = delta_;
-      warm_valid_ = true;
-    }
     stats.linear_iterations += ls.iterations;
     stats.refactorizations += ls.refactorized ? 1 : 0;
-    if (!ls.converged || !delta_.allFinite() || !ApplyLowRank(system, stats)) {
+    const bool solved = ls.converged && delta_.allFinite() && ApplyLowRank(system, stats);
+    if (!solved && !fresh) {
+      if (!refresh()) {
+        stats.inadmissible = true;
+        return stats;
+      }
+      --it;  // the same iteration again, with a fresh Jacobian
+      continue;
+    }
+    if (!solved) {
       stats.linear_failure = true;
       return stats;
+    }
+    if (it == 1) {
+      warm_ = delta_;
+      warm_valid_ = true;
     }
     const bool last_fixed = options_.fixed_iterations && it == options_.max_iterations;
     if (last_fixed && !options_.line_search) {
@@ -91,6 +119,15 @@ NewtonStats NewtonSolver::Solve(NonlinearSystem& system, VecX& d, SparseMatrix& 
         break;
       }
     }
+    if (!accepted && !fresh) {
+      // The old Jacobian's direction does not descend: try again with a fresh one.
+      if (!refresh()) {
+        stats.inadmissible = true;
+        return stats;
+      }
+      --it;
+      continue;
+    }
     if (!accepted) {
       // No decrease: take the full step anyway if it is admissible (Newton may need to climb
       // out of a poor start); otherwise report the failure.
@@ -102,6 +139,7 @@ NewtonStats NewtonSolver::Solve(NonlinearSystem& system, VecX& d, SparseMatrix& 
       trial_norm = r_trial_.norm();
     }
     d.swap(d_trial_);
+    const double ratio = norm > 0 ? trial_norm / norm : 0;
     norm = trial_norm;
     stats.final_residual = norm;
     if (it < NewtonStats::kHistory) stats.residual_history[static_cast<std::size_t>(it)] = norm;
@@ -120,10 +158,15 @@ NewtonStats NewtonSolver::Solve(NonlinearSystem& system, VecX& d, SparseMatrix& 
       stats.converged = true;
       return stats;
     }
+    if (reuse && ratio < 0.5) {
+      r_.swap(r_trial_);  // keep the factorisation: it still contracts well
+      continue;
+    }
     if (!system.CalcResidualAndJacobian(d, r_, J)) {
       stats.inadmissible = true;
       return stats;
     }
+    need_factor = true;
   }
   return stats;
 }
@@ -151,8 +194,8 @@ bool NewtonSolver::ApplyLowRank(NonlinearSystem& system, NewtonStats& stats) {
     active[static_cast<std::size_t>(m++)] = i;
   }
   if (m == 0) return true;
-  using Small = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxLowRankTerms,
-                              kMaxLowRankTerms>;
+  using Small =
+      Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxLowRankTerms, kMaxLowRankTerms>;
   using SmallVec = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxLowRankTerms, 1>;
   Small s(m, m);
   SmallVec c(m);
@@ -160,7 +203,8 @@ bool NewtonSolver::ApplyLowRank(NonlinearSystem& system, NewtonStats& stats) {
     const auto ai = static_cast<std::size_t>(active[static_cast<std::size_t>(i)]);
     c[i] = b[ai]->dot(delta_);
     for (int j = 0; j < m; ++j)
-      s(i, j) = b[ai]->dot(low_rank_z_[static_cast<std::size_t>(active[static_cast<std::size_t>(j)])]);
+      s(i, j) =
+          b[ai]->dot(low_rank_z_[static_cast<std::size_t>(active[static_cast<std::size_t>(j)])]);
     s(i, i) += 1 / w[ai];
   }
   const SmallVec coef = s.ldlt().solve(c);

@@ -62,6 +62,14 @@ struct NewtonOptions {
   /// Start the first linear solve of each Solve from the previous Solve's first correction
   /// (iterative solvers converge faster when consecutive steps are alike).
   bool warm_start = true;
+  /// Keep the factorised Jacobian (of an earlier iteration, or of the previous Solve) while it
+  /// still works: a new Jacobian is assembled and factorised only when an iteration reduced the
+  /// residual by less than half, or a solve or line search with the old one failed. Newton
+  /// then converges linearly but each iteration costs a residual and a back-substitution
+  /// instead of an assembly and a factorisation — a large gain with direct solvers on
+  /// slowly varying problems (a beating heart). Needs the Jacobian matrix left untouched
+  /// between Solves (the system only writes it in CalcResidualAndJacobian).
+  bool reuse_factorization = false;
 };
 
 /// Outcome of one solve. Plain struct.
@@ -102,6 +110,7 @@ class NewtonSolver {
   VecX r_, r_trial_, delta_, d_trial_, rhs_;
   VecX warm_;  // first correction of the last solve
   bool warm_valid_ = false;
+  bool factor_valid_ = false;  // the linear solver holds a factorisation of the current J
   static constexpr int kMaxLowRankTerms = 8;
   std::vector<VecX> low_rank_z_;  // J⁻¹ b_k of the low-rank terms (sized on first use)
 

@@ -16,6 +16,7 @@
 #include <fmt/format.h>
 
 #include "gipsi/base/error.h"
+#include "gipsi/base/log.h"
 #include "gipsi/models/fem/fem_solid.h"
 
 namespace gipsi {
@@ -39,8 +40,8 @@ bool SolvePressure(CavityLaw& law, double t, double dt, double v, double guess, 
     return true;
   }
   // Bracket: step away from the guess in the direction that reduces |h|, doubling the step.
-  const double first =
-      stiffness > 0 ? std::max(2 * std::abs(ha) * stiffness, 1e-3) : std::max(1.0, 0.01 * std::abs(a));
+  const double first = stiffness > 0 ? std::max(2 * std::abs(ha) * stiffness, 1e-3)
+                                     : std::max(1.0, 0.01 * std::abs(a));
   double step = ha > 0 ? -first : first;
   double b = a, hb = ha;
   for (int k = 0; k < 80; ++k) {
@@ -85,9 +86,16 @@ void FemSolid::AttachCavityLaw(std::string_view cavity, CavityLaw* law) {
   for (std::size_t i = 0; i < cavities_.size(); ++i) {
     if (params_.cavities[i].name != cavity) continue;
     if (cavities_[i].law != nullptr)
-      throw InputError(fmt::format("object '{}': cavity '{}' is already coupled to blood", name(),
-                                   cavity));
+      throw InputError(
+          fmt::format("object '{}': cavity '{}' is already coupled to blood", name(), cavity));
     cavities_[i].law = law;
+    cavity_follower_tangent_ = newton_->linear_solver().AcceptIndefinite();
+    if (!cavity_follower_tangent_)
+      Log().warn(
+          "object '{}': cavity '{}' is coupled to blood but the linear solver '{}' needs "
+          "positive definite matrices, so the pressure's follower tangent is left out and "
+          "Newton converges linearly; \"linear_solver\": {{\"type\": \"ldlt\"}} keeps it",
+          name(), cavity, newton_->linear_solver().name());
     return;
   }
   std::string names;
@@ -133,8 +141,11 @@ void FemSolid::AddCoupledCavityTangent(const double* u, double* jv) {
   for (Cavity& cavity : cavities_) {
     if (cavity.law == nullptr) continue;
     // The follower part p ∂²V/∂x² is the faces' pressure tangent (the cap of an open rim moves
-    // only with the rim; its curvature terms are left out, exact when the rim is held).
-    for (int f : cavity.faces) AddFaceLoadTangent(f, u, cavity.pressure, Vec3::Zero(), jv);
+    // only with the rim; its curvature terms are left out, exact when the rim is held). It can
+    // make the sparse part indefinite (the rank-one term restores definiteness), so it is left
+    // out for solvers that need SPD matrices: Newton then converges linearly.
+    if (cavity_follower_tangent_)
+      for (int f : cavity.faces) AddFaceLoadTangent(f, u, cavity.pressure, Vec3::Zero(), jv);
     // C = −dV_b/dp by a one-sided difference of 1e-6 of the pressure (at least 1 mPa).
     const double p = cavity.pressure;
     const double dp = std::max(1e-3, 1e-6 * std::abs(p));

@@ -213,15 +213,16 @@ class FemSolid final : public SimObject, private NonlinearSystem {
     mutable Points positions;  // work buffer, 3 by nodes.size()
     double pressure = 0;       // Pa, written through the field, or solved when coupled
     FieldId f_volume, f_pressure;
-    CavityLaw* law = nullptr;  // coupled to blood when set
+    CavityLaw* law = nullptr;   // coupled to blood when set
     double pressure_begin = 0;  // at the start of the step
     VecX gradient{};            // 3N: ∂V/∂x, zero on constrained dofs (coupled)
     double stiffness = 0;       // −∂p/∂V of the law at the current pressure [Pa/m³]
     mutable Points local_gradient{};
   };
   std::vector<Cavity> cavities_;
-  double step_time_ = 0, step_dt_ = 0;  // of the step in progress (the laws' interval)
-  int failed_cavity_ = -1;              // whose law could not answer in the last solve
+  double step_time_ = 0, step_dt_ = 0;   // of the step in progress (the laws' interval)
+  int failed_cavity_ = -1;               // whose law could not answer in the last solve
+  bool cavity_follower_tangent_ = true;  // the solver takes indefinite matrices
 
   MechanicalFieldIds mech_;
   FieldId f_fibre_, f_active_, f_nodal_active_, f_von_mises_, f_jacobian_, f_kinetic_,

@@ -12,8 +12,8 @@ namespace gipsi {
 namespace {
 
 NewtonOptions ParseNewton(const JsonNode& node, NewtonOptions options) {
-  node.CheckKeys(
-      {"max_iterations", "tolerance", "increment_tolerance", "line_search", "fixed_iterations"});
+  node.CheckKeys({"max_iterations", "tolerance", "increment_tolerance", "line_search",
+                  "fixed_iterations", "reuse_factorization"});
   if (auto it = node.Find("max_iterations")) {
     const std::int64_t n = it->AsInt();
     if (n < 1 || n > 10000) it->Expected("an integer in [1, 10000]");
@@ -24,6 +24,7 @@ NewtonOptions ParseNewton(const JsonNode& node, NewtonOptions options) {
       node.NonNegative("increment_tolerance", options.increment_tolerance);
   options.line_search = node.Bool("line_search", options.line_search);
   options.fixed_iterations = node.Bool("fixed_iterations", options.fixed_iterations);
+  options.reuse_factorization = node.Bool("reuse_factorization", options.reuse_factorization);
   return options;
 }
 

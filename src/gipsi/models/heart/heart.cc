@@ -36,9 +36,9 @@ constexpr const char* kHeartDefaults = R"({
                    "bulk_modulus": 50000},
       "fibres": {"rule": "transmural", "endo": {"group": "endo"}, "epi": {"group": "epi"},
                  "axis": [0, 0, 1], "endo_angle": 60, "epi_angle": -60},
-      "integrator": "Static", "gravity": [0, 0, 0],
-      "linear_solver": {"type": "cholmod"},
-      "newton": {"tolerance": 1e-8, "max_iterations": 30},
+      "integrator": "BackwardEuler", "density": 1060, "gravity": [0, 0, 0],
+      "linear_solver": {"type": "ldlt"},
+      "newton": {"tolerance": 1e-6, "max_iterations": 40, "reuse_factorization": true},
       "cavities": {"lumen": {"group": "endo"}},
       "boundary_conditions": [{"name": "base", "region": {"group": "base"}, "fix": true}]
     },
@@ -49,9 +49,9 @@ constexpr const char* kHeartDefaults = R"({
   },
   "connectors": {
     "excitation_contraction": {"type": "ExcitationContraction", "from": "bioelectricity.V",
-                               "to": "muscle.nodal_active_tension", "gain": "60 kPa"},
+                               "to": "muscle.nodal_active_tension", "gain": "120 kPa"},
     "cavity_coupling": {"type": "CavityCoupling", "wall": "muscle", "cavity": "lumen",
-                        "blood": "blood", "chamber": "lv"}
+                        "blood": "blood", "chamber": "lv", "blood_bulk_modulus": "20 MPa"}
   },
   "order": ["bioelectricity", "excitation_contraction", "muscle", "cavity_coupling", "blood"],
   "monitor": {"blood": "blood", "chamber": "lv", "artery": "aorta", "period": "0.8 s"}
@@ -63,8 +63,8 @@ Heart::Heart(std::string name, Coordinator parts, HeartMonitorSpec monitor)
     : AggregateObject(std::move(name), std::move(parts)), monitor_(std::move(monitor)) {
   blood_ = FindPart(monitor_.blood);
   if (blood_ == nullptr)
-    throw InputError(fmt::format("heart '{}': no part '{}' to monitor", this->name(),
-                                 monitor_.blood));
+    throw InputError(
+        fmt::format("heart '{}': no part '{}' to monitor", this->name(), monitor_.blood));
   chamber_volume_ = blood_->FindField(monitor_.chamber + "_volume");
   chamber_pressure_ = blood_->FindField(monitor_.chamber + "_pressure");
   artery_pressure_ = blood_->FindField(monitor_.artery + "_pressure");
@@ -81,8 +81,7 @@ Heart::Heart(std::string name, Coordinator parts, HeartMonitorSpec monitor)
       {"ejection_fraction", L::kGlobal, 1, "1", A::kRead, "SV / EDV of the last completed beat"},
       {"peak_chamber_pressure", L::kGlobal, 1, "Pa", A::kRead, "of the last completed beat"},
       {"arterial_systolic_pressure", L::kGlobal, 1, "Pa", A::kRead, "of the last completed beat"},
-      {"arterial_diastolic_pressure", L::kGlobal, 1, "Pa", A::kRead,
-       "of the last completed beat"},
+      {"arterial_diastolic_pressure", L::kGlobal, 1, "Pa", A::kRead, "of the last completed beat"},
       {"cycle_change", L::kGlobal, 1, "1", A::kRead,
        "largest relative change of the beat's figures from the previous beat (1: first beat)"},
   };
@@ -144,9 +143,8 @@ void Heart::FinishBeat(double t) {
       "{}: beat {} ({:.3f} s): EDV {:.1f} mL, ESV {:.1f} mL, SV {:.1f} mL, EF {:.1f} %, peak {} "
       "pressure {:.1f} mmHg, {} {:.1f}/{:.1f} mmHg, change from the previous beat {:.2f} %",
       name(), beat.beat, t, kMl * beat.edv, kMl * beat.esv, kMl * beat.stroke_volume(),
-      100 * beat.ejection_fraction(), monitor_.chamber, kMmHg * beat.peak_pressure,
-      monitor_.artery, kMmHg * beat.arterial_systolic, kMmHg * beat.arterial_diastolic,
-      100 * beat.change);
+      100 * beat.ejection_fraction(), monitor_.chamber, kMmHg * beat.peak_pressure, monitor_.artery,
+      kMmHg * beat.arterial_systolic, kMmHg * beat.arterial_diastolic, 100 * beat.change);
 }
 
 void Heart::DoReadField(FieldId id, Eigen::Ref<Eigen::MatrixXd> out) const {
@@ -157,15 +155,33 @@ void Heart::DoReadField(FieldId id, Eigen::Ref<Eigen::MatrixXd> out) const {
   }
   const BeatSummary last = beats_.empty() ? BeatSummary{} : beats_.back();
   switch (index - first_own_field_) {
-    case 0: out(0, 0) = static_cast<double>(beats_.size()); break;
-    case 1: out(0, 0) = last.edv; break;
-    case 2: out(0, 0) = last.esv; break;
-    case 3: out(0, 0) = last.stroke_volume(); break;
-    case 4: out(0, 0) = last.ejection_fraction(); break;
-    case 5: out(0, 0) = last.peak_pressure; break;
-    case 6: out(0, 0) = last.arterial_systolic; break;
-    case 7: out(0, 0) = last.arterial_diastolic; break;
-    default: out(0, 0) = last.change; break;
+    case 0:
+      out(0, 0) = static_cast<double>(beats_.size());
+      break;
+    case 1:
+      out(0, 0) = last.edv;
+      break;
+    case 2:
+      out(0, 0) = last.esv;
+      break;
+    case 3:
+      out(0, 0) = last.stroke_volume();
+      break;
+    case 4:
+      out(0, 0) = last.ejection_fraction();
+      break;
+    case 5:
+      out(0, 0) = last.peak_pressure;
+      break;
+    case 6:
+      out(0, 0) = last.arterial_systolic;
+      break;
+    case 7:
+      out(0, 0) = last.arterial_diastolic;
+      break;
+    default:
+      out(0, 0) = last.change;
+      break;
   }
 }
 
@@ -186,10 +202,9 @@ void RegisterHeart(TypeRegistry& registry) {
         for (const std::string& key : ObjectBuildContext::CommonKeys())
           if (key != "dt") patch.erase(key);
         merged.merge_patch(patch);
-        const JsonNode root(merged,
-                            fmt::format("{} (heart defaults patched by the scene)",
-                                        ctx.params.file()),
-                            ctx.params.path());
+        const JsonNode root(
+            merged, fmt::format("{} (heart defaults patched by the scene)", ctx.params.file()),
+            ctx.params.path());
         HeartMonitorSpec monitor;
         const JsonNode m = root.At("monitor");
         m.CheckKeys({"blood", "chamber", "artery", "period"});

@@ -98,18 +98,27 @@ class DirectSolver : public LinearSolver {
 };
 
 /// Eigen SimplicialLDLT with AMD ordering. LDLᵀ itself accepts indefinite matrices, so
-/// FactorizeNumeric also requires every pivot D_ii > 0: the solver is for SPD systems, and a
-/// non-positive pivot means A is not positive definite (or is numerically singular).
+/// FactorizeNumeric also requires every pivot D_ii > 0 (a non-positive pivot means A is not
+/// positive definite, or is numerically singular) unless AcceptIndefinite was called; then it
+/// only requires pivots away from zero (no pivoting: fine for the mildly indefinite tangents of
+/// pressure-loaded solids whose volume is constrained, not for saddle-point systems).
 class LdltSolver final : public DirectSolver {
  public:
   using DirectSolver::DirectSolver;
   [[nodiscard]] std::string name() const override { return "ldlt"; }
+  bool AcceptIndefinite() override {
+    indefinite_ = true;
+    return true;
+  }
 
  protected:
   void Analyze(const SparseMatrix& A) override { ldlt_.analyzePattern(A); }
   bool FactorizeNumeric(const SparseMatrix& A) override {
     ldlt_.factorize(A);
-    return ldlt_.info() == Eigen::Success && (ldlt_.vectorD().array() > 0.0).all();
+    if (ldlt_.info() != Eigen::Success) return false;
+    const VecX& d = ldlt_.vectorD();
+    if (!indefinite_) return (d.array() > 0.0).all();
+    return d.allFinite() && d.cwiseAbs().minCoeff() > 1e-13 * d.cwiseAbs().maxCoeff();
   }
   bool SolveInto(const VecX& b, VecX& x) override {
     x = ldlt_.solve(b);
@@ -118,6 +127,7 @@ class LdltSolver final : public DirectSolver {
 
  private:
   Eigen::SimplicialLDLT<SparseMatrix, Eigen::Lower, Eigen::AMDOrdering<int>> ldlt_;
+  bool indefinite_ = false;
 };
 
 /// CHOLMOD supernodal LLᵀ (CHOLMOD's default ordering: AMD, or METIS when AMD fills badly).
