@@ -12,18 +12,16 @@
 namespace gipsi {
 
 CavityCoupling::CavityCoupling(std::string name, SimObject& wall, const std::string& cavity,
-                               Circulation& blood, const std::string& chamber,
-                               double bulk_modulus)
+                               Circulation& blood, const std::string& chamber, double bulk_modulus)
     : Connector(std::move(name)), wall_(wall), blood_(blood), bulk_modulus_(bulk_modulus) {
   if (!(bulk_modulus_ > 0))
-    throw InputError(fmt::format("connector '{}': the blood bulk modulus must be positive",
-                                 this->name()));
+    throw InputError(
+        fmt::format("connector '{}': the blood bulk modulus must be positive", this->name()));
   chamber_ = blood_.FindCompartment(chamber);
   if (chamber_ < 0)
     throw InputError(fmt::format("connector '{}': object '{}' has no compartment '{}'",
                                  this->name(), blood_.name(), chamber));
-  const CompartmentSpec& spec =
-      blood_.circuit().compartments()[static_cast<std::size_t>(chamber_)];
+  const CompartmentSpec& spec = blood_.circuit().compartments()[static_cast<std::size_t>(chamber_)];
   if (spec.kind != CompartmentSpec::Kind::kChamber ||
       spec.drive != CompartmentSpec::Drive::kPressure)
     throw InputError(fmt::format(
@@ -40,7 +38,7 @@ CavityCoupling::CavityCoupling(std::string name, SimObject& wall, const std::str
   wall_.ReadField(wall_pressure_, p);
   const double blood_volume = v(0, 0) / (1 - p(0, 0) / bulk_modulus_);
   Log().info("connector '{}': chamber '{}' starts with the cavity's {:.2f} mL (was {:.2f} mL)",
-                 this->name(), chamber, 1e6 * blood_volume, 1e6 * blood_.volume(chamber_));
+             this->name(), chamber, 1e6 * blood_volume, 1e6 * blood_.volume(chamber_));
   blood_.SetVolume(chamber_, blood_volume);
   blood_.WriteField(blood_pressure_, p);
 }
@@ -62,7 +60,8 @@ StepStatus CavityCoupling::DoFire(double /*t*/) {
         "it between them in the order)");
   Eigen::Matrix<double, 1, 1> p;
   wall_.ReadField(wall_pressure_, p);
-  if (!std::isfinite(p(0, 0))) return StepStatus::Diverged("non-finite cavity pressure", 0, p(0, 0));
+  if (!std::isfinite(p(0, 0)))
+    return StepStatus::Diverged("non-finite cavity pressure", 0, p(0, 0));
   blood_.WriteField(blood_pressure_, p);
   return StepStatus::Ok();
 }
@@ -82,13 +81,14 @@ void RegisterCavityCoupling(TypeRegistry& registry) {
         double bulk = 2.2e9;
         if (auto k = p.Find("blood_bulk_modulus")) bulk = ReadPositiveQuantity(*k, "Pa");
         try {
-          return std::make_unique<CavityCoupling>(ctx.name, wall, p.At("cavity").AsString(),
-                                                  *blood, p.At("chamber").AsString(), bulk);
+          return std::make_unique<CavityCoupling>(ctx.name, wall, p.At("cavity").AsString(), *blood,
+                                                  p.At("chamber").AsString(), bulk);
         } catch (const InputError& e) {
           p.Fail(e.what());
         }
       },
-      "boundary coupling: cavity volume <-> lumped blood pressure (monolithic, isovolumetric-safe)");
+      "boundary coupling: cavity volume <-> lumped blood pressure (monolithic, "
+      "isovolumetric-safe)");
 }
 
 }  // namespace gipsi

@@ -33,11 +33,11 @@ struct HeartMonitorSpec {
 
 /// One completed beat. Plain struct (SI units).
 struct BeatSummary {
-  int beat = 0;           ///< 1, 2, …
-  double end_time = 0;    ///< [s]
-  double edv = 0;         ///< end-diastolic volume [m³]
-  double esv = 0;         ///< end-systolic volume [m³]
-  double peak_pressure = 0;     ///< chamber [Pa]
+  int beat = 0;                   ///< 1, 2, …
+  double end_time = 0;            ///< [s]
+  double edv = 0;                 ///< end-diastolic volume [m³]
+  double esv = 0;                 ///< end-systolic volume [m³]
+  double peak_pressure = 0;       ///< chamber [Pa]
   double arterial_systolic = 0;   ///< [Pa]
   double arterial_diastolic = 0;  ///< [Pa]
   double change = 1;  ///< largest relative change of the above from the previous beat (1: first)
