@@ -66,6 +66,11 @@ VizCommands::VizCommands(CLI::App& app) {
       ->capture_default_str();
   snapshot_->add_option("--range", range_, "Fixed colour range LO,HI (default: the values')");
   snapshot_->add_flag("--wireframe", wireframe_, "Draw triangle edges");
+  snapshot_->add_option("--as", as_,
+                        "Draw OBJECT:surface, OBJECT:lines (springs or mesh edges) or "
+                        "OBJECT:points (nodes) whatever the scene says (repeatable)");
+  snapshot_->add_option("--show", show_, "Draw OBJECT even if the scene hides it (repeatable)");
+  snapshot_->add_option("--hide", hide_, "Do not draw OBJECT (repeatable)");
   snapshot_->add_flag("--unlit", unlit_,
                       "No shading: every pixel shows its exact colour-map colour");
   snapshot_->add_flag("--no-color-bar", no_color_bar_, "Do not draw the colour bar");
@@ -81,6 +86,9 @@ VizCommands::VizCommands(CLI::App& app) {
   view_->add_option("--color", colors_, "Colour OBJECT by FIELD: OBJECT:FIELD[.x|.y|.z]");
   view_->add_option("--map", map_, "Colour map for --color")->capture_default_str();
   view_->add_option("--range", range_, "Fixed colour range LO,HI for --color");
+  view_->add_option("--as", as_, "OBJECT:surface|lines|points, as for snapshot");
+  view_->add_option("--show", show_, "Show OBJECT at first even if the scene hides it");
+  view_->add_option("--hide", hide_, "Hide OBJECT at first (repeatable)");
   view_->add_flag("--play", play_, "Start playing");
   view_->add_option("--speed", speed_, "Target real-time factor (0: as fast as possible)")
       ->capture_default_str()
@@ -102,7 +110,12 @@ VizCommands::VizCommands(CLI::App& app) {
   plot_->add_option("CSV", csv_, "CSV file with a header row, e.g. out/SCENE/probes/tip.csv")
       ->required();
   plot_->add_option("-o,--out", plot_out_, "Image to write: .png or .svg")->required();
-  plot_->add_option("--x", plot_x_, "Column on the horizontal axis")->capture_default_str();
+  plot_->add_option("--x", plot_x_,
+                    "Column on the horizontal axis (default: time; for a line probe's CSV, "
+                    "distance)");
+  plot_->add_option("--by", plot_by_,
+                    "One curve per run of equal values of this column (default: for a line "
+                    "probe's CSV, time: one profile per sample time)");
   plot_->add_option("--y", plot_y_, "Column to plot (repeatable; default: every other column)");
   plot_->add_option("--title", title_, "Title above the plot");
   plot_->add_option("--size", plot_size_, "Image size WIDTHxHEIGHT in pixels")
@@ -123,13 +136,26 @@ int VizCommands::Plot() {
   data.title = title_;
   data.width = w;
   data.height = h;
-  data.x_label = plot_x_ == "time" ? "time [s]" : plot_x_;
-  const std::vector<double>& x = table.Column(plot_x_);
+  // A line probe's CSV (time, distance, x, y, z, fields...): profiles along the line.
+  const bool line = table.names.size() > 5 && table.names[0] == "time" &&
+                    table.names[1] == "distance" && table.names[2] == "x" &&
+                    table.names[3] == "y" && table.names[4] == "z";
+  const std::string x_name = !plot_x_.empty() ? plot_x_ : line ? "distance" : "time";
+  const std::string by = !plot_by_.empty() ? plot_by_ : line && x_name != "time" ? "time" : "";
+  data.x_label = x_name == "time" ? "time [s]" : x_name;
+  const std::vector<double>& x = table.Column(x_name);
   std::vector<std::string> ys = plot_y_;
   if (ys.empty())
-    for (const auto& name : table.names)
-      if (name != plot_x_) ys.push_back(name);
-  for (const auto& y : ys) data.series.push_back({y, x, table.Column(y)});
+    for (std::size_t c = line ? 5 : 0; c < table.names.size(); ++c)
+      if (table.names[c] != x_name && table.names[c] != by) ys.push_back(table.names[c]);
+  for (const auto& y : ys) {
+    if (by.empty()) {
+      data.series.push_back({y, x, table.Column(y)});
+    } else {
+      for (auto& series : viz::SplitSeries(y, x, table.Column(y), table.Column(by), by))
+        data.series.push_back(std::move(series));
+    }
+  }
   if (ys.size() == 1) data.y_label = ys[0];
   try {
     viz::WritePlot(data, plot_out_);
@@ -150,6 +176,9 @@ int VizCommands::View() {
   options.scene = scene_;
   options.plugins = plugins_;
   options.colors = ParseColors();
+  options.show = show_;
+  options.hide = hide_;
+  options.as = as_;
   if (!camera_.empty()) viz::ParseCamera(camera_, "--camera", options.camera);
   options.play = play_;
   options.speed = speed_;
@@ -194,6 +223,9 @@ int VizCommands::Snapshot() {
   options.time = time_;
   if (!camera_.empty()) viz::ParseCamera(camera_, "--camera", options.camera);
   options.colors = ParseColors();
+  options.show = show_;
+  options.hide = hide_;
+  options.as = as_;
   options.render.wireframe = wireframe_;
   options.render.color_bar = !no_color_bar_;
   options.render.lighting = !unlit_;

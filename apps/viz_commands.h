@@ -34,7 +34,7 @@ class VizCommands {
 
   CLI::App* snapshot_ = nullptr;
   std::string scene_, out_, camera_, size_ = "800x600", map_ = "viridis", range_;
-  std::vector<std::string> colors_, plugins_;
+  std::vector<std::string> colors_, plugins_, show_, hide_, as_;
   double time_ = 0;
   bool wireframe_ = false, no_color_bar_ = false, unlit_ = false;
 
@@ -44,7 +44,7 @@ class VizCommands {
   bool play_ = false, no_ui_ = false;
 
   CLI::App* plot_ = nullptr;
-  std::string csv_, plot_out_, plot_x_ = "time", title_, plot_size_ = "800x500";
+  std::string csv_, plot_out_, plot_x_, plot_by_, title_, plot_size_ = "800x500";
   std::vector<std::string> plot_y_;
 };
 

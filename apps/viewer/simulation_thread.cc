@@ -31,11 +31,15 @@ SimulationThread::~SimulationThread() {
 void SimulationThread::Load() {
   tool_.Release();
   auto scene = std::make_unique<Scene>(load_());
-  auto display = std::make_unique<SceneDisplay>(*scene->kernel, initial_colors_);
+  auto display = std::make_unique<SceneDisplay>(*scene->kernel, scene->display, initial_colors_);
   scene_ = std::move(scene);
   display_ = std::move(display);
   traces_.clear();
-  for (const Probe& probe : scene_->probes) {
+  trace_probes_.clear();
+  for (std::size_t p = 0; p < scene_->probes.size(); ++p) {
+    const Probe& probe = scene_->probes[p];
+    if (probe.is_line()) continue;  // a profile along a line, not a trace over time
+    trace_probes_.push_back(p);
     ProbeTrace trace;
     trace.name = probe.name;
     const auto columns = ProbeColumns(probe);
@@ -48,9 +52,9 @@ void SimulationThread::Load() {
     s.end_time = scene_->end_time;
     s.macro_dt = scene_->kernel->macro_dt();
     s.objects.clear();
-    s.colors.clear();
+    s.draws.clear();
     for (std::size_t i = 0; i < display_->size(); ++i) {
-      s.colors.push_back(display_->manager(i).spec());
+      s.draws.push_back(display_->manager(i).draw());
       const SimObject& object = display_->manager(i).object();
       std::vector<std::string> fields;
       for (const FieldInfo& f : object.fields())
@@ -70,7 +74,7 @@ void SimulationThread::Publish() {
   for (std::size_t p = 0; p < traces_.size(); ++p) {
     ProbeTrace& trace = traces_[p];
     if (!trace.time.empty() && float(scene_->kernel->time()) <= trace.time.back()) continue;
-    scene_->probes[p].Sample(sample_);
+    scene_->probes[trace_probes_[p]].Sample(sample_);
     if (trace.time.size() >= kMaxTraceSamples) {
       const auto half = static_cast<std::ptrdiff_t>(kMaxTraceSamples / 2);
       trace.time.erase(trace.time.begin(), trace.time.begin() + half);
@@ -191,8 +195,10 @@ void SimulationThread::Loop() {
     for (auto& [surface, spec] : c.colors) {
       if (surface >= display_->size()) continue;
       try {
-        display_->manager(surface) = DisplayManager(display_->manager(surface).object(), spec);
-        UpdateStatus([&](SimulationStatus& s) { s.colors[surface] = spec; });
+        DrawSpec draw = display_->manager(surface).draw();
+        draw.color = spec;
+        display_->manager(surface) = DisplayManager(display_->manager(surface).object(), draw);
+        UpdateStatus([&](SimulationStatus& s) { s.draws[surface] = draw; });
       } catch (const std::exception& e) {
         UpdateStatus([&](SimulationStatus& s) { s.message = e.what(); });
       }

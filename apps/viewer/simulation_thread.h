@@ -31,8 +31,8 @@ struct SimulationStatus {
   std::string message;  ///< why it stopped (divergence, reload error), or ""
   /// Per display surface (in frame order): object name and the fields it can be coloured by.
   std::vector<std::pair<std::string, std::vector<std::string>>> objects;
-  /// Per display surface: how it is coloured now.
-  std::vector<ColorSpec> colors;
+  /// Per display surface: how it is drawn and coloured now.
+  std::vector<DrawSpec> draws;
 };
 
 /// Owns the scene while it runs. Not copyable or movable.
@@ -91,6 +91,7 @@ class SimulationThread {
   std::unique_ptr<Scene> scene_;
   std::unique_ptr<SceneDisplay> display_;
   std::vector<ProbeTrace> traces_;
+  std::vector<std::size_t> trace_probes_;  // the probe of each trace (line probes have none)
   std::vector<double> sample_;
   DragTool tool_;
 

@@ -55,6 +55,7 @@ const char* const kComponents[] = {"magnitude", "x", "y", "z"};
 
 struct SurfaceUi {
   bool visible = true;
+  bool wireframe = false;
   int field = 0;      // 0 = solid, else index + 1 into the object's fields
   int component = 0;  // kComponents
   int map = 0;        // ColorMap::Names()
@@ -67,10 +68,21 @@ int RunViewer(const ViewerOptions& options) {
     TypeRegistry registry;
     RegisterBuiltins(registry);
     for (const auto& plugin : options.plugins) registry.LoadPlugin(plugin);
-    return LoadScene(options.scene, registry);
+    Scene scene = LoadScene(options.scene, registry);
+    ApplyGeometryOptions(*scene.kernel, options.as, "--as", scene.display);
+    return scene;
   };
   TripleBuffer<FrameBuffers> frames;
   SimulationThread sim(load, options.colors, frames);  // bad input throws here
+  // --show / --hide name drawn objects; checked before any window opens.
+  std::vector<bool> initially_hidden;
+  {
+    const SimulationStatus status = sim.status();
+    std::vector<std::string> names;
+    for (const auto& object : status.objects) names.push_back(object.first);
+    for (const DrawSpec& draw : status.draws) initially_hidden.push_back(!draw.visible);
+    ApplyVisibility(names, options.show, options.hide, initially_hidden);
+  }
   sim.SetSpeed(options.speed);
 
   glfwSetErrorCallback(OnGlfwError);
@@ -82,7 +94,7 @@ int RunViewer(const ViewerOptions& options) {
   glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 3);
   glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 3);
   glfwWindowHint(GLFW_OPENGL_PROFILE, GLFW_OPENGL_CORE_PROFILE);
-  glfwWindowHint(GLFW_OPENGL_FORWARD_COMPAT, GLFW_TRUE);
+  // Not forward-compatible: such contexts reject line widths above 1 pixel (line sets).
   const std::string title = "GiPSi - " + options.scene;
   GLFWwindow* window =
       glfwCreateWindow(options.width, options.height, title.c_str(), nullptr, nullptr);
@@ -144,10 +156,13 @@ int RunViewer(const ViewerOptions& options) {
       const double scale = win_width > 0 ? double(fb_width) / win_width : 1.0;
       const int panel = options.show_ui ? std::min(340, fb_width / 3) : 0;
       const int scene_width = fb_width - panel;
-      if (ui.size() != status.colors.size()) {  // (re)loaded: start from the scene's colours
-        ui.assign(status.colors.size(), SurfaceUi{});
+      if (ui.size() != status.draws.size()) {  // (re)loaded: start from the scene's choices
+        ui.assign(status.draws.size(), SurfaceUi{});
         for (std::size_t i = 0; i < ui.size() && i < status.objects.size(); ++i) {
-          const ColorSpec& spec = status.colors[i];
+          const ColorSpec& spec = status.draws[i].color;
+          ui[i].visible =
+              i < initially_hidden.size() ? !initially_hidden[i] : status.draws[i].visible;
+          ui[i].wireframe = status.draws[i].wireframe;
           const auto& fields = status.objects[i].second;
           const auto f = std::find(fields.begin(), fields.end(), spec.field);
           ui[i].field = f == fields.end() ? 0 : static_cast<int>(f - fields.begin()) + 1;
@@ -157,7 +172,11 @@ int RunViewer(const ViewerOptions& options) {
         }
       }
       render.hidden.resize(ui.size());
-      for (std::size_t i = 0; i < ui.size(); ++i) render.hidden[i] = !ui[i].visible;
+      render.edges.resize(ui.size());
+      for (std::size_t i = 0; i < ui.size(); ++i) {
+        render.hidden[i] = !ui[i].visible;
+        render.edges[i] = ui[i].wireframe;
+      }
       if (!fitted && frame.frame >= 0) {
         camera.FitTo(frame, double(scene_width) / fb_height);
         fitted = true;
@@ -237,13 +256,17 @@ int RunViewer(const ViewerOptions& options) {
         if (!status.message.empty())
           ImGui::TextColored(ImVec4(0.8f, 0.1f, 0.1f, 1), "%s", status.message.c_str());
         ImGui::Separator();
-        ImGui::Checkbox("wireframe", &render.wireframe);
+        ImGui::Checkbox("wireframe (all)", &render.wireframe);
         ImGui::SameLine();
         ImGui::Checkbox("lighting", &render.lighting);
         for (std::size_t i = 0; i < ui.size() && i < status.objects.size(); ++i) {
           const auto& [name, fields] = status.objects[i];
           ImGui::PushID(static_cast<int>(i));
           ImGui::Checkbox(name.c_str(), &ui[i].visible);
+          if (i < frame.surfaces.size() && frame.surfaces[i].primitive == Primitive::kTriangles) {
+            ImGui::SameLine();
+            ImGui::Checkbox("edges", &ui[i].wireframe);
+          }
           std::string items = std::string("(solid)") + '\0';
           for (const auto& f : fields) items += f + '\0';
           bool changed = ImGui::Combo("field", &ui[i].field, items.c_str());

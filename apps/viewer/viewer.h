@@ -21,6 +21,8 @@ struct ViewerOptions {
   std::string scene;
   std::vector<std::string> plugins;
   std::vector<std::pair<std::string, ColorSpec>> colors;
+  std::vector<std::string> show, hide;  ///< objects to show or hide at first (scene: "visible")
+  std::vector<std::string> as;          ///< "OBJECT:lines" etc.: geometry whatever the scene says
   Camera camera;
   int width = 1280, height = 800;
   bool play = false;    ///< start playing

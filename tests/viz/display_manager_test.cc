@@ -38,7 +38,7 @@ TEST(DisplayManager, SolidSurfaceIsTheOutwardBoundary) {
   TypeRegistry registry;
   Scene scene = LoadBlock(false, registry);
   const SimObject& block = scene.kernel->FindObject("block");
-  DisplayManager manager(block, {});
+  DisplayManager manager(block, ColorSpec{});
   SurfaceBuffers out;
   manager.Fill(out);
   const BoundarySurface& boundary = block.boundary();

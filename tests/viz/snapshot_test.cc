@@ -165,6 +165,123 @@ TEST(SnapshotCommand, RejectsBadOptionsNamingThem) {
   r = run("--color nobody:displacement");
   EXPECT_EQ(r.code, 1);
   EXPECT_THAT(r.output, HasSubstr("nobody"));
+  r = run("--as beam:wires");
+  EXPECT_EQ(r.code, 1);
+  EXPECT_THAT(r.output, HasSubstr("--as: expected OBJECT:surface, OBJECT:lines or OBJECT:points"));
+  r = run("--as nobody:lines");
+  EXPECT_EQ(r.code, 1);
+  EXPECT_THAT(r.output, HasSubstr("--as: no object named 'nobody'"));
+  r = run("--hide bean");
+  EXPECT_EQ(r.code, 1);
+  EXPECT_THAT(r.output, HasSubstr("--hide: no drawn object named 'bean' (did you mean 'beam'?)"));
+}
+
+/// The unit-cube block drawn as the scene's "display" entry asks, head-on (as RenderHeadOn),
+/// without labels or colour bar, one sample per pixel (so no edge is blended with the
+/// background).
+Image RenderBlockAs(const std::string& display, int width, int height) {
+  std::string text = kBlockScene;
+  const std::string anchor = R"("integrator": "BackwardEuler")";
+  text.replace(text.find(anchor), anchor.size(), anchor + R"(, "display": )" + display);
+  TypeRegistry registry;
+  RegisterBuiltins(registry);
+  Scene scene = LoadSceneFromString(text, "block.json", ".", registry);
+  SnapshotOptions options;
+  options.width = width;
+  options.height = height;
+  options.supersample = 1;
+  options.camera.azimuth = 0;
+  options.camera.elevation = 0;
+  options.labels = false;
+  options.render.color_bar = false;
+  try {
+    return RenderSnapshot(scene, options);
+  } catch (const std::runtime_error& e) {
+    ADD_FAILURE() << "off-screen rendering (OSMesa) is unavailable: " << e.what();
+    return {};
+  }
+}
+
+bool Near(const Rgb& c, const Rgb& expected) {
+  constexpr float kLevel = 0.5f / 255 + 1e-6f;  // 8-bit rounding
+  return std::abs(c.r - expected.r) <= kLevel && std::abs(c.g - expected.g) <= kLevel &&
+         std::abs(c.b - expected.b) <= kLevel;
+}
+
+// Lines are unshaded and not blended: every drawn pixel is exactly the solid colour. Seen
+// head-on, the near face's outline is a square of side H / 1.1 around the centre (see the face
+// test above), so on the middle row the first drawn pixel from the left is the left edge
+// x = 0 at W/2 - H/2.2, within the 3-pixel line width; the interior of the near face's cells
+// shows lines of the cells behind and tet diagonals, but the corners outside the square are
+// background.
+TEST(Snapshot, DrawsMeshEdgesAsLinesInTheirColour) {
+  const Rgb red{1, 0, 0};
+  const Image image =
+      RenderBlockAs(R"({"as": "lines", "size": 3, "color": {"color": [1, 0, 0]}})", 240, 180);
+  ASSERT_EQ(image.width, 240);
+  int drawn = 0;
+  for (int y = 0; y < image.height; ++y)
+    for (int x = 0; x < image.width; ++x) {
+      const Rgb c = image.At(x, y);
+      if (IsBackground(c)) continue;
+      ++drawn;
+      EXPECT_TRUE(Near(c, red)) << x << ", " << y;
+    }
+  EXPECT_GT(drawn, 4 * 160);  // at least the near face's outline, 4 sides of 164 px
+  int first = 0;
+  while (first < image.width && IsBackground(image.At(first, 90))) ++first;
+  EXPECT_NEAR(first + 1.5, 120 - 90 / 1.1, 2.0);
+  for (auto [x, y] : {std::pair{0, 0}, {239, 0}, {0, 179}, {239, 179}, {20, 90}, {220, 90}})
+    EXPECT_TRUE(IsBackground(image.At(x, y))) << x << ", " << y;
+}
+
+// Points coloured by x through the grey map over a fixed range [0, 2]: the near face's corner
+// node (0, 0, 0) projects to (W/2 - H/2.2, H/2 + H/2.2) and is black; (1, 0, 1) projects to
+// (W/2 + H/2.2, H/2 - H/2.2) with grey 0.5; the centre (x = 0.5 on every node behind it) has
+// grey 0.25. 8-px points cover their node's pixel and its neighbours.
+TEST(Snapshot, DrawsNodesAsPointsInTheirFieldColour) {
+  const Image image = RenderBlockAs(
+      R"({"as": "points", "size": 8,
+          "color": {"field": "position", "component": "x", "map": "grey", "range": [0, 2]}})",
+      240, 180);
+  ASSERT_EQ(image.width, 240);
+  const double half = 90 / 1.1;
+  auto at = [&](double x, double y) {
+    return image.At(static_cast<int>(std::floor(x)), static_cast<int>(std::floor(y)));
+  };
+  EXPECT_TRUE(Near(at(120 - half, 90 + half), Rgb{0, 0, 0}));
+  EXPECT_TRUE(Near(at(120 + half, 90 - half), Rgb{0.5f, 0.5f, 0.5f}));
+  EXPECT_TRUE(Near(at(120, 90), Rgb{0.25f, 0.25f, 0.25f}));
+  // Between nodes there is nothing: the middle of the near face's lower-left cell.
+  EXPECT_TRUE(IsBackground(at(120 - half / 2, 90 + half / 2)));
+  EXPECT_TRUE(IsBackground(image.At(0, 0)));
+}
+
+// The scene's "visible": false hides the object in the snapshot; the command line's --show
+// brings it back, and --as draws it as points whatever the scene says.
+TEST(Snapshot, HonoursTheScenesVisibilityUnlessTheCommandLineOverridesIt) {
+  const Image image = RenderBlockAs(R"({"visible": false})", 120, 90);
+  ASSERT_EQ(image.width, 120);
+  for (int y = 0; y < image.height; ++y)
+    for (int x = 0; x < image.width; ++x) ASSERT_TRUE(IsBackground(image.At(x, y))) << x << y;
+
+  const auto dir = testing::TempDir("gipsi_snapshot_", "show");
+  std::string text = kBlockScene;
+  const std::string anchor = R"("integrator": "BackwardEuler")";
+  text.replace(text.find(anchor), anchor.size(), anchor + R"(, "display": {"visible": false})");
+  { std::ofstream(dir / "block.json") << text; }
+  const auto result = testing::Gipsi(
+      fmt::format("snapshot {} --out {} --size 120x90 --show block --as block:points --camera 0,0",
+                  (dir / "block.json").string(), (dir / "block.png").string()));
+  ASSERT_EQ(result.code, 0) << result.output;
+  const Image shown = ReadPng(dir / "block.png");
+  // The near face's centre node, in the solid colour (points are unshaded; the 2x2
+  // supersampling averages the point's interior to its exact colour).
+  const Rgb centre = shown.At(60, 45), solid = ColorSpec{}.solid;
+  EXPECT_NEAR(centre.r, solid.r, 0.5 / 255 + 1e-6);
+  EXPECT_NEAR(centre.g, solid.g, 0.5 / 255 + 1e-6);
+  // Between nodes: background (points, not the surface).
+  EXPECT_TRUE(IsBackground(shown.At(60 - 18, 45 + 18)));
 }
 
 }  // namespace

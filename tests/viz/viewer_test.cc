@@ -50,14 +50,15 @@ struct ViewRun {
 
 /// Runs `gipsi view block.json --camera 0,0 --size 640x480 --screenshot shot.png ARGS` under
 /// xvfb-run (a virtual X display; OpenGL from Mesa's software rasteriser through GLX).
-ViewRun ViewUnderXvfb(const std::string& name, const std::string& args) {
+ViewRun ViewUnderXvfb(const std::string& name, const std::string& args,
+                      const std::string& scene = kBlock) {
   ViewRun run;
   if (!HaveXvfbRun()) {
     run.skip = "xvfb-run is not installed (Debian package xvfb)";
     return run;
   }
   const auto dir = gipsi::testing::TempDir("gipsi_view_", name);
-  std::ofstream(dir / "block.json") << kBlock;
+  std::ofstream(dir / "block.json") << scene;
   const std::string command = fmt::format(
       "xvfb-run -a -s '-screen 0 1024x768x24' {}/bin/gipsi view {} --camera 0,0 --size 640x480 "
       "--screenshot {} {} 2>&1",
@@ -135,6 +136,40 @@ TEST(Viewer, TheMouseToolPullsTheSurface) {
   EXPECT_GT(object_above, 20);
   // Far from the pulled vertex, above the old top edge, stays background.
   EXPECT_TRUE(IsBackground(image.At(panel + 20, 30)));
+}
+
+// The scene asks for the block's mesh edges as 3-pixel red lines (unshaded, so every drawn
+// pixel is exactly red; the viewer has no multisampling). Without the panel the scene fills the
+// window; seen head-on the near face's outline is a square of side H / 1.1 around the centre, so
+// on the middle row the first drawn pixel from the left is its left edge at W/2 - H/2.2.
+TEST(Viewer, DrawsTheScenesLinesInTheirColour) {
+#if defined(__SANITIZE_ADDRESS__)
+  GTEST_SKIP() << "the windowed viewer (GLFW, Mesa's GLX) is not run under AddressSanitizer";
+#endif
+  std::string scene = kBlock;
+  const std::string anchor = R"("integrator": "BackwardEuler")";
+  scene.replace(
+      scene.find(anchor), anchor.size(),
+      anchor + R"(, "display": {"as": "lines", "size": 3, "color": {"color": [1, 0, 0]}})");
+  const ViewRun run = ViewUnderXvfb("lines", "--no-ui --screenshot-time 0", scene);
+  SKIP_WITHOUT_DISPLAY(run);
+  ASSERT_EQ(run.code, 0) << run.output;
+  const Image& image = run.image;
+  ASSERT_EQ(image.width, 640);
+  int red = 0, other = 0;
+  for (int y = 0; y < image.height; ++y)
+    for (int x = 0; x < image.width; ++x) {
+      const Rgb c = image.At(x, y);
+      if (IsBackground(c)) continue;
+      const bool exact = c.r == 1.0f && c.g == 0.0f && c.b == 0.0f;
+      red += exact;
+      other += !exact;
+    }
+  EXPECT_GT(red, 4 * 400);  // at least the outline: 4 sides of 436 px, 3 px wide
+  EXPECT_EQ(other, 0);
+  int first = 0;
+  while (first < image.width && IsBackground(image.At(first, 240))) ++first;
+  EXPECT_NEAR(first + 1.5, 320 - 240 / 1.1, 2.0);
 }
 
 TEST(Viewer, SaysSoWhenThereIsNoDisplay) {

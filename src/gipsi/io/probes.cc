@@ -10,9 +10,19 @@
 #include "gipsi/geometry/region_json.h"
 
 namespace gipsi {
+namespace {
+
+/// Values per CSV row after time.
+std::size_t ProbeWidth(const Probe& probe) {
+  std::size_t width = probe.is_line() ? 4 : 0;
+  for (FieldId id : probe.fields) width += std::size_t(probe.object->field_info(id).components);
+  return width;
+}
+
+}  // namespace
 
 std::string Probe::Header() const {
-  std::string header = "time";
+  std::string header = is_line() ? "time,distance,x,y,z" : "time";
   for (FieldId id : fields) {
     const FieldInfo& info = object->field_info(id);
     if (info.components == 1) {
@@ -29,6 +39,29 @@ std::string Probe::Header() const {
 
 void Probe::Sample(std::vector<double>& out) const {
   out.clear();
+  if (is_line()) {
+    const std::size_t width = ProbeWidth(*this);
+    const Index n = line.cols();
+    out.assign(width * std::size_t(n), 0.0);
+    for (Index j = 0; j < n; ++j) {
+      double* row = out.data() + width * std::size_t(j);
+      row[0] = distance[std::size_t(j)];
+      for (int k = 0; k < 3; ++k) row[1 + k] = line(k, j);
+    }
+    std::size_t column = 4;
+    for (FieldId id : fields) {
+      const FieldInfo& info = object->field_info(id);
+      Eigen::MatrixXd values(info.components, object->FieldCount(id));
+      object->ReadField(id, values);
+      Eigen::MatrixXd at_points(info.components, n);
+      point->Apply(values, at_points);
+      for (Index j = 0; j < n; ++j)
+        for (int c = 0; c < info.components; ++c)
+          out[width * std::size_t(j) + column + std::size_t(c)] = at_points(c, j);
+      column += std::size_t(info.components);
+    }
+    return;
+  }
   for (FieldId id : fields) {
     const FieldInfo& info = object->field_info(id);
     Eigen::MatrixXd values(info.components, object->FieldCount(id));
@@ -61,8 +94,8 @@ void Probe::Sample(std::vector<double>& out) const {
 }
 
 Probe ParseProbe(const std::string& name, const JsonNode& node, const Kernel& kernel) {
-  node.CheckKeys(
-      {"object", "point", "region", "fields", "field", "reduce", "every", "description"});
+  node.CheckKeys({"object", "point", "region", "line", "at", "fields", "field", "reduce", "every",
+                  "description"});
   // The name becomes <out>/probes/<name>.csv: it must not climb out of that folder.
   const bool plain = !name.empty() && name.front() != '.' &&
                      name.find_first_of("/\\") == std::string::npos &&
@@ -88,7 +121,12 @@ Probe ParseProbe(const std::string& name, const JsonNode& node, const Kernel& ke
     names.insert(names.end(), more.begin(), more.end());
   }
   if (names.empty()) node.Fail("missing required key 'fields'");
-  if (node.Has("point") && node.Has("region")) node.Fail("give either 'point' or 'region'");
+  if (int(node.Has("point")) + int(node.Has("region")) + int(node.Has("line")) > 1)
+    node.Fail("give one of 'point', 'region' or 'line'");
+  if (node.Has("at") && !node.Has("line"))
+    node.At("at").Fail("only line probes take sample times 'at' (others use 'every')");
+  if (node.Has("every") && node.Has("line"))
+    node.At("every").Fail("a line probe samples at the times 'at' (or at the end), not 'every'");
   probe.every = node.Has("every") ? ReadPositiveQuantity(node.At("every"), "s", true) : 0.0;
 
   bool needs_location = false;
@@ -121,6 +159,47 @@ Probe ParseProbe(const std::string& name, const JsonNode& node, const Kernel& ke
     if (probe.point->max_distance() > 1e-6 * diag)
       p->Fail(fmt::format("the point lies {:.4g} outside the domain of '{}'",
                           probe.point->max_distance(), object.name()));
+  } else if (auto l = node.Find("line")) {
+    if (location != FieldLocation::kNode || !needs_location)
+      node.At(node.Has("field") ? "field" : "fields")
+          .Fail("line probes interpolate node fields; give node fields only");
+    for (FieldId id : probe.fields)
+      if (object.field_info(id).location != FieldLocation::kNode)
+        node.At(node.Has("field") ? "field" : "fields")
+            .Fail(fmt::format("field '{}' is not a node field; line probes interpolate node "
+                              "fields only",
+                              object.field_info(id).name));
+    l->CheckKeys({"from", "to", "points"});
+    const Vec3 from = l->At("from").AsVec3(), to = l->At("to").AsVec3();
+    const JsonNode points_node = l->At("points");
+    const auto n = points_node.AsInt();
+    if (n < 2 || n > 100000) points_node.Expected("a number of points in [2, 100000]");
+    if (!((to - from).norm() > 0)) l->At("to").Fail("the line has zero length ('to' = 'from')");
+    probe.line.resize(3, n);
+    probe.distance.resize(std::size_t(n));
+    for (Index j = 0; j < n; ++j) {
+      const double s = double(j) / double(n - 1);
+      probe.line.col(j) = (1 - s) * from + s * to;
+      probe.distance[std::size_t(j)] = s * (to - from).norm();
+    }
+    probe.point = object.MapFromNodes(probe.line);
+    const Mesh& mesh = object.domain();
+    const double diag = (mesh.nodes.rowwise().maxCoeff() - mesh.nodes.rowwise().minCoeff()).norm();
+    if (probe.point->max_distance() > 1e-6 * diag)
+      l->Fail(fmt::format("the line leaves the domain of '{}' (a point lies {:.4g} outside it)",
+                          object.name(), probe.point->max_distance()));
+    if (auto at = node.Find("at")) {
+      if (at->is_array()) {
+        for (const auto& item : at->Items())
+          probe.at.push_back(ReadPositiveQuantity(item, "s", /*allow_zero=*/true));
+        if (probe.at.empty()) at->Expected("a time or a non-empty array of times");
+        if (!std::is_sorted(probe.at.begin(), probe.at.end()) ||
+            std::adjacent_find(probe.at.begin(), probe.at.end()) != probe.at.end())
+          at->Expected("increasing times");
+      } else {
+        probe.at.push_back(ReadPositiveQuantity(*at, "s", /*allow_zero=*/true));
+      }
+    }
   } else if (auto r = node.Find("region")) {
     probe.region = true;
     Region region = ParseRegion(*r);
@@ -162,23 +241,43 @@ ProbeRecorder::ProbeRecorder(std::vector<Probe> probes, const std::filesystem::p
   }
 }
 
+void ProbeRecorder::Write(Stream& s, double t) {
+  s.probe.Sample(row_);
+  const std::size_t width = ProbeWidth(s.probe);
+  for (std::size_t start = 0; start < row_.size(); start += width) {  // line probes: n rows
+    s.file << t;
+    for (std::size_t k = start; k < start + width; ++k) s.file << ',' << row_[k];
+    s.file << '\n';
+  }
+  s.file.flush();
+  if (!s.file) throw std::runtime_error(fmt::format("probe '{}': write failed", s.probe.name));
+}
+
 void ProbeRecorder::Observe(const Kernel& kernel, double t) {
   const double tolerance = 1e-9 * kernel.macro_dt();
   for (auto& s : streams_) {
+    if (s.probe.is_line()) {
+      if (s.next_at < s.probe.at.size() && t + tolerance >= s.probe.at[s.next_at]) {
+        Write(s, t);
+        while (s.next_at < s.probe.at.size() && t + tolerance >= s.probe.at[s.next_at]) ++s.next_at;
+      }
+      continue;
+    }
     if (t + tolerance < s.next) continue;
-    s.probe.Sample(row_);
-    s.file << t;
-    for (double v : row_) s.file << ',' << v;
-    s.file << '\n';
-    s.file.flush();
-    if (!s.file) throw std::runtime_error(fmt::format("probe '{}': write failed", s.probe.name));
+    Write(s, t);
     if (s.probe.every > 0)
       while (s.next <= t + tolerance) s.next += s.probe.every;
   }
 }
 
-void ProbeRecorder::Finish(const Kernel& /*kernel*/) {
-  for (auto& s : streams_) s.file.flush();
+void ProbeRecorder::Finish(const Kernel& kernel) {
+  for (auto& s : streams_) {
+    if (s.probe.is_line() && s.probe.at.empty() && s.next_at == 0) {
+      Write(s, kernel.time());  // once, at the end of the run
+      s.next_at = 1;
+    }
+    s.file.flush();
+  }
 }
 
 }  // namespace gipsi

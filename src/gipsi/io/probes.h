@@ -6,12 +6,20 @@
 ///     "tip":  {"object": "sheet", "point": [x, y, z], "fields": ["displacement"], "every": 0.01},
 ///     "top":  {"object": "sheet", "region": <region>, "fields": ["reaction_force"],
 ///              "reduce": "sum"},
-///     "energy": {"object": "sheet", "fields": ["kinetic_energy"]}
+///     "energy": {"object": "sheet", "fields": ["kinetic_energy"]},
+///     "diagonal": {"object": "tissue", "line": {"from": [0, 0, 0], "to": [0.02, 0.007, 0.003],
+///                  "points": 101}, "fields": ["activation_time"], "at": [0.03, 0.06]}
 ///   }
 /// A point probe interpolates node fields at the point (barycentric in the domain at rest). A
 /// region probe reduces node or boundary-vertex fields over the region ("mean", "sum", "min",
 /// "max", per component). Global fields need neither. `every` is in seconds of simulated time
 /// (default: every macro step).
+///
+/// A line probe samples node fields at `points` evenly spaced points from `from` to `to`
+/// (interpolated like a point probe, through SimObject::MapFromNodes) at the times `at` [s] (at
+/// the first macro step reaching each), or once at the end of the run when `at` is absent. Its
+/// CSV has one row per point and sample time: time, distance along the line from `from`, the
+/// point's x, y, z (rest coordinates), then the field columns.
 
 #include <filesystem>
 #include <fstream>
@@ -32,15 +40,23 @@ struct Probe {
   std::string name;
   const SimObject* object = nullptr;
   std::vector<FieldId> fields;
-  std::optional<PointMap> point;  ///< point probes: interpolation weights
-  std::vector<int> items;         ///< region probes: node or boundary-vertex ids
+  std::optional<PointMap> point;  ///< point and line probes: interpolation weights
+  /// Line probes: the sample points (3 by n, rest coordinates) and distances from the first.
+  Points line = Points(3, 0);
+  std::vector<double> distance;
+  /// Line probes: sample times [s], ascending; empty = once, at the end of the run.
+  std::vector<double> at;
+  std::vector<int> items;  ///< region probes: node or boundary-vertex ids
   bool region = false;
   Reduce reduce = Reduce::kMean;
   double every = 0;
 
-  /// CSV header: time then one column per component ("displacement_x", ...).
+  [[nodiscard]] bool is_line() const { return line.cols() > 0; }
+  /// CSV header: time then one column per component ("displacement_x", ...); line probes have
+  /// "distance,x,y,z" after time.
   [[nodiscard]] std::string Header() const;
-  /// Current values, one per column after time.
+  /// Current values, one per column after time (line probes: all rows, row after row, each
+  /// starting with distance, x, y, z).
   void Sample(std::vector<double>& out) const;
 };
 
@@ -62,7 +78,9 @@ class ProbeRecorder final : public Observer {
     Probe probe;
     std::ofstream file;
     double next = 0;
+    std::size_t next_at = 0;  // line probes: index into probe.at
   };
+  void Write(Stream& s, double t);
   std::vector<Stream> streams_;
   std::vector<double> row_;
 };

@@ -78,18 +78,37 @@ class ObjectBuilder {
 
  private:
   void ApplyDisplay(SimObject& object, const JsonNode& node) {
-    node.CheckKeys({"mesh", "mapping", "max_distance"});
-    auto mesh = meshes_.GetMesh(node.At("mesh").AsString(), node.At("mesh"));
-    if (mesh->num_triangles() == 0)
-      node.At("mesh").Fail("a display mesh needs triangles (a surface)");
-    if (auto mapping = node.Find("mapping")) (void)mapping->AsChoice({"barycentric"});
-    const Points& nodes = object.domain().nodes;
-    const double diag = (nodes.rowwise().maxCoeff() - nodes.rowwise().minCoeff()).norm();
-    try {
-      object.EmbedDisplay(mesh->nodes, mesh->triangles,
-                          node.NonNegative("max_distance", 0.05 * diag));
-    } catch (const InputError& e) {
-      node.Fail(e.what());
+    viz::DrawSpec draw = viz::ParseDrawSpec(node, {"mesh", "mapping", "max_distance"});
+    if (node.Has("mesh")) {
+      auto mesh = meshes_.GetMesh(node.At("mesh").AsString(), node.At("mesh"));
+      if (mesh->num_triangles() == 0)
+        node.At("mesh").Fail("a display mesh needs triangles (a surface)");
+      if (auto mapping = node.Find("mapping")) (void)mapping->AsChoice({"barycentric"});
+      const Points& nodes = object.domain().nodes;
+      const double diag = (nodes.rowwise().maxCoeff() - nodes.rowwise().minCoeff()).norm();
+      try {
+        object.EmbedDisplay(mesh->nodes, mesh->triangles,
+                            node.NonNegative("max_distance", 0.05 * diag));
+      } catch (const InputError& e) {
+        node.Fail(e.what());
+      }
+    } else {
+      for (const char* key : {"mapping", "max_distance"})
+        if (node.Has(key)) node.At(key).Fail("only applies with a display 'mesh'");
+    }
+    if (node.Has("color") || node.Has("as") || node.Has("wireframe") || node.Has("visible") ||
+        node.Has("size")) {
+      try {  // resolve the field and geometry now, so errors name this JSON path
+        (void)viz::DisplayManager(object, draw);
+      } catch (const InputError& e) {
+        // "object 'x': display: ..." is about the geometry, anything else about the colour.
+        const bool geometry =
+            std::string_view(e.what()).find("': display: ") != std::string_view::npos;
+        if (!geometry && node.Has("color")) node.At("color").Fail(e.what());
+        if (geometry && node.Has("as")) node.At("as").Fail(e.what());
+        node.Fail(e.what());
+      }
+      scene_.display.emplace_back(&object, std::move(draw));
     }
   }
 

@@ -5,9 +5,11 @@
 #include <limits>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include "gipsi/base/error.h"
 #include "gipsi/geometry/normals.h"
+#include "gipsi/models/mass_spring/mass_spring.h"
 
 namespace gipsi::viz {
 namespace {
@@ -27,7 +29,70 @@ std::string FieldLabel(const FieldInfo& info, int component) {
   return fmt::format("{} [{}]", info.name, component);
 }
 
+/// Default line width and point diameter [pixels].
+constexpr float kDefaultLineWidth = 2.0f, kDefaultPointSize = 6.0f;
+
+/// Line segments of an object: a MassSpring's springs, else the unique edges of the domain's
+/// tets (or, without tets, its triangles), as node pairs (lower index first, sorted).
+std::vector<std::uint32_t> Segments(const SimObject& object) {
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> edges;
+  if (const auto* springs = dynamic_cast<const MassSpring*>(&object)) {
+    const Eigen::Matrix2Xi& s = springs->springs();
+    for (Index k = 0; k < s.cols(); ++k)
+      edges.emplace_back(std::uint32_t(s(0, k)), std::uint32_t(s(1, k)));
+  } else {
+    const Mesh& mesh = object.domain();
+    auto add = [&](int a, int b) {
+      edges.emplace_back(std::uint32_t(std::min(a, b)), std::uint32_t(std::max(a, b)));
+    };
+    if (mesh.num_tets() > 0) {
+      for (Index e = 0; e < mesh.num_tets(); ++e)
+        for (int i = 0; i < 4; ++i)
+          for (int j = i + 1; j < 4; ++j) add(mesh.tets(i, e), mesh.tets(j, e));
+    } else {
+      for (Index e = 0; e < mesh.num_triangles(); ++e)
+        for (int i = 0; i < 3; ++i) add(mesh.triangles(i, e), mesh.triangles((i + 1) % 3, e));
+    }
+    std::sort(edges.begin(), edges.end());
+    edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
+  }
+  std::vector<std::uint32_t> out;
+  out.reserve(2 * edges.size());
+  for (const auto& [a, b] : edges) out.insert(out.end(), {a, b});
+  return out;
+}
+
+bool IsSpringNetwork(const SimObject& object) {
+  const auto* springs = dynamic_cast<const MassSpring*>(&object);
+  return springs && springs->num_springs() > 0;
+}
+
 }  // namespace
+
+DrawSpec ParseDrawSpec(const JsonNode& node, std::initializer_list<std::string_view> known_keys) {
+  std::vector<std::string> keys{"color", "as", "wireframe", "visible", "size"};
+  for (auto k : known_keys) keys.emplace_back(k);
+  node.CheckKeys(keys);
+  DrawSpec spec;
+  if (auto c = node.Find("color")) {
+    spec.color = ParseColorSpec(*c);
+    spec.solid_given = c->Has("color");
+  }
+  if (auto as = node.Find("as")) {
+    const std::string s = as->AsChoice({"surface", "lines", "points"});
+    spec.as = s == "surface" ? Primitive::kTriangles
+              : s == "lines" ? Primitive::kLines
+                             : Primitive::kPoints;
+  }
+  spec.wireframe = node.Bool("wireframe", false);
+  spec.visible = node.Bool("visible", true);
+  if (auto size = node.Find("size")) {
+    const double v = size->AsNumber();
+    if (!(v >= 1 && v <= 64)) size->Expected("a line width or point size in pixels, in [1, 64]");
+    spec.size = static_cast<float>(v);
+  }
+  return spec;
+}
 
 ColorSpec ParseColorSpec(const JsonNode& node) {
   node.CheckKeys({"field", "component", "map", "range", "color"});
@@ -94,31 +159,66 @@ std::pair<std::string, ColorSpec> ParseColorOption(std::string_view text, std::s
   return {std::string(text.substr(0, colon)), spec};
 }
 
+bool DisplayManager::HasDefaultGeometry(const SimObject& object) {
+  return object.display().triangles.cols() > 0 || IsSpringNetwork(object);
+}
+
 DisplayManager::DisplayManager(const SimObject& object, ColorSpec spec)
-    : object_(&object), spec_(std::move(spec)), map_(ColorMap::Named("viridis")) {
+    : DisplayManager(object, DrawSpec{std::move(spec), std::nullopt, false, true, 0, false}) {}
+
+DisplayManager::DisplayManager(const SimObject& object, DrawSpec spec)
+    : object_(&object), draw_(std::move(spec)), map_(ColorMap::Named("viridis")) {
+  if (draw_.as) {
+    primitive_ = *draw_.as;
+  } else if (object.display().triangles.cols() == 0 && IsSpringNetwork(object)) {
+    primitive_ = Primitive::kLines;
+  }
+  auto fail_geometry = [&](const std::string& what) {
+    throw InputError(fmt::format("object '{}': display: {}", object.name(), what));
+  };
+  switch (primitive_) {
+    case Primitive::kTriangles:
+      if (object.display().triangles.cols() == 0)
+        fail_geometry("it has no display surface; draw it \"as\": \"lines\" or \"points\"");
+      break;
+    case Primitive::kLines:
+      segments_ = Segments(object);
+      if (segments_.empty()) fail_geometry("it has no springs or mesh edges to draw as lines");
+      break;
+    case Primitive::kPoints:
+      if (object.domain_positions().cols() == 0) fail_geometry("it has no nodes to draw as points");
+      break;
+  }
+  const bool surface = primitive_ == Primitive::kTriangles;
   auto fail = [&](const std::string& what) {
     throw InputError(fmt::format("object '{}': display colour: {}", object.name(), what));
   };
   try {
-    map_ = ColorMap::Named(spec_.color_map);
+    map_ = ColorMap::Named(draw_.color.color_map);
   } catch (const InputError& e) {
     fail(e.what());
   }
-  if (spec_.range && !(spec_.range->second > spec_.range->first))
-    fail(fmt::format("range [{}, {}] is empty", spec_.range->first, spec_.range->second));
-  if (spec_.field.empty()) return;
-  field_ = object.FindField(spec_.field);  // throws naming the object and its fields
+  if (draw_.color.range && !(draw_.color.range->second > draw_.color.range->first))
+    fail(fmt::format("range [{}, {}] is empty", draw_.color.range->first,
+                     draw_.color.range->second));
+  if (draw_.color.field.empty()) return;
+  field_ = object.FindField(draw_.color.field);  // throws naming the object and its fields
   const FieldInfo& info = object.field_info(*field_);
   if (!info.readable()) fail(fmt::format("field '{}' cannot be read", info.name));
-  if (spec_.component >= info.components)
+  if (draw_.color.component >= info.components)
     fail(fmt::format("field '{}' has {} component(s); component {} does not exist", info.name,
-                     info.components, spec_.component));
+                     info.components, draw_.color.component));
   location_ = info.location;
   const bool embedded = object.display().map.has_value();
   switch (location_) {
     case FieldLocation::kNode:
       break;
     case FieldLocation::kBoundaryVertex:
+      if (!surface)
+        fail(
+            fmt::format("field '{}' lives on boundary vertices, but the object is drawn as {}; "
+                        "colour by a node or element field",
+                        info.name, primitive_ == Primitive::kLines ? "lines" : "points"));
       if (embedded)
         fail(
             fmt::format("field '{}' lives on boundary vertices, but the object is drawn with an "
@@ -150,7 +250,7 @@ DisplayManager::DisplayManager(const SimObject& object, ColorSpec spec)
                       "field",
                       info.name, ToString(location_)));
   }
-  label_ = FieldLabel(info, spec_.component);
+  label_ = FieldLabel(info, draw_.color.component);
   raw_.resize(info.components, object.FieldCount(*field_));
   item_.resize(raw_.cols());
 }
@@ -158,8 +258,8 @@ DisplayManager::DisplayManager(const SimObject& object, ColorSpec spec)
 void DisplayManager::ComputeValues() {
   const SimObject& object = *object_;
   object.ReadField(*field_, raw_);
-  if (spec_.component >= 0)
-    item_ = raw_.row(spec_.component);
+  if (draw_.color.component >= 0)
+    item_ = raw_.row(draw_.color.component);
   else
     item_ = raw_.colwise().norm();
   const Eigen::RowVectorXd* per_node = &item_;
@@ -173,6 +273,10 @@ void DisplayManager::ComputeValues() {
     per_node = &node_;
   }
   const DisplayGeometry& display = object.display();
+  if (primitive_ != Primitive::kTriangles) {  // drawn on the domain nodes
+    values_ = *per_node;
+    return;
+  }
   const Index num_vertices = display.positions.cols();
   values_.resize(num_vertices);
   if (location_ == FieldLocation::kBoundaryVertex) {
@@ -187,29 +291,51 @@ void DisplayManager::ComputeValues() {
 
 void DisplayManager::Fill(SurfaceBuffers& out) {
   const SimObject& object = *object_;
-  object.UpdateDisplay();
-  const DisplayGeometry& display = object.display();
-  const Points& x = display.positions;
-  const Triangles& tris = display.triangles;
-  VertexNormals(x, tris, normals_);
-  const auto num_vertices = static_cast<std::size_t>(x.cols());
   if (out.object != object.name()) out.object = object.name();
-  out.positions.resize(3 * num_vertices);
-  out.normals.resize(3 * num_vertices);
-  out.colors.resize(3 * num_vertices);
-  for (std::size_t i = 0; i < 3 * num_vertices; ++i) {
-    out.positions[i] = static_cast<float>(x.data()[i]);
-    out.normals[i] = static_cast<float>(normals_.data()[i]);
+  out.primitive = primitive_;
+  out.wireframe = draw_.wireframe && primitive_ == Primitive::kTriangles;
+  out.size = draw_.size > 0                     ? draw_.size
+             : primitive_ == Primitive::kPoints ? kDefaultPointSize
+                                                : kDefaultLineWidth;
+  std::size_t num_vertices = 0;
+  if (primitive_ == Primitive::kTriangles) {
+    object.UpdateDisplay();
+    const DisplayGeometry& display = object.display();
+    const Points& x = display.positions;
+    const Triangles& tris = display.triangles;
+    VertexNormals(x, tris, normals_);
+    num_vertices = static_cast<std::size_t>(x.cols());
+    out.positions.resize(3 * num_vertices);
+    out.normals.resize(3 * num_vertices);
+    for (std::size_t i = 0; i < 3 * num_vertices; ++i) {
+      out.positions[i] = static_cast<float>(x.data()[i]);
+      out.normals[i] = static_cast<float>(normals_.data()[i]);
+    }
+    out.indices.resize(3 * static_cast<std::size_t>(tris.cols()));
+    for (std::size_t i = 0; i < out.indices.size(); ++i)
+      out.indices[i] = static_cast<std::uint32_t>(tris.data()[i]);
+  } else {
+    // Lines and points live on the current domain nodes and are drawn unshaded (zero normals).
+    const Points& x = object.domain_positions();
+    num_vertices = static_cast<std::size_t>(x.cols());
+    out.positions.resize(3 * num_vertices);
+    out.normals.assign(3 * num_vertices, 0.0f);
+    for (std::size_t i = 0; i < 3 * num_vertices; ++i)
+      out.positions[i] = static_cast<float>(x.data()[i]);
+    if (primitive_ == Primitive::kLines) {
+      out.indices.assign(segments_.begin(), segments_.end());
+    } else {
+      out.indices.resize(num_vertices);
+      for (std::size_t i = 0; i < num_vertices; ++i) out.indices[i] = std::uint32_t(i);
+    }
   }
-  out.indices.resize(3 * static_cast<std::size_t>(tris.cols()));
-  for (std::size_t i = 0; i < out.indices.size(); ++i)
-    out.indices[i] = static_cast<std::uint32_t>(tris.data()[i]);
+  out.colors.resize(3 * num_vertices);
 
   if (!field_) {
     for (std::size_t v = 0; v < num_vertices; ++v) {
-      out.colors[3 * v] = spec_.solid.r;
-      out.colors[3 * v + 1] = spec_.solid.g;
-      out.colors[3 * v + 2] = spec_.solid.b;
+      out.colors[3 * v] = draw_.color.solid.r;
+      out.colors[3 * v + 1] = draw_.color.solid.g;
+      out.colors[3 * v + 2] = draw_.color.solid.b;
     }
     out.values.clear();
     out.field.clear();
@@ -220,8 +346,8 @@ void DisplayManager::Fill(SurfaceBuffers& out) {
   }
   ComputeValues();
   double lo = std::numeric_limits<double>::infinity(), hi = -lo;
-  if (spec_.range) {
-    std::tie(lo, hi) = *spec_.range;
+  if (draw_.color.range) {
+    std::tie(lo, hi) = *draw_.color.range;
   } else {
     for (Index v = 0; v < values_.size(); ++v) {
       if (std::isnan(values_(v))) continue;
@@ -248,28 +374,46 @@ void DisplayManager::Fill(SurfaceBuffers& out) {
 }
 
 SceneDisplay::SceneDisplay(const Kernel& kernel,
-                           const std::vector<std::pair<std::string, ColorSpec>>& specs) {
+                           const std::vector<std::pair<std::string, ColorSpec>>& colors)
+    : SceneDisplay(kernel, {}, colors) {}
+
+SceneDisplay::SceneDisplay(const Kernel& kernel,
+                           const std::vector<std::pair<const SimObject*, DrawSpec>>& scene_specs,
+                           const std::vector<std::pair<std::string, ColorSpec>>& colors) {
   std::vector<const SimObject*> leaves;
   const Coordinator& coordinator = kernel.coordinator();
   for (std::size_t i = 0; i < coordinator.num_objects(); ++i)
     coordinator.object(i).CollectLeaves(leaves);
   std::vector<const SimObject*> named;
-  for (const auto& [name, spec] : specs) named.push_back(&kernel.FindObject(name));
+  for (const auto& [name, spec] : colors) named.push_back(&kernel.FindObject(name));
   std::size_t solid = 0;
   for (const SimObject* leaf : leaves) {
-    if (leaf->display().triangles.cols() == 0) continue;
+    auto s = std::find_if(scene_specs.begin(), scene_specs.end(),
+                          [&](const auto& p) { return p.first == leaf; });
+    const bool asked = s != scene_specs.end();
+    if (!asked && !DisplayManager::HasDefaultGeometry(*leaf)) continue;
+    DrawSpec draw = asked ? s->second : DrawSpec{};
     auto it = std::find(named.begin(), named.end(), leaf);
     if (it != named.end()) {
-      managers_.emplace_back(*leaf, specs[std::size_t(it - named.begin())].second);
-    } else {
-      ColorSpec spec;
-      spec.solid = kPalette[solid++ % std::size(kPalette)];
-      managers_.emplace_back(*leaf, spec);
+      draw.color = colors[std::size_t(it - named.begin())].second;
+    } else if (draw.color.field.empty() && !draw.solid_given) {
+      draw.color.solid = kPalette[solid++ % std::size(kPalette)];
     }
+    managers_.emplace_back(*leaf, std::move(draw));
   }
   for (std::size_t i = 0; i < named.size(); ++i)
-    if (named[i]->display().triangles.cols() == 0)
-      throw InputError(fmt::format("object '{}' has no display surface to colour", specs[i].first));
+    if (std::none_of(managers_.begin(), managers_.end(),
+                     [&](const DisplayManager& m) { return &m.object() == named[i]; }))
+      throw InputError(
+          fmt::format("object '{}' has nothing to draw and colour (no display surface or springs; "
+                      "its scene \"display\" may ask for \"as\": \"points\")",
+                      colors[i].first));
+}
+
+std::vector<bool> SceneDisplay::Hidden() const {
+  std::vector<bool> hidden;
+  for (const DisplayManager& m : managers_) hidden.push_back(!m.draw().visible);
+  return hidden;
 }
 
 void SceneDisplay::Fill(double t, FrameBuffers& out) {
@@ -277,6 +421,52 @@ void SceneDisplay::Fill(double t, FrameBuffers& out) {
   out.frame = frames_++;
   out.surfaces.resize(managers_.size());
   for (std::size_t i = 0; i < managers_.size(); ++i) managers_[i].Fill(out.surfaces[i]);
+}
+
+void ApplyGeometryOptions(const Kernel& kernel, const std::vector<std::string>& options,
+                          std::string_view option,
+                          std::vector<std::pair<const SimObject*, DrawSpec>>& specs) {
+  for (const std::string& text : options) {
+    const std::size_t colon = text.rfind(':');
+    const std::string geometry = colon == std::string::npos ? "" : text.substr(colon + 1);
+    if (colon == std::string::npos || colon == 0 ||
+        (geometry != "surface" && geometry != "lines" && geometry != "points"))
+      ThrowInputError("command line", option,
+                      fmt::format("expected OBJECT:surface, OBJECT:lines or OBJECT:points, got "
+                                  "'{}'",
+                                  text));
+    const SimObject* object = nullptr;
+    try {
+      object = &kernel.FindObject(text.substr(0, colon));
+    } catch (const InputError& e) {
+      ThrowInputError("command line", option, e.what());
+    }
+    auto it =
+        std::find_if(specs.begin(), specs.end(), [&](const auto& p) { return p.first == object; });
+    if (it == specs.end()) it = specs.insert(specs.end(), {object, DrawSpec{}});
+    it->second.as = geometry == "surface" ? Primitive::kTriangles
+                    : geometry == "lines" ? Primitive::kLines
+                                          : Primitive::kPoints;
+    try {
+      (void)DisplayManager(*object, it->second);
+    } catch (const InputError& e) {
+      ThrowInputError("command line", option, e.what());
+    }
+  }
+}
+
+void ApplyVisibility(const std::vector<std::string>& names, const std::vector<std::string>& show,
+                     const std::vector<std::string>& hide, std::vector<bool>& hidden) {
+  hidden.resize(names.size(), false);
+  for (const auto* list : {&show, &hide})
+    for (const std::string& name : *list) {
+      const auto it = std::find(names.begin(), names.end(), name);
+      if (it == names.end())
+        ThrowInputError("command line", list == &show ? "--show" : "--hide",
+                        fmt::format("no drawn object named '{}'{}; drawn: {}", name,
+                                    SuggestClosest(name, names), fmt::join(names, ", ")));
+      hidden[std::size_t(it - names.begin())] = list == &hide;
+    }
 }
 
 }  // namespace gipsi::viz

@@ -30,9 +30,31 @@ struct ColorSpec {
   Rgb solid{0.80f, 0.45f, 0.40f};  ///< colour when `field` is empty
 };
 
+/// How to draw one object: its colour, which geometry (its display surface, its springs or
+/// mesh edges as lines, its nodes as points), wireframe, visibility. Plain struct.
+struct DrawSpec {
+  ColorSpec color;
+  /// Triangles: the display surface; lines: a MassSpring's springs, else the unique edges of
+  /// the domain's tets (or triangles); points: the domain nodes. Absent: the display surface
+  /// if the object has one, else the springs of a spring network, else nothing is drawn.
+  std::optional<Primitive> as;
+  bool wireframe = false;  ///< draw the surface's triangle edges too
+  bool visible = true;     ///< initially shown (the viewer can toggle it)
+  /// Line width or point diameter in pixels; 0 = default (2 for lines, 6 for points).
+  float size = 0;
+  /// The scene gave `color.color` (then no palette colour replaces it).
+  bool solid_given = false;
+};
+
 /// Parses {"field": "displacement", "component": "magnitude"|0|1|2|"x"|"y"|"z",
 /// "map": "viridis", "range": [lo, hi], "color": [r, g, b]}; throws InputError naming the path.
 ColorSpec ParseColorSpec(const JsonNode& node);
+
+/// Parses the drawing keys of an object's "display" entry (other keys, e.g. "mesh", are the
+/// caller's): {"color": <ColorSpec>, "as": "surface"|"lines"|"points", "wireframe": bool,
+/// "visible": bool, "size": pixels}. `known_keys` lists the caller's keys, so unknown keys are
+/// reported together. Throws InputError naming the path.
+DrawSpec ParseDrawSpec(const JsonNode& node, std::initializer_list<std::string_view> known_keys);
 
 /// Parses a command-line colour choice "OBJECT:FIELD" where FIELD may end in ".x", ".y", ".z"
 /// (or ".0" ... ".8") for one component (else the magnitude), with colour map `map` and
@@ -41,17 +63,26 @@ std::pair<std::string, ColorSpec> ParseColorOption(std::string_view text, std::s
                                                    std::optional<std::pair<double, double>> range,
                                                    std::string_view option);
 
-/// Fills one object's `SurfaceBuffers` from its display geometry. Built once (it resolves the
-/// field and precomputes the mapping to display vertices); `Fill` allocates nothing after the
-/// first call on the same buffers. Not copyable (holds a reference); movable.
+/// Fills one object's `SurfaceBuffers` from its display geometry: its display surface
+/// (triangles), its springs or mesh edges (lines) or its nodes (points). Built once (it
+/// resolves the field and precomputes the mapping to display vertices); `Fill` allocates
+/// nothing after the first call on the same buffers. Not copyable (holds a reference); movable.
 class DisplayManager {
  public:
   /// Throws InputError (naming the object) for an unknown or unreadable field, a component out
-  /// of range, an unsupported field location, an unknown colour map or an empty range.
+  /// of range, an unsupported field location, an unknown colour map, an empty range, or a
+  /// geometry the object does not have (no display surface, no springs or edges, no nodes).
+  DisplayManager(const SimObject& object, DrawSpec spec);
+  /// The object drawn in its default way, coloured by `spec`.
   DisplayManager(const SimObject& object, ColorSpec spec);
 
+  /// Whether the object has something to draw by default (see DrawSpec::as).
+  static bool HasDefaultGeometry(const SimObject& object);
+
   [[nodiscard]] const SimObject& object() const { return *object_; }
-  [[nodiscard]] const ColorSpec& spec() const { return spec_; }
+  [[nodiscard]] const ColorSpec& spec() const { return draw_.color; }
+  [[nodiscard]] const DrawSpec& draw() const { return draw_; }
+  [[nodiscard]] Primitive primitive() const { return primitive_; }
   /// Recomputes the display positions from the object's state and writes all buffers. Call on
   /// the thread that steps the object (between steps).
   void Fill(SurfaceBuffers& out);
@@ -60,7 +91,9 @@ class DisplayManager {
   void ComputeValues();  // values_ at display vertices
 
   const SimObject* object_;
-  ColorSpec spec_;
+  DrawSpec draw_;
+  Primitive primitive_ = Primitive::kTriangles;
+  std::vector<std::uint32_t> segments_;  // lines: node pairs
   ColorMap map_;
   std::optional<FieldId> field_;
   std::string label_;  // e.g. "|displacement|"
@@ -74,13 +107,20 @@ class DisplayManager {
   Points normals_ = Points(3, 0);
 };
 
-/// Display managers for every leaf object of a kernel that has a display surface, coloured by
-/// `specs[name]` when given (else solid colours from a fixed palette), and `Fill` for all of
-/// them into one frame. Not copyable; movable.
+/// Display managers for every leaf object of a kernel that has something to draw (see
+/// DrawSpec::as) or that the scene asks to draw, and `Fill` for all of them into one frame.
+/// Each is drawn as the scene's spec says (`scene_specs`, from the objects' "display" keys),
+/// with its colour replaced by `colors[name]` when given (the command line's choice); objects
+/// without a colour get solid colours from a fixed palette. Not copyable; movable.
 class SceneDisplay {
  public:
-  /// Throws InputError for a spec naming no such object or an invalid spec.
-  SceneDisplay(const Kernel& kernel, const std::vector<std::pair<std::string, ColorSpec>>& specs);
+  /// Throws InputError for a colour naming no such object or an invalid spec.
+  SceneDisplay(const Kernel& kernel, const std::vector<std::pair<std::string, ColorSpec>>& colors);
+  SceneDisplay(const Kernel& kernel,
+               const std::vector<std::pair<const SimObject*, DrawSpec>>& scene_specs,
+               const std::vector<std::pair<std::string, ColorSpec>>& colors);
+  /// Hidden flags for RenderOptions::hidden: !visible of each manager's spec.
+  [[nodiscard]] std::vector<bool> Hidden() const;
   [[nodiscard]] std::size_t size() const { return managers_.size(); }
   [[nodiscard]] DisplayManager& manager(std::size_t i) { return managers_[i]; }
   /// Fills `out` (one surface per manager) at simulated time `t`.
@@ -90,5 +130,18 @@ class SceneDisplay {
   std::vector<DisplayManager> managers_;
   std::int64_t frames_ = 0;
 };
+
+/// Applies the command line's `--as OBJECT:surface|lines|points` choices (`options`) to a
+/// scene's draw specs (adding one for an object that has none). Throws InputError naming
+/// `option` for bad syntax or an unknown object.
+void ApplyGeometryOptions(const Kernel& kernel, const std::vector<std::string>& options,
+                          std::string_view option,
+                          std::vector<std::pair<const SimObject*, DrawSpec>>& specs);
+
+/// Applies the command line's `--show` and `--hide` (object names) to `hidden` (one flag per
+/// drawn object, named `names`). Throws InputError naming the option for a name that is not
+/// drawn.
+void ApplyVisibility(const std::vector<std::string>& names, const std::vector<std::string>& show,
+                     const std::vector<std::string>& hide, std::vector<bool>& hidden);
 
 }  // namespace gipsi::viz

@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
+#include "gipsi/base/error.h"
 #include "gipsi/viz/csv_table.h"
 
 namespace gipsi::viz {
@@ -36,6 +37,28 @@ ColumnRef ParseColumn(const JsonNode& node, const std::vector<Probe>& probes) {
 
 }  // namespace
 
+std::vector<PlotData::Series> SplitSeries(const std::string& label, const std::vector<double>& x,
+                                          const std::vector<double>& y,
+                                          const std::vector<double>& key,
+                                          const std::string& key_name) {
+  GIPSI_CHECK(x.size() == y.size() && y.size() == key.size());
+  std::vector<PlotData::Series> out;
+  for (std::size_t start = 0; start < key.size();) {
+    std::size_t end = start + 1;
+    while (end < key.size() && key[end] == key[start]) ++end;
+    PlotData::Series series;
+    series.label = key_name == "time"
+                       ? fmt::format("{} at t = {:.4g} s", label, key[start])
+                       : fmt::format("{} at {} = {:.4g}", label, key_name, key[start]);
+    series.x.assign(x.begin() + std::ptrdiff_t(start), x.begin() + std::ptrdiff_t(end));
+    series.y.assign(y.begin() + std::ptrdiff_t(start), y.begin() + std::ptrdiff_t(end));
+    out.push_back(std::move(series));
+    start = end;
+  }
+  if (out.size() == 1) out[0].label = label;
+  return out;
+}
+
 std::vector<std::string> ProbeColumns(const Probe& probe) {
   std::vector<std::string> columns;
   const std::string header = probe.Header();
@@ -65,6 +88,26 @@ PlotSpec ParsePlotSpec(const JsonNode& node, const std::vector<Probe>& probes) {
     const auto items = y.Items();
     if (items.empty()) y.Expected("a column or a non-empty array of columns");
     for (const auto& item : items) spec.y.push_back(ParseColumn(item, probes));
+  }
+  const auto line_probe = [&](const std::string& name) {
+    return std::any_of(probes.begin(), probes.end(),
+                       [&](const Probe& p) { return p.name == name && p.is_line(); });
+  };
+  if (line_probe(spec.y[0].probe)) {
+    spec.profile = true;
+    if (auto x = node.Find("x"); x && x->AsString() == "time")
+      x->Fail(
+          fmt::format("probe '{}' samples along a line: plot against its 'distance' (the "
+                      "default) or a coordinate, e.g. \"{}.x\"",
+                      spec.y[0].probe, spec.y[0].probe));
+    if (!spec.x) spec.x = ColumnRef{spec.y[0].probe, "distance"};
+  } else if (!spec.x) {
+    for (std::size_t i = 0; i < spec.y.size(); ++i)
+      if (line_probe(spec.y[i].probe))
+        (y.is_string() ? y : y.Item(i))
+            .Fail(fmt::format("comes from line probe '{}', but the first column does not: plot "
+                              "a line probe's columns on their own",
+                              spec.y[i].probe));
   }
   if (spec.x)
     for (std::size_t i = 0; i < spec.y.size(); ++i)
@@ -98,8 +141,13 @@ PlotData LoadPlotData(const PlotSpec& spec, const std::filesystem::path& probe_d
   };
   for (const ColumnRef& y : spec.y) {
     const CsvTable& t = table(y.probe);
-    data.series.push_back(
-        {label(y), spec.x ? t.Column(spec.x->column) : t.Column("time"), t.Column(y.column)});
+    const std::vector<double>& x = spec.x ? t.Column(spec.x->column) : t.Column("time");
+    if (spec.profile) {
+      for (auto& series : SplitSeries(label(y), x, t.Column(y.column), t.Column("time")))
+        data.series.push_back(std::move(series));
+    } else {
+      data.series.push_back({label(y), x, t.Column(y.column)});
+    }
   }
   data.y_label = spec.y.size() == 1 ? label(spec.y[0]) : "";
   return data;

@@ -9,7 +9,10 @@
 ///   ]
 /// A column is named `PROBE.COLUMN` with the probe's CSV column (`time`, `displacement_x`, ...);
 /// `x` defaults to `time` (each trace against its own probe's time); any other `x` must come
-/// from the same probe as every `y`.
+/// from the same probe as every `y`. For a line probe (a profile along a line) `x` defaults to
+/// its `distance`, and each sample time becomes its own curve:
+///
+///     {"file": "activation.png", "y": "diagonal.activation_time"}
 
 #include <filesystem>
 #include <optional>
@@ -33,6 +36,8 @@ struct PlotSpec {
   std::string title;
   std::optional<ColumnRef> x;  ///< absent: time
   std::vector<ColumnRef> y;    ///< at least one
+  /// The columns come from a line probe: one curve per sample time (the rows of one time).
+  bool profile = false;
   int width = 800, height = 500;
 };
 
@@ -55,6 +60,14 @@ struct PlotData {
 /// Reads the columns of `spec` from `<probe_dir>/<probe>.csv`; throws InputError naming the
 /// file for a missing file or column.
 PlotData LoadPlotData(const PlotSpec& spec, const std::filesystem::path& probe_dir);
+
+/// Splits (x, y) into one series per run of equal `key` values (e.g. the rows of one sample
+/// time of a line probe), labelled "`label` at t = VALUE s" (`key_name` "time") or "`label` at
+/// KEY_NAME = VALUE" when there is more than one run, else `label`. Sizes must agree (checked).
+std::vector<PlotData::Series> SplitSeries(const std::string& label, const std::vector<double>& x,
+                                          const std::vector<double>& y,
+                                          const std::vector<double>& key,
+                                          const std::string& key_name = "time");
 
 /// The CSV columns a probe writes (its header split at commas).
 std::vector<std::string> ProbeColumns(const Probe& probe);

@@ -1,7 +1,8 @@
 #pragma once
 /// @file
 /// The standard format the visualization tool draws: per object, vertex positions, normals,
-/// colours and triangle indices (GiPSi's display-manager output). Plain data, filled by display
+/// colours and the indices of triangles, line segments or points (GiPSi's display-manager
+/// output). Plain data, filled by display
 /// managers on the simulation thread and published to renderers through a `TripleBuffer`.
 
 #include <cstdint>
@@ -10,15 +11,26 @@
 
 namespace gipsi::viz {
 
-/// One object's display surface. Vectors are flat, vertex-major (x0 y0 z0 x1 ...), ready for
-/// OpenGL vertex buffers. Copyable and movable; refilling keeps the capacity.
+/// What the indices of a `SurfaceBuffers` connect: triangles (3 each), line segments (2 each,
+/// drawn as GL_LINES) or points (1 each, GL_POINTS).
+enum class Primitive : std::uint8_t { kTriangles, kLines, kPoints };
+
+/// One object's display geometry (a surface, a line set or a point set). Vectors are flat,
+/// vertex-major (x0 y0 z0 x1 ...), ready for OpenGL vertex buffers. Copyable and movable; refilling
+/// keeps the capacity.
 struct SurfaceBuffers {
-  std::string object;                  ///< leaf object name
-  std::vector<float> positions;        ///< 3V, scene units
-  std::vector<float> normals;          ///< 3V, unit (zero at vertices of degenerate triangles)
-  std::vector<float> colors;           ///< 3V, sRGB in [0, 1]
-  std::vector<float> values;           ///< V field values behind the colours (empty if solid)
-  std::vector<std::uint32_t> indices;  ///< 3T, counter-clockwise seen from outside
+  std::string object;            ///< leaf object name
+  std::vector<float> positions;  ///< 3V, scene units
+  /// 3V, unit (zero at vertices of degenerate triangles, and for lines and points, which are
+  /// drawn unshaded)
+  std::vector<float> normals;
+  std::vector<float> colors;  ///< 3V, sRGB in [0, 1]
+  std::vector<float> values;  ///< V field values behind the colours (empty if solid)
+  /// Triangles: 3T, counter-clockwise seen from outside; lines: 2 per segment; points: 1 each.
+  std::vector<std::uint32_t> indices;
+  Primitive primitive = Primitive::kTriangles;
+  bool wireframe = false;  ///< triangles: also draw their edges (the object's own choice)
+  float size = 1;          ///< lines: width, points: diameter, in pixels of the final image
   /// Colour field label, e.g. "|displacement|", "position x"; "" for a solid colour.
   std::string field;
   std::string units;                  ///< its units
@@ -26,7 +38,10 @@ struct SurfaceBuffers {
   double range_lo = 0, range_hi = 0;  ///< the value range the colours span
 
   [[nodiscard]] std::size_t num_vertices() const { return positions.size() / 3; }
-  [[nodiscard]] std::size_t num_triangles() const { return indices.size() / 3; }
+  /// Number of triangles (0 for lines and points).
+  [[nodiscard]] std::size_t num_triangles() const {
+    return primitive == Primitive::kTriangles ? indices.size() / 3 : 0;
+  }
 };
 
 /// Recent samples of one probe, for live plots. Copyable and movable.

@@ -24,7 +24,8 @@ namespace gipsi::viz {
   X(EnableVertexAttribArray) X(Finish) X(FramebufferRenderbuffer) X(GenBuffers) \
   X(GenFramebuffers) X(GenRenderbuffers) X(GenVertexArrays) X(GetError) \
   X(GetIntegerv) X(GetProgramInfoLog) X(GetProgramiv) X(GetShaderInfoLog) \
-  X(GetShaderiv) X(GetString) X(GetUniformLocation) X(LinkProgram) X(PixelStorei) \
+  X(GetShaderiv) X(GetString) X(GetUniformLocation) X(LineWidth) X(LinkProgram) \
+  X(PixelStorei) \
   X(PolygonMode) X(PolygonOffset) X(ReadPixels) X(RenderbufferStorage) \
   X(ShaderSource) X(Uniform1f) X(Uniform1i) X(Uniform3f) X(UniformMatrix4fv) \
   X(UseProgram) X(VertexAttribPointer) X(Viewport)

@@ -73,7 +73,15 @@ Image OffscreenContext::ReadImage() const {
 
 Image RenderSnapshot(Scene& scene, SnapshotOptions options, SnapshotResult* result) {
   GIPSI_CHECK(options.supersample >= 1 && options.supersample <= 4);
-  SceneDisplay display(*scene.kernel, options.colors);  // validate before running
+  ApplyGeometryOptions(*scene.kernel, options.as, "--as", scene.display);
+  SceneDisplay display(*scene.kernel, scene.display, options.colors);  // validate before running
+  if (options.render.hidden.empty()) {
+    options.render.hidden = display.Hidden();
+    std::vector<std::string> names;
+    for (std::size_t i = 0; i < display.size(); ++i)
+      names.push_back(display.manager(i).object().name());
+    ApplyVisibility(names, options.show, options.hide, options.render.hidden);
+  }
   SnapshotResult local;
   SnapshotResult& r = result ? *result : local;
   if (options.time > scene.kernel->time()) {
@@ -84,6 +92,7 @@ Image RenderSnapshot(Scene& scene, SnapshotOptions options, SnapshotResult* resu
   r.time = scene.kernel->time();
   display.Fill(r.time, r.frame);
   const int k = options.supersample;
+  options.render.pixel_scale = float(k);
   const int scene_width = LegendSurface(r.frame, options.render)
                               ? LayoutColorBar(options.width * k, options.height * k).strip_x0
                               : options.width * k;

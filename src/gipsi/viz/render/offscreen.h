@@ -55,6 +55,8 @@ struct SnapshotOptions {
   RenderOptions render;
   bool labels = true;  ///< time, colour-bar values and field name (needs fonts-dejavu-core)
   std::vector<std::pair<std::string, ColorSpec>> colors;  ///< per object
+  std::vector<std::string> show, hide;  ///< objects shown or hidden whatever the scene says
+  std::vector<std::string> as;          ///< "OBJECT:lines" etc.: geometry whatever the scene says
 };
 
 /// What a snapshot did, for the command line's summary. Plain struct.
@@ -72,8 +74,10 @@ struct SnapshotResult {
 void DrawLabels(Image& image, const FrameBuffers& frame, const RenderOptions& render,
                 int supersample);
 
-/// Runs `scene` (without outputs) to `options.time`, draws every display surface off screen and
-/// returns the image. Throws InputError for bad colour specs, std::runtime_error if rendering
+/// Runs `scene` (without outputs) to `options.time`, draws every object as the scene's
+/// "display" keys say (colours replaced by `options.colors`; hidden objects as
+/// `options.render.hidden` says, else as the scene's "visible") off screen and returns the
+/// image. Throws InputError for bad colour specs, std::runtime_error if rendering
 /// is unavailable.
 Image RenderSnapshot(Scene& scene, SnapshotOptions options, SnapshotResult* result = nullptr);
 

@@ -14,12 +14,14 @@ layout(location = 1) in vec3 normal;
 layout(location = 2) in vec3 color;
 uniform mat4 view;
 uniform mat4 projection;
+uniform float point_size;
 out vec3 v_normal;
 out vec3 v_color;
 void main() {
   v_normal = mat3(view) * normal;
   v_color = color;
   gl_Position = projection * view * vec4(position, 1.0);
+  gl_PointSize = point_size;
 }
 )";
 
@@ -99,6 +101,7 @@ SurfaceRenderer::SurfaceRenderer(const GlApi& gl) : gl_(gl) {
   u_override_ = gl.GetUniformLocation(program_, "override_color");
   u_use_override_ = gl.GetUniformLocation(program_, "use_override");
   u_ambient_ = gl.GetUniformLocation(program_, "ambient");
+  u_point_size_ = gl.GetUniformLocation(program_, "point_size");
 }
 
 SurfaceRenderer::~SurfaceRenderer() {
@@ -155,6 +158,7 @@ void SurfaceRenderer::Draw(const FrameBuffers& frame, const Camera& camera, int 
   gl_.UniformMatrix4fv(u_view_, 1, GL_FALSE, view.data());
   gl_.UniformMatrix4fv(u_projection_, 1, GL_FALSE, projection.data());
   gl_.Uniform1f(u_ambient_, options.lighting ? kAmbient : 1.0f);
+  gl_.Enable(GL_PROGRAM_POINT_SIZE);
 
   if (meshes_.size() < frame.surfaces.size()) meshes_.resize(frame.surfaces.size());
   for (std::size_t i = 0; i < frame.surfaces.size(); ++i) {
@@ -165,12 +169,27 @@ void SurfaceRenderer::Draw(const FrameBuffers& frame, const Camera& camera, int 
            s.indices.data(), s.indices.size());
     const auto count = static_cast<GLsizei>(s.indices.size());
     gl_.Uniform1i(u_use_override_, 0);
-    if (options.wireframe) {
+    if (s.primitive != Primitive::kTriangles) {
+      // Lines and points: unshaded (zero normals), sized in pixels of the final image.
+      const float size = std::max(1.0f, s.size * options.pixel_scale);
+      if (s.primitive == Primitive::kLines) {
+        gl_.LineWidth(size);
+        gl_.DrawElements(GL_LINES, count, GL_UNSIGNED_INT, nullptr);
+        gl_.LineWidth(1.0f);
+      } else {
+        gl_.Uniform1f(u_point_size_, size);
+        gl_.DrawElements(GL_POINTS, count, GL_UNSIGNED_INT, nullptr);
+      }
+      continue;
+    }
+    const bool wireframe =
+        options.wireframe || (i < options.edges.size() ? bool(options.edges[i]) : s.wireframe);
+    if (wireframe) {
       gl_.Enable(GL_POLYGON_OFFSET_FILL);
       gl_.PolygonOffset(1.0f, 1.0f);
     }
     gl_.DrawElements(GL_TRIANGLES, count, GL_UNSIGNED_INT, nullptr);
-    if (options.wireframe) {
+    if (wireframe) {
       gl_.Disable(GL_POLYGON_OFFSET_FILL);
       gl_.PolygonMode(GL_FRONT_AND_BACK, GL_LINE);
       gl_.Uniform1i(u_use_override_, 1);

@@ -1,7 +1,8 @@
 #pragma once
 /// @file
 /// `SurfaceRenderer`: draws published `FrameBuffers` with OpenGL 3.3 core — lit, two-sided
-/// surfaces in their vertex colours, optional wire edges and a colour bar. It reads only the
+/// surfaces in their vertex colours, optional wire edges, unshaded line sets (GL_LINES) and
+/// point sets (GL_POINTS), and a colour bar. It reads only the
 /// frame it is given (never simulation state), so the same code serves the off-screen snapshot
 /// and the interactive viewer.
 
@@ -22,7 +23,13 @@ struct RenderOptions {
   bool color_bar = true;     ///< a vertical colour bar at the right edge for the first surface
                              ///< coloured by a field
   std::vector<bool> hidden;  ///< surface i is not drawn if hidden[i] (shorter = visible)
-  int viewport_x = 0;        ///< left edge of the drawing area in the framebuffer (pixels)
+  /// Per surface: draw its triangle edges (overrides SurfaceBuffers::wireframe; shorter = the
+  /// surface's own choice). `wireframe` above draws them for all.
+  std::vector<bool> edges;
+  int viewport_x = 0;  ///< left edge of the drawing area in the framebuffer (pixels)
+  /// Framebuffer pixels per image pixel (the snapshot's supersampling factor): line widths and
+  /// point sizes are multiplied by it.
+  float pixel_scale = 1;
 };
 
 /// The surface whose colours the colour bar explains: the first visible one coloured by a
@@ -68,7 +75,7 @@ class SurfaceRenderer {
   const GlApi& gl_;
   GLuint program_ = 0;
   GLint u_view_ = -1, u_projection_ = -1, u_override_ = -1, u_use_override_ = -1;
-  GLint u_ambient_ = -1;
+  GLint u_ambient_ = -1, u_point_size_ = -1;
   std::vector<GpuMesh> meshes_;
   GpuMesh bar_;
 };
