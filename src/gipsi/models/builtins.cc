@@ -3,6 +3,7 @@
 #include "gipsi/collision/contact.h"
 #include "gipsi/collision/rigid_tool.h"
 #include "gipsi/core/aggregate.h"
+#include "gipsi/haptics/haptic_probe.h"
 #include "gipsi/models/circulation/circulation.h"
 #include "gipsi/models/connectors/boundary_coupling.h"
 #include "gipsi/models/connectors/excitation_contraction.h"
@@ -31,6 +32,7 @@ void RegisterBuiltins(TypeRegistry& registry) {
   RegisterBoundaryCoupling(registry);
   RegisterRigidTool(registry);
   RegisterContact(registry);
+  RegisterHaptics(registry);
 }
 
 }  // namespace gipsi
