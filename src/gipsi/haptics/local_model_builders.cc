@@ -131,6 +131,10 @@ FemCondensation::FemCondensation(FemSolid& object) : object_(object) {
     for (int a = 0; a < 4; ++a)
       lumped_mass_[mesh.tets(a, e)] += 0.25 * rho * object.assembly().volume(e);
   k_ = object.assembly().MakePattern();
+  LinearSolverOptions options;
+  options.type = "cholmod";
+  options.tolerance = 1e-8;
+  solver_ = MakeLinearSolver(options);
 }
 
 SimObject& FemCondensation::object() { return object_; }
@@ -155,17 +159,20 @@ bool FemCondensation::Build(Index vertex, const Vec3& normal, double anchor_forc
     }
   }
   if (!analysed_ || fixed_ != analysed_fixed_) {
-    ldlt_.analyzePattern(k_);
+    solver_->AnalyzePattern(k_);
     analysed_fixed_ = fixed_;
     analysed_ = true;
   }
-  ldlt_.factorize(k_);
   ++factorisations_;
-  if (ldlt_.info() != Eigen::Success) return false;
-  Eigen::MatrixXd rhs = Eigen::MatrixXd::Zero(ndof, 3);
-  for (int a = 0; a < 3; ++a) rhs(3 * contact + a, a) = 1;
-  const Eigen::MatrixXd x = ldlt_.solve(rhs);
-  Mat3 compliance = x.block<3, 3>(3 * contact, 0);
+  if (!solver_->Factorize(k_)) return false;
+  Mat3 compliance;
+  rhs_.setZero(ndof);
+  for (int a = 0; a < 3; ++a) {
+    rhs_[3 * contact + a] = 1;
+    if (!solver_->Solve(rhs_, solution_).converged) return false;
+    compliance.col(a) = solution_.segment<3>(3 * contact);
+    rhs_[3 * contact + a] = 0;
+  }
   compliance = 0.5 * (compliance + compliance.transpose()).eval();
   const Eigen::LDLT<Mat3> small(compliance);
   if (small.info() != Eigen::Success || !(small.vectorD().minCoeff() > 0)) return false;

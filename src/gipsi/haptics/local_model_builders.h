@@ -6,13 +6,13 @@
 ///    move, the next ring is held fixed; mass, damping and tangent stiffness of the springs
 ///    are linearised at the current state.
 ///  - `FemCondensation`: the FEM object's tangent stiffness (FemSolid::CalcStiffness at the
-///    current state, constrained dofs eliminated) is factorised (sparse LDLᵀ, symbolic analysis
+///    current state, constrained dofs eliminated) is factorised (CHOLMOD, symbolic analysis
 ///    kept between builds) and condensed at the contact node: K_c = (E_cᵀ K⁻¹ E_c)⁻¹, the 3×3
 ///    stiffness the tissue offers a point load there; the node keeps its lumped mass and the
 ///    object's Rayleigh damping (α m + β K_c).
 /// Nodes with a constrained axis count as fixed.
 
-#include <Eigen/SparseCholesky>
+#include <memory>
 #include <vector>
 
 #include "gipsi/haptics/local_model.h"
@@ -81,7 +81,8 @@ class FemCondensation final : public LocalModelBuilder {
   VecX lumped_mass_;  // per node
   SparseMatrix k_;
   std::vector<std::uint8_t> fixed_, analysed_fixed_;  // per dof
-  Eigen::SimplicialLDLT<SparseMatrix> ldlt_;
+  std::unique_ptr<LinearSolver> solver_;              // CHOLMOD
+  VecX rhs_, solution_;
   bool analysed_ = false;
   Mat3 condensed_ = Mat3::Zero();
   std::int64_t factorisations_ = 0;

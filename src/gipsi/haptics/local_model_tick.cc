@@ -50,6 +50,9 @@ Vec3 LocalModelTick::Run(double t, double dt) noexcept {
   } else {
     rendered_ = force;
   }
+  // A contact only pushes: the fading offset may not pull the device into the tissue.
+  const double normal_part = rendered_.dot(model.normal);
+  if (normal_part < 0) rendered_ -= normal_part * model.normal;
   const Vec3 desired = workspace_.ForceToDevice(rendered_);
   const Vec3 out = safety_.Filter(desired, dt, t - model.published_at, pose.connected);
   device_.Command(out, Vec3::Zero());

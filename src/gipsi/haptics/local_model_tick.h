@@ -4,7 +4,8 @@
 /// reads the device, takes the newest published model if there is one (re-anchoring: the local
 /// state is reset to the new anchor, and the difference between the force rendered last tick
 /// and the new model's force is added as an offset that fades linearly to zero over
-/// `blend_time`, so a hand-over never makes the force jump), steps the model for the device's
+/// `blend_time`, so a hand-over never makes the force jump; the rendered force's normal part is
+/// kept ≥ 0, a contact only pushes), steps the model for the device's
 /// depth, passes the force through `ForceSafety`, commands the device, and publishes the tool
 /// position and the contact force for the simulation (`HapticFeedback`). No allocation, locks,
 /// exceptions or I/O.
