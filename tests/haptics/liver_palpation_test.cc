@@ -3,9 +3,13 @@
 
 #include <cmath>
 #include <cstdio>
+#include <fstream>
+#include <sstream>
 
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include "gipsi/base/error.h"
 #include "gipsi/haptics/haptic_probe.h"
 #include "gipsi/io/scene.h"
 #include "gipsi/models/builtins.h"
@@ -44,6 +48,39 @@ TEST(LiverPalpationScene, PressesIntoTheLiverAndTheSupportCarriesToolAndWeight) 
   // After 1 s of hold with mass-proportional damping 1/s the organ is close to static
   // equilibrium: support + tool + weight = the rate of momentum (small); 2 % of the weight.
   EXPECT_LT((support + tool + Vec3(0, 0, -weight)).norm(), 0.02 * weight);
+}
+
+TEST(LiverPalpationScene, BadHapticKeysAreErrorsNamingTheJsonPath) {
+  std::ifstream in(std::string(GIPSI_SOURCE_DIR) + "/scenes/liver_palpation.json");
+  std::stringstream buffer;
+  buffer << in.rdbuf();
+  const std::string scene = buffer.str();
+  auto error = [&](const std::string& from, const std::string& to) -> std::string {
+    std::string text = scene;
+    const auto at = text.find(from);
+    if (at == std::string::npos) return "(pattern not in the scene)";
+    text.replace(at, from.size(), to);
+    TypeRegistry registry;
+    RegisterBuiltins(registry);
+    try {
+      (void)LoadSceneFromString(text, "palpation.json", std::string(GIPSI_SOURCE_DIR) + "/scenes",
+                                registry);
+    } catch (const InputError& e) {
+      return e.what();
+    }
+    return "(no error)";
+  };
+  using ::testing::HasSubstr;
+  EXPECT_THAT(error(R"("device": "probe")", R"("device": "liver")"),
+              HasSubstr("connectors.haptics.device: expected the name of a HapticProbe object"));
+  EXPECT_THAT(error(R"("rate": 1000,)", R"("rate": 1000, "ratee": 3,)"),
+              HasSubstr("objects.probe: unknown key 'ratee' (did you mean 'rate'?)"));
+  EXPECT_THAT(error("[1.5, -0.0175", "[0.4, -0.0175"),
+              HasSubstr("objects.probe.path[2]: keyframe times must increase strictly"));
+  EXPECT_THAT(error(R"("rate": 1000,)", R"("rate": 20000,)"),
+              HasSubstr("objects.probe.rate: expected a rate in (0, 10000] Hz"));
+  EXPECT_THAT(error(R"("capture_distance": 0.01)", R"("capture_distance": -1)"),
+              HasSubstr("connectors.haptics.capture_distance"));
 }
 
 }  // namespace
