@@ -16,28 +16,26 @@
 #include "gipsi/haptics/haptic_tick.h"
 #include "gipsi/haptics/latest_value.h"
 #include "gipsi/haptics/virtual_device.h"
+#include "haptics/no_allocation_guard.h"
 
 // Counts global operator new calls made by the current thread while a guard is active (the
 // Drake-style proof that a real-time path allocates nothing). The haptic code uses only
-// fixed-size Eigen types, which never allocate; dynamic Eigen allocations would go through
-// malloc directly and are not counted here.
-namespace {
-thread_local bool g_counting = false;
+// fixed-size Eigen types (or dynamic ones with a fixed maximum size, stored inline), which never
+// allocate; dynamic Eigen allocations would go through malloc directly and are not counted here.
+namespace gipsi::testing {
+thread_local bool g_counting_allocations = false;
 thread_local long g_allocations = 0;
-}  // namespace
+}  // namespace gipsi::testing
 
 // Replacement allocation functions may use malloc and free. Not under AddressSanitizer, whose
 // own operator new must stay in place (with this replacement, a system library loaded by Gmsh,
 // libfreeimage, trips ASan's alloc-dealloc-mismatch check at exit): there the guard counts
 // nothing, and the release build is the one that proves the loop allocation-free.
-#if defined(__SANITIZE_ADDRESS__)
-constexpr bool kCountsAllocations = false;
-#else
-constexpr bool kCountsAllocations = true;
+#if !defined(__SANITIZE_ADDRESS__)
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wmismatched-new-delete"
 void* operator new(std::size_t size) {
-  if (g_counting) ++g_allocations;
+  if (gipsi::testing::g_counting_allocations) ++gipsi::testing::g_allocations;
   if (void* p = std::malloc(size == 0 ? 1 : size)) return p;
   throw std::bad_alloc();
 }
@@ -49,32 +47,19 @@ void operator delete(void* p, std::size_t) noexcept { std::free(p); }
 namespace gipsi {
 namespace {
 
+using testing::g_allocations;
+using testing::g_counting_allocations;
 using ::testing::HasSubstr;
-
-/// Fails the test if the current thread allocates while it lives.
-class NoAllocationGuard {
- public:
-  NoAllocationGuard() {
-    g_allocations = 0;
-    g_counting = true;
-  }
-  ~NoAllocationGuard() {
-    g_counting = false;
-    if (kCountsAllocations) {
-      EXPECT_EQ(g_allocations, 0) << "heap allocations inside a real-time section";
-    }
-  }
-  NoAllocationGuard(const NoAllocationGuard&) = delete;
-  NoAllocationGuard& operator=(const NoAllocationGuard&) = delete;
-};
+using testing::kCountsAllocations;
+using testing::NoAllocationGuard;
 
 TEST(NoAllocationGuard, CatchesAnAllocation) {
   if (!kCountsAllocations) GTEST_SKIP() << "allocations are not counted under AddressSanitizer";
   g_allocations = 0;
-  g_counting = true;
+  g_counting_allocations = true;
   auto* p = new int(3);
   asm volatile("" : : "r"(p) : "memory");  // keep the compiler from eliding the pair
-  g_counting = false;
+  g_counting_allocations = false;
   delete p;
   EXPECT_EQ(g_allocations, 1);
 }

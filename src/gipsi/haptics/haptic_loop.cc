@@ -12,7 +12,7 @@ namespace {
 using Clock = std::chrono::steady_clock;
 }  // namespace
 
-HapticLoop::HapticLoop(HapticTick& tick, double rate, std::size_t max_records)
+HapticLoop::HapticLoop(HapticRenderer& tick, double rate, std::size_t max_records)
     : tick_(tick), period_(1.0 / rate) {
   GIPSI_CHECK(rate > 0 && rate <= 10000, "haptic rate {} Hz out of (0, 10000]", rate);
   periods_.resize(max_records);

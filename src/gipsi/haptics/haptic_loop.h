@@ -1,9 +1,9 @@
 #pragma once
 /// @file
-/// `HapticLoop`: runs a `HapticTick` on its own thread at a fixed rate (default 1 kHz) and records
-/// the measured periods (into storage reserved before the thread starts) so their percentiles can
-/// be reported. The loop sleeps until each deadline (it does not spin: the machine is shared);
-/// after an overrun it resynchronises instead of bursting to catch up.
+/// `HapticLoop`: runs a `HapticRenderer` on its own thread at a fixed rate (default 1 kHz) and
+/// records the measured periods (into storage reserved before the thread starts) so their
+/// percentiles can be reported. The loop sleeps until each deadline (it does not spin: the machine
+/// is shared); after an overrun it resynchronises instead of bursting to catch up.
 
 #include <atomic>
 #include <thread>
@@ -20,14 +20,14 @@ struct HapticLoopStats {
   double p50 = 0, p99 = 0, p999 = 0, max = 0;  ///< measured periods
   /// Percentiles of |period − target|.
   double error_p50 = 0, error_p99 = 0, error_p999 = 0;
-  double mean_tick_cost = 0;  ///< wall time inside HapticTick::Run per tick
+  double mean_tick_cost = 0;  ///< wall time inside HapticRenderer::Run per tick
 };
 
 /// Not copyable or movable (its thread refers to it).
 class HapticLoop {
  public:
   /// `rate` in Hz (> 0, up to 10 kHz); records up to `max_records` periods.
-  HapticLoop(HapticTick& tick, double rate = 1000, std::size_t max_records = 1 << 20);
+  HapticLoop(HapticRenderer& tick, double rate = 1000, std::size_t max_records = 1 << 20);
   HapticLoop(const HapticLoop&) = delete;
   HapticLoop& operator=(const HapticLoop&) = delete;
   ~HapticLoop();
@@ -41,7 +41,7 @@ class HapticLoop {
 
  private:
   void Run();
-  HapticTick& tick_;
+  HapticRenderer& tick_;
   double period_;
   std::vector<double> periods_;
   std::size_t recorded_ = 0;

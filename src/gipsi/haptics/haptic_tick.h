@@ -6,10 +6,8 @@
 /// the device is below it; the force is k (proxy − x). `HapticTick` reads the device, fetches
 /// the latest published model from a lock-free buffer, renders, passes the force through
 /// `ForceSafety` and commands the device: no locks, no exceptions, no allocation.
-///
-/// Not here yet (issue 5): the haptic thread with its rate control, the low-order local
-/// dynamic models (mass-spring neighbourhood, FEM condensation) and their re-anchoring, the
-/// OpenIGTLink device.
+/// `HapticRenderer` is what the haptic loop ticks; `LocalModelTick` (local_model_tick.h)
+/// renders the local dynamic models.
 
 #include "gipsi/haptics/device.h"
 #include "gipsi/haptics/force_safety.h"
@@ -36,15 +34,27 @@ struct ProxyForce {
 /// it; the force is stiffness · (proxy − x).
 ProxyForce RenderPlane(const PlaneLocalModel& model, const Vec3& x) noexcept;
 
+/// One tick of a haptic renderer, run by `HapticLoop` on the haptic thread. Not copyable.
+class HapticRenderer {
+ public:
+  HapticRenderer() = default;
+  HapticRenderer(const HapticRenderer&) = delete;
+  HapticRenderer& operator=(const HapticRenderer&) = delete;
+  virtual ~HapticRenderer() = default;
+  /// Runs one tick at haptic time `t` [s] with period `dt` [s]; returns the force commanded
+  /// [N, device coordinates]. No allocation, locks, exceptions or I/O.
+  virtual Vec3 Run(double t, double dt) noexcept = 0;
+};
+
 /// Not copyable or movable (holds references to the device and the buffer).
-class HapticTick {
+class HapticTick final : public HapticRenderer {
  public:
   HapticTick(HapticDevice& device, const DeviceWorkspace& workspace,
              LatestValue<PlaneLocalModel>& models, const ForceSafetyParams& safety);
 
   /// Runs one tick at haptic time `t` [s] with period `dt` [s]; the model's age is t minus its
   /// publication time. Returns the force commanded [N, device coordinates].
-  Vec3 Run(double t, double dt) noexcept;
+  Vec3 Run(double t, double dt) noexcept override;
 
   [[nodiscard]] const ProxyForce& last_render() const { return render_; }
   [[nodiscard]] const ForceSafety& safety() const { return safety_; }

@@ -3,6 +3,7 @@
 #include "gipsi/collision/contact.h"
 #include "gipsi/collision/rigid_tool.h"
 #include "gipsi/core/aggregate.h"
+#include "gipsi/haptics/haptic_probe.h"
 #include "gipsi/models/circulation/circulation.h"
 #include "gipsi/models/connectors/boundary_coupling.h"
 #include "gipsi/models/connectors/cavity_coupling.h"
@@ -35,6 +36,7 @@ void RegisterBuiltins(TypeRegistry& registry) {
   RegisterBoundaryCoupling(registry);
   RegisterRigidTool(registry);
   RegisterContact(registry);
+  RegisterHaptics(registry);
 }
 
 }  // namespace gipsi

@@ -1,0 +1,67 @@
+#pragma once
+/// @file
+/// `HapticBridge`: the simulation side of multi-rate haptics for one object. Around each of the
+/// object's steps it (1) takes the latest `HapticFeedback` from the haptic loop and applies the
+/// tool's force to the object as a boundary condition (an applied nodal force on the contact
+/// vertex, replacing the one it applied before), and (2) after the step picks the contact
+/// vertex and the tangent plane at the object's new state, builds a local dynamic model there
+/// with a `LocalModelBuilder`, and publishes it through the lock-free buffer the haptic loop
+/// reads. The haptic loop never touches the object.
+///
+/// Contact vertex: while the tool pushes (non-zero force) the vertex and its normal are kept;
+/// otherwise the boundary vertex nearest to the tool is taken if it lies within
+/// `capture_distance`, with its area-weighted outward normal at the current state; farther away
+/// an inactive model is published (free motion).
+
+#include <memory>
+
+#include "gipsi/haptics/latest_value.h"
+#include "gipsi/haptics/local_model_builders.h"
+#include "gipsi/haptics/local_model_tick.h"
+
+namespace gipsi {
+
+/// Parameters. Plain struct with defaults.
+struct HapticBridgeParams {
+  double period = 1e-3;            ///< haptic period the models are discretised for [s]
+  double capture_distance = 0.01;  ///< m, see the file comment
+};
+
+/// Not copyable or movable (the haptic loop holds references to its buffers).
+class HapticBridge {
+ public:
+  HapticBridge(LocalModelBuilder& builder, const HapticBridgeParams& params);
+  HapticBridge(const HapticBridge&) = delete;
+  HapticBridge& operator=(const HapticBridge&) = delete;
+
+  /// Before the object's step: applies the newest feedback force. Returns the force applied [N].
+  Vec3 ApplyFeedback();
+  /// After the object's step: builds and publishes a model stamped with time `now` [s] (on the
+  /// haptic loop's clock). Returns whether the published model is active.
+  bool Publish(double now);
+
+  /// Where the tool is until the first feedback arrives (e.g. the device's initial position),
+  /// so the first published model can already be active.
+  void SeedTool(const Vec3& position) { latest_.tool = position; }
+
+  /// The buffers the haptic side uses.
+  [[nodiscard]] LatestValue<LocalDynamicModel>& models() { return *models_; }
+  [[nodiscard]] LatestValue<HapticFeedback>& feedback() { return *feedback_; }
+  /// The newest feedback taken by ApplyFeedback.
+  [[nodiscard]] const HapticFeedback& last_feedback() const { return latest_; }
+  /// Contact vertex of the last published model (−1: none).
+  [[nodiscard]] Index contact_vertex() const { return contact_; }
+  [[nodiscard]] LocalModelBuilder& builder() { return builder_; }
+
+ private:
+  LocalModelBuilder& builder_;
+  HapticBridgeParams params_;
+  std::unique_ptr<LatestValue<LocalDynamicModel>> models_;
+  std::unique_ptr<LatestValue<HapticFeedback>> feedback_;
+  HapticFeedback latest_;
+  Index applied_vertex_ = -1, contact_ = -1;
+  Vec3 normal_ = Vec3::UnitZ();
+  Points boundary_positions_, normals_;
+};
+
+}  // namespace gipsi

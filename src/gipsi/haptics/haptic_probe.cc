@@ -1,0 +1,154 @@
+#include "gipsi/haptics/haptic_probe.h"
+
+#include <cmath>
+
+#include <fmt/format.h>
+
+#include "gipsi/base/error.h"
+#include "gipsi/models/fem/fem_solid.h"
+#include "gipsi/models/mass_spring/mass_spring.h"
+
+namespace gipsi {
+
+HapticProbe::HapticProbe(std::string name, const HapticProbeSpec& spec)
+    : SimObject(std::move(name)), spec_(spec), device_(spec.path) {
+  if (!(spec.rate > 0 && spec.rate <= 10000))
+    throw InputError(
+        fmt::format("haptic probe '{}': rate {} Hz outside (0, 10000]", this->name(), spec.rate));
+  using L = FieldLocation;
+  using A = FieldAccess;
+  f_force_ = DeclareField({"tool_force", L::kGlobal, 3, "N", A::kRead,
+                           "force commanded to the device (after the safety stage)"});
+  f_position_ = DeclareField({"tool_position", L::kGlobal, 3, "m", A::kRead, "device position"});
+  f_proxy_ = DeclareField({"proxy_position", L::kGlobal, 3, "m", A::kRead,
+                           "god-object: the device held on the local surface"});
+  f_model_force_ = DeclareField(
+      {"model_force", L::kGlobal, 1, "N", A::kRead, "normal contact force of the local model"});
+  position_ = proxy_ = device_.Read(0).position;
+}
+
+void HapticProbe::Attach(LatestValue<LocalDynamicModel>& models,
+                         LatestValue<HapticFeedback>& feedback) {
+  if (tick_) throw InputError(fmt::format("haptic probe '{}' is coupled to two objects", name()));
+  tick_ =
+      std::make_unique<LocalModelTick>(device_, DeviceWorkspace{}, models, &feedback, spec_.tick);
+}
+
+StepStatus HapticProbe::DoStep(double t, double dt) {
+  const int n = std::max(1, static_cast<int>(std::lround(dt * spec_.rate)));
+  const double h = dt / n;
+  for (int k = 1; k <= n; ++k) {
+    const double tk = t + k * h;
+    if (tick_) {
+      force_ = tick_->Run(tk, h);
+      proxy_ = tick_->proxy();
+      model_force_ = tick_->model_force();
+    } else {
+      proxy_ = device_.Read(tk).position;
+    }
+    position_ = device_.Read(tk).position;
+    ++ticks_;
+  }
+  return StepStatus::Ok();
+}
+
+void HapticProbe::DoReadField(FieldId id, Eigen::Ref<Eigen::MatrixXd> out) const {
+  if (id == f_force_) {
+    out.col(0) = force_;
+  } else if (id == f_position_) {
+    out.col(0) = position_;
+  } else if (id == f_proxy_) {
+    out.col(0) = proxy_;
+  } else if (id == f_model_force_) {
+    out(0, 0) = model_force_;
+  }
+}
+
+void HapticProbe::DoWriteField(FieldId /*id*/, const Eigen::Ref<const Eigen::MatrixXd>& /*in*/) {
+  GIPSI_CHECK(false, "HapticProbe has no writable field");
+}
+
+// ---------------------------------------------------------------------------------------------
+
+HapticCoupling::HapticCoupling(std::string name, SimObject& object, HapticProbe& probe,
+                               const HapticBridgeParams& params, int rings)
+    : Connector(std::move(name)) {
+  if (auto* fem = dynamic_cast<FemSolid*>(&object)) {
+    builder_ = std::make_unique<FemCondensation>(*fem);
+  } else if (auto* ms = dynamic_cast<MassSpring*>(&object)) {
+    builder_ = std::make_unique<MassSpringNeighbourhood>(*ms, rings);
+  } else {
+    throw InputError(
+        fmt::format("object '{}' is a {}; haptic coupling needs a FemSolid or a "
+                    "MassSpring",
+                    object.name(), object.type_name()));
+  }
+  if (object.boundary().num_vertices() == 0)
+    throw InputError(fmt::format("object '{}' has no boundary surface", object.name()));
+  bridge_ = std::make_unique<HapticBridge>(*builder_, params);
+  bridge_->SeedTool(probe.spec().path.front().position);
+  probe.Attach(bridge_->models(), bridge_->feedback());
+}
+
+StepStatus HapticCoupling::DoFire(double t) {
+  bridge_->ApplyFeedback();
+  bridge_->Publish(t);
+  return StepStatus::Ok();
+}
+
+// ---------------------------------------------------------------------------------------------
+
+void RegisterHaptics(TypeRegistry& registry) {
+  registry.objects.Register(
+      "HapticProbe",
+      [](const ObjectBuildContext& ctx) -> std::unique_ptr<SimObject> {
+        const JsonNode& p = ctx.params;
+        ctx.CheckKeys({"path", "rate", "coupling_stiffness", "coupling_damping", "blend_time",
+                       "max_force", "max_rate", "stale_after", "fade_time"});
+        HapticProbeSpec spec;
+        const JsonNode path = p.At("path");
+        if (!path.is_array() || path.size() == 0)
+          path.Expected("an array of [t, x, y, z] keyframes");
+        for (const JsonNode& key : path.Items()) {
+          const std::vector<double> k = key.AsNumbers();
+          if (k.size() != 4) key.Expected("[t, x, y, z]");
+          if (!spec.path.empty() && !(k[0] > spec.path.back().time))
+            key.Fail("keyframe times must increase strictly");
+          spec.path.push_back({k[0], Vec3(k[1], k[2], k[3]), 0});
+        }
+        spec.rate = p.Positive("rate", 1000.0);
+        if (spec.rate > 10000) p.At("rate").Expected("a rate in (0, 10000] Hz");
+        spec.tick.coupling.stiffness = p.Positive("coupling_stiffness", 5000.0);
+        spec.tick.coupling.damping = p.NonNegative("coupling_damping", 0.0);
+        spec.tick.blend_time = p.NonNegative("blend_time", spec.tick.blend_time);
+        spec.tick.safety.max_force = p.Positive("max_force", spec.tick.safety.max_force);
+        spec.tick.safety.max_rate = p.Positive("max_rate", spec.tick.safety.max_rate);
+        spec.tick.safety.stale_after = p.Positive("stale_after", spec.tick.safety.stale_after);
+        spec.tick.safety.fade_time = p.NonNegative("fade_time", spec.tick.safety.fade_time);
+        return std::make_unique<HapticProbe>(ctx.name, spec);
+      },
+      "virtual haptic device on a scripted path, rendering local models at its rate");
+  registry.connectors.Register(
+      "HapticCoupling",
+      [](const ConnectorBuildContext& ctx) -> std::unique_ptr<Connector> {
+        const JsonNode& p = ctx.params;
+        ctx.CheckKeys({"object", "device", "capture_distance", "rings"});
+        SimObject& object = ctx.Object("object");
+        auto* probe = dynamic_cast<HapticProbe*>(&ctx.Object("device"));
+        if (!probe) p.At("device").Expected("the name of a HapticProbe object");
+        HapticBridgeParams params;
+        params.period = 1.0 / probe->spec().rate;
+        params.capture_distance = p.NonNegative("capture_distance", params.capture_distance);
+        const std::int64_t rings = p.Int("rings", 1);
+        if (rings < 0 || rings > 5) p.At("rings").Expected("an integer in [0, 5]");
+        try {
+          return std::make_unique<HapticCoupling>(ctx.name, object, *probe, params,
+                                                  static_cast<int>(rings));
+        } catch (const InputError& e) {
+          p.Fail(e.what());
+        }
+      },
+      "multi-rate haptics: local models of an object rendered by a HapticProbe");
+}
+
+}  // namespace gipsi

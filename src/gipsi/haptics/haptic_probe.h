@@ -1,0 +1,93 @@
+#pragma once
+/// @file
+/// Multi-rate haptics in scene files:
+///  - `HapticProbe` (object): a virtual haptic device on a scripted path whose step runs the
+///    haptic tick (`LocalModelTick`) at `rate` over the step, synchronously (headless runs are
+///    then deterministic; a live device would run the same tick in a `HapticLoop`). Fields
+///    (global, read): "tool_force" (force on the device [N]), "tool_position" [m],
+///    "proxy_position" [m] (the god-object on the local surface), "model_force" (the local
+///    model's normal contact force [N]).
+///  - `HapticCoupling` (connector): joins a deformable object and a probe through a
+///    `HapticBridge`: when it fires it applies the newest tool force to the object (boundary
+///    condition) and publishes a local model built at the object's current state
+///    (`FemCondensation` for FemSolid, `MassSpringNeighbourhood` for MassSpring). Building a
+///    model allocates (a factorisation for FEM), unlike other connectors' firings.
+///
+/// Scene:
+///   "probe": {"type": "HapticProbe", "path": [[t, x, y, z], ...], "rate": 1000,
+///             "coupling_stiffness": 5000, "coupling_damping": 0, "blend_time": 0.01,
+///             "max_force": 3, "max_rate": 1000, "stale_after": 0.05, "fade_time": 0.1}
+///   "haptics": {"type": "HapticCoupling", "object": "liver", "device": "probe",
+///               "capture_distance": 0.01, "rings": 1}
+
+#include <memory>
+
+#include "gipsi/core/connector.h"
+#include "gipsi/core/registry.h"
+#include "gipsi/core/sim_object.h"
+#include "gipsi/haptics/haptic_bridge.h"
+#include "gipsi/haptics/virtual_device.h"
+
+namespace gipsi {
+
+/// Parameters of a HapticProbe. Plain struct with defaults.
+struct HapticProbeSpec {
+  std::vector<DeviceKeyframe> path;  ///< device positions [m, simulation coordinates]
+  double rate = 1000;                ///< haptic ticks per second
+  LocalTickParams tick;
+};
+
+/// Not copyable or movable (a SimObject).
+class HapticProbe final : public SimObject {
+ public:
+  /// Throws InputError for an empty or non-increasing path or a rate outside (0, 10 kHz].
+  HapticProbe(std::string name, const HapticProbeSpec& spec);
+
+  [[nodiscard]] std::string_view type_name() const override { return "HapticProbe"; }
+  [[nodiscard]] const Points& domain_positions() const override { return no_positions_; }
+  [[nodiscard]] const HapticProbeSpec& spec() const { return spec_; }
+  /// Connects the probe to a bridge's buffers (once; the HapticCoupling connector does it).
+  /// Throws InputError if it is already connected.
+  void Attach(LatestValue<LocalDynamicModel>& models, LatestValue<HapticFeedback>& feedback);
+  [[nodiscard]] bool attached() const { return tick_ != nullptr; }
+  /// Number of haptic ticks run so far.
+  [[nodiscard]] std::int64_t num_ticks() const { return ticks_; }
+
+ protected:
+  StepStatus DoStep(double t, double dt) override;
+  void DoReadField(FieldId id, Eigen::Ref<Eigen::MatrixXd> out) const override;
+  void DoWriteField(FieldId id, const Eigen::Ref<const Eigen::MatrixXd>& in) override;
+
+ private:
+  HapticProbeSpec spec_;
+  VirtualDevice device_;
+  std::unique_ptr<LocalModelTick> tick_;
+  Points no_positions_ = Points(3, 0);
+  Vec3 force_ = Vec3::Zero(), position_ = Vec3::Zero(), proxy_ = Vec3::Zero();
+  double model_force_ = 0;
+  std::int64_t ticks_ = 0;
+  FieldId f_force_, f_position_, f_proxy_, f_model_force_;
+};
+
+/// Not copyable or movable (a Connector).
+class HapticCoupling final : public Connector {
+ public:
+  /// Builds the local-model builder for `object` (FemSolid or MassSpring; InputError
+  /// otherwise) and attaches `probe` to the bridge.
+  HapticCoupling(std::string name, SimObject& object, HapticProbe& probe,
+                 const HapticBridgeParams& params, int rings);
+  [[nodiscard]] std::string_view type_name() const override { return "HapticCoupling"; }
+  [[nodiscard]] HapticBridge& bridge() { return *bridge_; }
+
+ protected:
+  StepStatus DoFire(double t) override;
+
+ private:
+  std::unique_ptr<LocalModelBuilder> builder_;
+  std::unique_ptr<HapticBridge> bridge_;
+};
+
+/// Registers the object "HapticProbe" and the connector "HapticCoupling".
+void RegisterHaptics(TypeRegistry& registry);
+
+}  // namespace gipsi
