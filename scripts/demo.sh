@@ -1,10 +1,11 @@
 #!/usr/bin/env bash
-# Installs the dependencies, builds GiPSi (release) and runs the default demo: a mass-spring sheet
-# sagging under gravity, written to out/hanging_sheet/ (open sheet.pvd in ParaView).
+# Installs the dependencies, builds GiPSi (release) and runs the default demo: the GiPSi heart
+# (scenes/heart.json), written to out/heart/ (pv_loop.png, probes/*.csv, muscle.pvd, bioelectricity.pvd).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/install-deps.sh
 cmake --preset release
 cmake --build --preset release
-./build/release/bin/gipsi run scenes/hanging_sheet.json
-echo "Open out/hanging_sheet/sheet.pvd in ParaView; probe traces are in out/hanging_sheet/probes/."
+export OMP_WAIT_POLICY=passive
+./build/release/bin/gipsi run scenes/heart.json
+echo "The PV loop is out/heart/pv_loop.png; open out/heart/muscle.pvd and bioelectricity.pvd in ParaView; traces and the beat summary are in out/heart/probes/."

@@ -44,12 +44,13 @@ constexpr const char* kHeartDefaults = R"({
     },
     "blood": {
       "type": "Circulation", "preset": "closed_loop", "dt": "5 ms",
-      "compartments": {"lv": {"driven_by": "pressure", "volume": "60 mL", "pressure": "0 mmHg"}}
+      "compartments": {"lv": {"driven_by": "pressure", "volume": "60 mL", "pressure": "0 mmHg"}},
+      "connections": {"peripheral": {"resistance": "1.1 mmHg*s/mL"}}
     }
   },
   "connectors": {
     "excitation_contraction": {"type": "ExcitationContraction", "from": "bioelectricity.V",
-                               "to": "muscle.nodal_active_tension", "gain": "120 kPa"},
+                               "to": "muscle.nodal_active_tension", "gain": "115 kPa"},
     "cavity_coupling": {"type": "CavityCoupling", "wall": "muscle", "cavity": "lumen",
                         "blood": "blood", "chamber": "lv", "blood_bulk_modulus": "20 MPa"}
   },

@@ -1,0 +1,109 @@
+// The Heart aggregate and the default demo scene (scenes/heart.json).
+
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "gipsi/io/scene.h"
+#include "gipsi/models/builtins.h"
+#include "gipsi/models/circulation/circulation.h"
+#include "gipsi/models/fem/fem_solid.h"
+#include "gipsi/models/heart/heart.h"
+#include "io/scene_test_util.h"
+
+namespace gipsi {
+namespace {
+
+constexpr double kMmHg = 133.322387415, kMl = 1e-6;
+
+std::filesystem::path HeartScene() {
+  return std::filesystem::path(GIPSI_SOURCE_DIR) / "scenes" / "heart.json";
+}
+
+/// scenes/heart.json loaded with its own registry.
+struct HeartRun {
+  TypeRegistry registry;
+  Scene scene;
+  HeartRun() {
+    RegisterBuiltins(registry);
+    scene = LoadScene(HeartScene(), registry);
+  }
+  Heart& heart() { return dynamic_cast<Heart&>(scene.kernel->FindObject("heart")); }
+  Circulation& blood() { return dynamic_cast<Circulation&>(*heart().FindPart("blood")); }
+  FemSolid& muscle() { return dynamic_cast<FemSolid&>(*heart().FindPart("muscle")); }
+};
+
+TEST(Heart, DefaultDemoBeatsPhysiologically) {
+#if defined(__SANITIZE_ADDRESS__)
+  GTEST_SKIP() << "five coupled beats take minutes under ASan; the release build runs them";
+#endif
+  HeartRun run;
+  Circulation& blood = run.blood();
+  FemSolid& muscle = run.muscle();
+  const int lv = blood.FindCompartment("lv");
+  const double total0 = blood.total_volume();
+  // Step by step to 4 s (five beats): the wall always encloses the blood (to its effective
+  // compression V p / K, K = 20 MPa: at most 0.1 % here, plus the Newton tolerance).
+  const double k = 20e6;
+  double worst = 0;
+  for (int i = 1; i <= 800; ++i) {
+    const RunResult result = run.scene.kernel->Run(0.005 * i);
+    ASSERT_TRUE(result.ok()) << result.diagnostic;
+    const double p = blood.pressure(lv);
+    worst = std::max(worst, std::abs(muscle.CavityVolume(0) - blood.volume(lv) * (1 - p / k)) /
+                                blood.volume(lv));
+  }
+  EXPECT_LT(worst, 1e-6);
+  // The closed loop conserves blood (adaptive DP5(4) with event location: round-off).
+  EXPECT_NEAR(blood.total_volume(), total0, 1e-12 * total0);
+  // Valve events in the physiological order every beat after the first: mitral closes,
+  // aortic opens, aortic closes, mitral opens.
+  std::vector<std::string> order;
+  for (const ValveEvent& e : blood.valve_events().Events())
+    if (e.time > 0.8) order.push_back(blood.valve_name(e.valve) + (e.state == ValveState::kOpen ? " opens" : " closes"));
+  ASSERT_GE(order.size(), 16u);
+  const char* expected[4] = {"mitral closes", "aortic opens", "aortic closes", "mitral opens"};
+  for (std::size_t i = 0; i < order.size(); ++i) EXPECT_EQ(order[i], expected[i % 4]) << i;
+  // The summary of the last beat: physiological at rest (REFERENCES.md: aortic about 120/80
+  // mmHg, ejection fraction 50–65 %), and periodic to within 2 % beat to beat.
+  const std::vector<BeatSummary>& beats = run.heart().beats();
+  ASSERT_EQ(beats.size(), 5u);
+  const BeatSummary& last = beats.back();
+  std::printf("beat 5: EDV %.1f mL, ESV %.1f mL, EF %.1f %%, LV peak %.1f mmHg, aorta %.1f/%.1f "
+              "mmHg, change %.2f %%\n",
+              last.edv / kMl, last.esv / kMl, 100 * last.ejection_fraction(),
+              last.peak_pressure / kMmHg, last.arterial_systolic / kMmHg,
+              last.arterial_diastolic / kMmHg, 100 * last.change);
+  EXPECT_GT(last.ejection_fraction(), 0.50);
+  EXPECT_LT(last.ejection_fraction(), 0.65);
+  EXPECT_NEAR(last.arterial_systolic / kMmHg, 120, 10);
+  EXPECT_NEAR(last.arterial_diastolic / kMmHg, 80, 10);
+  EXPECT_LT(last.change, 0.02);
+}
+
+TEST(Heart, ScenePatchesAndBadKeysGetClearErrors) {
+  const std::string base = R"({"gipsi": 1, "units": "SI",
+    "meshes": {"lv": {"generate": "ellipsoid_shell", "endo": [0.022, 0.048],
+                      "epi": [0.032, 0.058], "base_z": 0.012, "size": 0.012}},
+    "objects": {"heart": {"type": "Heart", "dt": "5 ms" PATCH}},
+    "schedule": {"end": "10 ms"}})";
+  auto with = [&](const std::string& patch) {
+    std::string text = base;
+    text.replace(text.find("PATCH"), 5, patch);
+    return testing::SceneLoadError(text);
+  };
+  EXPECT_EQ(with(""), "(no error)");
+  EXPECT_NE(with(R"(, "monitor": {"chamber": "rv"})").find("rv_volume"), std::string::npos);
+  EXPECT_NE(with(R"(, "monitr": {})").find("monitr"), std::string::npos);
+  EXPECT_NE(with(R"(, "parts": {"muscle": {"material": {"C": -1}}})").find("parts.muscle.material"),
+            std::string::npos);
+  EXPECT_NE(with(R"(, "connectors": {"cavity_coupling": {"chamber": "aorta"}})")
+                .find("must be a chamber"),
+            std::string::npos);
+}
+
+}  // namespace
+}  // namespace gipsi
