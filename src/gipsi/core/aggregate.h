@@ -28,6 +28,8 @@ class AggregateObject final : public SimObject {
   void BeginMacroStep() override { parts_.BeginMacroStep(); }
   [[nodiscard]] const Coordinator& parts() const { return parts_; }
   [[nodiscard]] std::string failure_detail() const override { return failure_detail_; }
+  void SaveObjectState(StateWriter& out) const override;
+  void RestoreObjectState(StateReader& in) override;
 
  protected:
   StepStatus DoStep(double t, double dt) override;

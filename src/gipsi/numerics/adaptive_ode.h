@@ -20,6 +20,9 @@
 
 namespace gipsi {
 
+class StateReader;
+class StateWriter;
+
 /// Event functions for AdaptiveOde: `num_events()` values g_i(t, x); event i happens where g_i
 /// crosses zero upward (from ≤ 0 to > 0). A caller that wants a downward crossing negates its
 /// function. `Calc` must not allocate. Interface only (not copyable through the base).
@@ -110,6 +113,9 @@ class AdaptiveOde {
   [[nodiscard]] double next_step() const { return h_; }
   /// Forgets the step-size guess (e.g. after a discontinuity in the model).
   void ResetStepSize() { h_ = 0; }
+  /// Checkpoints (gipsi/core/state.h; defined in circulation_state.cc).
+  void SaveState(StateWriter& out) const;
+  void RestoreState(StateReader& in);
 
  private:
   double InitialStep(const OdeView& system, double t, double t_end, const VecX& x);

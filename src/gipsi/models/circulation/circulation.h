@@ -67,6 +67,8 @@ class Circulation final : public SimObject {
   [[nodiscard]] std::int64_t accepted_steps() const { return accepted_; }
   [[nodiscard]] std::int64_t rejected_steps() const { return rejected_; }
   [[nodiscard]] std::vector<ProfileEntry> ProfileBreakdown() const override;
+  void SaveObjectState(StateWriter& out) const override;
+  void RestoreObjectState(StateReader& in) override;
   /// After a failed step: the compartment or connection whose value was not finite, if any.
   [[nodiscard]] std::string failure_detail() const override;
 
