@@ -5,8 +5,8 @@
 #    total blood volume exactly (compartment flows cancel), so its drift must stay at round-off.
 #  - coupled_blocks.json (an Aggregate of two mass-spring blocks glued by BoundaryCoupling) for
 #    STEPS macro steps of 0.1 ms: resident memory only.
-# Memory growth is the RSS at the end minus the RSS after the first quarter of the run (warm-up:
-# set-up, solver and output buffers; the closed loop reaches its plateau within 2 s of wall time).
+# Memory growth is the RSS at the end minus the RSS after warm-up (the first quarter of the run,
+# at least 3 s of wall time: both scenes reach their plateau within 2 s).
 # Usage: bash scripts/soak.sh [STEPS]   (default 100000; needs a release build)
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -24,7 +24,7 @@ soak() {  # name scene end_time
   local pid=$!
   while kill -0 "$pid" 2>/dev/null; do
     awk '/VmRSS/ {print $2}' "/proc/$pid/status" 2>/dev/null >>"$log" || true
-    sleep 1
+    sleep 0.2
   done
   wait "$pid"
   local wall=$((SECONDS - start))
@@ -35,8 +35,9 @@ name, wall = sys.argv[2], sys.argv[3]
 if len(samples) < 3:
     print(f"{name}: {wall} s wall, too short to sample RSS ({len(samples)} samples)")
     sys.exit(0)
-# Warm-up: the first quarter of the run (scene set-up, solver and output buffers, OpenMP).
-warm = samples[len(samples) // 4:]
+# Warm-up: the first quarter of the run, at least 3 s of wall time (loading the libraries,
+# scene set-up, solver and output buffers, OpenMP's threads).
+warm = samples[min(len(samples) - 1, max(len(samples) // 4, 15)):]
 print(f"{name}: {wall} s wall, {len(samples)} RSS samples: start {samples[0] / 1024:.1f} MiB, "
       f"after warm-up {warm[0] / 1024:.1f} MiB, max after warm-up {max(warm) / 1024:.1f} MiB, "
       f"end {samples[-1] / 1024:.1f} MiB, growth after warm-up "
