@@ -2,8 +2,10 @@
 /// @file
 /// `Kernel`: owns the object pool (through a Coordinator), runs the macro-step loop with
 /// multi-rate sub-stepping, fires scheduled discrete events, notifies observers (output writers,
-/// probes) and applies the divergence policy: a failing object stops the run with a diagnostic,
-/// and everything already written stays written.
+/// probes) and applies the divergence policy (FailurePolicy): a failing object stops the run
+/// with a diagnostic, or the macro step is rolled back and retried with halved steps; everything
+/// already written stays written. Writes and restores checkpoints of the whole run
+/// (kernel_state.cc).
 
 #include <atomic>
 #include <filesystem>
