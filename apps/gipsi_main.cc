@@ -9,6 +9,7 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <cmath>
 #include <csignal>
 #include <cstdio>
 #include <fstream>
@@ -123,17 +124,37 @@ std::string ProfileTable(const gipsi::Kernel& kernel, double wall_seconds) {
   return table;
 }
 
+/// Options of `gipsi run` about checkpoints.
+struct CheckpointOptions {
+  double every = 0;    ///< simulated seconds between checkpoints; 0: none
+  std::string file;    ///< where to write them (default <out>/checkpoint.gck)
+  std::string resume;  ///< checkpoint to continue from
+};
+
 int Run(const std::string& file, const std::string& out_dir, double until, bool quiet, bool no_vtu,
-        bool profile, const std::vector<std::string>& plugins) {
+        bool profile, const std::vector<std::string>& plugins,
+        const CheckpointOptions& checkpoints) {
   gipsi::TypeRegistry registry;
   gipsi::Scene scene = Load(file, plugins, registry);
   if (until > 0) scene.end_time = until;
   if (no_vtu) scene.vtu.enabled = false;
   std::filesystem::path out =
       out_dir.empty() ? scene.output_directory : std::filesystem::path(out_dir);
-  gipsi::AttachOutputs(scene, out);
-
   gipsi::Kernel& kernel = *scene.kernel;
+  if (checkpoints.every > 0) {
+    const double steps = checkpoints.every / kernel.macro_dt();
+    const auto every = static_cast<std::int64_t>(std::llround(steps));
+    if (every < 1 || std::abs(steps - static_cast<double>(every)) > 1e-9 * steps)
+      gipsi::ThrowInputError("command line", "--checkpoint-every",
+                             fmt::format("{} s is not a whole number of macro steps of {} s",
+                                         checkpoints.every, kernel.macro_dt()));
+    kernel.SetCheckpointing(
+        checkpoints.file.empty() ? out / "checkpoint.gck" : std::filesystem::path(checkpoints.file),
+        every);
+  }
+  gipsi::AttachOutputs(scene, out, !checkpoints.resume.empty());
+  if (!checkpoints.resume.empty()) kernel.ReadCheckpoint(checkpoints.resume);
+
   Progress progress(quiet);
   g_running_kernel.store(&kernel);
   std::signal(SIGINT, HandleStopSignal);
@@ -165,6 +186,10 @@ int Run(const std::string& file, const std::string& out_dir, double until, bool 
   }
   for (const auto& [t, what] : kernel.fired_events())
     summary += fmt::format("  event at {:.6g} s: {}\n", t, what);
+  if (kernel.retried_steps() > 0)
+    summary +=
+        fmt::format("retried steps:    {} (failed, rolled back, retried with halved steps)\n",
+                    kernel.retried_steps());
   summary += fmt::format("outputs:          {}\n", out.string());
   std::string plot_error;  // plots of a run that stopped early still show what was recorded
   try {
@@ -357,6 +382,17 @@ int main(int argc, char** argv) {
                 "Print where the wall time went: per object (and its own breakdown, e.g. "
                 "assembly and linear solves), per connector, and in outputs");
   run->add_option("--plugin", plugins, "Load a plugin shared library (repeatable)");
+  CheckpointOptions checkpoints;
+  run->add_option("--checkpoint-every", checkpoints.every,
+                  "Write a checkpoint every T seconds of simulated time (a whole number of macro "
+                  "steps), and when stopped by SIGINT/SIGTERM")
+      ->check(CLI::PositiveNumber);
+  run->add_option("--checkpoint", checkpoints.file,
+                  "Checkpoint file to write (default: <out>/checkpoint.gck)");
+  run->add_option("--resume", checkpoints.resume,
+                  "Continue from a checkpoint of the same scene, appending to the outputs in the "
+                  "output directory (continued outputs are bitwise identical to an "
+                  "uninterrupted run with the same thread count)");
 
   auto* validate = app.add_subcommand("validate", "Check a scene without running it");
   validate->add_option("SCENE", scene_file, "Scene file (JSON)")->required();
@@ -414,7 +450,7 @@ int main(int argc, char** argv) {
   CLI11_PARSE(app, argc, argv);
   gipsi::Log().set_level(verbose ? spdlog::level::debug : spdlog::level::info);
   try {
-    if (*run) return Run(scene_file, out_dir, until, quiet, no_vtu, profile, plugins);
+    if (*run) return Run(scene_file, out_dir, until, quiet, no_vtu, profile, plugins, checkpoints);
     if (*validate) return Validate(scene_file, plugins);
     if (*info) return Info(mesh_file);
     if (*types) return Types(plugins);

@@ -15,6 +15,7 @@
 #include "gipsi/core/coordinator.h"
 #include "gipsi/core/registry.h"
 #include "gipsi/core/sim_object.h"
+#include "gipsi/core/state.h"
 #include "gipsi/geometry/region_json.h"
 
 namespace example {
@@ -37,6 +38,11 @@ class Oscillator final : public gipsi::SimObject {
   }
   std::string_view type_name() const override { return "Oscillator"; }
   const gipsi::Points& domain_positions() const override { return positions_; }
+  // Checkpoints: the position is a function of time, so only the cached node is saved.
+  void SaveObjectState(gipsi::StateWriter& out) const override { out.WriteMatrix(positions_); }
+  void RestoreObjectState(gipsi::StateReader& in) override {
+    in.ReadMatrixExact(positions_, "the oscillator position");
+  }
 
  protected:
   gipsi::StepStatus DoStep(double t, double dt) override {
@@ -71,6 +77,10 @@ class Follow final : public gipsi::Connector {
         vertices_(std::move(vertices)),
         value_(3, 1) {}
   std::string_view type_name() const override { return "Follow"; }
+  // Checkpoints: Follow only transfers values (the prescribed velocities are the target's
+  // boundary conditions, saved with it).
+  void SaveConnectorState(gipsi::StateWriter&) const override {}
+  void RestoreConnectorState(gipsi::StateReader&) override {}
 
  protected:
   gipsi::StepStatus DoFire(double) override {

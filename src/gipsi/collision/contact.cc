@@ -9,6 +9,7 @@
 #include "gipsi/base/error.h"
 #include "gipsi/collision/rigid_tool.h"
 #include "gipsi/core/coordinator.h"
+#include "gipsi/core/state.h"
 
 namespace gipsi {
 
@@ -293,6 +294,20 @@ void RegisterContact(TypeRegistry& registry) {
       },
       "collision: penalty contact (damping, friction) between objects and tools, as boundary "
       "forces");
+}
+
+// Checkpoints: which boundary vertices the projection response holds on a tool (the
+// constraints themselves are the objects' boundary conditions, saved with them). Forces,
+// velocities and proximity results are recomputed by every Fire.
+void Contact::SaveConnectorState(StateWriter& out) const {
+  out.WriteInt(static_cast<std::int64_t>(bodies_.size()));
+  for (const auto& body : bodies_) out.WriteArray(body->held);
+}
+
+void Contact::RestoreConnectorState(StateReader& in) {
+  if (in.ReadInt() != static_cast<std::int64_t>(bodies_.size()))
+    in.Fail("the contact connector has a different number of objects in the checkpoint");
+  for (auto& body : bodies_) in.ReadArrayExact(body->held, "the held vertices of a contact body");
 }
 
 }  // namespace gipsi

@@ -72,6 +72,8 @@ class Contact final : public Connector {
   ~Contact() override;
 
   [[nodiscard]] std::string_view type_name() const override { return "Contact"; }
+  void SaveConnectorState(StateWriter& out) const override;
+  void RestoreConnectorState(StateReader& in) override;
   [[nodiscard]] const ContactStats& stats() const { return stats_; }
   [[nodiscard]] const ContactMaterial& material() const { return material_; }
   /// Force each object received at the last firing (3 by boundary vertices), in objects order.

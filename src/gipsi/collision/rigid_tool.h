@@ -45,6 +45,8 @@ class RigidTool final : public SimObject {
 
   [[nodiscard]] std::string_view type_name() const override { return "RigidTool"; }
   [[nodiscard]] const Points& domain_positions() const override { return positions_; }
+  void SaveObjectState(StateWriter& out) const override;
+  void RestoreObjectState(StateReader& in) override;
   [[nodiscard]] const RigidToolSpec& spec() const { return spec_; }
   /// True for sphere and capsule tools (contacts use the exact primitive).
   [[nodiscard]] bool is_primitive() const { return spec_.shape != RigidToolSpec::Shape::kMesh; }

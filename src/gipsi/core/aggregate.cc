@@ -1,4 +1,8 @@
 #include "gipsi/core/aggregate.h"
+
+#include <algorithm>
+#include <cmath>
+
 #include "gipsi/base/units.h"
 
 #include <fmt/format.h>
@@ -31,8 +35,10 @@ SimObject* AggregateObject::FindPart(std::string_view name) const {
   return parts_.FindObject(name);
 }
 
-StepStatus AggregateObject::DoStep(double t, double /*dt*/) {
-  if (auto failure = parts_.MacroStep(t, step_count())) {
+StepStatus AggregateObject::DoStep(double t, double dt) {
+  // A kernel retrying a failed macro step asks for a fraction of the aggregate's step.
+  const int split = std::max(1, static_cast<int>(std::lround(parts_.macro_dt() / dt)));
+  if (auto failure = parts_.MacroStep(t, step_count(), split)) {
     SimObject* part = failure->is_connector ? nullptr : parts_.FindObject(failure->who);
     std::string inner = part ? part->failure_detail() : std::string();
     failure_detail_ = std::string(failure->is_connector ? "connector '" : "part '") +

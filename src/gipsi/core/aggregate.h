@@ -30,6 +30,8 @@ class AggregateObject : public SimObject {
   [[nodiscard]] std::string failure_detail() const override { return failure_detail_; }
   /// Wall time per part and per connector, then each part's own breakdown ("part: entry").
   [[nodiscard]] std::vector<ProfileEntry> ProfileBreakdown() const override;
+  void SaveObjectState(StateWriter& out) const override;
+  void RestoreObjectState(StateReader& in) override;
 
  protected:
   /// Number of fields that forward to parts (ids 0 … n−1); a subclass declares its own after.

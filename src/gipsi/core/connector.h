@@ -11,6 +11,9 @@
 
 namespace gipsi {
 
+class StateReader;
+class StateWriter;
+
 /// Base class of connectors. Not copyable or movable.
 ///
 /// A connector resolves everything it needs (objects, field ids, mappings, buffers) when it is
@@ -31,6 +34,15 @@ class Connector {
     return DoFire(t);
   }
   [[nodiscard]] std::int64_t fire_count() const { return fire_count_; }
+  /// Checkpoints and roll-back (gipsi/core/state.h): the fire count, then the type's own state
+  /// (SaveConnectorState). RestoreState throws InputError for state from another scene.
+  void SaveState(StateWriter& out) const;
+  void RestoreState(StateReader& in);
+  /// State that outlives a Fire (e.g. a low-pass filtered value); connectors that only transfer
+  /// values override these with empty bodies. The defaults throw InputError("connector type X
+  /// does not support checkpoints").
+  virtual void SaveConnectorState(StateWriter& out) const;
+  virtual void RestoreConnectorState(StateReader& in);
 
  protected:
   explicit Connector(std::string name) : name_(std::move(name)) {}

@@ -104,8 +104,11 @@ void Coordinator::BeginMacroStep() {
   for (auto& slot : objects_) slot.object->BeginMacroStep();
 }
 
-std::optional<ScheduleFailure> Coordinator::MacroStep(double t, std::int64_t macro_index) {
+std::optional<ScheduleFailure> Coordinator::MacroStep(double t, std::int64_t macro_index,
+                                                      int split) {
   GIPSI_CHECK(macro_dt_ > 0, "Coordinator::Prepare was not called");
+  GIPSI_CHECK(split >= 1);
+  const double macro_dt = split == 1 ? macro_dt_ : macro_dt_ / split;
   for (const Entry& entry : order_) {
     if (entry.is_connector) {
       ConnectorSlot& slot = connectors_[entry.index];
@@ -116,7 +119,7 @@ std::optional<ScheduleFailure> Coordinator::MacroStep(double t, std::int64_t mac
       if (!status.ok()) return ScheduleFailure{status, slot.connector->name(), true, t};
     } else {
       ObjectSlot& slot = objects_[entry.index];
-      const double dt = macro_dt_ / slot.substeps;
+      const double dt = macro_dt / slot.substeps;
       const auto start = Clock::now();
       for (int k = 0; k < slot.substeps; ++k) {
         StepStatus status = slot.object->Step(dt);
@@ -126,7 +129,7 @@ std::optional<ScheduleFailure> Coordinator::MacroStep(double t, std::int64_t mac
         }
       }
       slot.seconds += std::chrono::duration<double>(Clock::now() - start).count();
-      slot.object->SetTime(t + macro_dt_);
+      slot.object->SetTime(t + macro_dt);
     }
   }
   return std::nullopt;

@@ -49,10 +49,14 @@ class Coordinator {
   void Prepare(double macro_dt);
   /// Largest object dt (the natural macro step), or 0 when there are no objects.
   [[nodiscard]] double max_object_dt() const;
+  /// The macro step fixed by Prepare (0 before).
+  [[nodiscard]] double macro_dt() const { return macro_dt_; }
 
   /// Runs one macro step from time t: for each entry in order, sub-steps an object
   /// `substeps` times or fires a due connector. Stops at the first failure. Never throws.
-  std::optional<ScheduleFailure> MacroStep(double t, std::int64_t macro_index);
+  /// `split` > 1 makes it a 1/split fraction of a macro step (every object's sub-step divided
+  /// by split; connectors fire as in the full step): the kernel's retry after a failure.
+  std::optional<ScheduleFailure> MacroStep(double t, std::int64_t macro_index, int split = 1);
   /// Forwards `BeginMacroStep` to every object.
   void BeginMacroStep();
 

@@ -104,8 +104,15 @@ RunResult Kernel::Run(double end_time, const ProgressFn& progress) {
       return finish(RunResult::Outcome::kStopped,
                     fmt::format("event at t = {:.6g} s failed: {}", t, e.what()));
     }
-    coordinator_.BeginMacroStep();
-    if (auto failure = coordinator_.MacroStep(t, macro_index_)) {
+    std::string retry_note;
+    std::optional<ScheduleFailure> failure;
+    try {
+      failure = StepWithPolicy(t, retry_note);
+    } catch (const std::exception& e) {  // a state that cannot be saved for roll-back
+      return finish(RunResult::Outcome::kStopped,
+                    fmt::format("the failure policy needs checkpoints: {}", e.what()));
+    }
+    if (failure) {
       std::string detail;
       if (!failure->is_connector)
         if (SimObject* object = coordinator_.FindObject(failure->who))
@@ -117,11 +124,11 @@ RunResult Kernel::Run(double end_time, const ProgressFn& progress) {
       return finish(
           RunResult::Outcome::kDiverged,
           fmt::format("{} '{}'{} {} at t = {:.6g} s (macro step {}): {}{}; the run was "
-                      "stopped, outputs written up to t = {:.6g} s are kept",
+                      "stopped, outputs written up to t = {:.6g} s are kept{}",
                       failure->is_connector ? "connector" : "object", failure->who,
                       detail.empty() ? "" : " (" + detail + ")",
                       failure->status.code == StepStatus::Code::kDiverged ? "diverged" : "failed",
-                      failure->time, macro_index_, failure->status.what, where, t));
+                      failure->time, macro_index_, failure->status.what, where, t, retry_note));
     }
     ++macro_index_;
     ++result.macro_steps;
@@ -132,9 +139,22 @@ RunResult Kernel::Run(double end_time, const ProgressFn& progress) {
                     fmt::format("writing outputs failed at t = {:.6g} s: {}", time(), e.what()));
     }
     if (progress) progress(time(), end_time);
-    if (stop_requested_.load()) {
-      return finish(RunResult::Outcome::kStopped,
-                    fmt::format("stopped on request at t = {:.6g} s", time()));
+    const bool stop = stop_requested_.load();
+    if (checkpoint_every_ > 0 && (stop || macro_index_ % checkpoint_every_ == 0)) {
+      try {
+        WriteCheckpoint(checkpoint_file_);
+      } catch (const std::exception& e) {
+        return finish(
+            RunResult::Outcome::kOutputFailed,
+            fmt::format("writing the checkpoint failed at t = {:.6g} s: {}", time(), e.what()));
+      }
+    }
+    if (stop) {
+      return finish(
+          RunResult::Outcome::kStopped,
+          fmt::format("stopped on request at t = {:.6g} s{}", time(),
+                      checkpoint_every_ > 0 ? "; checkpoint written to " + checkpoint_file_.string()
+                                            : std::string()));
     }
   }
   return finish(RunResult::Outcome::kCompleted, "");

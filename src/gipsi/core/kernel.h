@@ -2,12 +2,16 @@
 /// @file
 /// `Kernel`: owns the object pool (through a Coordinator), runs the macro-step loop with
 /// multi-rate sub-stepping, fires scheduled discrete events, notifies observers (output writers,
-/// probes) and applies the divergence policy: a failing object stops the run with a diagnostic,
-/// and everything already written stays written.
+/// probes) and applies the divergence policy (FailurePolicy): a failing object stops the run
+/// with a diagnostic, or the macro step is rolled back and retried with halved steps; everything
+/// already written stays written. Writes and restores checkpoints of the whole run
+/// (kernel_state.cc).
 
 #include <atomic>
+#include <filesystem>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -16,6 +20,8 @@
 namespace gipsi {
 
 class Kernel;
+class StateReader;
+class StateWriter;
 
 /// Something that watches the run: output writers and probes. Observe is called once before
 /// the first step (at the start time) and after every macro step; an observer decides itself
@@ -27,6 +33,20 @@ class Observer {
   virtual void Observe(const Kernel& kernel, double t) = 0;
   /// Called once when the run ends, however it ends (flush files here).
   virtual void Finish(const Kernel& /*kernel*/) {}
+  /// Checkpoints: where the observer is (next output time, frame numbers, file lengths), so a
+  /// resumed run continues its files exactly. Called between macro steps. The defaults throw
+  /// InputError("this output does not support checkpoints").
+  virtual void SaveState(StateWriter& out);
+  virtual void RestoreState(StateReader& in);
+};
+
+/// What the kernel does when an object or connector fails a macro step (scene key
+/// "schedule.on_failure"). Plain struct.
+struct FailurePolicy {
+  /// 0: stop with a diagnostic (the default). N > 0: roll the macro step back and retry it as 2,
+  /// 4, ... 2^N steps of half, a quarter, ... the size (every object's sub-step shrinks alike)
+  /// before stopping.
+  int max_halvings = 0;
 };
 
 /// A discrete event scheduled at a simulated time, e.g. "at t = 0.5 s release the clamp".
@@ -76,6 +96,27 @@ class Kernel {
   /// an object's dt does not divide it.
   void Initialize(double macro_dt = 0);
   [[nodiscard]] double macro_dt() const { return macro_dt_; }
+  /// Sets the divergence policy (before Run).
+  void SetFailurePolicy(FailurePolicy policy) { policy_ = policy; }
+  [[nodiscard]] const FailurePolicy& failure_policy() const { return policy_; }
+  /// Macro steps that failed and were retried with smaller steps, so far.
+  [[nodiscard]] std::int64_t retried_steps() const { return retried_; }
+
+  /// Writes a checkpoint to `file` every `every` macro steps (> 0) during Run, and when a run
+  /// is stopped on request. Atomic: a crash mid-write leaves the previous checkpoint.
+  void SetCheckpointing(std::filesystem::path file, std::int64_t every);
+  /// The complete state between macro steps: clock, event queue position, every object and
+  /// connector, and every observer's position. Clears the coupling loads first (as the next
+  /// macro step would). Throws InputError if an object, connector or observer does not
+  /// support checkpoints.
+  void SaveState(StateWriter& out);
+  /// Restores what SaveState wrote for the same scene (after Initialize and AddObserver, before
+  /// Run); throws InputError naming what differs for a checkpoint of another scene.
+  void RestoreState(StateReader& in);
+  /// SaveState into a checkpoint file (gipsi/core/state.h: atomic, checksummed).
+  void WriteCheckpoint(const std::filesystem::path& file);
+  /// RestoreState from a checkpoint file.
+  void ReadCheckpoint(const std::filesystem::path& file);
 
   /// Runs until `end_time` (rounded to a whole number of macro steps). Never throws for a
   /// numerical failure: the outcome and diagnostic say what happened.
@@ -98,6 +139,8 @@ class Kernel {
  private:
   void FireDueEvents(double t);
   void Notify(double t);
+  /// One macro step from time t under the failure policy; the failure if it could not be done.
+  std::optional<ScheduleFailure> StepWithPolicy(double t, std::string& retry_note);
 
   Coordinator coordinator_;
   std::vector<ScheduledEvent> events_;  // sorted by time (stable)
@@ -109,6 +152,11 @@ class Kernel {
   double start_time_ = 0;
   std::int64_t macro_index_ = 0;
   bool started_ = false;
+  FailurePolicy policy_;
+  std::int64_t retried_ = 0;
+  std::string rollback_;  // state at the start of the current macro step (retry policy)
+  std::filesystem::path checkpoint_file_;
+  std::int64_t checkpoint_every_ = 0;
   std::atomic<bool> stop_requested_{false};
 };
 

@@ -18,7 +18,7 @@
 #include "gipsi/numerics/ode.h"
 
 /// Version of the plugin interface; a plugin built against another version is refused.
-#define GIPSI_PLUGIN_ABI_VERSION 1
+#define GIPSI_PLUGIN_ABI_VERSION 2  // 2: SimObject/Connector checkpoint hooks
 
 namespace gipsi {
 

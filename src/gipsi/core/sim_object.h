@@ -21,6 +21,9 @@
 
 namespace gipsi {
 
+class StateReader;
+class StateWriter;
+
 /// What an object is drawn with: a triangle surface whose vertices follow the domain through a
 /// mapping (barycentric embedding of a finer or coarser surface), or the boundary itself.
 /// Copyable and movable.
@@ -128,6 +131,16 @@ class SimObject {
   /// enclosed volume equal `law`'s end volume (cavity_law.h). `law` must outlive the object's
   /// steps. Throws InputError if the object has no such cavity (the default: no cavities).
   virtual void AttachCavityLaw(std::string_view cavity, CavityLaw* law);
+  /// Checkpoints and roll-back (gipsi/core/state.h): writes the clock, step count and applied
+  /// boundary conditions, then the type's own state (SaveObjectState); coupling loads must have
+  /// been cleared (BeginMacroStep). RestoreState reads it back; the object then continues
+  /// bitwise identically. Throw InputError for state from another scene or object type.
+  void SaveState(StateWriter& out) const;
+  void RestoreState(StateReader& in);
+  /// Everything of the subclass that influences the future (state, integrator history, event
+  /// logs). The defaults throw InputError("object type X does not support checkpoints").
+  virtual void SaveObjectState(StateWriter& out) const;
+  virtual void RestoreObjectState(StateReader& in);
   /// Called by the kernel at the start of every macro step (aggregates forward it).
   virtual void BeginMacroStep() { bcs_.ClearCouplingLoads(); }
 

@@ -2,6 +2,8 @@
 
 #include <fmt/format.h>
 
+#include "gipsi/core/state.h"
+
 namespace gipsi {
 
 VtuSeriesWriter::VtuSeriesWriter(std::vector<const SimObject*> objects,
@@ -68,12 +70,95 @@ void VtuSeriesWriter::Observe(const Kernel& kernel, double t) {
     WriteFrame(series, t);
   }
   ++frame_;
+  frame_times_.push_back(t);
   if (every_ > 0) {
     while (next_ <= t + tolerance) next_ += every_;
   }
 }
 
-void AttachOutputs(Scene& scene, const std::filesystem::path& directory) {
+namespace {
+std::string FrameFile(const std::string& name, std::int64_t frame, bool display) {
+  return display ? fmt::format("{}_display/{}_display_{:06d}.vtu", name, name, frame)
+                 : fmt::format("{}/{}_{:06d}.vtu", name, name, frame);
+}
+}  // namespace
+
+void PvdWriter::SetFrames(const std::vector<std::pair<double, std::string>>& frames) {
+  frames_.clear();
+  for (const auto& [time, file] : frames) frames_.push_back({time, file});
+  Rewrite();
+}
+
+void VtuSeriesWriter::SaveState(StateWriter& out) {
+  out.BeginSection("VtuSeriesWriter", 1);
+  out.WriteDouble(next_);
+  out.WriteInt(frame_);
+  out.WriteInt(static_cast<std::int64_t>(series_.size()));
+  out.WriteArray(frame_times_);
+  out.EndSection();
+}
+
+void VtuSeriesWriter::RestoreState(StateReader& in) {
+  in.BeginSection("VtuSeriesWriter", 1);
+  next_ = in.ReadDouble();
+  frame_ = in.ReadInt();
+  if (in.ReadInt() != static_cast<std::int64_t>(series_.size()))
+    in.Fail("the checkpoint has VTU series of other objects");
+  in.ReadArray(frame_times_);
+  if (static_cast<std::int64_t>(frame_times_.size()) != frame_) in.Fail("corrupted VTU frames");
+  in.EndSection();
+  for (Series& series : series_) {
+    std::vector<std::pair<double, std::string>> frames, display;
+    for (std::int64_t k = 0; k < frame_; ++k) {
+      const double t = frame_times_[static_cast<std::size_t>(k)];
+      frames.emplace_back(t, FrameFile(series.object->name(), k, false));
+      display.emplace_back(t, FrameFile(series.object->name(), k, true));
+    }
+    series.domain.SetFrames(frames);
+    if (series.display) series.display->SetFrames(display);
+  }
+}
+
+void ProbeRecorder::SaveState(StateWriter& out) {
+  out.BeginSection("ProbeRecorder", 1);
+  out.WriteInt(static_cast<std::int64_t>(streams_.size()));
+  for (auto& s : streams_) {
+    s.file.flush();
+    const auto length = static_cast<std::int64_t>(s.file.tellp());
+    if (!s.file || length < 0)
+      throw std::runtime_error(fmt::format("{}: cannot tell the file length", s.path.string()));
+    out.WriteString(s.probe.name);
+    out.WriteDouble(s.next);
+    out.WriteInt(length);
+  }
+  out.EndSection();
+}
+
+void ProbeRecorder::RestoreState(StateReader& in) {
+  in.BeginSection("ProbeRecorder", 1);
+  if (in.ReadInt() != static_cast<std::int64_t>(streams_.size()))
+    in.Fail("the checkpoint has other probes");
+  for (auto& s : streams_) {
+    if (in.ReadString() != s.probe.name) in.Fail("the checkpoint has other probes");
+    s.next = in.ReadDouble();
+    const std::int64_t length = in.ReadInt();
+    s.file.close();
+    std::error_code error;
+    const auto size = std::filesystem::file_size(s.path, error);
+    if (error || length < 0 || static_cast<std::uintmax_t>(length) > size)
+      in.Fail(
+          fmt::format("{} is shorter than at the checkpoint ({} bytes); resume with the "
+                      "output directory of the interrupted run",
+                      s.path.string(), length));
+    std::filesystem::resize_file(s.path, static_cast<std::uintmax_t>(length));
+    s.file.open(s.path, std::ios::app);
+    if (!s.file) throw std::runtime_error(fmt::format("{}: cannot reopen", s.path.string()));
+    s.file.precision(17);
+  }
+  in.EndSection();
+}
+
+void AttachOutputs(Scene& scene, const std::filesystem::path& directory, bool resume) {
   Kernel& kernel = *scene.kernel;
   if (scene.vtu.enabled) {
     std::vector<const SimObject*> leaves;
@@ -87,7 +172,7 @@ void AttachOutputs(Scene& scene, const std::filesystem::path& directory) {
                                                          scene.vtu.every, scene.vtu.display));
   }
   if (!scene.probes.empty())
-    kernel.AddObserver(std::make_unique<ProbeRecorder>(scene.probes, directory / "probes"));
+    kernel.AddObserver(std::make_unique<ProbeRecorder>(scene.probes, directory / "probes", resume));
 }
 
 }  // namespace gipsi

@@ -27,6 +27,9 @@ class VtuSeriesWriter final : public Observer {
   VtuSeriesWriter(std::vector<const SimObject*> objects, const std::filesystem::path& directory,
                   double every, bool display);
   void Observe(const Kernel& kernel, double t) override;
+  /// Checkpoints: next output time, frame number and the frames of every collection.
+  void SaveState(StateWriter& out) override;
+  void RestoreState(StateReader& in) override;
 
  private:
   struct Series {
@@ -40,11 +43,14 @@ class VtuSeriesWriter final : public Observer {
   double every_;
   double next_ = 0;
   std::int64_t frame_ = 0;
+  std::vector<double> frame_times_;  // of every frame so far (all series share them)
   std::vector<Series> series_;
 };
 
 /// Attaches the scene's outputs (VTU series if enabled, probe CSVs) to its kernel, writing under
-/// `directory`. Throws std::exception if the directory or files cannot be created.
-void AttachOutputs(Scene& scene, const std::filesystem::path& directory);
+/// `directory`. Throws std::exception if the directory or files cannot be created. With
+/// `resume`, existing probe files are kept for a run continued from a checkpoint (the kernel's
+/// RestoreState then cuts every file back to its length at the checkpoint).
+void AttachOutputs(Scene& scene, const std::filesystem::path& directory, bool resume = false);
 
 }  // namespace gipsi

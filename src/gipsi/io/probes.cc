@@ -227,15 +227,16 @@ Probe ParseProbe(const std::string& name, const JsonNode& node, const Kernel& ke
   return probe;
 }
 
-ProbeRecorder::ProbeRecorder(std::vector<Probe> probes, const std::filesystem::path& directory) {
+ProbeRecorder::ProbeRecorder(std::vector<Probe> probes, const std::filesystem::path& directory,
+                             bool resume) {
   std::filesystem::create_directories(directory);
   for (auto& probe : probes) {
-    Stream stream{std::move(probe), {}, 0};
-    auto path = directory / (stream.probe.name + ".csv");
-    stream.file.open(path, std::ios::out | std::ios::trunc);
+    auto path = directory / (probe.name + ".csv");
+    Stream stream{std::move(probe), {}, 0, path};
+    stream.file.open(path, resume ? std::ios::app : std::ios::out | std::ios::trunc);
     if (!stream.file)
       throw std::runtime_error(fmt::format("{}: cannot create file", path.string()));
-    stream.file << stream.probe.Header() << '\n';
+    if (!resume) stream.file << stream.probe.Header() << '\n';
     stream.file.precision(17);
     streams_.push_back(std::move(stream));
   }

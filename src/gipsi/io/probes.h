@@ -69,9 +69,14 @@ Probe ParseProbe(const std::string& name, const JsonNode& node, const Kernel& ke
 class ProbeRecorder final : public Observer {
  public:
   /// Opens the files (throws std::runtime_error naming the file if one cannot be created).
-  ProbeRecorder(std::vector<Probe> probes, const std::filesystem::path& directory);
+  /// With `resume`, existing files are kept (RestoreState cuts them to the checkpoint's length).
+  ProbeRecorder(std::vector<Probe> probes, const std::filesystem::path& directory,
+                bool resume = false);
   void Observe(const Kernel& kernel, double t) override;
   void Finish(const Kernel& kernel) override;
+  /// Checkpoints: next sample time and length of every file (defined in outputs.cc).
+  void SaveState(StateWriter& out) override;
+  void RestoreState(StateReader& in) override;
 
  private:
   struct Stream {
@@ -79,6 +84,7 @@ class ProbeRecorder final : public Observer {
     std::ofstream file;
     double next = 0;
     std::size_t next_at = 0;  // line probes: index into probe.at
+    std::filesystem::path path;
   };
   void Write(Stream& s, double t);
   std::vector<Stream> streams_;

@@ -119,6 +119,23 @@ class ObjectBuilder {
   BuildObjectFn fn_;
 };
 
+/// "on_failure": "stop" or {"retry": {"max_halvings": N}} (1 <= N <= 20).
+FailurePolicy ParseFailurePolicy(const JsonNode& node) {
+  FailurePolicy policy;
+  if (node.is_string()) {
+    (void)node.AsChoice({"stop"});
+    return policy;
+  }
+  if (!node.is_object()) node.Expected("\"stop\" or {\"retry\": {\"max_halvings\": N}}");
+  node.CheckKeys({"retry"});
+  const JsonNode retry = node.At("retry");
+  retry.CheckKeys({"max_halvings"});
+  const std::int64_t halvings = retry.Int("max_halvings");
+  if (halvings < 1 || halvings > 20) retry.At("max_halvings").Expected("an integer from 1 to 20");
+  policy.max_halvings = static_cast<int>(halvings);
+  return policy;
+}
+
 void ParseEvent(const JsonNode& node, Scene& scene) {
   node.CheckKeys({"at", "object", "apply", "remove", "set_field", "description"});
   const double at = ReadPositiveQuantity(node.At("at"), "s", /*allow_zero=*/true);
@@ -327,7 +344,7 @@ Scene LoadSceneFromString(std::string_view text, const std::string& name,
   SceneMeshes mesh_provider(scene.meshes);
 
   JsonNode schedule = root.At("schedule");
-  schedule.CheckKeys({"end", "dt", "order", "events"});
+  schedule.CheckKeys({"end", "dt", "order", "events", "on_failure"});
   scene.end_time = ReadPositiveQuantity(schedule.At("end"), "s");
   const double macro_dt = schedule.Has("dt") ? ReadPositiveQuantity(schedule.At("dt"), "s") : 0.0;
 
@@ -368,6 +385,8 @@ Scene LoadSceneFromString(std::string_view text, const std::string& name,
   }
   if (auto events = schedule.Find("events"))
     for (const auto& event : events->Items()) ParseEvent(event, scene);
+  if (auto on_failure = schedule.Find("on_failure"))
+    scene.kernel->SetFailurePolicy(ParseFailurePolicy(*on_failure));
 
   if (auto probes = root.Find("probes"))
     for (const auto& [probe_name, node] : probes->Members())

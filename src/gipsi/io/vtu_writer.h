@@ -66,6 +66,9 @@ class PvdWriter {
 
   [[nodiscard]] const std::filesystem::path& path() const { return path_; }
   [[nodiscard]] std::size_t num_frames() const { return frames_.size(); }
+  /// Replaces the frames (time, file) and rewrites the collection: a series resumed from a
+  /// checkpoint (defined in outputs.cc).
+  void SetFrames(const std::vector<std::pair<double, std::string>>& frames);
 
  private:
   struct Frame {

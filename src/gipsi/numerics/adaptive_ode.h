@@ -20,6 +20,9 @@
 
 namespace gipsi {
 
+class StateReader;
+class StateWriter;
+
 /// Event functions for AdaptiveOde: `num_events()` values g_i(t, x); event i happens where g_i
 /// crosses zero upward (from ≤ 0 to > 0). A caller that wants a downward crossing negates its
 /// function. `Calc` must not allocate. Interface only (not copyable through the base).
@@ -113,6 +116,9 @@ class AdaptiveOde {
   /// Sets the step-size guess (0: choose one): a second integrator started like this one
   /// repeats its steps exactly (trial integrations).
   void SetStepSize(double h) { h_ = h; }
+  /// Checkpoints (gipsi/core/state.h; defined in circulation_state.cc).
+  void SaveState(StateWriter& out) const;
+  void RestoreState(StateReader& in);
 
  private:
   double InitialStep(const OdeView& system, double t, double t_end, const VecX& x);

@@ -23,6 +23,9 @@
 
 namespace gipsi {
 
+class StateReader;
+class StateWriter;
+
 enum class ImplicitSchemeKind { kStatic, kBackwardEuler, kBdf2, kNewmark };
 
 /// Name used in scene files: "Static", "BackwardEuler", "BDF2", "Newmark".
@@ -62,6 +65,9 @@ class ImplicitScheme {
   void SetPositions(const VecX& x);
   /// Overwrites the current accelerations (Newmark's initial a_0).
   void SetAcceleration(const VecX& a) { a_ = a; }
+  /// Checkpoints (gipsi/core/state.h): the state and the multistep history.
+  void SaveState(StateWriter& out) const;
+  void RestoreState(StateReader& in);
 
  private:
   ImplicitSchemeKind kind_ = ImplicitSchemeKind::kBackwardEuler;

@@ -21,6 +21,9 @@
 
 namespace gipsi {
 
+class StateReader;
+class StateWriter;
+
 /// What Newton needs from a problem. Implementations must not allocate or throw.
 class NonlinearSystem {
  public:
@@ -103,6 +106,9 @@ class NewtonSolver {
   [[nodiscard]] LinearSolver& linear_solver() { return *linear_; }
   /// The residual at the last accepted iterate (valid unless fixed_iterations).
   [[nodiscard]] const VecX& residual() const { return r_; }
+  /// Checkpoints (gipsi/core/state.h): the warm start carried from one Solve to the next.
+  void SaveState(StateWriter& out) const;
+  void RestoreState(StateReader& in);
 
  private:
   NewtonOptions options_;

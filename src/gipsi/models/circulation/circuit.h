@@ -28,6 +28,9 @@
 
 namespace gipsi {
 
+class StateReader;
+class StateWriter;
+
 /// A blood-holding compartment. Plain struct; copyable.
 struct CompartmentSpec {
   enum class Kind { kChamber, kCompliance, kReservoir };
@@ -136,6 +139,9 @@ class Circuit {
   }
   /// Field-driven source connection c.
   void SetSourceFlow(int c, double q) { source_value_[static_cast<std::size_t>(c)] = q; }
+  /// Checkpoints (gipsi/core/state.h; defined in circulation_state.cc).
+  void SaveState(StateWriter& out) const;
+  void RestoreState(StateReader& in);
 
  private:
   class Guards final : public EventFunctions {

@@ -75,6 +75,8 @@ class Circulation final : public SimObject {
   /// Sets the blood volume of compartment `c` [m³] (before the first step: a 3-D cavity's
   /// volume), and re-initialises the valves from the new pressures.
   void SetVolume(int c, double volume);
+  void SaveObjectState(StateWriter& out) const override;
+  void RestoreObjectState(StateReader& in) override;
   /// After a failed step: the compartment or connection whose value was not finite, if any.
   [[nodiscard]] std::string failure_detail() const override;
 

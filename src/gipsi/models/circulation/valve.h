@@ -15,6 +15,9 @@
 
 namespace gipsi {
 
+class StateReader;
+class StateWriter;
+
 /// The discrete state of a valve.
 enum class ValveState : std::uint8_t { kClosed, kOpen };
 
@@ -54,6 +57,9 @@ class ValveEventLog {
   /// The kept events with index ≥ `first` in the total numbering (for "what is new since").
   [[nodiscard]] std::vector<ValveEvent> EventsSince(std::int64_t first) const;
   [[nodiscard]] std::size_t capacity() const { return ring_.size(); }
+  /// Checkpoints (gipsi/core/state.h; defined in circulation_state.cc).
+  void SaveState(StateWriter& out) const;
+  void RestoreState(StateReader& in);
 
  private:
   std::vector<ValveEvent> ring_;

@@ -46,6 +46,8 @@ class ExcitationContraction final : public Connector {
                         FieldId tension, const ExcitationContractionParams& params);
 
   [[nodiscard]] std::string_view type_name() const override { return "ExcitationContraction"; }
+  void SaveConnectorState(StateWriter& out) const override;
+  void RestoreConnectorState(StateReader& in) override;
   /// The active tension [Pa] per target item (last value Set).
   [[nodiscard]] const VecX& tension() const { return tension_; }
 

@@ -28,6 +28,8 @@ class FieldCopy final : public Connector {
             Mapping mapping, double scale);
 
   [[nodiscard]] std::string_view type_name() const override { return "FieldCopy"; }
+  void SaveConnectorState(StateWriter& out) const override;
+  void RestoreConnectorState(StateReader& in) override;
   /// The mapping in use (kDirect when values are copied item by item).
   [[nodiscard]] Mapping mapping() const { return mapping_; }
 

@@ -114,6 +114,8 @@ class EpTissue : public SimObject {
   /// Nodes driven by each stimulus / clamp (in declaration order).
   [[nodiscard]] const std::vector<std::vector<int>>& stimulus_nodes() const { return stim_nodes_; }
   [[nodiscard]] std::vector<ProfileEntry> ProfileBreakdown() const override;
+  void SaveObjectState(StateWriter& out) const override;
+  void RestoreObjectState(StateReader& in) override;
   [[nodiscard]] std::string failure_detail() const override { return failure_detail_; }
 
  protected:

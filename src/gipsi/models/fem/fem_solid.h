@@ -96,6 +96,8 @@ class FemSolid final : public SimObject, private NonlinearSystem {
   [[nodiscard]] const NewtonStats& last_newton() const { return last_newton_; }
   [[nodiscard]] const FemProfile& profile() const { return profile_; }
   [[nodiscard]] std::vector<ProfileEntry> ProfileBreakdown() const override;
+  void SaveObjectState(StateWriter& out) const override;
+  void RestoreObjectState(StateReader& in) override;
 
   /// Internal forces f_int(x) (3N) for positions x (3N); false if an element is outside its
   /// law's domain. For tests and connectors.

@@ -55,6 +55,8 @@ class MassSpring final : public SimObject {
 
   [[nodiscard]] std::string_view type_name() const override { return "MassSpring"; }
   [[nodiscard]] const Points& domain_positions() const override { return positions_; }
+  void SaveObjectState(StateWriter& out) const override;
+  void RestoreObjectState(StateReader& in) override;
 
   // --- OdeSystem contract: x = [q (3N); v (3N)] ---
   [[nodiscard]] Index ode_size() const { return 6 * num_nodes(); }

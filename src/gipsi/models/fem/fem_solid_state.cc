@@ -1,0 +1,58 @@
+/// @file
+/// FemSolid checkpoints: the time scheme (displacements, velocities, accelerations and BDF2
+/// history), the previous step's loads (interpolated within load steps), the fields written from
+/// outside (external force, active tension, fibres, cavity pressures), the Newton warm start and
+/// the last Jacobian norm (it sets the round-off floor of the next step's first residual).
+/// Constraint targets and the current loads are gathered afresh at the start of every step.
+
+#include "gipsi/core/state.h"
+#include "gipsi/models/fem/fem_solid.h"
+
+namespace gipsi {
+
+void FemSolid::SaveObjectState(StateWriter& out) const {
+  scheme_.SaveState(out);
+  newton_->SaveState(out);
+  out.WriteMatrix(f_nodal_prev_);
+  out.WriteMatrix(pressure_prev_);
+  out.WriteMatrix(traction_prev_);
+  out.WriteBool(have_prev_loads_);
+  out.WriteMatrix(external_force_);
+  out.WriteMatrix(active_tension_);
+  out.WriteMatrix(nodal_active_tension_);
+  out.WriteBool(active_from_nodes_);
+  out.WriteArray(
+      std::span<const double>(axes_.empty() ? nullptr : axes_.front().data(), 9 * axes_.size()));
+  std::vector<double> cavity_pressures;
+  for (const Cavity& c : cavities_) cavity_pressures.push_back(c.pressure);
+  out.WriteArray(cavity_pressures);
+  out.WriteDouble(jacobian_norm_);
+  out.WriteArray(std::span<const NewtonStats>(&last_newton_, 1));
+}
+
+void FemSolid::RestoreObjectState(StateReader& in) {
+  scheme_.RestoreState(in);
+  newton_->RestoreState(in);
+  in.ReadMatrixExact(f_nodal_prev_, "the previous nodal loads");
+  in.ReadMatrixExact(pressure_prev_, "the previous pressures");
+  in.ReadMatrixExact(traction_prev_, "the previous tractions");
+  have_prev_loads_ = in.ReadBool();
+  in.ReadMatrixExact(external_force_, "the external force field");
+  in.ReadMatrixExact(active_tension_, "the active tension");
+  in.ReadMatrixExact(nodal_active_tension_, "the nodal active tension");
+  active_from_nodes_ = in.ReadBool();
+  std::vector<double> axes(9 * axes_.size());
+  in.ReadArrayExact(axes, "the material axes");
+  for (std::size_t e = 0; e < axes_.size(); ++e)
+    axes_[e] = Eigen::Map<const Mat3>(axes.data() + 9 * e);
+  std::vector<double> cavity_pressures(cavities_.size());
+  in.ReadArrayExact(cavity_pressures, "the cavity pressures");
+  for (std::size_t c = 0; c < cavities_.size(); ++c) cavities_[c].pressure = cavity_pressures[c];
+  jacobian_norm_ = in.ReadDouble();
+  std::vector<NewtonStats> stats(1);
+  in.ReadArrayExact(stats, "the Newton statistics");
+  last_newton_ = stats.front();
+  UpdatePositions();
+}
+
+}  // namespace gipsi
