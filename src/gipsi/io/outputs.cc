@@ -120,7 +120,7 @@ void VtuSeriesWriter::RestoreState(StateReader& in) {
 }
 
 void ProbeRecorder::SaveState(StateWriter& out) {
-  out.BeginSection("ProbeRecorder", 1);
+  out.BeginSection("ProbeRecorder", 2);
   out.WriteInt(static_cast<std::int64_t>(streams_.size()));
   for (auto& s : streams_) {
     s.file.flush();
@@ -129,18 +129,20 @@ void ProbeRecorder::SaveState(StateWriter& out) {
       throw std::runtime_error(fmt::format("{}: cannot tell the file length", s.path.string()));
     out.WriteString(s.probe.name);
     out.WriteDouble(s.next);
+    out.WriteInt(static_cast<std::int64_t>(s.next_at));
     out.WriteInt(length);
   }
   out.EndSection();
 }
 
 void ProbeRecorder::RestoreState(StateReader& in) {
-  in.BeginSection("ProbeRecorder", 1);
+  in.BeginSection("ProbeRecorder", 2);
   if (in.ReadInt() != static_cast<std::int64_t>(streams_.size()))
     in.Fail("the checkpoint has other probes");
   for (auto& s : streams_) {
     if (in.ReadString() != s.probe.name) in.Fail("the checkpoint has other probes");
     s.next = in.ReadDouble();
+    s.next_at = static_cast<std::size_t>(in.ReadInt());
     const std::int64_t length = in.ReadInt();
     s.file.close();
     std::error_code error;

@@ -232,7 +232,7 @@ ProbeRecorder::ProbeRecorder(std::vector<Probe> probes, const std::filesystem::p
   std::filesystem::create_directories(directory);
   for (auto& probe : probes) {
     auto path = directory / (probe.name + ".csv");
-    Stream stream{std::move(probe), {}, 0, path};
+    Stream stream{std::move(probe), {}, 0, 0, path};
     stream.file.open(path, resume ? std::ios::app : std::ios::out | std::ios::trunc);
     if (!stream.file)
       throw std::runtime_error(fmt::format("{}: cannot create file", path.string()));

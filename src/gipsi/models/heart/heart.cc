@@ -8,6 +8,7 @@
 #include "gipsi/base/error.h"
 #include "gipsi/base/log.h"
 #include "gipsi/base/units.h"
+#include "gipsi/core/state.h"
 
 namespace gipsi {
 namespace {
@@ -189,6 +190,41 @@ void Heart::DoReadField(FieldId id, Eigen::Ref<Eigen::MatrixXd> out) const {
 void Heart::DoWriteField(FieldId id, const Eigen::Ref<const Eigen::MatrixXd>& in) {
   // Only the parts' writable fields reach here (the monitor's are read-only).
   AggregateObject::DoWriteField(id, in);
+}
+
+void Heart::SaveObjectState(StateWriter& out) const {
+  AggregateObject::SaveObjectState(out);
+  out.BeginSection("HeartMonitor", 1);
+  std::vector<double> flat;
+  for (const BeatSummary& b : beats_)
+    flat.insert(flat.end(), {static_cast<double>(b.beat), b.end_time, b.edv, b.esv,
+                             b.peak_pressure, b.arterial_systolic, b.arterial_diastolic, b.change});
+  out.WriteArray(flat);
+  out.WriteArray(std::vector<double>{v_max_, v_min_, p_max_, a_max_, a_min_});
+  out.WriteBool(beat_started_);
+  out.WriteInt(beat_index_);
+  out.EndSection();
+}
+
+void Heart::RestoreObjectState(StateReader& in) {
+  AggregateObject::RestoreObjectState(in);
+  in.BeginSection("HeartMonitor", 1);
+  std::vector<double> flat, running;
+  in.ReadArray(flat);
+  in.ReadArray(running);
+  if (flat.size() % 8 != 0 || running.size() != 5) in.Fail("the heart monitor's record is malformed");
+  beats_.clear();
+  for (std::size_t i = 0; i < flat.size(); i += 8)
+    beats_.push_back({static_cast<int>(flat[i]), flat[i + 1], flat[i + 2], flat[i + 3],
+                      flat[i + 4], flat[i + 5], flat[i + 6], flat[i + 7]});
+  v_max_ = running[0];
+  v_min_ = running[1];
+  p_max_ = running[2];
+  a_max_ = running[3];
+  a_min_ = running[4];
+  beat_started_ = in.ReadBool();
+  beat_index_ = static_cast<int>(in.ReadInt());
+  in.EndSection();
 }
 
 void RegisterHeart(TypeRegistry& registry) {

@@ -54,6 +54,9 @@ class Heart final : public AggregateObject {
   [[nodiscard]] std::string_view type_name() const override { return "Heart"; }
   /// Every completed beat so far.
   [[nodiscard]] const std::vector<BeatSummary>& beats() const { return beats_; }
+  /// The aggregate's state, then the monitor's (completed beats, the beat in progress).
+  void SaveObjectState(StateWriter& out) const override;
+  void RestoreObjectState(StateReader& in) override;
 
  protected:
   StepStatus DoStep(double t, double dt) override;
