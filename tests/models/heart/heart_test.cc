@@ -63,7 +63,9 @@ TEST(Heart, DefaultDemoBeatsPhysiologically) {
   // aortic opens, aortic closes, mitral opens.
   std::vector<std::string> order;
   for (const ValveEvent& e : blood.valve_events().Events())
-    if (e.time > 0.8) order.push_back(blood.valve_name(e.valve) + (e.state == ValveState::kOpen ? " opens" : " closes"));
+    if (e.time > 0.8)
+      order.push_back(blood.valve_name(e.valve) +
+                      (e.state == ValveState::kOpen ? " opens" : " closes"));
   ASSERT_GE(order.size(), 16u);
   const char* expected[4] = {"mitral closes", "aortic opens", "aortic closes", "mitral opens"};
   for (std::size_t i = 0; i < order.size(); ++i) EXPECT_EQ(order[i], expected[i % 4]) << i;
@@ -72,11 +74,11 @@ TEST(Heart, DefaultDemoBeatsPhysiologically) {
   const std::vector<BeatSummary>& beats = run.heart().beats();
   ASSERT_EQ(beats.size(), 5u);
   const BeatSummary& last = beats.back();
-  std::printf("beat 5: EDV %.1f mL, ESV %.1f mL, EF %.1f %%, LV peak %.1f mmHg, aorta %.1f/%.1f "
-              "mmHg, change %.2f %%\n",
-              last.edv / kMl, last.esv / kMl, 100 * last.ejection_fraction(),
-              last.peak_pressure / kMmHg, last.arterial_systolic / kMmHg,
-              last.arterial_diastolic / kMmHg, 100 * last.change);
+  std::printf(
+      "beat 5: EDV %.1f mL, ESV %.1f mL, EF %.1f %%, LV peak %.1f mmHg, aorta %.1f/%.1f "
+      "mmHg, change %.2f %%\n",
+      last.edv / kMl, last.esv / kMl, 100 * last.ejection_fraction(), last.peak_pressure / kMmHg,
+      last.arterial_systolic / kMmHg, last.arterial_diastolic / kMmHg, 100 * last.change);
   EXPECT_GT(last.ejection_fraction(), 0.50);
   EXPECT_LT(last.ejection_fraction(), 0.65);
   EXPECT_NEAR(last.arterial_systolic / kMmHg, 120, 10);

@@ -157,6 +157,18 @@ void FemSolid::AddCoupledCavityTangent(const double* u, double* jv) {
   }
 }
 
+void FemSolid::AddCoupledCavityForces(VecX& f) const {
+  for (const Cavity& cavity : cavities_) {
+    if (cavity.law == nullptr) continue;
+    for (std::size_t k = 0; k < cavity.nodes.size(); ++k)
+      cavity.positions.col(static_cast<Index>(k)) = positions_.col(cavity.nodes[k]);
+    cavity.volume.Compute(cavity.positions, &cavity.local_gradient);
+    for (std::size_t k = 0; k < cavity.nodes.size(); ++k)
+      f.segment<3>(3 * static_cast<Index>(cavity.nodes[k])) +=
+          cavity.pressure * cavity.local_gradient.col(static_cast<Index>(k));
+  }
+}
+
 void FemSolid::RestoreCavityPressures() {
   for (Cavity& cavity : cavities_)
     if (cavity.law != nullptr) cavity.pressure = cavity.pressure_begin;

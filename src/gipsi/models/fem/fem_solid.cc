@@ -630,6 +630,7 @@ void FemSolid::DoReadField(FieldId id, Eigen::Ref<Eigen::MatrixXd> out) const {
     out.setZero();
     if (!AssembleElements(u().data(), f_int_, nullptr)) return;
     AssembleExternal(u().data(), 1.0);  // after a step the previous loads equal the new ones
+    AddCoupledCavityForces(f_ext_);
     work2_ = f_int_ - f_ext_;
     if (params_.scheme != ImplicitSchemeKind::kStatic) {
       if (params_.lumped_mass) {

@@ -160,6 +160,9 @@ class FemSolid final : public SimObject, private NonlinearSystem {
   bool AddCoupledCavityLoads(const double* u);
   /// Their follower tangent and the weight of the rank-one term −∂p/∂V ∂V/∂x ⊗ ∂V/∂x.
   void AddCoupledCavityTangent(const double* u, double* jv);
+  /// Adds p ∂V/∂x of every coupled cavity at the current positions to f (every dof, the held
+  /// ones too: for reaction forces).
+  void AddCoupledCavityForces(VecX& f) const;
   /// Back to the pressures at the start of the step (after a failed Newton solve).
   void RestoreCavityPressures();
   void InitialAcceleration();

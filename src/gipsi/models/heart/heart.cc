@@ -197,8 +197,8 @@ void Heart::SaveObjectState(StateWriter& out) const {
   out.BeginSection("HeartMonitor", 1);
   std::vector<double> flat;
   for (const BeatSummary& b : beats_)
-    flat.insert(flat.end(), {static_cast<double>(b.beat), b.end_time, b.edv, b.esv,
-                             b.peak_pressure, b.arterial_systolic, b.arterial_diastolic, b.change});
+    flat.insert(flat.end(), {static_cast<double>(b.beat), b.end_time, b.edv, b.esv, b.peak_pressure,
+                             b.arterial_systolic, b.arterial_diastolic, b.change});
   out.WriteArray(flat);
   out.WriteArray(std::vector<double>{v_max_, v_min_, p_max_, a_max_, a_min_});
   out.WriteBool(beat_started_);
@@ -212,11 +212,12 @@ void Heart::RestoreObjectState(StateReader& in) {
   std::vector<double> flat, running;
   in.ReadArray(flat);
   in.ReadArray(running);
-  if (flat.size() % 8 != 0 || running.size() != 5) in.Fail("the heart monitor's record is malformed");
+  if (flat.size() % 8 != 0 || running.size() != 5)
+    in.Fail("the heart monitor's record is malformed");
   beats_.clear();
   for (std::size_t i = 0; i < flat.size(); i += 8)
-    beats_.push_back({static_cast<int>(flat[i]), flat[i + 1], flat[i + 2], flat[i + 3],
-                      flat[i + 4], flat[i + 5], flat[i + 6], flat[i + 7]});
+    beats_.push_back({static_cast<int>(flat[i]), flat[i + 1], flat[i + 2], flat[i + 3], flat[i + 4],
+                      flat[i + 5], flat[i + 6], flat[i + 7]});
   v_max_ = running[0];
   v_min_ = running[1];
   p_max_ = running[2];
