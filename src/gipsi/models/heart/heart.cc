@@ -44,7 +44,7 @@ constexpr const char* kHeartDefaults = R"({
       "boundary_conditions": [{"name": "base", "region": {"group": "base"}, "fix": true}]
     },
     "blood": {
-      "type": "Circulation", "preset": "closed_loop", "dt": "5 ms",
+      "type": "Circulation", "preset": "closed_loop", "dt": "5 ms", "log_events": false,
       "compartments": {"lv": {"driven_by": "pressure", "volume": "60 mL", "pressure": "0 mmHg"}},
       "connections": {"peripheral": {"resistance": "1.1 mmHg*s/mL"}}
     }
