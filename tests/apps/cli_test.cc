@@ -12,6 +12,7 @@
 #include "apps/cli_test_util.h"
 
 #include "gipsi/io/vtu_reader.h"
+#include "test_paths.h"
 
 namespace gipsi {
 namespace {

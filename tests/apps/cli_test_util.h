@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <string>
+#include "test_paths.h"
 
 namespace gipsi::testing {
 

@@ -10,6 +10,7 @@
 
 #include "gipsi/io/scene.h"
 #include "gipsi/models/builtins.h"
+#include "test_paths.h"
 
 namespace gipsi {
 namespace {

@@ -18,6 +18,7 @@
 #include "gipsi/base/error.h"
 #include "gipsi/core/kernel.h"
 #include "gipsi/core/state.h"
+#include "test_paths.h"
 
 namespace gipsi {
 namespace {

@@ -6,6 +6,7 @@
 #include "gipsi/geometry/generators.h"
 #include "gipsi/geometry/quality.h"
 #include "gipsi/io/mesh_io.h"
+#include "test_paths.h"
 
 namespace gipsi {
 namespace {

@@ -14,6 +14,7 @@
 #include "gipsi/io/scene.h"
 #include "gipsi/models/builtins.h"
 #include "gipsi/models/fem/fem_solid.h"
+#include "test_paths.h"
 
 namespace gipsi {
 namespace {

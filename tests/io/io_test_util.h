@@ -15,6 +15,7 @@
 
 #include "gipsi/base/error.h"
 #include "gipsi/geometry/mesh.h"
+#include "test_paths.h"
 
 namespace gipsi::test {
 

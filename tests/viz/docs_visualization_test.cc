@@ -11,6 +11,7 @@
 #include "gipsi/io/scene.h"
 #include "gipsi/models/builtins.h"
 #include "gipsi/viz/display_manager.h"
+#include "test_paths.h"
 
 namespace gipsi::viz {
 namespace {

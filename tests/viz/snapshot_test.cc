@@ -9,6 +9,7 @@
 #include "gipsi/io/scene.h"
 #include "gipsi/models/builtins.h"
 #include "gipsi/viz/render/offscreen.h"
+#include "test_paths.h"
 
 namespace gipsi::viz {
 namespace {

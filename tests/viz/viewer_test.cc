@@ -15,6 +15,7 @@
 
 #include "apps/cli_test_util.h"
 #include "gipsi/viz/render/image.h"
+#include "test_paths.h"
 
 namespace gipsi::viz {
 namespace {

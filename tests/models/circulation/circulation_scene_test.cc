@@ -11,6 +11,7 @@
 
 #include "apps/cli_test_util.h"
 #include "models/circulation/circulation_test_util.h"
+#include "test_paths.h"
 
 namespace gipsi {
 namespace {

@@ -13,6 +13,7 @@
 #include "gipsi/models/fem/fem_solid.h"
 #include "gipsi/models/heart/heart.h"
 #include "io/scene_test_util.h"
+#include "test_paths.h"
 
 namespace gipsi {
 namespace {
