@@ -109,7 +109,7 @@ TEST(LineProbe, SamplesAtEachRequestedTimeOrOnceAtTheEnd) {
   EXPECT_EQ(data.series[0].label, "two.displacement_z at t = 0.01 s");
   EXPECT_EQ(data.series[1].label, "two.displacement_z at t = 0.02 s");
   EXPECT_THAT(data.series[1].x, ElementsAre(0.0, 0.5, 1.0));
-  EXPECT_EQ(data.x_label, "two.distance");
+  EXPECT_EQ(data.x_label, "two.distance [m]");
 }
 
 TEST(LineProbe, BadLinesNameTheirJsonPath) {

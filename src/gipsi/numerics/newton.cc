@@ -57,6 +57,7 @@ NewtonStats NewtonSolver::Solve(NonlinearSystem& system, VecX& d, SparseMatrix& 
     if (!system.CalcResidualAndJacobian(d, r_, J)) return false;
     norm = r_.norm();
     need_factor = true;
+    factor_valid_ = false;  // J now differs from the factorised matrix
     return true;
   };
   for (int it = 1; it <= options_.max_iterations; ++it) {
@@ -80,7 +81,9 @@ NewtonStats NewtonSolver::Solve(NonlinearSystem& system, VecX& d, SparseMatrix& 
       delta_.setZero();
     const LinearSolveStats ls = linear_->Solve(rhs_, delta_);
     stats.linear_iterations += ls.iterations;
-    stats.refactorizations += ls.refactorized ? 1 : 0;
+    // `refactorized` describes the last Factorize, so count it only in the iteration that called
+    // it.
+    stats.refactorizations += fresh && ls.refactorized ? 1 : 0;
     const bool solved = ls.converged && delta_.allFinite() && ApplyLowRank(system, stats);
     if (!solved && !fresh) {
       if (!refresh()) {
@@ -167,6 +170,9 @@ NewtonStats NewtonSolver::Solve(NonlinearSystem& system, VecX& d, SparseMatrix& 
       return stats;
     }
     need_factor = true;
+    // J now differs from the factorised matrix: if the iterations run out here, the next Solve
+    // must not reuse the old factors.
+    factor_valid_ = false;
   }
   return stats;
 }

@@ -1,12 +1,15 @@
 #include "gipsi/viz/plot_spec.h"
 
 #include <algorithm>
+#include <cmath>
 #include <map>
+#include <stdexcept>
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
 #include "gipsi/base/error.h"
+#include "gipsi/base/units.h"
 #include "gipsi/viz/csv_table.h"
 
 namespace gipsi::viz {
@@ -71,8 +74,44 @@ std::vector<std::string> ProbeColumns(const Probe& probe) {
   }
 }
 
+std::string ProbeColumnUnits(const Probe& probe, const std::string& column) {
+  if (column == "time") return "s";
+  if (probe.is_line() && (column == "distance" || column == "x" || column == "y" || column == "z"))
+    return "m";
+  for (FieldId id : probe.fields) {
+    const FieldInfo& info = probe.object->field_info(id);
+    if (column == info.name ||
+        (column.size() > info.name.size() + 1 &&
+         column.compare(0, info.name.size(), info.name) == 0 && column[info.name.size()] == '_'))
+      return info.units == "1" ? "" : info.units;
+  }
+  return "";
+}
+
+namespace {
+
+/// The unit an axis is drawn in and the factor from the columns' SI unit `si` to it: the
+/// node's unit if given (it must convert from `si`), else `si` itself.
+void AxisUnit(const JsonNode* node, const std::string& si, std::string& unit, double& scale) {
+  unit = si;
+  scale = 1;
+  if (node == nullptr) return;
+  const std::string wanted = node->AsString();
+  try {
+    scale = 1 / UnitFactor(wanted, si.empty() ? "1" : si);
+  } catch (const std::invalid_argument&) {
+    node->Expected(fmt::format("a unit that converts from the column's unit '{}'",
+                               si.empty() ? "1 (dimensionless)" : si));
+  }
+  if (!std::isfinite(scale) || scale == 0)
+    node->Expected(fmt::format("a unit that converts from '{}'", si));
+  unit = wanted;
+}
+
+}  // namespace
+
 PlotSpec ParsePlotSpec(const JsonNode& node, const std::vector<Probe>& probes) {
-  node.CheckKeys({"file", "x", "y", "title", "size"});
+  node.CheckKeys({"file", "x", "y", "title", "size", "x_unit", "y_unit"});
   PlotSpec spec;
   const JsonNode file = node.At("file");
   spec.file = file.AsString();
@@ -116,6 +155,25 @@ PlotSpec ParsePlotSpec(const JsonNode& node, const std::vector<Probe>& probes) {
             .Fail(fmt::format("comes from probe '{}', but x comes from probe '{}': a plot "
                               "against a column other than time needs both from one probe",
                               spec.y[i].probe, spec.x->probe));
+  // Units: the columns' SI units, or the plot's; all y columns share one axis, so one unit.
+  auto probe_of = [&](const ColumnRef& c) -> const Probe& {
+    return *std::find_if(probes.begin(), probes.end(),
+                         [&](const Probe& p) { return p.name == c.probe; });
+  };
+  const std::string x_si = spec.x ? ProbeColumnUnits(probe_of(*spec.x), spec.x->column) : "s";
+  const std::string y_si = ProbeColumnUnits(probe_of(spec.y[0]), spec.y[0].column);
+  const auto y_unit = node.Find("y_unit");
+  for (std::size_t i = 1; i < spec.y.size(); ++i) {
+    const std::string other = ProbeColumnUnits(probe_of(spec.y[i]), spec.y[i].column);
+    if (y_unit && other != y_si)
+      y_unit->Fail(
+          fmt::format("the y columns have different units ('{}' and '{}'): one y_unit "
+                      "cannot convert both",
+                      y_si, other));
+  }
+  const auto x_unit = node.Find("x_unit");
+  AxisUnit(x_unit ? &*x_unit : nullptr, x_si, spec.x_unit, spec.x_scale);
+  AxisUnit(y_unit ? &*y_unit : nullptr, y_si, spec.y_unit, spec.y_scale);
   if (auto size = node.Find("size")) {
     const auto v = size->AsInts();
     if (v.size() != 2 || v[0] < 100 || v[1] < 100 || v[0] > 8192 || v[1] > 8192)
@@ -132,7 +190,15 @@ PlotData LoadPlotData(const PlotSpec& spec, const std::filesystem::path& probe_d
   data.width = spec.width;
   data.height = spec.height;
   auto label = [](const ColumnRef& c) { return c.probe + "." + c.column; };
-  data.x_label = spec.x ? label(*spec.x) : "time [s]";
+  auto with_unit = [](std::string text, const std::string& unit) {
+    return unit.empty() ? text : text + " [" + unit + "]";
+  };
+  data.x_label = with_unit(spec.x ? label(*spec.x) : "time", spec.x_unit);
+  auto scaled = [](std::vector<double> v, double factor) {
+    if (factor != 1)
+      for (double& value : v) value *= factor;
+    return v;
+  };
   std::map<std::string, CsvTable> tables;
   auto table = [&](const std::string& probe) -> const CsvTable& {
     auto it = tables.find(probe);
@@ -141,15 +207,18 @@ PlotData LoadPlotData(const PlotSpec& spec, const std::filesystem::path& probe_d
   };
   for (const ColumnRef& y : spec.y) {
     const CsvTable& t = table(y.probe);
-    const std::vector<double>& x = spec.x ? t.Column(spec.x->column) : t.Column("time");
+    const std::vector<double> x =
+        scaled(spec.x ? t.Column(spec.x->column) : t.Column("time"), spec.x_scale);
+    const std::vector<double> values = scaled(t.Column(y.column), spec.y_scale);
     if (spec.profile) {
-      for (auto& series : SplitSeries(label(y), x, t.Column(y.column), t.Column("time")))
+      for (auto& series : SplitSeries(label(y), x, values, t.Column("time")))
         data.series.push_back(std::move(series));
     } else {
-      data.series.push_back({label(y), x, t.Column(y.column)});
+      data.series.push_back({label(y), x, values});
     }
   }
-  data.y_label = spec.y.size() == 1 ? label(spec.y[0]) : "";
+  data.y_label = spec.y.size() == 1 ? with_unit(label(spec.y[0]), spec.y_unit)
+                                    : (spec.y_unit.empty() ? "" : "[" + spec.y_unit + "]");
   return data;
 }
 

@@ -13,6 +13,12 @@
 /// its `distance`, and each sample time becomes its own curve:
 ///
 ///     {"file": "activation.png", "y": "diagonal.activation_time"}
+///
+/// `x_unit` and `y_unit` draw the axes in other units than the fields' SI units (converted by
+/// UDUNITS-2, e.g. a pressure-volume loop in mL and mmHg):
+///
+///     {"file": "pv.png", "x": "pv.lv_volume", "y": "pv.lv_pressure",
+///      "x_unit": "mL", "y_unit": "mmHg"}
 
 #include <filesystem>
 #include <optional>
@@ -38,12 +44,17 @@ struct PlotSpec {
   std::vector<ColumnRef> y;    ///< at least one
   /// The columns come from a line probe: one curve per sample time (the rows of one time).
   bool profile = false;
+  /// Axis units as shown in the labels (the columns' SI units unless the plot names others),
+  /// and the factors that convert the CSV values (SI) to them; "" for a dimensionless axis.
+  std::string x_unit, y_unit;
+  double x_scale = 1, y_scale = 1;
   int width = 800, height = 500;
 };
 
 /// Parses and checks one plot against the scene's probes (their names and CSV columns); throws
-/// InputError naming the JSON path for an unknown probe or column, a bad file extension, or
-/// an `x` from another probe than a `y`.
+/// InputError naming the JSON path for an unknown probe or column, a bad file extension, an
+/// `x` from another probe than a `y`, or a unit that does not parse or does not convert from
+/// the column's SI unit.
 PlotSpec ParsePlotSpec(const JsonNode& node, const std::vector<Probe>& probes);
 
 /// A plot's data, ready to draw. Plain struct.
@@ -71,5 +82,9 @@ std::vector<PlotData::Series> SplitSeries(const std::string& label, const std::v
 
 /// The CSV columns a probe writes (its header split at commas).
 std::vector<std::string> ProbeColumns(const Probe& probe);
+
+/// The SI unit of one of a probe's CSV columns ("s" for time, "m" for a line probe's distance
+/// and coordinates, else its field's unit); empty if the probe has no such column.
+std::string ProbeColumnUnits(const Probe& probe, const std::string& column);
 
 }  // namespace gipsi::viz

@@ -1,5 +1,6 @@
-// Direct solvers (Eigen SimplicialLDLT, CHOLMOD supernodal LLᵀ): SPD checks, recovery after a
-// failed factorisation, reuse of the symbolic analysis, and their stats.
+// Direct solvers (Eigen SimplicialLDLT, CHOLMOD supernodal LLᵀ): SPD checks, indefinite matrices
+// once accepted, recovery after a failed factorisation, reuse of the symbolic analysis, and their
+// stats.
 
 #include <string>
 
@@ -54,6 +55,26 @@ TEST_P(DirectSparseSolver, RecoversAfterAFailedFactorization) {
   const LinearSolveStats stats = solver->Solve(problem.b, x);
   EXPECT_TRUE(stats.converged);
   EXPECT_LE(IndependentRelativeResidual(good, problem.b, x), 1e-12);
+}
+
+// After AcceptIndefinite (the pressure-loaded solids' tangents), both solve the indefinite
+// shifted Laplacian to round-off; "cholmod" falls back from its LLᵀ to LDLᵀ for it and goes back
+// to LLᵀ for the next, definite matrix of the pattern. Bound 1e-10: the shifted matrix's
+// condition number is about 1e2, so round-off leaves residuals near 1e-14.
+TEST_P(DirectSparseSolver, AfterAcceptIndefiniteSolvesIndefiniteAndDefiniteMatrices) {
+  const SparseMatrix indefinite = MakeLaplacian3D(10, -1.0);
+  const SparseMatrix definite = MakeLaplacian3D(10, 0.2);
+  auto solver = MakeSolver();
+  ASSERT_TRUE(solver->AcceptIndefinite());
+  solver->AnalyzePattern(definite);
+  for (const SparseMatrix* A : {&indefinite, &definite, &indefinite}) {
+    ASSERT_TRUE(solver->Factorize(*A));
+    const auto problem = Manufacture(*A);
+    VecX x;
+    const LinearSolveStats stats = solver->Solve(problem.b, x);
+    EXPECT_TRUE(stats.converged);
+    EXPECT_LE(IndependentRelativeResidual(*A, problem.b, x), 1e-10);
+  }
 }
 
 // One AnalyzePattern, then several matrices of that pattern: each Factorize is numeric only

@@ -94,7 +94,8 @@ void FemSolid::AttachCavityLaw(std::string_view cavity, CavityLaw* law) {
       Log().warn(
           "object '{}': cavity '{}' is coupled to blood but the linear solver '{}' needs "
           "positive definite matrices, so the pressure's follower tangent is left out and "
-          "Newton converges linearly; \"linear_solver\": {{\"type\": \"ldlt\"}} keeps it",
+          "Newton converges linearly; \"linear_solver\": {{\"type\": \"cholmod\"}} or "
+          "{{\"type\": \"ldlt\"}} keeps it",
           name(), cavity, newton_->linear_solver().name());
     return;
   }

@@ -493,6 +493,7 @@ StepStatus FemSolid::Advance(double s0, double s1, double dt, int depth) {
   last_newton_ = newton_->Solve(*this, d_, jac_);
   profile_.newton_iterations += last_newton_.iterations;
   profile_.linear_iterations += last_newton_.linear_iterations;
+  profile_.factorizations += last_newton_.refactorizations;
   if (last_newton_.converged && d_.allFinite()) {
     scheme_.Commit(d_);
     return StepStatus::Ok();
@@ -556,7 +557,9 @@ std::vector<SimObject::ProfileEntry> FemSolid::ProfileBreakdown() const {
   return {{"assembly (residual, tangent)", profile_.assembly_seconds, "s"},
           {"linear solves", profile_.solve_seconds, "s"},
           {"Newton iterations", static_cast<double>(profile_.newton_iterations), ""},
-          {"linear iterations", static_cast<double>(profile_.linear_iterations), ""}};
+          {"linear iterations", static_cast<double>(profile_.linear_iterations), ""},
+          {"factorisations or preconditioner set-ups", static_cast<double>(profile_.factorizations),
+           ""}};
 }
 
 void FemSolid::UpdatePositions() {

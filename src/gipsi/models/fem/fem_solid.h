@@ -67,6 +67,7 @@ struct FemProfile {
   double solve_seconds = 0;     ///< linear solves (including factorisations)
   std::int64_t newton_iterations = 0;
   std::int64_t linear_iterations = 0;
+  std::int64_t factorizations = 0;  ///< factorisations (or preconditioner set-ups) of the tangent
   std::int64_t steps = 0;
 };
 

@@ -1,4 +1,5 @@
-// Direct sparse solvers: Eigen's simplicial LDLᵀ and CHOLMOD's supernodal LLᵀ, behind one
+// Direct sparse solvers: Eigen's simplicial LDLᵀ and CHOLMOD's supernodal LLᵀ (with an LDLᵀ
+// fallback for accepted indefinite matrices), behind one
 // base class that owns the shared bookkeeping and the honest residual check.
 
 #include <cmath>
@@ -131,7 +132,10 @@ class LdltSolver final : public DirectSolver {
 };
 
 /// CHOLMOD supernodal LLᵀ (CHOLMOD's default ordering: AMD, or METIS when AMD fills badly).
-/// Both read the lower triangle only.
+/// Both read the lower triangle only. After AcceptIndefinite, a matrix that LLᵀ finds not
+/// positive definite is factorised by LDLᵀ instead (the simplicial LdltSolver's pivot rule):
+/// the tangents of pressure-loaded solids are positive definite most of the time, and the
+/// supernodal LLᵀ is several times faster than a simplicial LDLᵀ.
 class CholmodSolver final : public DirectSolver {
  public:
   explicit CholmodSolver(const LinearSolverOptions& options) : DirectSolver(options) {
@@ -140,20 +144,46 @@ class CholmodSolver final : public DirectSolver {
     llt_.cholmod().print = 0;
   }
   [[nodiscard]] std::string name() const override { return "cholmod"; }
+  bool AcceptIndefinite() override {
+    indefinite_ = true;
+    return true;
+  }
 
  protected:
-  void Analyze(const SparseMatrix& A) override { llt_.analyzePattern(A); }
+  void Analyze(const SparseMatrix& A) override {
+    llt_.analyzePattern(A);
+    ldlt_analysed_ = false;
+  }
   bool FactorizeNumeric(const SparseMatrix& A) override {
+    use_ldlt_ = false;
     llt_.factorize(A);
-    return llt_.info() == Eigen::Success;
+    if (llt_.info() == Eigen::Success) return true;
+    if (!indefinite_) return false;
+    if (!ldlt_analysed_) {
+      ldlt_.analyzePattern(A);
+      ldlt_analysed_ = true;
+    }
+    ldlt_.factorize(A);
+    if (ldlt_.info() != Eigen::Success) return false;
+    const VecX& d = ldlt_.vectorD();
+    use_ldlt_ = true;
+    return d.allFinite() && d.cwiseAbs().minCoeff() > 1e-13 * d.cwiseAbs().maxCoeff();
   }
   bool SolveInto(const VecX& b, VecX& x) override {
+    if (use_ldlt_) {
+      x = ldlt_.solve(b);
+      return ldlt_.info() == Eigen::Success;
+    }
     x = llt_.solve(b);
     return llt_.info() == Eigen::Success;
   }
 
  private:
   Eigen::CholmodSupernodalLLT<SparseMatrix, Eigen::Lower> llt_;
+  Eigen::SimplicialLDLT<SparseMatrix, Eigen::Lower, Eigen::AMDOrdering<int>> ldlt_;
+  bool indefinite_ = false;
+  bool ldlt_analysed_ = false;
+  bool use_ldlt_ = false;  // the last factorisation fell back to LDLᵀ
 };
 
 }  // namespace

@@ -90,7 +90,9 @@ class LinearSolver {
   virtual void SetNearNullSpace(const Eigen::MatrixXd& /*modes*/) {}
   /// From now on, accepts symmetric indefinite (nonsingular) matrices where the method can:
   /// "ldlt" factorises them without pivoting (a pivot below 1e-13 of the largest in magnitude
-  /// still fails). Returns whether the solver can; the others are for SPD matrices only.
+  /// still fails); "cholmod" tries its supernodal LLᵀ and falls back to that LDLᵀ for a matrix
+  /// that is not positive definite. Returns whether the solver can; the others are for SPD
+  /// matrices only.
   virtual bool AcceptIndefinite() { return false; }
   /// Symbolic analysis (ordering, elimination tree) for matrices with A's pattern. Call again
   /// only when the pattern changes (it also drops any factorisation). A must be square and
