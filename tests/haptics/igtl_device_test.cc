@@ -292,10 +292,8 @@ TEST(IgtlDevice, RefusedOrBadConnectionsAreInputErrors) {
     EXPECT_THAT(e.what(), HasSubstr("OpenIGTLink device at 127.0.0.1:" +
                                     std::to_string(closed.port()) + ": cannot connect within 2 s"));
   }
-  IgtlDeviceParams p = Params(closed.port());
-  p.host = "no-such-host.invalid";
-  EXPECT_THROW(IgtlDevice{p}, InputError);
-  p = Params(0);
+  // (No unknown-host case: resolving a name could leave the loopback interface.)
+  IgtlDeviceParams p = Params(0);
   EXPECT_THROW(IgtlDevice{p}, InputError);
 }
 
