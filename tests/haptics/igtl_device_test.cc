@@ -12,6 +12,7 @@
 #include <chrono>
 #include <cstring>
 #include <functional>
+#include <limits>
 #include <string>
 #include <thread>
 #include <vector>
@@ -190,6 +191,22 @@ TEST(IgtlDevice, ReportsExactlyTheTransformsOfItsDeviceName) {
               1e-7);
   }
   EXPECT_EQ(device.num_poses(), 6);
+  // Malformed poses (a NaN translation, an all-zero rotation) are dropped: the device keeps
+  // reporting the last good pose, and the next good one is taken.
+  igtl::Matrix4x4 bad;
+  MakePose(7, bad);
+  bad[1][3] = std::numeric_limits<float>::quiet_NaN();
+  ASSERT_TRUE(server.SendTransform("Tool", bad));
+  MakePose(8, bad);
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) bad[i][j] = 0;
+  ASSERT_TRUE(server.SendTransform("Tool", bad));
+  igtl::Matrix4x4 good;
+  MakePose(9, good);
+  ASSERT_TRUE(server.SendTransform("Tool", good));
+  ASSERT_TRUE(WaitFor([&] { return device.num_poses() == 7; }));
+  EXPECT_EQ(device.Read(0).position, 0.001 * Vec3(good[0][3], good[1][3], good[2][3]));
+  EXPECT_TRUE(device.Read(0).orientation.coeffs().allFinite());
 }
 
 TEST(IgtlDevice, SendsTheSurfaceAsPolyDataExactly) {

@@ -239,7 +239,14 @@ bool IgtlDevice::ReceiveOne() {
   Mat3 rotation;
   for (int i = 0; i < 3; ++i)
     for (int j = 0; j < 3; ++j) rotation(i, j) = m[i][j];
-  received_.position = params_.length_unit * Vec3(m[0][3], m[1][3], m[2][3]);
+  const Vec3 translation(m[0][3], m[1][3], m[2][3]);
+  // A malformed pose (non-finite entries, or a rotation that is not one: float32 entries of a
+  // rotation are orthonormal to ~1e-7, far inside 1e-3) is dropped, never passed on.
+  if (!rotation.allFinite() || !translation.allFinite() ||
+      !((rotation.transpose() * rotation - Mat3::Identity()).norm() < 1e-3) ||
+      !(rotation.determinant() > 0))
+    return true;
+  received_.position = params_.length_unit * translation;
   received_.orientation = Eigen::Quaterniond(rotation).normalized();
   received_.connected = true;
   poses_.back() = received_;
