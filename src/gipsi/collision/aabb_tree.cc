@@ -67,7 +67,6 @@ void AabbTree::BuildRange(int self, int begin, int end) {
     cbox.Add(centroid_[t]);
   }
   nodes_[static_cast<std::size_t>(self)].box = box;
-  nodes_[static_cast<std::size_t>(self)].area = box.SurfaceArea();
   if (end - begin <= leaf_size_) {
     nodes_[static_cast<std::size_t>(self)].first = begin;
     nodes_[static_cast<std::size_t>(self)].count = end - begin;
@@ -108,14 +107,13 @@ void AabbTree::Refit(const Points& positions, const Triangles& triangles) {
       b.Add(nodes_[static_cast<std::size_t>(n.first) + 1].box);
     }
     n.box = b;
-    n.area = b.SurfaceArea();
   }
 }
 
 double AabbTree::InnerArea() const {
   double area = 0;
   for (const Node& n : nodes_)
-    if (!n.is_leaf()) area += n.area;
+    if (!n.is_leaf()) area += n.box.SurfaceArea();
   return area;
 }
 

@@ -51,7 +51,6 @@ class AabbTree {
   /// triangles [first, first + count) of `order()` (a leaf has count > 0).
   struct Node {
     Box3 box;
-    double area = 0;  ///< box.SurfaceArea(), kept by Build and Refit (traversal order)
     int first = 0;
     int count = 0;
     [[nodiscard]] bool is_leaf() const { return count > 0; }

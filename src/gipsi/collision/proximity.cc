@@ -119,29 +119,17 @@ void ProximityQuery::Query(const CollisionSurface& a, const CollisionSurface& b,
         OfferTriangle(xb.col(w), w, a, i, d, best_b_, touched_b_);
     }
     if (!edge_edge) return;
-    // The edges of triangle j this pair owns, with their boxes, gathered once (not per edge of
-    // triangle i).
-    int num_b = 0, eb_of[3];
-    Box3 box_eb[3];
-    for (int kb = 0; kb < 3; ++kb) {
-      const int eb = b.triangle_edges()(kb, j);
-      if (b.edge_owner()[static_cast<std::size_t>(eb)] != j) continue;
-      const Box3 box = EdgeBox(xb.col(b.edges()(0, eb)), xb.col(b.edges()(1, eb)));
-      if (!box.Near(box_i, d)) continue;  // no edge of triangle i can be near it
-      eb_of[num_b] = eb;
-      box_eb[num_b++] = box;
-    }
-    if (num_b == 0) return;
     for (int ka = 0; ka < 3; ++ka) {
       const int ea = a.triangle_edges()(ka, i);
       if (a.edge_owner()[static_cast<std::size_t>(ea)] != i) continue;
       const Vec3 a0 = xa.col(a.edges()(0, ea)), a1 = xa.col(a.edges()(1, ea));
       const Box3 box_ea = EdgeBox(a0, a1);
       if (!box_ea.Near(box_j, d)) continue;
-      for (int kb = 0; kb < num_b; ++kb) {
-        if (!box_ea.Near(box_eb[kb], d)) continue;
-        const int eb = eb_of[kb];
+      for (int kb = 0; kb < 3; ++kb) {
+        const int eb = b.triangle_edges()(kb, j);
+        if (b.edge_owner()[static_cast<std::size_t>(eb)] != j) continue;
         const Vec3 b0 = xb.col(b.edges()(0, eb)), b1 = xb.col(b.edges()(1, eb));
+        if (!box_ea.Near(EdgeBox(b0, b1), d)) continue;
         SegmentSegmentResult r;
         if (EdgeContact(a0, a1, b0, b1, d, r)) out.edges.push_back({ea, eb, r.s, r.t, r.distance});
       }
@@ -150,30 +138,25 @@ void ProximityQuery::Query(const CollisionSurface& a, const CollisionSurface& b,
 
   const auto& na = ta.nodes();
   const auto& nb = tb.nodes();
-  // A pair is pushed only if its boxes are near, so failing pairs cost one test and no stack
-  // traffic; the pair with the larger box (area kept by the tree) is split.
-  auto push = [&](int i, int j) {
-    if (na[static_cast<std::size_t>(i)].box.Near(nb[static_cast<std::size_t>(j)].box, d))
-      stack_.emplace_back(i, j);
-  };
   stack_.clear();
-  push(0, 0);
+  stack_.emplace_back(0, 0);
   while (!stack_.empty()) {
     const auto [i, j] = stack_.back();
     stack_.pop_back();
     const AabbTree::Node& ni = na[static_cast<std::size_t>(i)];
     const AabbTree::Node& nj = nb[static_cast<std::size_t>(j)];
     ++node_pairs_;
+    if (!ni.box.Near(nj.box, d)) continue;
     if (ni.is_leaf() && nj.is_leaf()) {
       for (int p = ni.first; p < ni.first + ni.count; ++p)
         for (int q = nj.first; q < nj.first + nj.count; ++q)
           process(ta.order()[static_cast<std::size_t>(p)], tb.order()[static_cast<std::size_t>(q)]);
-    } else if (nj.is_leaf() || (!ni.is_leaf() && ni.area >= nj.area)) {
-      push(ni.first + 1, j);
-      push(ni.first, j);
+    } else if (nj.is_leaf() || (!ni.is_leaf() && ni.box.SurfaceArea() >= nj.box.SurfaceArea())) {
+      stack_.emplace_back(ni.first + 1, j);
+      stack_.emplace_back(ni.first, j);
     } else {
-      push(i, nj.first + 1);
-      push(i, nj.first);
+      stack_.emplace_back(i, nj.first + 1);
+      stack_.emplace_back(i, nj.first);
     }
   }
   Emit(best_a_, touched_a_, out.a_on_b);
@@ -264,7 +247,7 @@ void ProximityQuery::QuerySelf(const CollisionSurface& s, double thickness, bool
       for (int p = ni.first; p < ni.first + ni.count; ++p)
         for (int q = nj.first; q < nj.first + nj.count; ++q)
           process(order[static_cast<std::size_t>(p)], order[static_cast<std::size_t>(q)]);
-    } else if (nj.is_leaf() || (!ni.is_leaf() && ni.area >= nj.area)) {
+    } else if (nj.is_leaf() || (!ni.is_leaf() && ni.box.SurfaceArea() >= nj.box.SurfaceArea())) {
       stack_.emplace_back(ni.first + 1, j);
       stack_.emplace_back(ni.first, j);
     } else {
