@@ -2,7 +2,8 @@
 // (FEM condensation: 3 dofs; mass-spring neighbourhood: up to 20 nodes, 60 dofs), the cost of
 // building those models on the simulation side, and the haptic loop's period percentiles over
 // 10 s at 1 kHz while a physics thread steps a 10x10x10 mass-spring block and publishes a
-// neighbourhood model after every step.
+// neighbourhood model after every step, at normal priority and under SCHED_FIFO (pinned to the
+// last CPU) in the same run.
 
 #include <benchmark/benchmark.h>
 
@@ -129,6 +130,11 @@ BENCHMARK(BM_BuildFemCondensation)->Arg(8)->Arg(16)->Unit(benchmark::kMillisecon
 
 void BM_HapticLoopUnderPhysics(benchmark::State& state) {
   const double seconds = static_cast<double>(state.range(0));
+  HapticRealtime realtime;
+  if (state.range(1) != 0) {
+    realtime.fifo = true;
+    realtime.cpu = static_cast<int>(std::thread::hardware_concurrency()) - 1;
+  }
   for (auto _ : state) {
     auto block = SpringBlock(10);
     MassSpringNeighbourhood builder(*block, 1);
@@ -150,7 +156,7 @@ void BM_HapticLoopUnderPhysics(benchmark::State& state) {
         published.fetch_add(1);
       }
     });
-    HapticLoop loop(tick, 1000);
+    HapticLoop loop(tick, 1000, 1 << 20, realtime);
     loop.Start();
     std::this_thread::sleep_for(std::chrono::duration<double>(seconds));
     loop.Stop();
@@ -162,11 +168,20 @@ void BM_HapticLoopUnderPhysics(benchmark::State& state) {
     state.counters["period_p50_us"] = 1e6 * s.p50;
     state.counters["period_p99_us"] = 1e6 * s.p99;
     state.counters["period_p999_us"] = 1e6 * s.p999;
+    state.counters["error_p50_us"] = 1e6 * s.error_p50;
     state.counters["error_p99_us"] = 1e6 * s.error_p99;
+    state.counters["error_p999_us"] = 1e6 * s.error_p999;
+    state.counters["period_max_us"] = 1e6 * s.max;
+    state.counters["fifo"] = s.fifo ? 1 : 0;
     state.counters["tick_cost_us"] = 1e6 * s.mean_tick_cost;
   }
 }
-BENCHMARK(BM_HapticLoopUnderPhysics)->Arg(10)->Iterations(1)->Unit(benchmark::kSecond);
+// Second argument: 0 normal priority, 1 SCHED_FIFO (priority 80) pinned to the last CPU.
+BENCHMARK(BM_HapticLoopUnderPhysics)
+    ->Args({10, 0})
+    ->Args({10, 1})
+    ->Iterations(1)
+    ->Unit(benchmark::kSecond);
 
 }  // namespace
 }  // namespace gipsi

@@ -23,6 +23,7 @@ packages=(
   xvfb xauth             # a virtual display for testing the viewer
   libgtest-dev libgmock-dev libbenchmark-dev
   clang-14 libclang-rt-14-dev libomp-14-dev  # libFuzzer targets (scripts/fuzz.sh)
+  libopenigtlink-dev     # OpenIGTLink 1.11: the networked haptic device (tracker, 3D Slicer)
   libfcl-dev             # FCL 0.7: the collision benchmark's baseline (bench/collision_bench.cc)
   clang-format clang-tidy
 )

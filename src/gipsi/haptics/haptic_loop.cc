@@ -1,10 +1,16 @@
 #include "gipsi/haptics/haptic_loop.h"
 
+#include <pthread.h>
+#include <sched.h>
+#include <sys/prctl.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstring>
 
 #include "gipsi/base/error.h"
+#include "gipsi/base/log.h"
 
 namespace gipsi {
 
@@ -12,9 +18,12 @@ namespace {
 using Clock = std::chrono::steady_clock;
 }  // namespace
 
-HapticLoop::HapticLoop(HapticRenderer& tick, double rate, std::size_t max_records)
-    : tick_(tick), period_(1.0 / rate) {
+HapticLoop::HapticLoop(HapticRenderer& tick, double rate, std::size_t max_records,
+                       const HapticRealtime& realtime)
+    : tick_(tick), period_(1.0 / rate), realtime_(realtime) {
   GIPSI_CHECK(rate > 0 && rate <= 10000, "haptic rate {} Hz out of (0, 10000]", rate);
+  GIPSI_CHECK(!realtime.fifo || (realtime.priority >= 1 && realtime.priority <= 99),
+              "SCHED_FIFO priority {} out of 1-99", realtime.priority);
   periods_.resize(max_records);
 }
 
@@ -23,7 +32,36 @@ HapticLoop::~HapticLoop() { Stop(); }
 void HapticLoop::Start() {
   GIPSI_CHECK(!thread_.joinable(), "HapticLoop started twice");
   stop_.store(false);
+  ready_.store(false);
   thread_ = std::thread([this] { Run(); });
+  while (!ready_.load()) std::this_thread::yield();
+  if (fifo_error_ != 0)
+    Log().warn(
+        "haptic loop: SCHED_FIFO (priority {}) not permitted ({}); running at normal "
+        "priority",
+        realtime_.priority, std::strerror(fifo_error_));
+  if (pin_error_ != 0)
+    Log().warn("haptic loop: cannot pin the thread to CPU {} ({}); running unpinned", realtime_.cpu,
+               std::strerror(pin_error_));
+}
+
+void HapticLoop::ApplyScheduling() {
+  // Wake-ups within ~1 µs of the deadline instead of up to 50 µs late (SCHED_FIFO threads have
+  // no slack anyway). Per thread; cannot fail for a valid value.
+  (void)prctl(PR_SET_TIMERSLACK, 1UL, 0UL, 0UL, 0UL);
+  if (realtime_.fifo) {
+    sched_param param{};
+    param.sched_priority = realtime_.priority;
+    fifo_error_ = pthread_setschedparam(pthread_self(), SCHED_FIFO, &param);
+  }
+  if (realtime_.cpu >= 0) {
+    cpu_set_t set;
+    CPU_ZERO(&set);
+    if (realtime_.cpu < CPU_SETSIZE) CPU_SET(static_cast<std::size_t>(realtime_.cpu), &set);
+    pin_error_ = realtime_.cpu < CPU_SETSIZE
+                     ? pthread_setaffinity_np(pthread_self(), sizeof(set), &set)
+                     : EINVAL;
+  }
 }
 
 void HapticLoop::Stop() {
@@ -32,6 +70,8 @@ void HapticLoop::Stop() {
 }
 
 void HapticLoop::Run() {
+  ApplyScheduling();
+  ready_.store(true);
   const auto period =
       std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(period_));
   const auto start = Clock::now();
@@ -57,6 +97,8 @@ HapticLoopStats HapticLoop::Stats() const {
   s.ticks = ticks_;
   s.target_period = period_;
   s.mean_tick_cost = ticks_ > 0 ? cost_ / static_cast<double>(ticks_) : 0;
+  s.fifo = realtime_.fifo && fifo_error_ == 0;
+  s.pinned = realtime_.cpu >= 0 && pin_error_ == 0;
   if (recorded_ == 0) return s;
   std::vector<double> p(periods_.begin(),
                         periods_.begin() + static_cast<std::ptrdiff_t>(recorded_));

@@ -5,13 +5,21 @@
 #include <fmt/format.h>
 
 #include "gipsi/base/error.h"
+#include "gipsi/haptics/igtl_surface_sender.h"
 #include "gipsi/models/fem/fem_solid.h"
 #include "gipsi/models/mass_spring/mass_spring.h"
 
 namespace gipsi {
 
 HapticProbe::HapticProbe(std::string name, const HapticProbeSpec& spec)
-    : SimObject(std::move(name)), spec_(spec), device_(spec.path) {
+    : SimObject(std::move(name)), spec_(spec) {
+  if (spec.igtl) {
+    auto igtl = std::make_unique<IgtlDevice>(*spec.igtl);
+    igtl_ = igtl.get();
+    device_ = std::move(igtl);
+  } else {
+    device_ = std::make_unique<VirtualDevice>(spec.path);
+  }
   if (!(spec.rate > 0 && spec.rate <= 10000))
     throw InputError(
         fmt::format("haptic probe '{}': rate {} Hz outside (0, 10000]", this->name(), spec.rate));
@@ -24,14 +32,14 @@ HapticProbe::HapticProbe(std::string name, const HapticProbeSpec& spec)
                            "god-object: the device held on the local surface"});
   f_model_force_ = DeclareField(
       {"model_force", L::kGlobal, 1, "N", A::kRead, "normal contact force of the local model"});
-  position_ = proxy_ = device_.Read(0).position;
+  position_ = proxy_ = initial_ = spec_.workspace.ToSimulation(device_->Read(0).position);
 }
 
 void HapticProbe::Attach(LatestValue<LocalDynamicModel>& models,
                          LatestValue<HapticFeedback>& feedback) {
   if (tick_) throw InputError(fmt::format("haptic probe '{}' is coupled to two objects", name()));
   tick_ =
-      std::make_unique<LocalModelTick>(device_, DeviceWorkspace{}, models, &feedback, spec_.tick);
+      std::make_unique<LocalModelTick>(*device_, spec_.workspace, models, &feedback, spec_.tick);
 }
 
 StepStatus HapticProbe::DoStep(double t, double dt) {
@@ -44,9 +52,9 @@ StepStatus HapticProbe::DoStep(double t, double dt) {
       proxy_ = tick_->proxy();
       model_force_ = tick_->model_force();
     } else {
-      proxy_ = device_.Read(tk).position;
+      proxy_ = spec_.workspace.ToSimulation(device_->Read(tk).position);
     }
-    position_ = device_.Read(tk).position;
+    position_ = spec_.workspace.ToSimulation(device_->Read(tk).position);
     ++ticks_;
   }
   return StepStatus::Ok();
@@ -86,7 +94,7 @@ HapticCoupling::HapticCoupling(std::string name, SimObject& object, HapticProbe&
   if (object.boundary().num_vertices() == 0)
     throw InputError(fmt::format("object '{}' has no boundary surface", object.name()));
   bridge_ = std::make_unique<HapticBridge>(*builder_, params);
-  bridge_->SeedTool(probe.spec().path.front().position);
+  bridge_->SeedTool(probe.initial_position());
   probe.Attach(bridge_->models(), bridge_->feedback());
 }
 
@@ -103,19 +111,30 @@ void RegisterHaptics(TypeRegistry& registry) {
       "HapticProbe",
       [](const ObjectBuildContext& ctx) -> std::unique_ptr<SimObject> {
         const JsonNode& p = ctx.params;
-        ctx.CheckKeys({"path", "rate", "coupling_stiffness", "coupling_damping", "blend_time",
-                       "max_force", "max_rate", "stale_after", "fade_time"});
+        ctx.CheckKeys({"path", "device", "rate", "coupling_stiffness", "coupling_damping",
+                       "blend_time", "max_force", "max_rate", "stale_after", "fade_time",
+                       "workspace_scale", "workspace_offset"});
         HapticProbeSpec spec;
-        const JsonNode path = p.At("path");
-        if (!path.is_array() || path.size() == 0)
-          path.Expected("an array of [t, x, y, z] keyframes");
-        for (const JsonNode& key : path.Items()) {
-          const std::vector<double> k = key.AsNumbers();
-          if (k.size() != 4) key.Expected("[t, x, y, z]");
-          if (!spec.path.empty() && !(k[0] > spec.path.back().time))
-            key.Fail("keyframe times must increase strictly");
-          spec.path.push_back({k[0], Vec3(k[1], k[2], k[3]), 0});
+        if (p.Has("device") == p.Has("path"))
+          p.Fail(
+              "a HapticProbe needs exactly one of \"path\" (a virtual device) and \"device\" (an "
+              "OpenIGTLink device)");
+        if (p.Has("device")) {
+          spec.igtl = ParseIgtlDevice(p.At("device"));
+        } else {
+          const JsonNode path = p.At("path");
+          if (!path.is_array() || path.size() == 0)
+            path.Expected("an array of [t, x, y, z] keyframes");
+          for (const JsonNode& key : path.Items()) {
+            const std::vector<double> k = key.AsNumbers();
+            if (k.size() != 4) key.Expected("[t, x, y, z]");
+            if (!spec.path.empty() && !(k[0] > spec.path.back().time))
+              key.Fail("keyframe times must increase strictly");
+            spec.path.push_back({k[0], Vec3(k[1], k[2], k[3]), 0});
+          }
         }
+        spec.workspace.scale = p.Positive("workspace_scale", 1.0);
+        spec.workspace.offset = p.Vector3("workspace_offset", Vec3::Zero());
         spec.rate = p.Positive("rate", 1000.0);
         if (spec.rate > 10000) p.At("rate").Expected("a rate in (0, 10000] Hz");
         spec.tick.coupling.stiffness = p.Positive("coupling_stiffness", 5000.0);
@@ -125,9 +144,15 @@ void RegisterHaptics(TypeRegistry& registry) {
         spec.tick.safety.max_rate = p.Positive("max_rate", spec.tick.safety.max_rate);
         spec.tick.safety.stale_after = p.Positive("stale_after", spec.tick.safety.stale_after);
         spec.tick.safety.fade_time = p.NonNegative("fade_time", spec.tick.safety.fade_time);
-        return std::make_unique<HapticProbe>(ctx.name, spec);
+        if (!spec.igtl) return std::make_unique<HapticProbe>(ctx.name, spec);
+        try {
+          return std::make_unique<HapticProbe>(ctx.name, spec);
+        } catch (const InputError& e) {
+          p.At("device").Fail(e.what());
+        }
       },
-      "virtual haptic device on a scripted path, rendering local models at its rate");
+      "haptic device (virtual on a scripted path, or OpenIGTLink) rendering local models at its "
+      "rate");
   registry.connectors.Register(
       "HapticCoupling",
       [](const ConnectorBuildContext& ctx) -> std::unique_ptr<Connector> {
@@ -149,6 +174,26 @@ void RegisterHaptics(TypeRegistry& registry) {
         }
       },
       "multi-rate haptics: local models of an object rendered by a HapticProbe");
+  registry.connectors.Register(
+      "OpenIGTLinkSurface",
+      [](const ConnectorBuildContext& ctx) -> std::unique_ptr<Connector> {
+        const JsonNode& p = ctx.params;
+        ctx.CheckKeys({"object", "device", "rate", "name"});
+        const SimObject& object = ctx.Object("object");
+        auto* probe = dynamic_cast<HapticProbe*>(&ctx.Object("device"));
+        if (probe == nullptr || probe->igtl_device() == nullptr)
+          p.At("device").Expected("the name of a HapticProbe with an OpenIGTLink device");
+        const double rate = p.Positive("rate", 30.0);
+        const std::string name = p.String("name", object.name());
+        if (name.empty()) p.At("name").Expected("a non-empty POLYDATA device name");
+        try {
+          return std::make_unique<IgtlSurfaceSender>(ctx.name, object, *probe->igtl_device(), rate,
+                                                     name);
+        } catch (const InputError& e) {
+          p.Fail(e.what());
+        }
+      },
+      "sends an object's deformed boundary surface as OpenIGTLink POLYDATA (e.g. to 3D Slicer)");
 }
 
 }  // namespace gipsi

@@ -1,9 +1,10 @@
 #pragma once
 /// @file
 /// Multi-rate haptics in scene files:
-///  - `HapticProbe` (object): a virtual haptic device on a scripted path whose step runs the
-///    haptic tick (`LocalModelTick`) at `rate` over the step, synchronously (headless runs are
-///    then deterministic; a live device would run the same tick in a `HapticLoop`). Fields
+///  - `HapticProbe` (object): a haptic device — a virtual one on a scripted path, or an
+///    OpenIGTLink client (`IgtlDevice`) — whose step runs the haptic tick (`LocalModelTick`) at
+///    `rate` over the step, synchronously (headless runs are then deterministic; a real-time
+///    run would tick the same renderer in a `HapticLoop`). Fields
 ///    (global, read): "tool_force" (force on the device [N]), "tool_position" [m],
 ///    "proxy_position" [m] (the god-object on the local surface), "model_force" (the local
 ///    model's normal contact force [N]).
@@ -16,36 +17,52 @@
 /// Scene:
 ///   "probe": {"type": "HapticProbe", "path": [[t, x, y, z], ...], "rate": 1000,
 ///             "coupling_stiffness": 5000, "coupling_damping": 0, "blend_time": 0.01,
-///             "max_force": 3, "max_rate": 1000, "stale_after": 0.05, "fade_time": 0.1}
+///             "max_force": 3, "max_rate": 1000, "stale_after": 0.05, "fade_time": 0.1,
+///             "workspace_scale": 1, "workspace_offset": [0, 0, 0]}
+///   or, instead of "path", "device": {"type": "OpenIGTLink", "host": "127.0.0.1",
+///             "port": 18944, "name": "Tool", "length_unit": 0.001, "connect_timeout": 2,
+///             "reconnect_interval": 0.5}
 ///   "haptics": {"type": "HapticCoupling", "object": "liver", "device": "probe",
 ///               "capture_distance": 0.01, "rings": 1}
 
 #include <memory>
 
+#include <optional>
 #include "gipsi/core/connector.h"
 #include "gipsi/core/registry.h"
 #include "gipsi/core/sim_object.h"
+
 #include "gipsi/haptics/haptic_bridge.h"
+#include "gipsi/haptics/igtl_device.h"
 #include "gipsi/haptics/virtual_device.h"
 
 namespace gipsi {
 
 /// Parameters of a HapticProbe. Plain struct with defaults.
 struct HapticProbeSpec {
-  std::vector<DeviceKeyframe> path;  ///< device positions [m, simulation coordinates]
-  double rate = 1000;                ///< haptic ticks per second
+  /// Virtual device: positions [m, device coordinates]; used when `igtl` is empty.
+  std::vector<DeviceKeyframe> path;
+  /// OpenIGTLink device: connection parameters (the path is then unused).
+  std::optional<IgtlDeviceParams> igtl;
+  DeviceWorkspace workspace;  ///< device → simulation coordinates
+  double rate = 1000;         ///< haptic ticks per second
   LocalTickParams tick;
 };
 
 /// Not copyable or movable (a SimObject).
 class HapticProbe final : public SimObject {
  public:
-  /// Throws InputError for an empty or non-increasing path or a rate outside (0, 10 kHz].
+  /// Throws InputError for an empty or non-increasing path, a rate outside (0, 10 kHz] or an
+  /// OpenIGTLink device that cannot connect (IgtlDevice's constructor).
   HapticProbe(std::string name, const HapticProbeSpec& spec);
 
   [[nodiscard]] std::string_view type_name() const override { return "HapticProbe"; }
   [[nodiscard]] const Points& domain_positions() const override { return no_positions_; }
   [[nodiscard]] const HapticProbeSpec& spec() const { return spec_; }
+  /// The device's position when the probe was built [m, simulation coordinates].
+  [[nodiscard]] const Vec3& initial_position() const { return initial_; }
+  /// The OpenIGTLink device, or null for a virtual one.
+  [[nodiscard]] IgtlDevice* igtl_device() { return igtl_; }
   /// Connects the probe to a bridge's buffers (once; the HapticCoupling connector does it).
   /// Throws InputError if it is already connected.
   void Attach(LatestValue<LocalDynamicModel>& models, LatestValue<HapticFeedback>& feedback);
@@ -60,7 +77,9 @@ class HapticProbe final : public SimObject {
 
  private:
   HapticProbeSpec spec_;
-  VirtualDevice device_;
+  std::unique_ptr<HapticDevice> device_;
+  IgtlDevice* igtl_ = nullptr;  // device_, when it is an OpenIGTLink device
+  Vec3 initial_ = Vec3::Zero();
   std::unique_ptr<LocalModelTick> tick_;
   Points no_positions_ = Points(3, 0);
   Vec3 force_ = Vec3::Zero(), position_ = Vec3::Zero(), proxy_ = Vec3::Zero();
@@ -87,7 +106,8 @@ class HapticCoupling final : public Connector {
   std::unique_ptr<HapticBridge> bridge_;
 };
 
-/// Registers the object "HapticProbe" and the connector "HapticCoupling".
+/// Registers the object "HapticProbe" and the connectors "HapticCoupling" and
+/// "OpenIGTLinkSurface" (igtl_surface_sender.h).
 void RegisterHaptics(TypeRegistry& registry);
 
 }  // namespace gipsi
