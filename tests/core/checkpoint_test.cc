@@ -212,6 +212,13 @@ TEST(Resume, CirculationIsBitwiseIdentical) {
   ExpectBitwiseResume("circulation_closed_loop.json", "blood", 0.4, 0.5, 1.0);
 }
 
+TEST(Resume, HeartIsBitwiseIdentical) {
+  // The coupled heart (monodomain, FEM wall whose Newton solver keeps its factorisation from
+  // step to step, cavity pressure solved with the wall, closed-loop blood, beat monitor):
+  // checkpoint at 0.1 s, in the first beat's contraction (stimulus at t = 0), resumed to 0.25 s.
+  ExpectBitwiseResume("heart.json", "heart", 0.1, 0.12, 0.25);
+}
+
 TEST(Resume, ACheckpointOfAnotherSceneIsRefused) {
   const fs::path dir = testing::TempDir("gipsi_resume_", "other");
   const std::string scenes = std::string(GIPSI_SOURCE_DIR) + "/scenes/";
