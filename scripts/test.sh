@@ -52,7 +52,10 @@ if [ "${1:-}" != "--fast" ]; then
   asan_skip+='|FemCondensation\.QuasiStaticIndentationThroughTheHapticPathMatchesTheFullModel'
   asan_skip+='|GipsiValidate\.AcceptsTheDemoScenes'
   asan_skip+='|FailurePolicy\.AFemSceneThatFailsAtItsStepSucceedsWithHalving'
-  asan_skip+='|Resume\.FemIsBitwiseIdentical|Resume\.MonodomainIsBitwiseIdentical)$'
+  asan_skip+='|Resume\.FemIsBitwiseIdentical|Resume\.MonodomainIsBitwiseIdentical'
+  # The heart's resume (three runs of the coupled heart, 10-30 s in release; minutes under ASan):
+  # its kept-factorisation restore (numerics/newton_state.cc) is checked in the release stage.
+  asan_skip+='|Resume\.HeartIsBitwiseIdentical)$'
   echo "== asan (address + undefined behavior sanitizers)"
   cmake --preset asan
   cmake --build --preset asan
