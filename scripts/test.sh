@@ -63,7 +63,7 @@ if [ "${1:-}" != "--fast" ]; then
   stage_done asan
 
   # ThreadSanitizer (haptic loop, display publishing, viewer simulation thread): 25 tests in
-  # 36 s on this machine; the build mostly hits ccache after the first (cold: about 55 min of
+  # 36 s on this machine; the build mostly hits ccache after the first (cold: about 50 min of
   # compilation under load, docs/robustness.md).
   echo "== tsan (thread sanitizer: haptic loop, display publishing, viewer simulation thread)"
   cmake --preset tsan
