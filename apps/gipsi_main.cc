@@ -376,7 +376,9 @@ int main(int argc, char** argv) {
   run->add_option("-o,--out", out_dir, "Output directory (default: the scene's, or out/<scene>)");
   run->add_option("--until", until, "End time in seconds, overriding schedule.end")
       ->check(CLI::PositiveNumber);
-  run->add_flag("-q,--quiet", quiet, "No progress bar and no summary unless the run fails");
+  run->add_flag("-q,--quiet", quiet,
+                "No progress bar, no summary unless the run fails, and only warnings and errors "
+                "in the log");
   run->add_flag("--no-vtu", no_vtu, "Do not write VTU/PVD series (probes are still written)");
   run->add_flag("--profile", profile,
                 "Print where the wall time went: per object (and its own breakdown, e.g. "
@@ -448,7 +450,10 @@ int main(int argc, char** argv) {
   gipsi::apps::VizCommands viz_commands(app);
 
   CLI11_PARSE(app, argc, argv);
-  gipsi::Log().set_level(verbose ? spdlog::level::debug : spdlog::level::info);
+  // -q (run): warnings and errors only; -v: debug lines too.
+  gipsi::Log().set_level(quiet     ? spdlog::level::warn
+                         : verbose ? spdlog::level::debug
+                                   : spdlog::level::info);
   try {
     if (*run) return Run(scene_file, out_dir, until, quiet, no_vtu, profile, plugins, checkpoints);
     if (*validate) return Validate(scene_file, plugins);

@@ -52,22 +52,24 @@ if [ "${1:-}" != "--fast" ]; then
   asan_skip+='|FemCondensation\.QuasiStaticIndentationThroughTheHapticPathMatchesTheFullModel'
   asan_skip+='|GipsiValidate\.AcceptsTheDemoScenes'
   asan_skip+='|FailurePolicy\.AFemSceneThatFailsAtItsStepSucceedsWithHalving'
-  asan_skip+='|Resume\.FemIsBitwiseIdentical|Resume\.MonodomainIsBitwiseIdentical)$'
+  asan_skip+='|Resume\.FemIsBitwiseIdentical|Resume\.MonodomainIsBitwiseIdentical'
+  # The heart's resume (three runs of the coupled heart, 10-30 s in release; minutes under ASan):
+  # its kept-factorisation restore (numerics/newton_state.cc) is checked in the release stage.
+  asan_skip+='|Resume\.HeartIsBitwiseIdentical)$'
   echo "== asan (address + undefined behavior sanitizers)"
   cmake --preset asan
   cmake --build --preset asan
   ctest --preset asan -E "$asan_skip"
   stage_done asan
 
-  # ThreadSanitizer (haptic loop, display publishing, viewer simulation thread): opt-in with
-  # GIPSI_TSAN=1 until its stage has been verified to fit the CI time budget.
-  if [ "${GIPSI_TSAN:-0}" = "1" ]; then
-    echo "== tsan (thread sanitizer: haptic loop, display publishing, viewer simulation thread)"
-    cmake --preset tsan
-    cmake --build --preset tsan
-    ctest --preset tsan
-    stage_done tsan
-  fi
+  # ThreadSanitizer (haptic loop, display publishing, viewer simulation thread): 25 tests in
+  # 36 s on this machine; the build mostly hits ccache after the first (cold: about 50 min of
+  # compilation under load, docs/robustness.md).
+  echo "== tsan (thread sanitizer: haptic loop, display publishing, viewer simulation thread)"
+  cmake --preset tsan
+  cmake --build --preset tsan
+  ctest --preset tsan
+  stage_done tsan
 
   echo "== fuzz (libFuzzer, clang, ASan + UBSan; 15 s per target)"
   bash scripts/fuzz.sh 15

@@ -103,6 +103,28 @@ TEST(GipsiRun, RunsTheElectrophysiologySlabWithItsProfile) {
   EXPECT_TRUE(fs::exists(out / "tissue.pvd"));
 }
 
+TEST(GipsiRun, QuietPrintsOnlyWarningsAndErrors) {
+  // The hanging sheet's corner is released at 1.5 s, an event the log reports at info level; a
+  // resumed run reports where it resumed from, also at info level. -q prints neither: a run
+  // without warnings prints nothing at all.
+  const fs::path out = TempDir("quiet");
+  const std::string run = "run " + Scene("hanging_sheet.json") + " --no-vtu -o " + out.string();
+  Result loud = Gipsi(run + " --until 1.6");
+  ASSERT_EQ(loud.code, 0) << loud.output;
+  EXPECT_THAT(loud.output, HasSubstr("s: event: release the corner"));
+  Result quiet = Gipsi(run + " --until 1.6 -q --checkpoint-every 1.0");
+  ASSERT_EQ(quiet.code, 0) << quiet.output;
+  EXPECT_EQ(quiet.output, "");
+  const std::string resume = " --until 1.7 --resume " + (out / "checkpoint.gck").string();
+  quiet = Gipsi(run + resume + " -q");
+  ASSERT_EQ(quiet.code, 0) << quiet.output;
+  EXPECT_EQ(quiet.output, "");
+  loud = Gipsi(run + resume);
+  ASSERT_EQ(loud.code, 0) << loud.output;
+  EXPECT_THAT(loud.output, HasSubstr("resumed from"));
+  EXPECT_THAT(loud.output, HasSubstr("s: event: release the corner"));
+}
+
 TEST(GipsiRun, DivergingSceneStopsWithDiagnosticAndKeepsOutputs) {
   fs::path dir = TempDir("diverge");
   {

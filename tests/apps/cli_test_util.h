@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <string>
+#include "temp_dir.h"
 #include "test_paths.h"
 
 namespace gipsi::testing {
@@ -29,14 +30,6 @@ inline Result Gipsi(const std::string& args) {
   const int status = pclose(pipe);
   result.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
   return result;
-}
-
-/// An empty temporary directory `<tmp>/<prefix><name>` (recreated).
-inline std::filesystem::path TempDir(const std::string& prefix, const std::string& name) {
-  const std::filesystem::path dir = std::filesystem::temp_directory_path() / (prefix + name);
-  std::filesystem::remove_all(dir);
-  std::filesystem::create_directories(dir);
-  return dir;
 }
 
 }  // namespace gipsi::testing

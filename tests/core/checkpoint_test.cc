@@ -212,6 +212,13 @@ TEST(Resume, CirculationIsBitwiseIdentical) {
   ExpectBitwiseResume("circulation_closed_loop.json", "blood", 0.4, 0.5, 1.0);
 }
 
+TEST(Resume, HeartIsBitwiseIdentical) {
+  // The coupled heart (monodomain, FEM wall whose Newton solver keeps its factorisation from
+  // step to step, cavity pressure solved with the wall, closed-loop blood, beat monitor):
+  // checkpoint at 0.1 s, in the first beat's contraction (stimulus at t = 0), resumed to 0.25 s.
+  ExpectBitwiseResume("heart.json", "heart", 0.1, 0.12, 0.25);
+}
+
 TEST(Resume, ACheckpointOfAnotherSceneIsRefused) {
   const fs::path dir = testing::TempDir("gipsi_resume_", "other");
   const std::string scenes = std::string(GIPSI_SOURCE_DIR) + "/scenes/";
@@ -227,6 +234,49 @@ TEST(Resume, ACheckpointOfAnotherSceneIsRefused) {
   EXPECT_EQ(r.code, 1) << r.output;
   EXPECT_THAT(r.output, HasSubstr("checkpoint.gck"));
   EXPECT_THAT(r.output, HasSubstr("another scene"));
+}
+
+TEST(Resume, ARefusedResumeLeavesEveryOutputFileUntouched) {
+  // A first run writes VTU series, probe CSVs and a checkpoint at 0.1 s, and goes on to 0.15 s.
+  const std::string scene = std::string(GIPSI_SOURCE_DIR) + "/scenes/hanging_sheet.json";
+  const fs::path dir = testing::TempDir("gipsi_resume_", "refused");
+  auto r = testing::Gipsi(
+      fmt::format("run {} -q --until 0.15 --checkpoint-every 0.1 -o {}", scene, dir.string()));
+  ASSERT_EQ(r.code, 0) << r.output;
+  const auto before = Tree(dir);
+  ASSERT_EQ(before.count("sheet.pvd"), 1u);
+  ASSERT_EQ(before.count("probes/centre.csv"), 1u);
+
+  // A corrupted checkpoint is refused before anything is restored.
+  std::string bytes = ReadAll(dir / "checkpoint.gck");
+  bytes[bytes.size() / 2] ^= 1;
+  std::ofstream(dir / "corrupt.gck", std::ios::binary) << bytes;
+  r = testing::Gipsi(fmt::format("run {} -q --until 0.2 --resume {} -o {}", scene,
+                                 (dir / "corrupt.gck").string(), dir.string()));
+  EXPECT_EQ(r.code, 1) << r.output;
+  EXPECT_THAT(r.output, HasSubstr("corrupted"));
+  EXPECT_TRUE(Tree(dir) == before) << "a refused resume changed the outputs";
+
+  // A scene whose probes differ is refused by the probe recorder, after the objects and the VTU
+  // series (restored first) have read their state: the series' collections are left alone too.
+  std::ifstream in(scene);
+  nlohmann::json json = nlohmann::json::parse(in);
+  json["probes"]["middle"] = json["probes"]["centre"];
+  json["probes"].erase("centre");
+  const fs::path other = testing::TempDir("gipsi_resume_", "refused_scene");
+  std::ofstream(other / "scene.json") << json.dump();
+  r = testing::Gipsi(fmt::format("run {} -q --until 0.2 --resume {} -o {}",
+                                 (other / "scene.json").string(), (dir / "checkpoint.gck").string(),
+                                 dir.string()));
+  EXPECT_EQ(r.code, 1) << r.output;
+  EXPECT_THAT(r.output, HasSubstr("other probes"));
+  EXPECT_TRUE(Tree(dir) == before) << "a refused resume changed the outputs";
+  EXPECT_FALSE(fs::exists(dir / "probes" / "middle.csv"));
+
+  // The good checkpoint still resumes (and cuts the files back to 0.1 s before going on).
+  r = testing::Gipsi(fmt::format("run {} -q --until 0.2 --resume {} -o {}", scene,
+                                 (dir / "checkpoint.gck").string(), dir.string()));
+  EXPECT_EQ(r.code, 0) << r.output;
 }
 
 // --- Roll-back and retry ---

@@ -17,6 +17,7 @@
 #include "gipsi/haptics/latest_value.h"
 #include "gipsi/haptics/virtual_device.h"
 #include "haptics/no_allocation_guard.h"
+#include "temp_dir.h"
 
 // Counts global operator new calls made by the current thread while a guard is active (the
 // Drake-style proof that a real-time path allocates nothing). The haptic code uses only
@@ -81,7 +82,7 @@ TEST(VirtualDevice, InterpolatesAndHoldsItsTrajectory) {
 }
 
 std::filesystem::path WriteFile(const std::string& name, const std::string& text) {
-  const auto path = std::filesystem::path(::testing::TempDir()) / name;
+  const auto path = gipsi::testing::ProcessTempRoot() / name;
   std::ofstream(path) << text;
   return path;
 }
@@ -108,7 +109,7 @@ TEST(VirtualDevice, ReadsTrajectoryFilesAndNamesTheLineOfAnError) {
   EXPECT_THAT(error(WriteFile("bad3.csv", "t x y z\n0 0 0 zero\n")),
               HasSubstr("bad3.csv: line 2: expected numbers"));
   EXPECT_THAT(error(WriteFile("empty.csv", "# nothing\n")), HasSubstr("no keyframe"));
-  EXPECT_THAT(error(std::filesystem::path(::testing::TempDir()) / "missing.csv"),
+  EXPECT_THAT(error(gipsi::testing::ProcessTempRoot() / "missing.csv"),
               HasSubstr("cannot open trajectory file"));
 }
 

@@ -15,6 +15,7 @@
 
 #include "gipsi/base/error.h"
 #include "gipsi/geometry/mesh.h"
+#include "temp_dir.h"
 #include "test_paths.h"
 
 namespace gipsi::test {
@@ -29,10 +30,11 @@ inline std::filesystem::path SharedData(std::string_view name) {
   return std::filesystem::path(GIPSI_SHARED_DATA_DIR) / name;
 }
 
-/// A scratch path unique to the running test: TMPDIR/gipsi_io/<Suite>.<Test>/<name>.
+/// A scratch path unique to the running test and process (tests/temp_dir.h):
+/// <temp>/gipsi_test_<pid>/gipsi_io/<Suite>.<Test>/<name>.
 inline std::filesystem::path Scratch(std::string_view name) {
   const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-  auto dir = std::filesystem::path(::testing::TempDir()) / "gipsi_io" /
+  auto dir = gipsi::testing::ProcessTempRoot() / "gipsi_io" /
              (std::string(info->test_suite_name()) + "." + info->name());
   std::filesystem::create_directories(dir);
   return dir / name;

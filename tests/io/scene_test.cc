@@ -10,6 +10,7 @@
 #include "gipsi/models/builtins.h"
 #include "gipsi/models/mass_spring/mass_spring.h"
 #include "io/scene_test_util.h"
+#include "temp_dir.h"
 
 namespace gipsi {
 namespace {
@@ -132,8 +133,7 @@ TEST(SceneErrors, MissingMeshFileNamesTheFile) {
 }
 
 TEST(SceneErrors, MeshWithOutOfRangeIndexIsRejected) {
-  auto dir = std::filesystem::temp_directory_path() / "gipsi_scene_test";
-  std::filesystem::create_directories(dir);
+  const auto dir = testing::TempDir("gipsi_scene_", "bad_index");
   {
     std::ofstream f(dir / "bad.msh");
     f << "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n4\n1 0 0 0\n2 1 0 0\n3 0 1 0\n4 0 0 1\n"

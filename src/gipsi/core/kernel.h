@@ -38,6 +38,10 @@ class Observer {
   /// InputError("this output does not support checkpoints").
   virtual void SaveState(StateWriter& out);
   virtual void RestoreState(StateReader& in);
+  /// Called once the whole checkpoint was read and checked (every RestoreState succeeded). Only
+  /// here may a restored observer change its files (cut them back, rewrite collections), so a
+  /// refused checkpoint leaves every output file as it was. Default: nothing.
+  virtual void CommitRestore() {}
 };
 
 /// What the kernel does when an object or connector fails a macro step (scene key

@@ -120,6 +120,7 @@ void Kernel::RestoreState(StateReader& in) {
   for (auto& observer : observers_) observer->RestoreState(in);
   in.EndSection();
   if (!in.at_end()) in.Fail("unexpected data after the kernel state");
+  for (auto& observer : observers_) observer->CommitRestore();
 }
 
 void Kernel::WriteCheckpoint(const std::filesystem::path& file) {

@@ -7,7 +7,8 @@
 namespace gipsi {
 
 VtuSeriesWriter::VtuSeriesWriter(std::vector<const SimObject*> objects,
-                                 const std::filesystem::path& directory, double every, bool display)
+                                 const std::filesystem::path& directory, double every, bool display,
+                                 bool resume)
     : directory_(directory), every_(every) {
   std::filesystem::create_directories(directory);
   for (const SimObject* object : objects) {
@@ -16,10 +17,11 @@ VtuSeriesWriter::VtuSeriesWriter(std::vector<const SimObject*> objects,
         object->boundary().num_triangles() == 0)
       continue;  // nothing drawable (a point object)
     std::filesystem::create_directories(directory / object->name());
-    Series series{object, PvdWriter(directory / (object->name() + ".pvd")), nullptr};
+    Series series{object, PvdWriter(directory / (object->name() + ".pvd"), !resume), nullptr};
     if (display && object->display().map) {
       std::filesystem::create_directories(directory / (object->name() + "_display"));
-      series.display = std::make_unique<PvdWriter>(directory / (object->name() + "_display.pvd"));
+      series.display =
+          std::make_unique<PvdWriter>(directory / (object->name() + "_display.pvd"), !resume);
     }
     series_.push_back(std::move(series));
   }
@@ -107,6 +109,9 @@ void VtuSeriesWriter::RestoreState(StateReader& in) {
   in.ReadArray(frame_times_);
   if (static_cast<std::int64_t>(frame_times_.size()) != frame_) in.Fail("corrupted VTU frames");
   in.EndSection();
+}
+
+void VtuSeriesWriter::CommitRestore() {
   for (Series& series : series_) {
     std::vector<std::pair<double, std::string>> frames, display;
     for (std::int64_t k = 0; k < frame_; ++k) {
@@ -144,7 +149,6 @@ void ProbeRecorder::RestoreState(StateReader& in) {
     s.next = in.ReadDouble();
     s.next_at = static_cast<std::size_t>(in.ReadInt());
     const std::int64_t length = in.ReadInt();
-    s.file.close();
     std::error_code error;
     const auto size = std::filesystem::file_size(s.path, error);
     if (error || length < 0 || static_cast<std::uintmax_t>(length) > size)
@@ -152,12 +156,19 @@ void ProbeRecorder::RestoreState(StateReader& in) {
           fmt::format("{} is shorter than at the checkpoint ({} bytes); resume with the "
                       "output directory of the interrupted run",
                       s.path.string(), length));
-    std::filesystem::resize_file(s.path, static_cast<std::uintmax_t>(length));
+    s.resume_length = static_cast<std::uintmax_t>(length);
+  }
+  in.EndSection();
+}
+
+void ProbeRecorder::CommitRestore() {
+  for (auto& s : streams_) {
+    s.file.close();
+    std::filesystem::resize_file(s.path, s.resume_length);
     s.file.open(s.path, std::ios::app);
     if (!s.file) throw std::runtime_error(fmt::format("{}: cannot reopen", s.path.string()));
     s.file.precision(17);
   }
-  in.EndSection();
 }
 
 void AttachOutputs(Scene& scene, const std::filesystem::path& directory, bool resume) {
@@ -170,8 +181,8 @@ void AttachOutputs(Scene& scene, const std::filesystem::path& directory, bool re
     } else {
       for (const auto& name : scene.vtu.objects) kernel.FindObject(name).CollectLeaves(leaves);
     }
-    kernel.AddObserver(std::make_unique<VtuSeriesWriter>(std::move(leaves), directory,
-                                                         scene.vtu.every, scene.vtu.display));
+    kernel.AddObserver(std::make_unique<VtuSeriesWriter>(
+        std::move(leaves), directory, scene.vtu.every, scene.vtu.display, resume));
   }
   if (!scene.probes.empty())
     kernel.AddObserver(std::make_unique<ProbeRecorder>(scene.probes, directory / "probes", resume));

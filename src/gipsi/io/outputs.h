@@ -24,12 +24,15 @@ namespace gipsi {
 class VtuSeriesWriter final : public Observer {
  public:
   /// Creates `directory` and one collection per object; throws std::exception on I/O errors.
+  /// With `resume`, existing collections are left untouched until CommitRestore.
   VtuSeriesWriter(std::vector<const SimObject*> objects, const std::filesystem::path& directory,
-                  double every, bool display);
+                  double every, bool display, bool resume = false);
   void Observe(const Kernel& kernel, double t) override;
-  /// Checkpoints: next output time, frame number and the frames of every collection.
+  /// Checkpoints: next output time, frame number and the frames of every collection
+  /// (RestoreState only reads and checks them; CommitRestore rewrites the collections).
   void SaveState(StateWriter& out) override;
   void RestoreState(StateReader& in) override;
+  void CommitRestore() override;
 
  private:
   struct Series {
@@ -49,8 +52,9 @@ class VtuSeriesWriter final : public Observer {
 
 /// Attaches the scene's outputs (VTU series if enabled, probe CSVs) to its kernel, writing under
 /// `directory`. Throws std::exception if the directory or files cannot be created. With
-/// `resume`, existing probe files are kept for a run continued from a checkpoint (the kernel's
-/// RestoreState then cuts every file back to its length at the checkpoint).
+/// `resume`, no existing file is changed until the kernel has read and checked the whole
+/// checkpoint (Kernel::RestoreState); then every file is cut back to its state at the
+/// checkpoint. A refused checkpoint leaves the outputs as they were.
 void AttachOutputs(Scene& scene, const std::filesystem::path& directory, bool resume = false);
 
 }  // namespace gipsi

@@ -233,11 +233,13 @@ ProbeRecorder::ProbeRecorder(std::vector<Probe> probes, const std::filesystem::p
   for (auto& probe : probes) {
     auto path = directory / (probe.name + ".csv");
     Stream stream{std::move(probe), {}, 0, 0, path};
-    stream.file.open(path, resume ? std::ios::app : std::ios::out | std::ios::trunc);
-    if (!stream.file)
-      throw std::runtime_error(fmt::format("{}: cannot create file", path.string()));
-    if (!resume) stream.file << stream.probe.Header() << '\n';
-    stream.file.precision(17);
+    if (!resume) {  // a resumed run opens its files once the checkpoint is restored
+      stream.file.open(path, std::ios::out | std::ios::trunc);
+      if (!stream.file)
+        throw std::runtime_error(fmt::format("{}: cannot create file", path.string()));
+      stream.file << stream.probe.Header() << '\n';
+      stream.file.precision(17);
+    }
     streams_.push_back(std::move(stream));
   }
 }

@@ -21,6 +21,7 @@
 /// CSV has one row per point and sample time: time, distance along the line from `from`, the
 /// point's x, y, z (rest coordinates), then the field columns.
 
+#include <cstdint>
 #include <filesystem>
 #include <fstream>
 #include <memory>
@@ -69,7 +70,8 @@ Probe ParseProbe(const std::string& name, const JsonNode& node, const Kernel& ke
 class ProbeRecorder final : public Observer {
  public:
   /// Opens the files (throws std::runtime_error naming the file if one cannot be created).
-  /// With `resume`, existing files are kept (RestoreState cuts them to the checkpoint's length).
+  /// With `resume`, the files are neither created nor opened here: RestoreState checks them
+  /// against the checkpoint, CommitRestore cuts them to the checkpoint's length and opens them.
   ProbeRecorder(std::vector<Probe> probes, const std::filesystem::path& directory,
                 bool resume = false);
   void Observe(const Kernel& kernel, double t) override;
@@ -77,6 +79,7 @@ class ProbeRecorder final : public Observer {
   /// Checkpoints: next sample time and length of every file (defined in outputs.cc).
   void SaveState(StateWriter& out) override;
   void RestoreState(StateReader& in) override;
+  void CommitRestore() override;
 
  private:
   struct Stream {
@@ -85,6 +88,7 @@ class ProbeRecorder final : public Observer {
     double next = 0;
     std::size_t next_at = 0;  // line probes: index into probe.at
     std::filesystem::path path;
+    std::uintmax_t resume_length = 0;  // the file's length at the checkpoint being restored
   };
   void Write(Stream& s, double t);
   std::vector<Stream> streams_;

@@ -118,7 +118,9 @@ void WriteVtu(const std::filesystem::path& path, const Mesh& mesh, const VtuFiel
   WriteVtu(path, mesh.nodes, mesh.tets, mesh.triangles, fields);
 }
 
-PvdWriter::PvdWriter(std::filesystem::path path) : path_(std::move(path)) { Rewrite(); }
+PvdWriter::PvdWriter(std::filesystem::path path, bool write) : path_(std::move(path)) {
+  if (write) Rewrite();
+}
 
 void PvdWriter::AddFrame(double time, const std::string& file) {
   frames_.push_back({time, file});

@@ -50,9 +50,10 @@ void WriteVtu(const std::filesystem::path& path, const Mesh& mesh, const VtuFiel
 /// Movable, not copyable (it stands for one file).
 class PvdWriter {
  public:
-  /// Starts a collection at `path` and writes it (empty). Throws InputError if it cannot be
-  /// written.
-  explicit PvdWriter(std::filesystem::path path);
+  /// Starts a collection at `path` and writes it (empty) if `write`; otherwise the file is left
+  /// as it is until the first AddFrame or SetFrames (a series resumed from a checkpoint).
+  /// Throws InputError if it cannot be written.
+  explicit PvdWriter(std::filesystem::path path, bool write = true);
 
   PvdWriter(const PvdWriter&) = delete;
   PvdWriter& operator=(const PvdWriter&) = delete;

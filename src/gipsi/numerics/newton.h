@@ -106,9 +106,13 @@ class NewtonSolver {
   [[nodiscard]] LinearSolver& linear_solver() { return *linear_; }
   /// The residual at the last accepted iterate (valid unless fixed_iterations).
   [[nodiscard]] const VecX& residual() const { return r_; }
-  /// Checkpoints (gipsi/core/state.h): the warm start carried from one Solve to the next.
-  void SaveState(StateWriter& out) const;
-  void RestoreState(StateReader& in);
+  /// Checkpoints (gipsi/core/state.h): what one Solve hands to the next — the warm start and,
+  /// with reuse_factorization, whether a factorisation is kept and the values of `J`, the
+  /// matrix given to Solve (it holds the factorised values then). RestoreState writes the
+  /// values back into `J` (same pattern) and factorises it again (deterministic: the same
+  /// factors), so a resumed run iterates exactly like an uninterrupted one.
+  void SaveState(StateWriter& out, const SparseMatrix& J) const;
+  void RestoreState(StateReader& in, SparseMatrix& J);
 
  private:
   NewtonOptions options_;

@@ -2,7 +2,9 @@
 /// FemSolid checkpoints: the time scheme (displacements, velocities, accelerations and BDF2
 /// history), the previous step's loads (interpolated within load steps), the fields written from
 /// outside (external force, active tension, fibres, cavity pressures), the Newton warm start and
-/// the last Jacobian norm (it sets the round-off floor of the next step's first residual).
+/// kept factorisation (newton_state.cc), the cavities' pressure–volume stiffness (the first
+/// pressure bracket and the low-rank tangent of a Solve that reuses the factorisation) and the
+/// last Jacobian norm (it sets the round-off floor of the next step's first residual).
 /// Constraint targets and the current loads are gathered afresh at the start of every step.
 
 #include "gipsi/core/state.h"
@@ -12,7 +14,7 @@ namespace gipsi {
 
 void FemSolid::SaveObjectState(StateWriter& out) const {
   scheme_.SaveState(out);
-  newton_->SaveState(out);
+  newton_->SaveState(out, jac_);
   out.WriteMatrix(f_nodal_prev_);
   out.WriteMatrix(pressure_prev_);
   out.WriteMatrix(traction_prev_);
@@ -23,16 +25,20 @@ void FemSolid::SaveObjectState(StateWriter& out) const {
   out.WriteBool(active_from_nodes_);
   out.WriteArray(
       std::span<const double>(axes_.empty() ? nullptr : axes_.front().data(), 9 * axes_.size()));
-  std::vector<double> cavity_pressures;
-  for (const Cavity& c : cavities_) cavity_pressures.push_back(c.pressure);
+  std::vector<double> cavity_pressures, cavity_stiffnesses;
+  for (const Cavity& c : cavities_) {
+    cavity_pressures.push_back(c.pressure);
+    cavity_stiffnesses.push_back(c.stiffness);
+  }
   out.WriteArray(cavity_pressures);
+  out.WriteArray(cavity_stiffnesses);
   out.WriteDouble(jacobian_norm_);
   out.WriteArray(std::span<const NewtonStats>(&last_newton_, 1));
 }
 
 void FemSolid::RestoreObjectState(StateReader& in) {
   scheme_.RestoreState(in);
-  newton_->RestoreState(in);
+  newton_->RestoreState(in, jac_);
   in.ReadMatrixExact(f_nodal_prev_, "the previous nodal loads");
   in.ReadMatrixExact(pressure_prev_, "the previous pressures");
   in.ReadMatrixExact(traction_prev_, "the previous tractions");
@@ -45,9 +51,13 @@ void FemSolid::RestoreObjectState(StateReader& in) {
   in.ReadArrayExact(axes, "the material axes");
   for (std::size_t e = 0; e < axes_.size(); ++e)
     axes_[e] = Eigen::Map<const Mat3>(axes.data() + 9 * e);
-  std::vector<double> cavity_pressures(cavities_.size());
+  std::vector<double> cavity_pressures(cavities_.size()), cavity_stiffnesses(cavities_.size());
   in.ReadArrayExact(cavity_pressures, "the cavity pressures");
-  for (std::size_t c = 0; c < cavities_.size(); ++c) cavities_[c].pressure = cavity_pressures[c];
+  in.ReadArrayExact(cavity_stiffnesses, "the cavity stiffnesses");
+  for (std::size_t c = 0; c < cavities_.size(); ++c) {
+    cavities_[c].pressure = cavity_pressures[c];
+    cavities_[c].stiffness = cavity_stiffnesses[c];
+  }
   jacobian_norm_ = in.ReadDouble();
   std::vector<NewtonStats> stats(1);
   in.ReadArrayExact(stats, "the Newton statistics");
