@@ -5,11 +5,9 @@
 /// factorised again on restore. Bitwise continuation needs both.
 ///
 /// The factorised values are those of J: while a factorisation is kept (factor_valid_), Solve
-/// only writes J in CalcResidualAndJacobian right before factorising it, except when it gives up
-/// after max_iterations (then J is newer than the factors). A step whose Newton solve gave up
-/// and was bisected can therefore keep factors J no longer holds; a checkpoint right after such
-/// a step restores the newer J's factors instead (the run stays correct, its iterates differ in
-/// round-off). A step that converged at once never does this.
+/// writes J only in CalcResidualAndJacobian, and it marks the factors stale whenever it does so
+/// without factorising (when the iterations run out), so the saved J is always the factorised
+/// matrix.
 
 #include <algorithm>
 #include <span>

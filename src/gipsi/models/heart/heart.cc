@@ -38,7 +38,7 @@ constexpr const char* kHeartDefaults = R"({
       "fibres": {"rule": "transmural", "endo": {"group": "endo"}, "epi": {"group": "epi"},
                  "axis": [0, 0, 1], "endo_angle": 60, "epi_angle": -60},
       "integrator": "BackwardEuler", "density": 1060, "gravity": [0, 0, 0],
-      "linear_solver": {"type": "cholmod"},
+      "linear_solver": {"type": "ldlt"},
       "newton": {"tolerance": 1e-6, "max_iterations": 40, "reuse_factorization": true},
       "cavities": {"lumen": {"group": "endo"}},
       "boundary_conditions": [{"name": "base", "region": {"group": "base"}, "fix": true}]
