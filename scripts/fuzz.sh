@@ -6,7 +6,6 @@
 # Usage: bash scripts/fuzz.sh [SECONDS_PER_TARGET]   (default 30)
 set -euo pipefail
 cd "$(dirname "$0")/.."
-export CCACHE_BASEDIR="$PWD"
 # Warnings are the gcc builds' business (errors there in CI); clang under sanitizers also warns
 # that some `omp simd` loops were not vectorised, which is expected in an instrumented build.
 export GIPSI_WERROR=OFF
