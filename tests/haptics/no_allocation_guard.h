@@ -19,13 +19,16 @@ inline constexpr bool kCountsAllocations = true;
 /// Fails the test if the current thread allocates while it lives.
 class NoAllocationGuard {
  public:
+  // Without counting (sanitizer builds) the thread-local flags are left alone.
   NoAllocationGuard() {
-    g_allocations = 0;
-    g_counting_allocations = true;
+    if constexpr (kCountsAllocations) {
+      g_allocations = 0;
+      g_counting_allocations = true;
+    }
   }
   ~NoAllocationGuard() {
-    g_counting_allocations = false;
-    if (kCountsAllocations) {
+    if constexpr (kCountsAllocations) {
+      g_counting_allocations = false;
       EXPECT_EQ(g_allocations, 0) << "heap allocations inside a real-time section";
     }
   }
