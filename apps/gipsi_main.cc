@@ -90,10 +90,25 @@ class Progress {
 };
 
 gipsi::Scene Load(const std::string& file, const std::vector<std::string>& plugins,
-                  gipsi::TypeRegistry& registry) {
+                  gipsi::TypeRegistry& registry, const gipsi::SceneLimits& limits) {
   gipsi::RegisterBuiltins(registry);
   for (const auto& plugin : plugins) registry.LoadPlugin(plugin);
-  return gipsi::LoadScene(file, registry);
+  return gipsi::LoadScene(file, registry, limits);
+}
+
+/// Adds the resource-limit options (SceneLimits) to a subcommand.
+void AddLimitOptions(CLI::App& command, gipsi::SceneLimits& limits) {
+  command
+      .add_option("--max-output", limits.max_output_bytes,
+                  "Refuse to start a run whose outputs (VTU series, probe CSVs) are estimated "
+                  "above SIZE, e.g. 500MB or 20GB; 0: no limit")
+      ->transform(CLI::AsSizeValue(true))
+      ->capture_default_str();
+  command
+      .add_option("--max-mesh-cells", limits.max_mesh_cells,
+                  "Refuse a scene mesh with more nodes or cells (tets + triangles) than N")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
 }
 
 /// `gipsi run --profile`: where the wall time went, per object (with the object's own
@@ -132,10 +147,10 @@ struct CheckpointOptions {
 };
 
 int Run(const std::string& file, const std::string& out_dir, double until, bool quiet, bool no_vtu,
-        bool profile, const std::vector<std::string>& plugins,
-        const CheckpointOptions& checkpoints) {
+        bool profile, const std::vector<std::string>& plugins, const CheckpointOptions& checkpoints,
+        const gipsi::SceneLimits& limits) {
   gipsi::TypeRegistry registry;
-  gipsi::Scene scene = Load(file, plugins, registry);
+  gipsi::Scene scene = Load(file, plugins, registry, limits);
   if (until > 0) scene.end_time = until;
   if (no_vtu) scene.vtu.enabled = false;
   std::filesystem::path out =
@@ -221,9 +236,10 @@ int Run(const std::string& file, const std::string& out_dir, double until, bool 
   return 0;
 }
 
-int Validate(const std::string& file, const std::vector<std::string>& plugins) {
+int Validate(const std::string& file, const std::vector<std::string>& plugins,
+             const gipsi::SceneLimits& limits) {
   gipsi::TypeRegistry registry;
-  gipsi::Scene scene = Load(file, plugins, registry);
+  gipsi::Scene scene = Load(file, plugins, registry, limits);
   const auto& coordinator = scene.kernel->coordinator();
   std::cout << fmt::format("{}: valid scene\n", file);
   std::cout << fmt::format("  end time {:.6g} s, macro step {:.6g} s\n", scene.end_time,
@@ -250,6 +266,15 @@ int Validate(const std::string& file, const std::vector<std::string>& plugins) {
                              bc.faces.size());
   for (const auto& probe : scene.probes)
     std::cout << fmt::format("  probe {:<15} {}\n", probe.name, probe.Header());
+  const gipsi::OutputEstimate outputs = gipsi::EstimateOutputs(scene);
+  std::cout << fmt::format(
+      "  outputs: about {:.1f} MB ({} VTU frames, {:.1f} MB; probe CSVs at most {:.1f} MB)\n",
+      static_cast<double>(outputs.total()) / 1e6, outputs.vtu_frames,
+      static_cast<double>(outputs.vtu_bytes) / 1e6, static_cast<double>(outputs.probe_bytes) / 1e6);
+  if (limits.max_output_bytes > 0 && outputs.total() > limits.max_output_bytes)
+    std::cout << fmt::format(
+        "  warning: over the output limit of {:.1f} MB (gipsi run refuses it)\n",
+        static_cast<double>(limits.max_output_bytes) / 1e6);
   return 0;
 }
 
@@ -384,6 +409,8 @@ int main(int argc, char** argv) {
                 "Print where the wall time went: per object (and its own breakdown, e.g. "
                 "assembly and linear solves), per connector, and in outputs");
   run->add_option("--plugin", plugins, "Load a plugin shared library (repeatable)");
+  gipsi::SceneLimits limits;
+  AddLimitOptions(*run, limits);
   CheckpointOptions checkpoints;
   run->add_option("--checkpoint-every", checkpoints.every,
                   "Write a checkpoint every T seconds of simulated time (a whole number of macro "
@@ -399,6 +426,7 @@ int main(int argc, char** argv) {
   auto* validate = app.add_subcommand("validate", "Check a scene without running it");
   validate->add_option("SCENE", scene_file, "Scene file (JSON)")->required();
   validate->add_option("--plugin", plugins, "Load a plugin shared library (repeatable)");
+  AddLimitOptions(*validate, limits);
 
   auto* info = app.add_subcommand(
       "info", "Describe a mesh file: counts, named regions, bounding box, element quality");
@@ -455,8 +483,9 @@ int main(int argc, char** argv) {
                          : verbose ? spdlog::level::debug
                                    : spdlog::level::info);
   try {
-    if (*run) return Run(scene_file, out_dir, until, quiet, no_vtu, profile, plugins, checkpoints);
-    if (*validate) return Validate(scene_file, plugins);
+    if (*run)
+      return Run(scene_file, out_dir, until, quiet, no_vtu, profile, plugins, checkpoints, limits);
+    if (*validate) return Validate(scene_file, plugins, limits);
     if (*info) return Info(mesh_file);
     if (*types) return Types(plugins);
     if (*cell) return Cell(cell_options, plugins);

@@ -168,6 +168,28 @@ TEST(GipsiValidate, AcceptsTheDemoScenes) {
   }
 }
 
+TEST(GipsiRun, ResourceLimitsRefuseOversizedRunsBeforeWriting) {
+  // hanging_sheet.json until 0.2 s writes 5 frames of the 441-node sheet (about 60 kB each).
+  fs::path out = TempDir("limits");
+  fs::remove_all(out);
+  Result big = Gipsi("run " + Scene("hanging_sheet.json") +
+                     " --until 0.2 --max-output 100kB --out " + out.string());
+  EXPECT_EQ(big.code, 1) << big.output;
+  EXPECT_THAT(big.output, HasSubstr("outputs.vtu.every: the run would write about"));
+  EXPECT_THAT(big.output, HasSubstr("over the limit of 100 kB"));
+  EXPECT_FALSE(fs::exists(out / "sheet.pvd"));
+  Result cells =
+      Gipsi("run " + Scene("hanging_sheet.json") + " --max-mesh-cells 100 --out " + out.string());
+  EXPECT_EQ(cells.code, 1) << cells.output;
+  EXPECT_THAT(cells.output, HasSubstr("over the limit of 100"));
+  Result validate = Gipsi("validate " + Scene("hanging_sheet.json"));
+  EXPECT_EQ(validate.code, 0) << validate.output;
+  EXPECT_THAT(validate.output, HasSubstr("outputs: about"));
+  Result bad = Gipsi("run " + Scene("hanging_sheet.json") + " --max-output lots");
+  EXPECT_NE(bad.code, 0);
+  EXPECT_THAT(bad.output, HasSubstr("--max-output"));
+}
+
 TEST(GipsiValidate, BadInputsExitNonZeroWithAClearMessage) {
   fs::path dir = TempDir("bad");
   auto write = [&](const std::string& name, const std::string& text) {

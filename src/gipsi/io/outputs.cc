@@ -1,6 +1,11 @@
 #include "gipsi/io/outputs.h"
 
+#include <algorithm>
+#include <cmath>
+
 #include <fmt/format.h>
+
+#include "gipsi/base/error.h"
 
 #include "gipsi/core/state.h"
 
@@ -171,19 +176,129 @@ void ProbeRecorder::CommitRestore() {
   }
 }
 
+namespace {
+
+/// The leaf objects whose VTU series a scene writes.
+std::vector<const SimObject*> VtuObjects(const Scene& scene) {
+  const Kernel& kernel = *scene.kernel;
+  std::vector<const SimObject*> leaves;
+  if (scene.vtu.objects.empty()) {
+    for (std::size_t i = 0; i < kernel.coordinator().num_objects(); ++i)
+      kernel.coordinator().object(i).CollectLeaves(leaves);
+  } else {
+    for (const auto& name : scene.vtu.objects) kernel.FindObject(name).CollectLeaves(leaves);
+  }
+  return leaves;
+}
+
+/// Output times of a series sampled every `every` seconds (0: every macro step) over a run of
+/// `steps` macro steps of `macro_dt`, the first at t = 0 — as the observers sample.
+std::int64_t Samples(double every, double macro_dt, std::int64_t steps) {
+  if (every <= macro_dt * (1 + 1e-9)) return steps + 1;
+  const double end = static_cast<double>(steps) * macro_dt;
+  return std::min(steps, static_cast<std::int64_t>(std::floor(end / every * (1 + 1e-12)))) + 1;
+}
+
+/// Bytes of one frame of `object`'s series (domain and, if written, display), as WriteFrame
+/// writes it; 0 for an object without a series.
+std::uintmax_t FrameBytes(const SimObject& object, bool display) {
+  const Mesh& mesh = object.domain();
+  std::vector<VtuArrayShape> point_data, cell_data;
+  for (const FieldInfo& info : object.fields()) {
+    if (!info.readable()) continue;
+    if (info.location == FieldLocation::kNode)
+      point_data.push_back({info.name, info.components});
+    else if (info.location == FieldLocation::kElement)
+      cell_data.push_back({info.name, info.components});
+  }
+  std::uintmax_t bytes = 0;
+  if (mesh.num_tets() > 0 || mesh.num_triangles() > 0) {
+    bytes = VtuFileBytes(object.domain_positions().cols(), mesh.num_tets(),
+                         mesh.num_tets() > 0 ? 0 : mesh.num_triangles(), point_data, cell_data);
+  } else if (object.boundary().num_triangles() > 0) {
+    bytes = VtuFileBytes(object.boundary().num_vertices(), 0, object.boundary().num_triangles(), {},
+                         {});
+  } else {
+    return 0;
+  }
+  if (display && object.display().map)
+    bytes += VtuFileBytes(object.display().positions.cols(), 0, object.display().triangles.cols(),
+                          {}, {});
+  return bytes;
+}
+
+/// Human-readable bytes ("3.2 GB").
+std::string Bytes(std::uintmax_t n) {
+  const double x = static_cast<double>(n);
+  if (x >= 1e9) return fmt::format("{:.3g} GB", x / 1e9);
+  if (x >= 1e6) return fmt::format("{:.3g} MB", x / 1e6);
+  if (x >= 1e3) return fmt::format("{:.3g} kB", x / 1e3);
+  return fmt::format("{} bytes", n);
+}
+
+}  // namespace
+
+OutputEstimate EstimateOutputs(const Scene& scene) {
+  const Kernel& kernel = *scene.kernel;
+  const double macro_dt = kernel.macro_dt();
+  const auto steps = static_cast<std::int64_t>(std::llround(scene.end_time / macro_dt));
+  OutputEstimate estimate;
+  if (scene.vtu.enabled) {
+    estimate.vtu_frames = Samples(scene.vtu.every, macro_dt, steps);
+    const auto frames = static_cast<std::uintmax_t>(estimate.vtu_frames);
+    for (const SimObject* object : VtuObjects(scene)) {
+      const std::uintmax_t frame = FrameBytes(*object, scene.vtu.display);
+      if (frame == 0) continue;
+      // A frame's line in its collection(s): the frame's time and file name, about 100 bytes.
+      const std::uintmax_t pvd = (scene.vtu.display && object->display().map ? 2 : 1) * 100;
+      estimate.vtu_bytes += frames * (frame + pvd);
+      if (frame > estimate.largest_frame) {
+        estimate.largest_frame = frame;
+        estimate.largest_series = object->name();
+      }
+    }
+  }
+  for (const Probe& probe : scene.probes) {
+    const std::string header = probe.Header();
+    const auto columns =
+        static_cast<std::uintmax_t>(std::count(header.begin(), header.end(), ',')) + 1;
+    std::uintmax_t rows = 0;
+    if (probe.is_line())
+      rows = static_cast<std::uintmax_t>(probe.line.cols()) *
+             std::max<std::uintmax_t>(probe.at.size(), 1);
+    else
+      rows = static_cast<std::uintmax_t>(Samples(probe.every, macro_dt, steps));
+    // %.17g of a double takes at most 24 characters ("-1.2345678901234567e-308"), plus a
+    // separator.
+    estimate.probe_bytes += header.size() + 1 + rows * 25 * columns;
+  }
+  return estimate;
+}
+
 void AttachOutputs(Scene& scene, const std::filesystem::path& directory, bool resume) {
   Kernel& kernel = *scene.kernel;
-  if (scene.vtu.enabled) {
-    std::vector<const SimObject*> leaves;
-    if (scene.vtu.objects.empty()) {
-      for (std::size_t i = 0; i < kernel.coordinator().num_objects(); ++i)
-        kernel.coordinator().object(i).CollectLeaves(leaves);
-    } else {
-      for (const auto& name : scene.vtu.objects) kernel.FindObject(name).CollectLeaves(leaves);
+  if (scene.limits.max_output_bytes > 0) {
+    const OutputEstimate estimate = EstimateOutputs(scene);
+    if (estimate.total() > scene.limits.max_output_bytes) {
+      const bool vtu = estimate.vtu_bytes >= estimate.probe_bytes;
+      ThrowInputError(
+          scene.file.string(), vtu ? "outputs.vtu.every" : "probes",
+          fmt::format(
+              "the run would write about {} ({}), over the limit of {}: {}, shorten the run, or "
+              "raise the limit with `gipsi run --max-output` if the scene is trusted",
+              Bytes(estimate.total()),
+              vtu ? fmt::format("{} VTU frames, {} per frame of '{}'", estimate.vtu_frames,
+                                Bytes(estimate.largest_frame), estimate.largest_series)
+                  : fmt::format("probe CSVs {}", Bytes(estimate.probe_bytes)),
+              Bytes(scene.limits.max_output_bytes),
+              vtu ? "write frames less often (outputs.vtu.every), fewer objects "
+                    "(outputs.vtu.objects) or none (--no-vtu)"
+                  : "sample the probes less often (probes.<name>.every)"));
     }
-    kernel.AddObserver(std::make_unique<VtuSeriesWriter>(
-        std::move(leaves), directory, scene.vtu.every, scene.vtu.display, resume));
   }
+  if (scene.vtu.enabled)
+    kernel.AddObserver(std::make_unique<VtuSeriesWriter>(
+        VtuObjects(scene), directory, scene.vtu.every, scene.vtu.display, resume));
   if (!scene.probes.empty())
     kernel.AddObserver(std::make_unique<ProbeRecorder>(scene.probes, directory / "probes", resume));
 }

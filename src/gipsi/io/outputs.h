@@ -9,8 +9,10 @@
 ///   <out>/<object>_display.pvd, <out>/<object>_display/...   display surface (if embedded)
 ///   <out>/probes/<probe>.csv           one row per sample: time, values
 
+#include <cstdint>
 #include <filesystem>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "gipsi/core/kernel.h"
@@ -50,8 +52,26 @@ class VtuSeriesWriter final : public Observer {
   std::vector<Series> series_;
 };
 
+/// What a run of a scene from t = 0 to its end time will write, estimated before it starts.
+/// Plain struct.
+struct OutputEstimate {
+  std::int64_t vtu_frames = 0;       ///< frames of every VTU series
+  std::uintmax_t vtu_bytes = 0;      ///< all VTU files and PVD collections (exact for the frames)
+  std::uintmax_t probe_bytes = 0;    ///< all probe CSVs (an upper bound: 25 bytes per number)
+  std::string largest_series;        ///< the object whose series is largest ("" if none)
+  std::uintmax_t largest_frame = 0;  ///< bytes of one frame of that series
+  [[nodiscard]] std::uintmax_t total() const { return vtu_bytes + probe_bytes; }
+};
+
+/// Estimates the files AttachOutputs would make a run write: the VTU frames' sizes are exact
+/// (VtuFileBytes), their number the output times up to `scene.end_time`; probe rows are
+/// counted the same way with a bound on each number's width.
+OutputEstimate EstimateOutputs(const Scene& scene);
+
 /// Attaches the scene's outputs (VTU series if enabled, probe CSVs) to its kernel, writing under
-/// `directory`. Throws std::exception if the directory or files cannot be created. With
+/// `directory`. Throws InputError, naming the scene key that drives it, if EstimateOutputs
+/// exceeds `scene.limits.max_output_bytes`; nothing is created then. Throws std::exception if
+/// the directory or files cannot be created. With
 /// `resume`, no existing file is changed until the kernel has read and checked the whole
 /// checkpoint (Kernel::RestoreState); then every file is cut back to its state at the
 /// checkpoint. A refused checkpoint leaves the outputs as they were.

@@ -1,5 +1,6 @@
 #include "gipsi/io/scene.h"
 
+#include <algorithm>
 #include <cstdlib>
 #include <fstream>
 #include <sstream>
@@ -303,16 +304,18 @@ Mesh BuildMesh(const JsonNode& node, const std::filesystem::path& base_dir) {
   return mesh;
 }
 
-Scene LoadScene(const std::filesystem::path& file, TypeRegistry& registry) {
+Scene LoadScene(const std::filesystem::path& file, TypeRegistry& registry,
+                const SceneLimits& limits) {
   std::ifstream in(file, std::ios::binary);
   if (!in) ThrowInputError(file.string(), "", "cannot open scene file for reading");
   std::stringstream text;
   text << in.rdbuf();
-  return LoadSceneFromString(text.str(), file.string(), file.parent_path(), registry);
+  return LoadSceneFromString(text.str(), file.string(), file.parent_path(), registry, limits);
 }
 
 Scene LoadSceneFromString(std::string_view text, const std::string& name,
-                          const std::filesystem::path& base_dir, TypeRegistry& registry) {
+                          const std::filesystem::path& base_dir, TypeRegistry& registry,
+                          const SceneLimits& limits) {
   JsonDocument doc = JsonDocument::Parse(text, name);
   JsonNode root = doc.root();
   if (!root.is_object()) root.Expected("a JSON object");
@@ -325,6 +328,7 @@ Scene LoadSceneFromString(std::string_view text, const std::string& name,
   Scene scene;
   scene.file = name;
   scene.kernel = std::make_unique<Kernel>();
+  scene.limits = limits;
 
   if (auto plugins = root.Find("plugins")) {
     for (const auto& item : plugins->Items()) {
@@ -338,8 +342,17 @@ Scene LoadSceneFromString(std::string_view text, const std::string& name,
   }
 
   if (auto meshes = root.Find("meshes")) {
-    for (const auto& [mesh_name, node] : meshes->Members())
-      scene.meshes[mesh_name] = std::make_shared<const Mesh>(BuildMesh(node, base_dir));
+    for (const auto& [mesh_name, node] : meshes->Members()) {
+      auto mesh = std::make_shared<const Mesh>(BuildMesh(node, base_dir));
+      const std::int64_t cells = mesh->num_tets() + mesh->num_triangles();
+      const std::int64_t most = std::max<std::int64_t>(mesh->num_nodes(), cells);
+      if (most > limits.max_mesh_cells)
+        node.Fail(
+            fmt::format("the mesh has {} nodes and {} cells, over the limit of {} (raise it with "
+                        "`gipsi run --max-mesh-cells` if the scene is trusted)",
+                        mesh->num_nodes(), cells, limits.max_mesh_cells));
+      scene.meshes[mesh_name] = std::move(mesh);
+    }
   }
   SceneMeshes mesh_provider(scene.meshes);
 
@@ -398,7 +411,18 @@ Scene LoadSceneFromString(std::string_view text, const std::string& name,
     if (auto plots = outputs->Find("plots"))
       for (const auto& plot : plots->Items())
         scene.plots.push_back(viz::ParsePlotSpec(plot, scene.probes));
-    if (auto dir = outputs->Find("directory")) scene.output_directory = dir->AsString();
+    if (auto dir = outputs->Find("directory")) {
+      // A scene may come from anyone: it names a folder under the working directory, and only
+      // the person running it (`gipsi run --out`) may send the outputs elsewhere.
+      const std::filesystem::path path = dir->AsString();
+      const bool climbs = std::any_of(
+          path.begin(), path.end(), [](const std::filesystem::path& part) { return part == ".."; });
+      if (path.empty() || path.has_root_path() || climbs)
+        dir->Expected(
+            "a relative folder without '..' (the outputs stay under the working directory; "
+            "`gipsi run --out DIR` writes elsewhere)");
+      scene.output_directory = path;
+    }
     if (auto vtu = outputs->Find("vtu")) {
       if (vtu->raw().is_boolean()) {
         scene.vtu.enabled = vtu->AsBool();

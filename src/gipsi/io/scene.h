@@ -5,6 +5,7 @@
 /// docs/scene-format.md. Every error names the file and the JSON path and says what was
 /// expected.
 
+#include <cstdint>
 #include <filesystem>
 #include <map>
 #include <memory>
@@ -28,6 +29,19 @@ struct VtuOutputSpec {
   bool display = true;               ///< also write embedded display surfaces
 };
 
+/// Resource limits for running scenes from untrusted sources (`gipsi run --max-mesh-cells`,
+/// `--max-output`). The defaults admit every scene we ship with a wide margin and stop a scene
+/// that would exhaust the machine before anything large is allocated or written. Plain struct.
+struct SceneLimits {
+  /// Largest mesh of the scene's "meshes" (nodes, and tets + triangles), checked as each is
+  /// built — before any object allocates per-element structures (which take many times the
+  /// mesh's memory). The readers themselves never allocate beyond what the file holds.
+  std::int64_t max_mesh_cells = 20'000'000;
+  /// Largest total size [bytes] of the files a run may write (VTU/PVD series and probe CSVs),
+  /// estimated from the scene before the run (EstimateOutputs in outputs.h); 0: no limit.
+  std::uintmax_t max_output_bytes = 10'000'000'000;
+};
+
 /// A loaded, ready-to-run scene. Not copyable; movable.
 struct Scene {
   std::filesystem::path file;
@@ -44,14 +58,19 @@ struct Scene {
   std::map<std::string, std::shared_ptr<const Mesh>> meshes;
   /// Boundary conditions by "object/name", for events and `gipsi validate`.
   std::map<std::string, BoundaryConditionSpec> boundary_conditions;
+  /// The limits it was loaded with (AttachOutputs checks the output volume against them).
+  SceneLimits limits;
 };
 
 /// Loads `file` with the types in `registry` (loading the scene's plugins into it first) and
-/// builds the kernel (Initialize is called). Throws InputError on any problem.
-Scene LoadScene(const std::filesystem::path& file, TypeRegistry& registry);
+/// builds the kernel (Initialize is called). Throws InputError on any problem, including a mesh
+/// over `limits.max_mesh_cells`.
+Scene LoadScene(const std::filesystem::path& file, TypeRegistry& registry,
+                const SceneLimits& limits = {});
 /// The same from text; `name` is used in messages and `base_dir` resolves relative paths.
 Scene LoadSceneFromString(std::string_view text, const std::string& name,
-                          const std::filesystem::path& base_dir, TypeRegistry& registry);
+                          const std::filesystem::path& base_dir, TypeRegistry& registry,
+                          const SceneLimits& limits = {});
 
 /// Where a scene's "plugins" entry points: a path with a '/' is taken relative to `base_dir`; a
 /// bare name ("gipsi_example_plugin", ".so" optional) is searched in $GIPSI_PLUGIN_PATH

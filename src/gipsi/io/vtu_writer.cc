@@ -45,14 +45,45 @@ std::string EncodeBlock(const void* data, std::size_t bytes) {
   return out;
 }
 
-void AppendArray(std::string& xml, std::string_view type, std::string_view name, int components,
-                 const void* data, std::size_t bytes) {
-  xml += fmt::format("        <DataArray type=\"{}\"", type);
+/// The text of a data array around its encoded block (VtuFileBytes counts the same strings).
+std::string ArrayOpening(std::string_view type, std::string_view name, int components) {
+  std::string xml = fmt::format("        <DataArray type=\"{}\"", type);
   if (!name.empty()) xml += fmt::format(" Name=\"{}\"", EscapeXml(name));
   if (components != 1) xml += fmt::format(" NumberOfComponents=\"{}\"", components);
   xml += " format=\"binary\">\n          ";
+  return xml;
+}
+constexpr std::string_view kArrayClosing = "\n        </DataArray>\n";
+
+/// Length of base64 text for `bytes` bytes (padded to whole 4-character groups).
+std::uintmax_t Base64Length(std::uintmax_t bytes) { return 4 * ((bytes + 2) / 3); }
+
+/// Length of an array: opening, base64 of its UInt64 byte count and of its bytes, closing.
+std::uintmax_t ArrayBytes(std::string_view type, std::string_view name, int components,
+                          std::uintmax_t bytes) {
+  return ArrayOpening(type, name, components).size() + Base64Length(8) + Base64Length(bytes) +
+         kArrayClosing.size();
+}
+
+std::string PieceOpening(Index num_nodes, Index num_cells) {
+  std::string xml = "<?xml version=\"1.0\"?>\n";
+  xml += fmt::format(
+      "<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"{}\" "
+      "header_type=\"UInt64\">\n  <UnstructuredGrid>\n"
+      "    <Piece NumberOfPoints=\"{}\" NumberOfCells=\"{}\">\n",
+      internal::HostIsLittleEndian() ? "LittleEndian" : "BigEndian", num_nodes, num_cells);
+  return xml;
+}
+constexpr std::string_view kPointsOpening = "      <Points>\n";
+constexpr std::string_view kCellsOpening = "      </Points>\n      <Cells>\n";
+constexpr std::string_view kPieceClosing =
+    "      </Cells>\n    </Piece>\n  </UnstructuredGrid>\n</VTKFile>\n";
+
+void AppendArray(std::string& xml, std::string_view type, std::string_view name, int components,
+                 const void* data, std::size_t bytes) {
+  xml += ArrayOpening(type, name, components);
   xml += EncodeBlock(data, bytes);
-  xml += "\n        </DataArray>\n";
+  xml += kArrayClosing;
 }
 
 void AppendFields(std::string& xml, const char* tag, const std::vector<NamedArray>& arrays,
@@ -95,23 +126,40 @@ void WriteVtu(const std::filesystem::path& path, const Points& nodes, const Tets
     offsets.push_back(static_cast<std::int64_t>(conn.size()));
     types.push_back(5);
   }
-  std::string xml = "<?xml version=\"1.0\"?>\n";
-  xml += fmt::format(
-      "<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"{}\" "
-      "header_type=\"UInt64\">\n  <UnstructuredGrid>\n"
-      "    <Piece NumberOfPoints=\"{}\" NumberOfCells=\"{}\">\n",
-      internal::HostIsLittleEndian() ? "LittleEndian" : "BigEndian", num_nodes, num_cells);
+  std::string xml = PieceOpening(num_nodes, num_cells);
   AppendFields(xml, "PointData", fields.point_data, num_nodes);
   AppendFields(xml, "CellData", fields.cell_data, num_cells);
-  xml += "      <Points>\n";
+  xml += kPointsOpening;
   AppendArray(xml, "Float64", "Points", 3, nodes.data(),
               sizeof(double) * static_cast<std::size_t>(nodes.size()));
-  xml += "      </Points>\n      <Cells>\n";
+  xml += kCellsOpening;
   AppendArray(xml, "Int64", "connectivity", 1, conn.data(), sizeof(std::int64_t) * conn.size());
   AppendArray(xml, "Int64", "offsets", 1, offsets.data(), sizeof(std::int64_t) * offsets.size());
   AppendArray(xml, "UInt8", "types", 1, types.data(), types.size());
-  xml += "      </Cells>\n    </Piece>\n  </UnstructuredGrid>\n</VTKFile>\n";
+  xml += kPieceClosing;
   internal::WriteFileBytes(path, xml);
+}
+
+std::uintmax_t VtuFileBytes(Index num_nodes, Index num_tets, Index num_triangles,
+                            const std::vector<VtuArrayShape>& point_data,
+                            const std::vector<VtuArrayShape>& cell_data) {
+  const auto nodes = static_cast<std::uintmax_t>(num_nodes);
+  const auto cells = static_cast<std::uintmax_t>(num_tets + num_triangles);
+  const auto corners = static_cast<std::uintmax_t>(4 * num_tets + 3 * num_triangles);
+  std::uintmax_t total = PieceOpening(num_nodes, num_tets + num_triangles).size();
+  auto fields = [&](std::string_view tag, const std::vector<VtuArrayShape>& arrays,
+                    std::uintmax_t count) {
+    total += fmt::format("      <{}>\n", tag).size() + fmt::format("      </{}>\n", tag).size();
+    for (const VtuArrayShape& a : arrays)
+      total += ArrayBytes("Float64", a.name, a.components,
+                          8 * static_cast<std::uintmax_t>(a.components) * count);
+  };
+  fields("PointData", point_data, nodes);
+  fields("CellData", cell_data, cells);
+  total += kPointsOpening.size() + ArrayBytes("Float64", "Points", 3, 24 * nodes);
+  total += kCellsOpening.size() + ArrayBytes("Int64", "connectivity", 1, 8 * corners) +
+           ArrayBytes("Int64", "offsets", 1, 8 * cells) + ArrayBytes("UInt8", "types", 1, cells);
+  return total + kPieceClosing.size();
 }
 
 void WriteVtu(const std::filesystem::path& path, const Mesh& mesh, const VtuFields& fields) {

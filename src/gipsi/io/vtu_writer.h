@@ -4,6 +4,7 @@
 /// `.pvd` collections that index them by time.
 
 #include <cstddef>
+#include <cstdint>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -40,6 +41,20 @@ struct VtuFields {
 /// Throws InputError if the file cannot be written.
 void WriteVtu(const std::filesystem::path& path, const Points& nodes, const Tets& tets,
               const Triangles& triangles, const VtuFields& fields = {});
+
+/// Name and number of components of a data array, for sizing a `.vtu` before writing it.
+struct VtuArrayShape {
+  std::string name;
+  int components = 1;
+};
+
+/// The exact size in bytes of the file `WriteVtu` writes for a grid of `num_nodes` nodes,
+/// `num_tets` tets and `num_triangles` triangles with these point and cell arrays (their values
+/// do not change the size: the encoding is uncompressed). Used to refuse output that would not
+/// fit before a run starts (outputs.h).
+std::uintmax_t VtuFileBytes(Index num_nodes, Index num_tets, Index num_triangles,
+                            const std::vector<VtuArrayShape>& point_data,
+                            const std::vector<VtuArrayShape>& cell_data);
 
 /// `WriteVtu(path, mesh.nodes, mesh.tets, mesh.triangles, fields)`.
 void WriteVtu(const std::filesystem::path& path, const Mesh& mesh, const VtuFields& fields = {});

@@ -116,7 +116,8 @@ PlotSpec ParsePlotSpec(const JsonNode& node, const std::vector<Probe>& probes) {
   const JsonNode file = node.At("file");
   spec.file = file.AsString();
   const auto ext = std::filesystem::path(spec.file).extension();
-  if ((ext != ".png" && ext != ".svg") || spec.file.find("..") != std::string::npos)
+  if ((ext != ".png" && ext != ".svg") || spec.file.find("..") != std::string::npos ||
+      std::filesystem::path(spec.file).has_root_path())
     file.Expected("a file name ending in .png or .svg (inside the output directory)");
   spec.title = node.String("title", "");
   if (auto x = node.Find("x"); x && x->AsString() != "time") spec.x = ParseColumn(*x, probes);
