@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include "gipsi/numerics/sparse/linear_solver.h"
+#include "gipsi/numerics/sparse/serial_openmp.h"
 #include "numerics/sparse/sparse_test_util.h"
 
 namespace gipsi {
@@ -97,6 +98,35 @@ TEST_P(DirectSparseSolver, ReusesOneAnalysisForManyMatricesOfThePattern) {
 }
 
 INSTANTIATE_TEST_SUITE_P(LdltAndCholmod, DirectSparseSolver, ::testing::Values("ldlt", "cholmod"));
+
+}  // namespace
+}  // namespace gipsi
+
+namespace gipsi {
+namespace {
+
+TEST(SerialOpenMp, RegionsInsideRunOnOneThreadAndTheSettingIsRestored) {
+  // CHOLMOD's regions ask for a fixed team of four (num_threads(4)); inside the guard such a
+  // region must get one thread, and GiPSi's own regions their usual team after it.
+  const int levels = omp_get_max_active_levels();
+  int inside = 0, after = 0;
+  {
+    const SerialOpenMp serial;
+#pragma omp parallel num_threads(4)
+    {
+#pragma omp single
+      inside = omp_get_num_threads();
+    }
+  }
+#pragma omp parallel num_threads(2)
+  {
+#pragma omp single
+    after = omp_get_num_threads();
+  }
+  EXPECT_EQ(inside, 1);
+  EXPECT_EQ(omp_get_max_active_levels(), levels);
+  EXPECT_EQ(after, levels > 0 ? 2 : 1);
+}
 
 }  // namespace
 }  // namespace gipsi

@@ -11,6 +11,7 @@
 #include <Eigen/CholmodSupport>
 
 #include "gipsi/base/error.h"
+#include "gipsi/numerics/sparse/serial_openmp.h"
 #include "gipsi/numerics/sparse/solvers.h"
 #include "gipsi/numerics/sparse/vector_ops.h"
 
@@ -406,7 +407,10 @@ bool SmoothedAggregationAmg::Setup(const SparseMatrix& A) {
   }
   coarse_ = std::make_unique<CoarseSolver>();
   coarse_->llt.cholmod().print = 0;  // failures are reported through the return value
-  coarse_->llt.compute(*levels_.back()->a);
+  {
+    const SerialOpenMp serial;  // serial_openmp.h: CHOLMOD's fixed 4-thread regions
+    coarse_->llt.compute(*levels_.back()->a);
+  }
   if (coarse_->llt.info() != Eigen::Success) return false;
   ready_ = true;
   return true;
@@ -551,6 +555,7 @@ void SmoothedAggregationAmg::LevelMultiply(const Level& level, const VecX& x, Ve
 void SmoothedAggregationAmg::Cycle(std::size_t l) {
   Level& level = *levels_[l];
   if (l + 1 == levels_.size()) {
+    const SerialOpenMp serial;
     level.x = coarse_->llt.solve(level.b);
     return;
   }

@@ -11,6 +11,7 @@
 #include <Eigen/SparseCholesky>
 
 #include "gipsi/base/error.h"
+#include "gipsi/numerics/sparse/serial_openmp.h"
 #include "gipsi/numerics/sparse/solvers.h"
 #include "gipsi/numerics/sparse/vector_ops.h"
 
@@ -151,12 +152,16 @@ class CholmodSolver final : public DirectSolver {
 
  protected:
   void Analyze(const SparseMatrix& A) override {
+    const SerialOpenMp serial;
     llt_.analyzePattern(A);
     ldlt_analysed_ = false;
   }
   bool FactorizeNumeric(const SparseMatrix& A) override {
     use_ldlt_ = false;
-    llt_.factorize(A);
+    {
+      const SerialOpenMp serial;
+      llt_.factorize(A);
+    }
     if (llt_.info() == Eigen::Success) return true;
     if (!indefinite_) return false;
     if (!ldlt_analysed_) {
@@ -174,6 +179,7 @@ class CholmodSolver final : public DirectSolver {
       x = ldlt_.solve(b);
       return ldlt_.info() == Eigen::Success;
     }
+    const SerialOpenMp serial;
     x = llt_.solve(b);
     return llt_.info() == Eigen::Success;
   }

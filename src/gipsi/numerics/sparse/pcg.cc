@@ -12,6 +12,7 @@
 
 #include "gipsi/base/error.h"
 #include "gipsi/numerics/sparse/amg.h"
+#include "gipsi/numerics/sparse/serial_openmp.h"
 #include "gipsi/numerics/sparse/solvers.h"
 #include "gipsi/numerics/sparse/vector_ops.h"
 
@@ -66,9 +67,11 @@ class PcgSolver final : public LinearSolver {
       case Preconditioner::kIncompleteCholesky:
         incomplete_.analyzePattern(A);
         break;
-      case Preconditioner::kLaggedCholesky:
+      case Preconditioner::kLaggedCholesky: {
+        const SerialOpenMp serial;  // serial_openmp.h: CHOLMOD's fixed 4-thread regions
         cholesky_.analyzePattern(A);
         break;
+      }
       case Preconditioner::kAmg:
         break;  // the hierarchy depends on the values: built by the first Factorize
     }
@@ -93,6 +96,7 @@ class PcgSolver final : public LinearSolver {
         break;
       case Preconditioner::kLaggedCholesky:
         if (!has_factor_ || refactor_pending_) {
+          const SerialOpenMp serial;
           cholesky_.factorize(A);  // numeric only: the symbolic analysis is reused
           refactorized_ = true;
           refactor_pending_ = false;
@@ -233,8 +237,10 @@ class PcgSolver final : public LinearSolver {
       case Preconditioner::kIncompleteCholesky:
         z_ = incomplete_.solve(r_);
         break;
-      case Preconditioner::kLaggedCholesky:
+      case Preconditioner::kLaggedCholesky: {
+        const SerialOpenMp serial;
         z_ = cholesky_.solve(r_);
+      }
         if (cholesky_.info() != Eigen::Success) return std::numeric_limits<double>::quiet_NaN();
         break;
       case Preconditioner::kAmg:
