@@ -296,10 +296,23 @@ bool FemSolid::CalcResidual(const VecX& d, VecX& r) {
   if (ok) {
     AssembleExternal(work_.data(), s_);
     ok = AddCoupledCavityLoads(work_.data());
-    if (ok) FinishResidual(d, r);
+    if (ok) {
+      TakeLoadScale();
+      FinishResidual(d, r);
+    }
   }
   profile_.assembly_seconds += Seconds(start);
   return ok;
+}
+
+void FemSolid::TakeLoadScale() {
+  if (!load_scale_pending_) return;
+  load_scale_pending_ = false;
+  // The applied loads at the step's first iterate, pressures included (a heart's only loads
+  // are its cavity pressure and its own active tension), over the unconstrained unknowns.
+  double sum = f_ext_.squaredNorm();
+  for (int dof : constrained_dofs_) sum -= f_ext_[dof] * f_ext_[dof];
+  force_scale_ = std::max(force_scale_, std::sqrt(std::max(sum, 0.0)));
 }
 
 bool FemSolid::CalcResidualAndJacobian(const VecX& d, VecX& r, SparseMatrix& J) {
@@ -314,6 +327,7 @@ bool FemSolid::CalcResidualAndJacobian(const VecX& d, VecX& r, SparseMatrix& J) 
     profile_.assembly_seconds += Seconds(start);
     return false;
   }
+  TakeLoadScale();
   double* jv = J.valuePtr();
   const Index nnz = J.nonZeros();
   if (params_.rayleigh_stiffness > 0 && first_iteration_)
@@ -479,18 +493,31 @@ StepStatus FemSolid::Advance(double s0, double s1, double dt, int depth) {
   saved_scheme_ = scheme_;
   scheme_.Begin((s1 - s0) * dt);
   s_ = s1;
-  first_iteration_ = true;
-  d_.setZero();
-  const VecX& xn = scheme_.x();
-  for (int dof : constrained_dofs_) {
-    if (constraint_[static_cast<std::size_t>(dof)] == 1)
-      d_[dof] = x_begin_[dof] + s1 * (target_[dof] - x_begin_[dof]) - xn[dof];
+  const bool predict = params_.predict_velocity && params_.scheme != ImplicitSchemeKind::kStatic;
+  auto solve = [&](bool predicted) {
+    first_iteration_ = true;
+    if (predicted)
+      d_ = ((s1 - s0) * dt) * scheme_.v();
     else
-      d_[dof] = scheme_.IncrementForVelocity(dof, target_[dof]);
+      d_.setZero();
+    const VecX& xn = scheme_.x();
+    for (int dof : constrained_dofs_) {
+      if (constraint_[static_cast<std::size_t>(dof)] == 1)
+        d_[dof] = x_begin_[dof] + s1 * (target_[dof] - x_begin_[dof]) - xn[dof];
+      else
+        d_[dof] = scheme_.IncrementForVelocity(dof, target_[dof]);
+    }
+    // The force scale for the convergence test: applied loads and the weight, raised to the
+    // loads at the first iterate (TakeLoadScale) once Newton evaluates it.
+    force_scale_ = (f_nodal_prev_ + s1 * (f_nodal_new_ - f_nodal_prev_)).norm();
+    load_scale_pending_ = true;
+    last_newton_ = newton_->Solve(*this, d_, jac_);
+  };
+  solve(predict);
+  if (predict && last_newton_.inadmissible && last_newton_.iterations == 0) {
+    RestoreCavityPressures();  // the predicted state was not admissible: start from x_n
+    solve(false);
   }
-  // The force scale for the convergence test: applied loads and the weight.
-  force_scale_ = (f_nodal_prev_ + s1 * (f_nodal_new_ - f_nodal_prev_)).norm();
-  last_newton_ = newton_->Solve(*this, d_, jac_);
   profile_.newton_iterations += last_newton_.iterations;
   profile_.linear_iterations += last_newton_.linear_iterations;
   profile_.factorizations += last_newton_.refactorizations;

@@ -44,7 +44,8 @@ void RegisterFemSolid(TypeRegistry& registry) {
       [](const ObjectBuildContext& ctx) -> std::unique_ptr<SimObject> {
         const JsonNode& p = ctx.params;
         ctx.CheckKeys({"density", "material", "mass", "damping", "gravity", "newmark", "newton",
-                       "linear_solver", "load_steps", "max_bisections", "fibres", "cavities"});
+                       "linear_solver", "load_steps", "max_bisections", "predictor", "fibres",
+                       "cavities"});
         FemParams params;
         params.density = p.Positive("density", params.density);
         params.material = ctx.registry.CreateMaterialAs<SolidMaterial>(p.At("material"), "solid");
@@ -80,6 +81,9 @@ void RegisterFemSolid(TypeRegistry& registry) {
           if (n < 0 || n > 30) bisections->Expected("an integer in [0, 30]");
           params.max_bisections = static_cast<int>(n);
         }
+        if (auto predictor = p.Find("predictor"))
+          params.predict_velocity =
+              predictor->AsChoice({"none", "constant_velocity"}) == "constant_velocity";
         std::optional<TransmuralFibreRule> fibre_rule;
         if (auto fibres = p.Find("fibres"); fibres && fibres->Has("rule")) {
           fibre_rule = ParseTransmuralFibreRule(*fibres);
