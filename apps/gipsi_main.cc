@@ -174,7 +174,7 @@ int Run(const std::string& file, const std::string& out_dir, double until, bool 
   haptics.Start();
   gipsi::RunResult result =
       kernel.Run(scene.end_time, [&](double t, double end) { progress.Update(t, end); });
-  const auto loops = haptics.Stop();
+  haptics.Stop();  // logs each loop's period percentiles
   g_running_kernel.store(nullptr);
   std::signal(SIGINT, SIG_DFL);
   std::signal(SIGTERM, SIG_DFL);
@@ -198,8 +198,6 @@ int Run(const std::string& file, const std::string& out_dir, double until, bool 
     summary += fmt::format("  {:<20} {:<14} fired {} times\n", connector.name(),
                            connector.type_name(), connector.fire_count());
   }
-  for (const auto& [name, stats] : loops)
-    summary += fmt::format("  haptic loop of {}: {}\n", name, gipsi::DescribeLoopStats(stats));
   for (const auto& [t, what] : kernel.fired_events())
     summary += fmt::format("  event at {:.6g} s: {}\n", t, what);
   if (kernel.retried_steps() > 0)
