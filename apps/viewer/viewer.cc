@@ -379,6 +379,11 @@ int RunViewer(const ViewerOptions& options) {
           std::cout << fmt::format("{}: {} x {} at t = {:.6g} s ({})\n", options.screenshot,
                                    image.width, image.height, frame.time,
                                    reinterpret_cast<const char*>(gl.GetString(GL_RENDERER)));
+          if (const auto tool = sim.HapticTool())
+            std::cout << fmt::format(
+                "haptic tool at ({:.9g}, {:.9g}, {:.9g}) m, force ({:.9g}, {:.9g}, {:.9g}) N\n",
+                tool->first.x(), tool->first.y(), tool->first.z(), tool->second.x(),
+                tool->second.y(), tool->second.z());
         } catch (const std::exception& e) {
           std::cerr << "gipsi: error: " << e.what() << "\n";
           exit_code = 4;

@@ -179,6 +179,10 @@ HapticCoupling::HapticCoupling(std::string name, SimObject& object, HapticProbe&
   bridge_ = std::make_unique<HapticBridge>(*builder_, params);
   bridge_->SeedTool(probe.initial_position());
   probe.Attach(bridge_->models(), bridge_->feedback());
+  // A first model at the object's initial state, so a real-time loop started before the first
+  // step (the viewer, paused) already renders the contact. The first firing supersedes it
+  // before any synchronous tick could fetch it.
+  bridge_->Publish(probe.time());
 }
 
 HapticCoupling::~HapticCoupling() { probe_.StopLoop(); }

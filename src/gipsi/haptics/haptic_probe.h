@@ -140,7 +140,8 @@ class HapticProbe final : public SimObject {
 class HapticCoupling final : public Connector {
  public:
   /// Builds the local-model builder for `object` (FemSolid or MassSpring; InputError
-  /// otherwise) and attaches `probe` to the bridge.
+  /// otherwise), attaches `probe` to the bridge and publishes a first model at the object's
+  /// current state.
   HapticCoupling(std::string name, SimObject& object, HapticProbe& probe,
                  const HapticBridgeParams& params, int rings);
   [[nodiscard]] std::string_view type_name() const override { return "HapticCoupling"; }
