@@ -53,6 +53,20 @@ std::pair<Vec3, Vec3> MouseRay(const Camera& camera, double x, double y, int lef
 
 const char* const kComponents[] = {"magnitude", "x", "y", "z"};
 
+/// The haptic tool at `position` as a point surface: black without force, red with.
+SurfaceBuffers HapticToolPoint(const Vec3& position, const Vec3& force) {
+  SurfaceBuffers s;
+  s.object = "haptic tool";
+  s.primitive = Primitive::kPoints;
+  s.size = 12;
+  s.positions = {float(position.x()), float(position.y()), float(position.z())};
+  s.normals = {0, 0, 0};
+  const bool pushing = force.squaredNorm() > 0;
+  s.colors = {pushing ? 1.0f : 0.0f, 0, 0};
+  s.indices = {0};
+  return s;
+}
+
 struct SurfaceUi {
   bool visible = true;
   bool wireframe = false;
@@ -336,8 +350,8 @@ int RunViewer(const ViewerOptions& options) {
               "drag moves the haptic tool in the plane facing you, Ctrl + wheel pushes it "
               "into the scene or pulls it back.");
           if (const auto tool = sim.HapticTool())
-            ImGui::Text("tool (%.4g, %.4g, %.4g) m, force %.3g N", tool->first.x(), tool->first.y(),
-                        tool->first.z(), tool->second.norm());
+            ImGui::Text("tool at (%.4g, %.4g, %.4g) m\nforce %.3g N", tool->first.x(),
+                        tool->first.y(), tool->first.z(), tool->second.norm());
         } else {
           ImGui::TextWrapped(
               "Mouse: left drag orbits, right drag pans, wheel zooms; Ctrl (or Shift) + left "
@@ -360,7 +374,17 @@ int RunViewer(const ViewerOptions& options) {
       }
 
       render.viewport_x = panel;
-      renderer.Draw(frame, camera, scene_width, fb_height, render);
+      // The haptic tool, drawn over a copy of the frame: a 12-pixel point, black while it
+      // feels nothing, red while a force is commanded to it.
+      const FrameBuffers* drawn = &frame;
+      FrameBuffers with_tool;
+      if (status.haptic_mouse && frame.frame >= 0)
+        if (const auto tool = sim.HapticTool()) {
+          with_tool = frame;
+          with_tool.surfaces.push_back(HapticToolPoint(tool->first, tool->second));
+          drawn = &with_tool;
+        }
+      renderer.Draw(*drawn, camera, scene_width, fb_height, render);
       ImGui::Render();
       gl.Viewport(0, 0, fb_width, fb_height);
       ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());

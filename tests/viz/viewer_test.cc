@@ -182,6 +182,32 @@ TEST(Viewer, TheMouseMovesAHapticToolIntoTheTissue) {
   EXPECT_NEAR(f[2], 0, 1e-9);
 }
 
+TEST(Viewer, DrawsTheHapticToolAsABlackPointWhileItFeelsNothing) {
+#if defined(__SANITIZE_ADDRESS__)
+  GTEST_SKIP() << "the windowed viewer (GLFW, Mesa's GLX) is not run under AddressSanitizer";
+#endif
+  // The mouse tool rests 0.1 m in front of the near face's centre, on the camera's axis (the
+  // window's centre without the panel), outside the block: a 12-pixel black point (points are
+  // unshaded, so exactly black) over the block's face, which shows around it.
+  std::string scene = kBlock;
+  const std::string objects_end = R"("fix": true}]}},)";
+  scene.replace(scene.find(objects_end), objects_end.size(), R"("fix": true}]},
+      "probe": {"type": "HapticProbe", "dt": 0.01, "realtime": true,
+                "device": {"type": "Mouse", "start": [0.5, -0.1, 0.5]}}},)");
+  const ViewRun run = ViewUnderXvfb("tool", "--no-ui --screenshot-time 0.05", scene);
+  SKIP_WITHOUT_DISPLAY(run);
+  ASSERT_EQ(run.code, 0) << run.output;
+  const Image& image = run.image;
+  for (int dy = -3; dy <= 3; ++dy)
+    for (int dx = -3; dx <= 3; ++dx) {
+      const Rgb c = image.At(320 + dx, 240 + dy);
+      EXPECT_TRUE(c.r == 0 && c.g == 0 && c.b == 0) << dx << ", " << dy;
+    }
+  const Rgb face = image.At(320 + 30, 240);
+  EXPECT_FALSE(IsBackground(face));
+  EXPECT_GT(face.r, 0.3f);  // the block's colour, not the point's
+}
+
 // The scene asks for the block's mesh edges as 3-pixel red lines (unshaded, so every drawn
 // pixel is exactly red; the viewer has no multisampling). Without the panel the scene fills the
 // window; seen head-on the near face's outline is a square of side H / 1.1 around the centre, so
