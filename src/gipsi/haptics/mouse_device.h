@@ -54,9 +54,11 @@ class MouseDevice final : public HapticDevice {
   void SetButtons(std::uint32_t buttons);
   /// The tool's position as last handed over [m, scene coordinates].
   [[nodiscard]] const Vec3& position() const { return pose_.position; }
+  /// Whether a drag is in progress (BeginDrag without EndDrag since).
   [[nodiscard]] bool dragging() const { return dragging_; }
   /// The newest force commanded by the haptic side [N] (zero before the first command).
   [[nodiscard]] const Vec3& TakeForce();
+  /// The parameters it was built with.
   [[nodiscard]] const MouseDeviceParams& params() const { return params_; }
 
   // --- haptic side ---

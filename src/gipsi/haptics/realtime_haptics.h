@@ -41,6 +41,7 @@ class RealtimeHaptics {
   /// Stops and joins the loops; logs and returns (probe name, statistics) for each loop that
   /// ran. Idempotent (a second call returns nothing).
   std::vector<std::pair<std::string, HapticLoopStats>> Stop();
+  /// The real-time probes it runs.
   [[nodiscard]] const std::vector<HapticProbe*>& probes() const { return probes_; }
 
  private:
