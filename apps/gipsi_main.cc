@@ -21,6 +21,7 @@
 
 #include "gipsi/base/error.h"
 #include "gipsi/base/log.h"
+#include "gipsi/haptics/realtime_haptics.h"
 #include "gipsi/io/mesh_io.h"
 #include "gipsi/io/mesh_summary.h"
 #include "gipsi/io/outputs.h"
@@ -156,6 +157,16 @@ int Run(const std::string& file, const std::string& out_dir, double until, bool 
   std::filesystem::path out =
       out_dir.empty() ? scene.output_directory : std::filesystem::path(out_dir);
   gipsi::Kernel& kernel = *scene.kernel;
+  // A real-time probe ticks on the wall clock: the run is not reproducible, so there is nothing
+  // a checkpoint could restore bit for bit.
+  if (checkpoints.every > 0 || !checkpoints.resume.empty())
+    if (const auto probes = gipsi::RealtimeProbes(kernel); !probes.empty())
+      gipsi::ThrowInputError(
+          "command line", checkpoints.every > 0 ? "--checkpoint-every" : "--resume",
+          fmt::format("the scene's HapticProbe '{}' is real-time (objects.{}.realtime): a "
+                      "real-time run is not deterministic and cannot be checkpointed or resumed; "
+                      "drop \"realtime\" for a reproducible run",
+                      probes.front()->name(), probes.front()->name()));
   if (checkpoints.every > 0) {
     const double steps = checkpoints.every / kernel.macro_dt();
     const auto every = static_cast<std::int64_t>(std::llround(steps));
@@ -174,8 +185,11 @@ int Run(const std::string& file, const std::string& out_dir, double until, bool 
   g_running_kernel.store(&kernel);
   std::signal(SIGINT, HandleStopSignal);
   std::signal(SIGTERM, HandleStopSignal);
+  gipsi::RealtimeHaptics haptics(kernel);  // joins the loops however the run ends
+  haptics.Start();
   gipsi::RunResult result =
       kernel.Run(scene.end_time, [&](double t, double end) { progress.Update(t, end); });
+  haptics.Stop();  // logs each loop's period percentiles
   g_running_kernel.store(nullptr);
   std::signal(SIGINT, SIG_DFL);
   std::signal(SIGTERM, SIG_DFL);

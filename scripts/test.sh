@@ -63,9 +63,10 @@ if [ "${1:-}" != "--fast" ]; then
   ctest --preset asan -E "$asan_skip"
   stage_done asan
 
-  # ThreadSanitizer (haptic loop, display publishing, viewer simulation thread): 25 tests in
-  # 36 s on this machine; the build mostly hits ccache after the first (cold: about 50 min of
-  # compilation under load, docs/robustness.md).
+  # ThreadSanitizer (haptic loop, real-time probes in scenes, display publishing, viewer
+  # simulation thread): 36 tests in 73 s on this machine (load average about 5); the build
+  # mostly hits ccache after the first (cold: about 50 min of compilation under load,
+  # docs/robustness.md).
   echo "== tsan (thread sanitizer: haptic loop, display publishing, viewer simulation thread)"
   cmake --preset tsan
   cmake --build --preset tsan

@@ -3,6 +3,7 @@
 #include <chrono>
 
 #include "gipsi/base/log.h"
+#include "gipsi/haptics/haptic_probe.h"
 
 namespace gipsi::viz {
 namespace {
@@ -32,8 +33,26 @@ void SimulationThread::Load() {
   tool_.Release();
   auto scene = std::make_unique<Scene>(load_());
   auto display = std::make_unique<SceneDisplay>(*scene->kernel, scene->display, initial_colors_);
+  {
+    std::lock_guard lock(mutex_);
+    mouse_ = nullptr;
+  }
+  haptics_.reset();  // joins the old scene's real-time haptic loops before the scene goes
   scene_ = std::move(scene);
   display_ = std::move(display);
+  // Real-time probes tick from the load on, playing or paused (paused, their models go stale
+  // and the watchdog fades the force out).
+  haptics_ = std::make_unique<RealtimeHaptics>(*scene_->kernel);
+  haptics_->Start();
+  MouseDevice* mouse = nullptr;
+  Coordinator& coordinator = scene_->kernel->coordinator();
+  for (std::size_t i = 0; i < coordinator.num_objects() && mouse == nullptr; ++i)
+    if (auto* probe = dynamic_cast<HapticProbe*>(&coordinator.object(i)))
+      mouse = probe->mouse_device();
+  {
+    std::lock_guard lock(mutex_);
+    mouse_ = mouse;
+  }
   traces_.clear();
   trace_probes_.clear();
   for (std::size_t p = 0; p < scene_->probes.size(); ++p) {
@@ -51,6 +70,7 @@ void SimulationThread::Load() {
     s.time = scene_->kernel->time();
     s.end_time = scene_->end_time;
     s.macro_dt = scene_->kernel->macro_dt();
+    s.haptic_mouse = mouse != nullptr;
     s.objects.clear();
     s.draws.clear();
     for (std::size_t i = 0; i < display_->size(); ++i) {
@@ -145,6 +165,27 @@ void SimulationThread::ReleaseTool() {
   std::lock_guard lock(mutex_);
   commands_.tool = 2;
   wake_.notify_all();
+}
+void SimulationThread::HapticBeginDrag(const Vec3& view_direction) {
+  std::lock_guard lock(mutex_);
+  if (mouse_) mouse_->BeginDrag(view_direction);
+}
+void SimulationThread::HapticDragTo(const Vec3& origin, const Vec3& direction) {
+  std::lock_guard lock(mutex_);
+  if (mouse_) (void)mouse_->DragTo(origin, direction);
+}
+void SimulationThread::HapticEndDrag() {
+  std::lock_guard lock(mutex_);
+  if (mouse_) mouse_->EndDrag();
+}
+void SimulationThread::HapticPush(const Vec3& view_direction, double notches) {
+  std::lock_guard lock(mutex_);
+  if (mouse_) mouse_->Push(view_direction, notches);
+}
+std::optional<std::pair<Vec3, Vec3>> SimulationThread::HapticTool() {
+  std::lock_guard lock(mutex_);
+  if (!mouse_) return std::nullopt;
+  return std::make_pair(mouse_->position(), mouse_->TakeForce());
 }
 void SimulationThread::RunUntil(double time) {
   std::lock_guard lock(mutex_);

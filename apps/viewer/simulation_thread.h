@@ -11,10 +11,13 @@
 #include <functional>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <thread>
 #include <vector>
 
+#include "gipsi/haptics/mouse_device.h"
+#include "gipsi/haptics/realtime_haptics.h"
 #include "gipsi/io/scene.h"
 #include "gipsi/viz/display_manager.h"
 #include "gipsi/viz/mouse_tool.h"
@@ -33,6 +36,8 @@ struct SimulationStatus {
   std::vector<std::pair<std::string, std::vector<std::string>>> objects;
   /// Per display surface: how it is drawn and coloured now.
   std::vector<DrawSpec> draws;
+  /// The scene has a haptic tool the mouse moves (a HapticProbe with a Mouse device).
+  bool haptic_mouse = false;
 };
 
 /// Owns the scene while it runs. Not copyable or movable.
@@ -63,6 +68,15 @@ class SimulationThread {
   void ReleaseTool();
   /// Runs (playing) until the simulated time reaches `time`, then pauses.
   void RunUntil(double time);
+  /// The scene's mouse-moved haptic tool (the first HapticProbe with a Mouse device), from the
+  /// window thread: MouseDevice's GUI-side calls, made under the mutex so that a reset cannot
+  /// take the device away during one. Each does nothing when the scene has no such tool.
+  void HapticBeginDrag(const Vec3& view_direction);
+  void HapticDragTo(const Vec3& origin, const Vec3& direction);
+  void HapticEndDrag();
+  void HapticPush(const Vec3& view_direction, double notches);
+  /// The tool's position [m] and the force last commanded to it [N], if there is a tool.
+  [[nodiscard]] std::optional<std::pair<Vec3, Vec3>> HapticTool();
 
   [[nodiscard]] SimulationStatus status() const;
 
@@ -89,6 +103,7 @@ class SimulationThread {
   std::vector<std::pair<std::string, ColorSpec>> initial_colors_;
   TripleBuffer<FrameBuffers>& frames_;
   std::unique_ptr<Scene> scene_;
+  std::unique_ptr<RealtimeHaptics> haptics_;  // after scene_: destroyed (loops joined) first
   std::unique_ptr<SceneDisplay> display_;
   std::vector<ProbeTrace> traces_;
   std::vector<std::size_t> trace_probes_;  // the probe of each trace (line probes have none)
@@ -99,6 +114,7 @@ class SimulationThread {
   std::condition_variable wake_;
   Commands commands_;
   SimulationStatus status_;
+  MouseDevice* mouse_ = nullptr;  // in scene_; guarded by mutex_
   std::atomic<bool> quit_{false};
   std::thread thread_;
 };

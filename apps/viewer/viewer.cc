@@ -53,6 +53,20 @@ std::pair<Vec3, Vec3> MouseRay(const Camera& camera, double x, double y, int lef
 
 const char* const kComponents[] = {"magnitude", "x", "y", "z"};
 
+/// The haptic tool at `position` as a point surface: black without force, red with.
+SurfaceBuffers HapticToolPoint(const Vec3& position, const Vec3& force) {
+  SurfaceBuffers s;
+  s.object = "haptic tool";
+  s.primitive = Primitive::kPoints;
+  s.size = 12;
+  s.positions = {float(position.x()), float(position.y()), float(position.z())};
+  s.normals = {0, 0, 0};
+  const bool pushing = force.squaredNorm() > 0;
+  s.colors = {pushing ? 1.0f : 0.0f, 0, 0};
+  s.indices = {0};
+  return s;
+}
+
 struct SurfaceUi {
   bool visible = true;
   bool wireframe = false;
@@ -134,7 +148,7 @@ int RunViewer(const ViewerOptions& options) {
     std::vector<SurfaceUi> ui;
     float speed = static_cast<float>(options.speed > 0 ? options.speed : 1.0);
     bool as_fast_as_possible = options.speed <= 0;
-    bool dragging_tool = false;
+    bool dragging_tool = false, dragging_haptic = false;
     Vec3 tool_plane_point = Vec3::Zero(), tool_plane_normal = Vec3::UnitZ();
     int frames_at_screenshot_time = 0;
     bool scripted_drag_done = !options.drag.has_value();
@@ -190,7 +204,14 @@ int RunViewer(const ViewerOptions& options) {
       if (!io.WantCaptureMouse) {
         const double mx = io.MousePos.x * scale, my = io.MousePos.y * scale;
         const bool tool_key = io.KeyCtrl || io.KeyShift;
-        if (ImGui::IsMouseClicked(ImGuiMouseButton_Left) && tool_key) {
+        const Vec3 forward = (camera.target - camera.Eye()).normalized();
+        if (ImGui::IsMouseClicked(ImGuiMouseButton_Left) && tool_key && status.haptic_mouse) {
+          // The scene's haptic tool: dragged in the plane through it that faces the viewer.
+          const auto [origin, dir] = MouseRay(camera, mx, my, panel, scene_width, fb_height);
+          sim.HapticBeginDrag(forward);
+          sim.HapticDragTo(origin, dir);
+          dragging_haptic = true;
+        } else if (ImGui::IsMouseClicked(ImGuiMouseButton_Left) && tool_key) {
           const auto [origin, dir] = MouseRay(camera, mx, my, panel, scene_width, fb_height);
           if (auto hit = PickSurface(frame, origin, dir, render.hidden)) {
             sim.Grab(hit->surface, hit->point);
@@ -199,7 +220,10 @@ int RunViewer(const ViewerOptions& options) {
             tool_plane_normal = (camera.target - camera.Eye()).normalized();
           }
         }
-        if (dragging_tool && ImGui::IsMouseDown(ImGuiMouseButton_Left)) {
+        if (dragging_haptic && ImGui::IsMouseDown(ImGuiMouseButton_Left)) {
+          const auto [origin, dir] = MouseRay(camera, mx, my, panel, scene_width, fb_height);
+          sim.HapticDragTo(origin, dir);
+        } else if (dragging_tool && ImGui::IsMouseDown(ImGuiMouseButton_Left)) {
           const auto [origin, dir] = MouseRay(camera, mx, my, panel, scene_width, fb_height);
           const double denom = dir.dot(tool_plane_normal);
           if (std::abs(denom) > 1e-9)
@@ -215,12 +239,20 @@ int RunViewer(const ViewerOptions& options) {
           const double k = camera.distance * 0.0015;
           camera.target -= k * (io.MouseDelta.x * right - io.MouseDelta.y * up);
         }
-        if (io.MouseWheel != 0) camera.distance *= std::pow(0.9, io.MouseWheel);
+        if (io.MouseWheel != 0 && tool_key && status.haptic_mouse)
+          sim.HapticPush(forward, io.MouseWheel);  // wheel up: the tool goes into the scene
+        else if (io.MouseWheel != 0)
+          camera.distance *= std::pow(0.9, io.MouseWheel);
       }
       if (!scripted_drag_done && fitted) {  // --drag: the same path as a real Ctrl + drag
         const auto& d = *options.drag;
         const auto [origin, dir] = MouseRay(camera, d[0], d[1], panel, scene_width, fb_height);
-        if (auto hit = PickSurface(frame, origin, dir, render.hidden)) {
+        if (status.haptic_mouse) {  // the haptic tool: to the end point, in its facing plane
+          const auto [o, r] = MouseRay(camera, d[2], d[3], panel, scene_width, fb_height);
+          sim.HapticBeginDrag((camera.target - camera.Eye()).normalized());
+          sim.HapticDragTo(o, r);
+          sim.HapticEndDrag();
+        } else if (auto hit = PickSurface(frame, origin, dir, render.hidden)) {
           sim.Grab(hit->surface, hit->point);
           const Vec3 normal = (camera.target - camera.Eye()).normalized();
           const auto [o, r] = MouseRay(camera, d[2], d[3], panel, scene_width, fb_height);
@@ -234,6 +266,10 @@ int RunViewer(const ViewerOptions& options) {
       if (dragging_tool && !ImGui::IsMouseDown(ImGuiMouseButton_Left)) {
         sim.ReleaseTool();
         dragging_tool = false;
+      }
+      if (dragging_haptic && !ImGui::IsMouseDown(ImGuiMouseButton_Left)) {
+        sim.HapticEndDrag();
+        dragging_haptic = false;
       }
 
       if (options.show_ui) {
@@ -308,9 +344,19 @@ int RunViewer(const ViewerOptions& options) {
           ImGui::PopID();
         }
         ImGui::Separator();
-        ImGui::TextWrapped(
-            "Mouse: left drag orbits, right drag pans, wheel zooms; Ctrl (or Shift) + left "
-            "drag pulls the surface.");
+        if (status.haptic_mouse) {
+          ImGui::TextWrapped(
+              "Mouse: left drag orbits, right drag pans, wheel zooms; Ctrl (or Shift) + left "
+              "drag moves the haptic tool in the plane facing you, Ctrl + wheel pushes it "
+              "into the scene or pulls it back.");
+          if (const auto tool = sim.HapticTool())
+            ImGui::Text("tool at (%.4g, %.4g, %.4g) m\nforce %.3g N", tool->first.x(),
+                        tool->first.y(), tool->first.z(), tool->second.norm());
+        } else {
+          ImGui::TextWrapped(
+              "Mouse: left drag orbits, right drag pans, wheel zooms; Ctrl (or Shift) + left "
+              "drag pulls the surface.");
+        }
         if (!frame.traces.empty()) {
           ImGui::Separator();
           for (const ProbeTrace& trace : frame.traces)
@@ -328,7 +374,17 @@ int RunViewer(const ViewerOptions& options) {
       }
 
       render.viewport_x = panel;
-      renderer.Draw(frame, camera, scene_width, fb_height, render);
+      // The haptic tool, drawn over a copy of the frame: a 12-pixel point, black while it
+      // feels nothing, red while a force is commanded to it.
+      const FrameBuffers* drawn = &frame;
+      FrameBuffers with_tool;
+      if (status.haptic_mouse && frame.frame >= 0)
+        if (const auto tool = sim.HapticTool()) {
+          with_tool = frame;
+          with_tool.surfaces.push_back(HapticToolPoint(tool->first, tool->second));
+          drawn = &with_tool;
+        }
+      renderer.Draw(*drawn, camera, scene_width, fb_height, render);
       ImGui::Render();
       gl.Viewport(0, 0, fb_width, fb_height);
       ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
@@ -347,6 +403,11 @@ int RunViewer(const ViewerOptions& options) {
           std::cout << fmt::format("{}: {} x {} at t = {:.6g} s ({})\n", options.screenshot,
                                    image.width, image.height, frame.time,
                                    reinterpret_cast<const char*>(gl.GetString(GL_RENDERER)));
+          if (const auto tool = sim.HapticTool())
+            std::cout << fmt::format(
+                "haptic tool at ({:.9g}, {:.9g}, {:.9g}) m, force ({:.9g}, {:.9g}, {:.9g}) N\n",
+                tool->first.x(), tool->first.y(), tool->first.z(), tool->second.x(),
+                tool->second.y(), tool->second.z());
         } catch (const std::exception& e) {
           std::cerr << "gipsi: error: " << e.what() << "\n";
           exit_code = 4;

@@ -139,6 +139,75 @@ TEST(Viewer, TheMouseToolPullsTheSurface) {
   EXPECT_TRUE(IsBackground(image.At(panel + 20, 30)));
 }
 
+TEST(Viewer, TheMouseMovesAHapticToolIntoTheTissue) {
+#if defined(__SANITIZE_ADDRESS__)
+  GTEST_SKIP() << "the windowed viewer (GLFW, Mesa's GLX) is not run under AddressSanitizer";
+#endif
+  // A haptic probe whose device is the mouse, ticking in a real-time loop, starts 5 cm left of
+  // the block's left face (x = 0) at the height of its centre. Seen head-on (looking along +y),
+  // --drag moves the tool in the plane y = 0.5 facing the viewer to the pick ray of the window's
+  // centre: the block's centre (0.5, 0.5, 0.5), the camera's target. There the coupling spring
+  // (1000 N/m) stretched over 0.5 m asks for far more than max_force, so the force commanded is
+  // clamped to 2 N and points out of the left face (−x, the contact vertex's normal); the
+  // staleness limit is raised because the simulation under Xvfb may lag the wall clock.
+  std::string scene = kBlock;
+  const std::string anchor = R"("schedule")";
+  scene.replace(
+      scene.find(anchor), anchor.size(),
+      R"("connectors": {"haptics": {"type": "HapticCoupling", "object": "block", "device": "probe", "capture_distance": 0.1}},
+    "schedule")");
+  const std::string objects_end = R"("fix": true}]}},)";
+  scene.replace(scene.find(objects_end), objects_end.size(), R"("fix": true}]},
+      "probe": {"type": "HapticProbe", "dt": 0.01, "rate": 1000, "coupling_stiffness": 1000,
+                "max_force": 2, "stale_after": 10, "realtime": true,
+                "device": {"type": "Mouse", "start": [-0.05, 0.5, 0.5]}}},)");
+  const ViewRun run =
+      ViewUnderXvfb("haptic", "--no-ui --screenshot-time 0.2 --drag 320,240,320,240", scene);
+  SKIP_WITHOUT_DISPLAY(run);
+  ASSERT_EQ(run.code, 0) << run.output;
+  double x[3], f[3];
+  const auto at = run.output.find("haptic tool at");
+  ASSERT_NE(at, std::string::npos) << run.output;
+  ASSERT_EQ(std::sscanf(run.output.c_str() + at,
+                        "haptic tool at (%lf, %lf, %lf) m, force (%lf, %lf, %lf) N", &x[0], &x[1],
+                        &x[2], &f[0], &f[1], &f[2]),
+            6)
+      << run.output;
+  // The centre pixel's ray is the camera's axis up to float rounding of the view matrices.
+  EXPECT_NEAR(x[0], 0.5, 1e-4);
+  EXPECT_NEAR(x[1], 0.5, 1e-9);  // on the drag plane (computed in double)
+  EXPECT_NEAR(x[2], 0.5, 1e-4);
+  EXPECT_NEAR(f[0], -2, 1e-9);  // clamped to max_force, normal to the left face
+  EXPECT_NEAR(f[1], 0, 1e-9);
+  EXPECT_NEAR(f[2], 0, 1e-9);
+}
+
+TEST(Viewer, DrawsTheHapticToolAsABlackPointWhileItFeelsNothing) {
+#if defined(__SANITIZE_ADDRESS__)
+  GTEST_SKIP() << "the windowed viewer (GLFW, Mesa's GLX) is not run under AddressSanitizer";
+#endif
+  // The mouse tool rests 0.1 m in front of the near face's centre, on the camera's axis (the
+  // window's centre without the panel), outside the block: a 12-pixel black point (points are
+  // unshaded, so exactly black) over the block's face, which shows around it.
+  std::string scene = kBlock;
+  const std::string objects_end = R"("fix": true}]}},)";
+  scene.replace(scene.find(objects_end), objects_end.size(), R"("fix": true}]},
+      "probe": {"type": "HapticProbe", "dt": 0.01, "realtime": true,
+                "device": {"type": "Mouse", "start": [0.5, -0.1, 0.5]}}},)");
+  const ViewRun run = ViewUnderXvfb("tool", "--no-ui --screenshot-time 0.05", scene);
+  SKIP_WITHOUT_DISPLAY(run);
+  ASSERT_EQ(run.code, 0) << run.output;
+  const Image& image = run.image;
+  for (int dy = -3; dy <= 3; ++dy)
+    for (int dx = -3; dx <= 3; ++dx) {
+      const Rgb c = image.At(320 + dx, 240 + dy);
+      EXPECT_TRUE(c.r == 0 && c.g == 0 && c.b == 0) << dx << ", " << dy;
+    }
+  const Rgb face = image.At(320 + 30, 240);
+  EXPECT_FALSE(IsBackground(face));
+  EXPECT_GT(face.r, 0.3f);  // the block's colour, not the point's
+}
+
 // The scene asks for the block's mesh edges as 3-pixel red lines (unshaded, so every drawn
 // pixel is exactly red; the viewer has no multisampling). Without the panel the scene fills the
 // window; seen head-on the near face's outline is a square of side H / 1.1 around the centre, so

@@ -33,6 +33,7 @@ void HapticLoop::Start() {
   GIPSI_CHECK(!thread_.joinable(), "HapticLoop started twice");
   stop_.store(false);
   ready_.store(false);
+  start_ = Clock::now();
   thread_ = std::thread([this] { Run(); });
   while (!ready_.load()) std::this_thread::yield();
   if (fifo_error_ != 0)
@@ -64,6 +65,11 @@ void HapticLoop::ApplyScheduling() {
   }
 }
 
+double HapticLoop::Elapsed() const {
+  if (start_ == Clock::time_point{}) return 0;
+  return std::chrono::duration<double>(Clock::now() - start_).count();
+}
+
 void HapticLoop::Stop() {
   stop_.store(true);
   if (thread_.joinable()) thread_.join();
@@ -74,9 +80,9 @@ void HapticLoop::Run() {
   ready_.store(true);
   const auto period =
       std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(period_));
-  const auto start = Clock::now();
-  auto previous = start;
-  auto next = start + period;
+  const auto start = start_;
+  auto previous = Clock::now();
+  auto next = previous + period;
   while (!stop_.load(std::memory_order_relaxed)) {
     std::this_thread::sleep_until(next);
     const auto now = Clock::now();

@@ -10,6 +10,7 @@
 /// the whole jitter budget).
 
 #include <atomic>
+#include <chrono>
 #include <thread>
 #include <vector>
 
@@ -54,6 +55,11 @@ class HapticLoop {
   void Stop();
   /// Statistics of the periods recorded so far (call after Stop).
   [[nodiscard]] HapticLoopStats Stats() const;
+  /// Whether the thread has been started and not stopped yet.
+  [[nodiscard]] bool running() const { return thread_.joinable(); }
+  /// Seconds on the loop's clock: wall-clock time since Start, the time the renderer is ticked
+  /// with. Safe from any thread once Start has returned (0 before the first Start).
+  [[nodiscard]] double Elapsed() const;
 
  private:
   void Run();
@@ -63,6 +69,7 @@ class HapticLoop {
   HapticRealtime realtime_;
   int fifo_error_ = 0, pin_error_ = 0;  // errno of the failed requests (set before ready_)
   std::atomic<bool> ready_{false};
+  std::chrono::steady_clock::time_point start_{};  // set before the thread starts
   std::vector<double> periods_;
   std::size_t recorded_ = 0;
   double cost_ = 0;

@@ -1,6 +1,10 @@
 #include "gipsi/haptics/haptic_probe.h"
 
+#include <sched.h>
+
+#include <chrono>
 #include <cmath>
+#include <thread>
 
 #include <fmt/format.h>
 
@@ -11,12 +15,41 @@
 
 namespace gipsi {
 
+/// Ticks the probe on the haptic thread and hands its outputs to the probe's step.
+class HapticProbe::LoopRenderer final : public HapticRenderer {
+ public:
+  explicit LoopRenderer(HapticProbe& probe) : probe_(probe) {}
+  Vec3 Run(double t, double dt) noexcept override {
+    const double th = probe_.loop_origin_ + t;  // the haptic clock in simulation seconds
+    Sample& s = probe_.samples_->back();
+    if (probe_.tick_) {
+      s.force = probe_.tick_->Run(th, dt);
+      s.position = probe_.tick_->tool_position();
+      s.proxy = probe_.tick_->proxy();
+      s.model_force = probe_.tick_->model_force();
+    } else {  // not coupled: the device moves freely
+      s.position = s.proxy = probe_.spec_.workspace.ToSimulation(probe_.device_->Read(th).position);
+    }
+    s.ticks = ++ticks_;
+    probe_.samples_->Publish();
+    return s.force;
+  }
+
+ private:
+  HapticProbe& probe_;
+  std::int64_t ticks_ = 0;
+};
+
 HapticProbe::HapticProbe(std::string name, const HapticProbeSpec& spec)
     : SimObject(std::move(name)), spec_(spec) {
   if (spec.igtl) {
     auto igtl = std::make_unique<IgtlDevice>(*spec.igtl);
     igtl_ = igtl.get();
     device_ = std::move(igtl);
+  } else if (spec.mouse) {
+    auto mouse = std::make_unique<MouseDevice>(*spec.mouse);
+    mouse_ = mouse.get();
+    device_ = std::move(mouse);
   } else {
     device_ = std::make_unique<VirtualDevice>(spec.path);
   }
@@ -33,6 +66,36 @@ HapticProbe::HapticProbe(std::string name, const HapticProbeSpec& spec)
   f_model_force_ = DeclareField(
       {"model_force", L::kGlobal, 1, "N", A::kRead, "normal contact force of the local model"});
   position_ = proxy_ = initial_ = spec_.workspace.ToSimulation(device_->Read(0).position);
+  if (spec_.realtime) {
+    Sample first;
+    first.position = first.proxy = initial_;
+    samples_ = std::make_unique<LatestValue<Sample>>(first);
+    renderer_ = std::make_unique<LoopRenderer>(*this);
+    loop_ =
+        std::make_unique<HapticLoop>(*renderer_, spec_.rate, std::size_t{1} << 20, *spec_.realtime);
+  }
+}
+
+HapticProbe::~HapticProbe() { StopLoop(); }
+
+void HapticProbe::StartLoop(double sim_time) {
+  GIPSI_CHECK(loop_ != nullptr, "HapticProbe '{}' is not real-time", name());
+  GIPSI_CHECK(!loop_->running(), "HapticProbe '{}': loop started twice", name());
+  loop_origin_ = sim_time;  // before the thread starts: it reads it
+  loop_->Start();
+}
+
+HapticLoopStats HapticProbe::StopLoop() {
+  if (!loop_) return {};
+  loop_->Stop();
+  return loop_->Stats();
+}
+
+HapticRenderer* HapticProbe::loop_renderer() { return renderer_.get(); }
+
+double HapticProbe::HapticTime(double sim_time) const {
+  if (!loop_running()) return sim_time;
+  return loop_origin_ + loop_->Elapsed();
 }
 
 void HapticProbe::Attach(LatestValue<LocalDynamicModel>& models,
@@ -42,7 +105,27 @@ void HapticProbe::Attach(LatestValue<LocalDynamicModel>& models,
       std::make_unique<LocalModelTick>(*device_, spec_.workspace, models, &feedback, spec_.tick);
 }
 
+StepStatus HapticProbe::StepRealtime(double t, double dt) {
+  if (!loop_running())
+    return StepStatus::Failed(
+        "the probe is real-time (\"realtime\") but its haptic loop is not running: run the scene "
+        "with gipsi run or gipsi view (a program starts the loop with RealtimeHaptics)");
+  // Never ahead of the wall clock: the device, the models' age and the watchdog live on it.
+  const double ahead = (t + dt) - HapticTime(t);
+  if (ahead > 0) std::this_thread::sleep_for(std::chrono::duration<double>(ahead));
+  if (samples_->Fetch()) {
+    const Sample& s = samples_->front();
+    force_ = s.force;
+    position_ = s.position;
+    proxy_ = s.proxy;
+    model_force_ = s.model_force;
+    ticks_ = s.ticks;
+  }
+  return StepStatus::Ok();
+}
+
 StepStatus HapticProbe::DoStep(double t, double dt) {
+  if (loop_) return StepRealtime(t, dt);
   const int n = std::max(1, static_cast<int>(std::lround(dt * spec_.rate)));
   const double h = dt / n;
   for (int k = 1; k <= n; ++k) {
@@ -51,10 +134,10 @@ StepStatus HapticProbe::DoStep(double t, double dt) {
       force_ = tick_->Run(tk, h);
       proxy_ = tick_->proxy();
       model_force_ = tick_->model_force();
+      position_ = tick_->tool_position();
     } else {
-      proxy_ = spec_.workspace.ToSimulation(device_->Read(tk).position);
+      position_ = proxy_ = spec_.workspace.ToSimulation(device_->Read(tk).position);
     }
-    position_ = spec_.workspace.ToSimulation(device_->Read(tk).position);
     ++ticks_;
   }
   return StepStatus::Ok();
@@ -80,7 +163,7 @@ void HapticProbe::DoWriteField(FieldId /*id*/, const Eigen::Ref<const Eigen::Mat
 
 HapticCoupling::HapticCoupling(std::string name, SimObject& object, HapticProbe& probe,
                                const HapticBridgeParams& params, int rings)
-    : Connector(std::move(name)) {
+    : Connector(std::move(name)), probe_(probe) {
   if (auto* fem = dynamic_cast<FemSolid*>(&object)) {
     builder_ = std::make_unique<FemCondensation>(*fem);
   } else if (auto* ms = dynamic_cast<MassSpring*>(&object)) {
@@ -96,15 +179,55 @@ HapticCoupling::HapticCoupling(std::string name, SimObject& object, HapticProbe&
   bridge_ = std::make_unique<HapticBridge>(*builder_, params);
   bridge_->SeedTool(probe.initial_position());
   probe.Attach(bridge_->models(), bridge_->feedback());
+  // A first model at the object's initial state, so a real-time loop started before the first
+  // step (the viewer, paused) already renders the contact. The first firing supersedes it
+  // before any synchronous tick could fetch it.
+  bridge_->Publish(probe.time());
 }
+
+HapticCoupling::~HapticCoupling() { probe_.StopLoop(); }
 
 StepStatus HapticCoupling::DoFire(double t) {
   bridge_->ApplyFeedback();
-  bridge_->Publish(t);
+  bridge_->Publish(probe_.HapticTime(t));
   return StepStatus::Ok();
 }
 
 // ---------------------------------------------------------------------------------------------
+
+namespace {
+
+MouseDeviceParams ParseMouseDevice(const JsonNode& node) {
+  node.CheckKeys({"type", "start", "wheel_step"});
+  MouseDeviceParams params;
+  params.start = node.Vector3("start");
+  params.wheel_step = node.Positive("wheel_step", params.wheel_step);
+  return params;
+}
+
+std::optional<HapticRealtime> ParseRealtime(const JsonNode& node) {
+  const char* const expected =
+      "true, false or an object {\"fifo\": false, \"priority\": 80, \"cpu\": -1}";
+  if (node.is_object()) {
+    node.CheckKeys({"fifo", "priority", "cpu"});
+    HapticRealtime realtime;
+    realtime.fifo = node.Bool("fifo", realtime.fifo);
+    const std::int64_t priority = node.Int("priority", realtime.priority);
+    if (priority < 1 || priority > 99) node.At("priority").Expected("an integer in 1-99");
+    realtime.priority = static_cast<int>(priority);
+    const std::int64_t cpu = node.Int("cpu", realtime.cpu);
+    if (cpu < -1 || cpu >= CPU_SETSIZE)
+      node.At("cpu").Expected(
+          fmt::format("a CPU number in 0-{}, or -1 (no pinning)", CPU_SETSIZE - 1));
+    realtime.cpu = static_cast<int>(cpu);
+    return realtime;
+  }
+  if (node.raw().is_boolean())
+    return node.AsBool() ? std::optional<HapticRealtime>(HapticRealtime{}) : std::nullopt;
+  node.Expected(expected);
+}
+
+}  // namespace
 
 void RegisterHaptics(TypeRegistry& registry) {
   registry.objects.Register(
@@ -113,14 +236,23 @@ void RegisterHaptics(TypeRegistry& registry) {
         const JsonNode& p = ctx.params;
         ctx.CheckKeys({"path", "device", "rate", "coupling_stiffness", "coupling_damping",
                        "blend_time", "max_force", "max_rate", "stale_after", "fade_time",
-                       "workspace_scale", "workspace_offset"});
+                       "workspace_scale", "workspace_offset", "realtime"});
         HapticProbeSpec spec;
         if (p.Has("device") == p.Has("path"))
           p.Fail(
               "a HapticProbe needs exactly one of \"path\" (a virtual device) and \"device\" (an "
-              "OpenIGTLink device)");
+              "OpenIGTLink or Mouse device)");
         if (p.Has("device")) {
-          spec.igtl = ParseIgtlDevice(p.At("device"));
+          const JsonNode device = p.At("device");
+          if (device.is_object() && device.Has("type") && device.At("type").is_string() &&
+              device.At("type").AsString() == "Mouse") {
+            spec.mouse = ParseMouseDevice(device);
+            for (const char* key : {"workspace_scale", "workspace_offset"})
+              if (p.Has(key))
+                p.At(key).Fail("a Mouse device works in scene coordinates: no workspace mapping");
+          } else {
+            spec.igtl = ParseIgtlDevice(device);
+          }
         } else {
           const JsonNode path = p.At("path");
           if (!path.is_array() || path.size() == 0)
@@ -144,6 +276,7 @@ void RegisterHaptics(TypeRegistry& registry) {
         spec.tick.safety.max_rate = p.Positive("max_rate", spec.tick.safety.max_rate);
         spec.tick.safety.stale_after = p.Positive("stale_after", spec.tick.safety.stale_after);
         spec.tick.safety.fade_time = p.NonNegative("fade_time", spec.tick.safety.fade_time);
+        if (p.Has("realtime")) spec.realtime = ParseRealtime(p.At("realtime"));
         if (!spec.igtl) return std::make_unique<HapticProbe>(ctx.name, spec);
         try {
           return std::make_unique<HapticProbe>(ctx.name, spec);

@@ -1,13 +1,16 @@
 #pragma once
 /// @file
 /// Multi-rate haptics in scene files:
-///  - `HapticProbe` (object): a haptic device — a virtual one on a scripted path, or an
-///    OpenIGTLink client (`IgtlDevice`) — whose step runs the haptic tick (`LocalModelTick`) at
-///    `rate` over the step, synchronously (headless runs are then deterministic; a real-time
-///    run would tick the same renderer in a `HapticLoop`). Fields
-///    (global, read): "tool_force" (force on the device [N]), "tool_position" [m],
-///    "proxy_position" [m] (the god-object on the local surface), "model_force" (the local
-///    model's normal contact force [N]).
+///  - `HapticProbe` (object): a haptic device — a virtual one on a scripted path, a mouse in the
+///    viewer (`MouseDevice`), or an OpenIGTLink client (`IgtlDevice`) — rendering local models
+///    with a `LocalModelTick` at `rate`. By default the probe's step runs the ticks over the
+///    step, synchronously (headless runs are then deterministic). With "realtime" the ticks run
+///    in a `HapticLoop` on their own thread, on the wall clock, while the simulation runs
+///    (`RealtimeHaptics`, realtime_haptics.h, starts and stops the loop with the run); the
+///    probe's step then only reads the loop's newest outputs into its fields and keeps the
+///    simulation from running ahead of the wall clock. Fields (global, read): "tool_force"
+///    (force on the device [N]), "tool_position" [m], "proxy_position" [m] (the god-object on
+///    the local surface), "model_force" (the local model's normal contact force [N]).
 ///  - `HapticCoupling` (connector): joins a deformable object and a probe through a
 ///    `HapticBridge`: when it fires it applies the newest tool force to the object (boundary
 ///    condition) and publishes a local model built at the object's current state
@@ -18,35 +21,43 @@
 ///   "probe": {"type": "HapticProbe", "path": [[t, x, y, z], ...], "rate": 1000,
 ///             "coupling_stiffness": 5000, "coupling_damping": 0, "blend_time": 0.01,
 ///             "max_force": 3, "max_rate": 1000, "stale_after": 0.05, "fade_time": 0.1,
-///             "workspace_scale": 1, "workspace_offset": [0, 0, 0]}
+///             "workspace_scale": 1, "workspace_offset": [0, 0, 0],
+///             "realtime": {"fifo": false, "priority": 80, "cpu": -1}}  (or "realtime": true)
 ///   or, instead of "path", "device": {"type": "OpenIGTLink", "host": "127.0.0.1",
 ///             "port": 18944, "name": "Tool", "length_unit": 0.001, "connect_timeout": 2,
 ///             "reconnect_interval": 0.5}
+///   or "device": {"type": "Mouse", "start": [x, y, z], "wheel_step": 0.002}
 ///   "haptics": {"type": "HapticCoupling", "object": "liver", "device": "probe",
 ///               "capture_distance": 0.01, "rings": 1}
 
 #include <memory>
-
 #include <optional>
+
 #include "gipsi/core/connector.h"
 #include "gipsi/core/registry.h"
 #include "gipsi/core/sim_object.h"
 
 #include "gipsi/haptics/haptic_bridge.h"
+#include "gipsi/haptics/haptic_loop.h"
 #include "gipsi/haptics/igtl_device.h"
+#include "gipsi/haptics/mouse_device.h"
 #include "gipsi/haptics/virtual_device.h"
 
 namespace gipsi {
 
 /// Parameters of a HapticProbe. Plain struct with defaults.
 struct HapticProbeSpec {
-  /// Virtual device: positions [m, device coordinates]; used when `igtl` is empty.
+  /// Virtual device: positions [m, device coordinates]; used when `igtl` and `mouse` are empty.
   std::vector<DeviceKeyframe> path;
   /// OpenIGTLink device: connection parameters (the path is then unused).
   std::optional<IgtlDeviceParams> igtl;
+  /// Mouse device (the viewer moves it; the path is then unused).
+  std::optional<MouseDeviceParams> mouse;
   DeviceWorkspace workspace;  ///< device → simulation coordinates
   double rate = 1000;         ///< haptic ticks per second
   LocalTickParams tick;
+  /// Run the ticks in a real-time HapticLoop with this scheduling (none: synchronously).
+  std::optional<HapticRealtime> realtime;
 };
 
 /// Not copyable or movable (a SimObject).
@@ -55,20 +66,42 @@ class HapticProbe final : public SimObject {
   /// Throws InputError for an empty or non-increasing path, a rate outside (0, 10 kHz] or an
   /// OpenIGTLink device that cannot connect (IgtlDevice's constructor).
   HapticProbe(std::string name, const HapticProbeSpec& spec);
+  /// Stops the real-time loop if it runs.
+  ~HapticProbe() override;
 
   [[nodiscard]] std::string_view type_name() const override { return "HapticProbe"; }
   [[nodiscard]] const Points& domain_positions() const override { return no_positions_; }
   [[nodiscard]] const HapticProbeSpec& spec() const { return spec_; }
   /// The device's position when the probe was built [m, simulation coordinates].
   [[nodiscard]] const Vec3& initial_position() const { return initial_; }
-  /// The OpenIGTLink device, or null for a virtual one.
+  /// The OpenIGTLink device, or null for another kind.
   [[nodiscard]] IgtlDevice* igtl_device() { return igtl_; }
+  /// The mouse device, or null for another kind.
+  [[nodiscard]] MouseDevice* mouse_device() { return mouse_; }
   /// Connects the probe to a bridge's buffers (once; the HapticCoupling connector does it).
   /// Throws InputError if it is already connected.
   void Attach(LatestValue<LocalDynamicModel>& models, LatestValue<HapticFeedback>& feedback);
   [[nodiscard]] bool attached() const { return tick_ != nullptr; }
-  /// Number of haptic ticks run so far.
+  /// Number of haptic ticks run so far (for a real-time probe: as of its last step).
   [[nodiscard]] std::int64_t num_ticks() const { return ticks_; }
+
+  /// Whether the probe ticks in a real-time HapticLoop (scene key "realtime").
+  [[nodiscard]] bool realtime() const { return spec_.realtime.has_value(); }
+  /// Starts the real-time loop with the haptic clock at `sim_time` [s] (RealtimeHaptics does
+  /// it when a run starts). Preconditions (checked, abort): realtime(), the loop is not running.
+  void StartLoop(double sim_time);
+  /// Stops and joins the real-time loop and returns its statistics (all zero for a loop that
+  /// never ran). Idempotent; does nothing for a synchronous probe.
+  HapticLoopStats StopLoop();
+  /// Whether the real-time loop runs.
+  [[nodiscard]] bool loop_running() const { return loop_ && loop_->running(); }
+  /// The haptic clock at simulation time `sim_time` [s]: `sim_time` itself for a synchronous
+  /// probe; for a real-time one with its loop running, the simulation time the loop started at
+  /// plus the wall-clock seconds since (models are stamped with it, so their age is real).
+  [[nodiscard]] double HapticTime(double sim_time) const;
+  /// The renderer the real-time loop ticks (null for a synchronous probe). Exposed so a test
+  /// can tick it on its own thread while the loop is stopped (e.g. under an allocation guard).
+  [[nodiscard]] HapticRenderer* loop_renderer();
 
  protected:
   StepStatus DoStep(double t, double dt) override;
@@ -76,9 +109,19 @@ class HapticProbe final : public SimObject {
   void DoWriteField(FieldId id, const Eigen::Ref<const Eigen::MatrixXd>& in) override;
 
  private:
+  class LoopRenderer;
+  /// What the loop hands to the probe's step after every tick. Plain struct.
+  struct Sample {
+    Vec3 force = Vec3::Zero(), position = Vec3::Zero(), proxy = Vec3::Zero();
+    double model_force = 0;
+    std::int64_t ticks = 0;
+  };
+  StepStatus StepRealtime(double t, double dt);
+
   HapticProbeSpec spec_;
   std::unique_ptr<HapticDevice> device_;
-  IgtlDevice* igtl_ = nullptr;  // device_, when it is an OpenIGTLink device
+  IgtlDevice* igtl_ = nullptr;    // device_, when it is an OpenIGTLink device
+  MouseDevice* mouse_ = nullptr;  // device_, when it is a mouse device
   Vec3 initial_ = Vec3::Zero();
   std::unique_ptr<LocalModelTick> tick_;
   Points no_positions_ = Points(3, 0);
@@ -86,22 +129,31 @@ class HapticProbe final : public SimObject {
   double model_force_ = 0;
   std::int64_t ticks_ = 0;
   FieldId f_force_, f_position_, f_proxy_, f_model_force_;
+  // Real-time mode (declared last: the loop stops first).
+  double loop_origin_ = 0;  // simulation time at which the loop started
+  std::unique_ptr<LatestValue<Sample>> samples_;
+  std::unique_ptr<LoopRenderer> renderer_;
+  std::unique_ptr<HapticLoop> loop_;
 };
 
 /// Not copyable or movable (a Connector).
 class HapticCoupling final : public Connector {
  public:
   /// Builds the local-model builder for `object` (FemSolid or MassSpring; InputError
-  /// otherwise) and attaches `probe` to the bridge.
+  /// otherwise), attaches `probe` to the bridge and publishes a first model at the object's
+  /// current state.
   HapticCoupling(std::string name, SimObject& object, HapticProbe& probe,
                  const HapticBridgeParams& params, int rings);
   [[nodiscard]] std::string_view type_name() const override { return "HapticCoupling"; }
+  /// Stops the probe's real-time loop (it reads this connector's buffers).
+  ~HapticCoupling() override;
   [[nodiscard]] HapticBridge& bridge() { return *bridge_; }
 
  protected:
   StepStatus DoFire(double t) override;
 
  private:
+  HapticProbe& probe_;
   std::unique_ptr<LocalModelBuilder> builder_;
   std::unique_ptr<HapticBridge> bridge_;
 };

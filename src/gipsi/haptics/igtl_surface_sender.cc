@@ -10,7 +10,7 @@ IgtlDeviceParams ParseIgtlDevice(const JsonNode& node) {
   if (!node.is_object()) node.Expected("an object {\"type\": \"OpenIGTLink\", \"host\": ...}");
   node.CheckKeys(
       {"type", "host", "port", "name", "length_unit", "connect_timeout", "reconnect_interval"});
-  (void)node.At("type").AsChoice({"OpenIGTLink"});
+  (void)node.At("type").AsChoice({"OpenIGTLink", "Mouse"});
   IgtlDeviceParams p;
   p.host = node.String("host", p.host);
   if (p.host.empty()) node.At("host").Expected("a host name or address");

@@ -17,6 +17,7 @@ LocalModelTick::LocalModelTick(HapticDevice& device, const DeviceWorkspace& work
 Vec3 LocalModelTick::Run(double t, double dt) noexcept {
   const DevicePose pose = device_.Read(t);
   const Vec3 x = workspace_.ToSimulation(pose.position);
+  tool_ = x;
   if (models_.Fetch()) {
     // Hand-over: re-anchor to the new model; the force offset is set after this tick's step.
     AnchorLocalState(models_.front(), state_);

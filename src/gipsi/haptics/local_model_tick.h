@@ -50,6 +50,8 @@ class LocalModelTick final : public HapticRenderer {
   [[nodiscard]] double proxy_depth() const { return proxy_depth_; }
   /// Proxy position [m, simulation coordinates].
   [[nodiscard]] const Vec3& proxy() const { return proxy_; }
+  /// Device position read in the last tick [m, simulation coordinates].
+  [[nodiscard]] const Vec3& tool_position() const { return tool_; }
   [[nodiscard]] const LocalState& state() const { return state_; }
   [[nodiscard]] const LocalDynamicModel& model() const { return models_.front(); }
   [[nodiscard]] const ForceSafety& safety() const { return safety_; }
@@ -66,6 +68,7 @@ class LocalModelTick final : public HapticRenderer {
   bool anchored_ = false, blend_pending_ = false, have_depth_ = false;
   double previous_depth_ = 0, depth_ = 0, proxy_depth_ = 0, model_force_ = 0;
   Vec3 rendered_ = Vec3::Zero(), offset_ = Vec3::Zero(), proxy_ = Vec3::Zero();
+  Vec3 tool_ = Vec3::Zero();
   double blend_left_ = 0;
   std::int64_t handovers_ = 0;
 };

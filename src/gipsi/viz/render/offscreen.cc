@@ -7,6 +7,7 @@
 #include <fmt/format.h>
 
 #include "gipsi/base/error.h"
+#include "gipsi/haptics/realtime_haptics.h"
 #include "gipsi/io/scene.h"
 #include "gipsi/viz/render/text.h"
 
@@ -85,7 +86,10 @@ Image RenderSnapshot(Scene& scene, SnapshotOptions options, SnapshotResult* resu
   SnapshotResult local;
   SnapshotResult& r = result ? *result : local;
   if (options.time > scene.kernel->time()) {
+    RealtimeHaptics haptics(*scene.kernel);  // real-time probes tick while it runs
+    haptics.Start();
     const RunResult run = scene.kernel->Run(options.time);
+    haptics.Stop();
     r.run_ok = run.ok();
     r.diagnostic = run.diagnostic;
   }
