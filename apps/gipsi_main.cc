@@ -21,6 +21,7 @@
 
 #include "gipsi/base/error.h"
 #include "gipsi/base/log.h"
+#include "gipsi/core/state.h"
 #include "gipsi/haptics/realtime_haptics.h"
 #include "gipsi/io/mesh_io.h"
 #include "gipsi/io/mesh_summary.h"
@@ -177,6 +178,15 @@ int Run(const std::string& file, const std::string& out_dir, double until, bool 
     kernel.SetCheckpointing(
         checkpoints.file.empty() ? out / "checkpoint.gck" : std::filesystem::path(checkpoints.file),
         every);
+    // Refuse now, not at the first checkpoint after minutes of running, if some object or
+    // connector cannot save its state (a trial save into memory; no outputs exist yet).
+    try {
+      gipsi::StateWriter trial;
+      kernel.SaveState(trial);
+    } catch (const gipsi::InputError& e) {
+      gipsi::ThrowInputError("command line", "--checkpoint-every",
+                             fmt::format("this scene cannot be checkpointed: {}", e.what()));
+    }
   }
   gipsi::AttachOutputs(scene, out, !checkpoints.resume.empty());
   if (!checkpoints.resume.empty()) kernel.ReadCheckpoint(checkpoints.resume);

@@ -190,6 +190,19 @@ TEST(GipsiRun, ResourceLimitsRefuseOversizedRunsBeforeWriting) {
   EXPECT_THAT(bad.output, HasSubstr("--max-output"));
 }
 
+TEST(GipsiRun, CheckpointingASceneThatCannotSaveItsStateIsRefusedBeforeRunning) {
+  // The haptic probe of liver_palpation.json keeps no checkpointable state: the run must say so
+  // at once, before writing anything, not fail at its first checkpoint.
+  fs::path out = TempDir("no_checkpoints");
+  fs::remove_all(out);
+  Result r = Gipsi("run " + Scene("liver_palpation.json") + " --checkpoint-every 0.1 --out " +
+                   out.string());
+  EXPECT_EQ(r.code, 1) << r.output;
+  EXPECT_THAT(r.output, HasSubstr("--checkpoint-every: this scene cannot be checkpointed: object"));
+  EXPECT_THAT(r.output, HasSubstr("does not support checkpoints"));
+  EXPECT_FALSE(fs::exists(out));
+}
+
 TEST(GipsiValidate, BadInputsExitNonZeroWithAClearMessage) {
   fs::path dir = TempDir("bad");
   auto write = [&](const std::string& name, const std::string& text) {
