@@ -68,7 +68,7 @@ constexpr const char* kHeartDefaults = R"({
 /// below the explicit stability limit at diastolic stretch. docs/heart.md has the numbers.
 constexpr const char* kMassSpringMuscle = R"({
   "type": "MassSpring", "domain": "lv", "dt": "0.1 ms",
-  "stiffness": 20, "material": {"law": "Exponential", "b": 7},
+  "stiffness": 11, "material": {"law": "Exponential", "b": 10}, "volume_stiffness": 50000,
   "density": 1060, "drag": 100, "damping": 0.002, "gravity": [0, 0, 0],
   "fibres": {"rule": "transmural", "endo": {"group": "endo"}, "epi": {"group": "epi"},
              "axis": [0, 0, 1], "endo_angle": 60, "epi_angle": -60},
@@ -79,8 +79,7 @@ constexpr const char* kMassSpringMuscle = R"({
 /// What else the mass-spring variant changes in the defaults (a merge patch).
 constexpr const char* kMassSpringPatch = R"({
   "dt": "0.1 ms",
-  "parts": {"blood": {"dt": "0.1 ms"}},
-  "connectors": {"excitation_contraction": {"gain": "115 kPa"}}
+  "parts": {"blood": {"dt": "0.1 ms"}}
 })";
 
 }  // namespace

@@ -126,6 +126,13 @@ void MassSpring::Finish() {
   if (!fibre.allFinite())
     throw InputError(fmt::format("object '{}': the fibre direction must be non-zero", name()));
   fibres_.colwise() = fibre;
+  tet_rest_volume_.resize(mesh.num_tets());
+  for (Index e = 0; e < mesh.num_tets(); ++e)
+    tet_rest_volume_[e] =
+        TetSignedVolume(mesh.nodes.col(mesh.tets(0, e)), mesh.nodes.col(mesh.tets(1, e)),
+                        mesh.nodes.col(mesh.tets(2, e)), mesh.nodes.col(mesh.tets(3, e)));
+  if (params_.volume_stiffness > 0 && mesh.num_tets() == 0)
+    throw InputError(fmt::format("object '{}': volume_stiffness needs a tet domain", this->name()));
   UpdateActiveWeights();
 
   using L = FieldLocation;
@@ -193,6 +200,7 @@ void MassSpring::CalcForces(double /*t*/, Eigen::Ref<const VecX> x, Eigen::Ref<V
       f.segment<3>(3 * i2) += load;
     }
   }
+  AddVolumeForces(q, f);
   AddCavityForces(q, f, !coupled_predictor_);
 }
 
@@ -255,6 +263,11 @@ StepStatus MassSpring::CheckState() const {
           s, length / rest_length_[s]);
   }
   (void)n;
+  if (const Index e = FirstInvertedTet(); e >= 0)
+    return StepStatus::Diverged(
+        "a tet was inverted (volume <= 0; time step too large, or a load the volume term cannot "
+        "hold); tet",
+        e);
   return StepStatus::Ok();
 }
 
@@ -283,6 +296,17 @@ double MassSpring::stable_dt_estimate() const {
     k_sum[springs_(0, s)] += params_.stiffness;
     k_sum[springs_(1, s)] += params_.stiffness;
   }
+  // The volume term's stiffness at node a of tet e: K |∂V/∂x_a|² / V0.
+  const Mesh& mesh = domain();
+  for (Index e = 0; e < mesh.num_tets() && params_.volume_stiffness > 0; ++e)
+    for (int a = 0; a < 4; ++a) {
+      const Vec3 p = mesh.nodes.col(mesh.tets((a + 1) % 4, e)),
+                 q = mesh.nodes.col(mesh.tets((a + 2) % 4, e)),
+                 r = mesh.nodes.col(mesh.tets((a + 3) % 4, e));
+      const double grad = (q - p).cross(r - p).norm() / 6.0;
+      k_sum[mesh.tets(a, e)] +=
+          params_.volume_stiffness * grad * grad / std::abs(tet_rest_volume_[e]);
+    }
   double omega2 = 0;
   for (Index i = 0; i < num_nodes(); ++i) omega2 = std::max(omega2, 4.0 * k_sum[i] / mass_[i]);
   return omega2 > 0 ? 2.0 / std::sqrt(omega2) : std::numeric_limits<double>::infinity();
@@ -304,7 +328,7 @@ double MassSpring::PotentialEnergy() const {
   }
   for (Index i = 0; i < num_nodes(); ++i)
     e -= mass_[i] * params_.gravity.dot(x_.segment<3>(3 * i) - domain().nodes.col(i));
-  return e;
+  return e + VolumeEnergy();
 }
 
 Vec3 MassSpring::Momentum() const {

@@ -14,6 +14,15 @@
 ///
 /// Heart-muscle extensions (a mass-spring variant of the GiPSi heart's muscle):
 ///
+/// *Volume term.* With `volume_stiffness` K > 0 each tet e adds the energy
+/// (K/2) |V0_e| (ln J_e)², J_e = V_e/V0_e: FemSolid's volumetric Guccione term, as a volume
+/// spring (after the volume constraints of Teschner et al., "A versatile and robust model for
+/// geometrically complex deformable solids", CGI 2004). Muscle is nearly
+/// incompressible: without this a contracting spring wall shrinks as a whole instead of
+/// thickening, and the thick-wall Laplace balance that ends ejection (the pressure a wall of
+/// tension T holds grows like T ln(r_epi/r_endo) as the endocardium moves in and the wall
+/// thickens) never comes: the cavity either barely ejects or collapses.
+///
 /// *Active tension.* A per-node field "nodal_active_tension" T [Pa] (written by an
 /// excitation–contraction connector) and a fibre direction f_e per tet (the "fibre" field, uniform
 /// or rule-based like FemSolid's). Spring s = (a, b) pulls its nodes together with the extra
@@ -85,6 +94,11 @@ struct MassSpringParams {
   double max_stretch = 100;
   /// The spring law; null means Hooke.
   std::shared_ptr<const SpringLaw> law;
+  /// K [Pa]: each tet resists a change of its volume with the energy (K/2) |V0| (ln J)²,
+  /// J = V/V0 (a bulk modulus, the volumetric term of FemSolid's Guccione law; 0: off, the
+  /// classic spring network). A tet inverted by a step (J ≤ 0) stops the run as diverged.
+  /// Tet domains only.
+  double volume_stiffness = 0;
   /// Uniform fibre direction of every tet (reference configuration; normalised); per-tet fibres
   /// can be written to the "fibre" field. Only used by the active tension.
   Vec3 fibre = Vec3::UnitX();
@@ -163,8 +177,14 @@ class MassSpring final : public SimObject {
   StepStatus CheckState() const;
   /// Rest lengths, state, buffers and fields, once springs_ and mass_ are set.
   void Finish();
-  /// Recomputes active_weight_ from the tets, rest geometry and fibres_ (mass_spring_active.cc).
+  /// Recomputes active_weight_ from the tets, rest geometry and fibres_ (mass_spring_muscle.cc).
   void UpdateActiveWeights();
+  /// Adds the tets' volume forces at positions q (3N) to f (mass_spring_muscle.cc).
+  void AddVolumeForces(Eigen::Ref<const VecX> q, Eigen::Ref<VecX> f) const;
+  /// Σ_e (K/2) |V0| (ln J)² at the current positions [J].
+  [[nodiscard]] double VolumeEnergy() const;
+  /// The first tet with J ≤ 0 at the current positions if volume_stiffness > 0, else −1.
+  [[nodiscard]] Index FirstInvertedTet() const;
   /// Declares the cavities of params_ and their fields (mass_spring_cavity.cc).
   void SetUpCavities();
   /// Adds p ∂V/∂x of every cavity at positions q (3N) to f; coupled ones only if
@@ -191,6 +211,7 @@ class MassSpring final : public SimObject {
   FieldId f_kinetic_, f_potential_, f_momentum_;
   FieldId f_fibre_, f_nodal_active_;
 
+  VecX tet_rest_volume_;       // signed, per tet
   Points fibres_;              // 3 by E unit fibre per tet (E = 0 for element-free networks)
   VecX active_weight_;         // per spring [m²]
   VecX nodal_active_tension_;  // per node [Pa]

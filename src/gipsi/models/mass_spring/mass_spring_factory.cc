@@ -20,7 +20,7 @@ void RegisterMassSpring(TypeRegistry& registry) {
       [](const ObjectBuildContext& ctx) -> std::unique_ptr<SimObject> {
         const JsonNode& p = ctx.params;
         ctx.CheckKeys({"density", "thickness", "stiffness", "damping", "drag", "gravity",
-                       "max_stretch", "material", "fibres", "cavities"});
+                       "max_stretch", "material", "volume_stiffness", "fibres", "cavities"});
         MassSpringParams params;
         params.density = p.Positive("density", params.density);
         params.thickness = p.Positive("thickness", params.thickness);
@@ -29,6 +29,7 @@ void RegisterMassSpring(TypeRegistry& registry) {
         params.drag = p.NonNegative("drag", params.drag);
         params.gravity = p.Vector3("gravity", params.gravity);
         params.max_stretch = p.Positive("max_stretch", params.max_stretch);
+        if (auto k = p.Find("volume_stiffness")) params.volume_stiffness = k->AsNonNegative();
         if (auto material = p.Find("material"))
           params.law = ctx.registry.CreateMaterialAs<SpringLaw>(*material, "spring");
         std::optional<TransmuralFibreRule> fibre_rule;
