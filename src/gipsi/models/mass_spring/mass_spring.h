@@ -33,13 +33,15 @@
 /// the springs crossing the cut are exactly the edges of that layer not lying in a plane, each
 /// with d̂·x̂ = h/L, so the force across the cut is Σ T w_s (d̂·x̂) = (T/h) Σ_e c_e (V_e/6)
 /// Σ_r (d̂_r·f)⁴ = (T/h) Σ_e V_e = T × (cut area): the stress T f ⊗ f exactly, on any such mesh
-/// (tests/models/mass_spring/mass_spring_heart_test.cc checks it). For edge directions spread
+/// (tests/models/mass_spring/mass_spring_active_test.cc checks it). For edge directions spread
 /// uniformly over the sphere ⟨(d̂·f)⁴⟩ = 1/5, so c_e ≈ 5 on average.
-/// Limits: this is a force model, not a stress model: the spring network has no transverse
-/// (Poisson) coupling or volume preservation, so a contracting fibre does not thicken the wall
-/// as muscle does; shear along the fibre is resisted only by the passive springs; the weights
-/// use the rest geometry (the tension is not corrected for fibre rotation, like the 2nd
-/// Piola–Kirchhoff active stress of FemSolid); and only the fibre-normal section force matches
+/// Limits: this is a force model, not a stress model. Besides the volume term there is no
+/// transverse (Poisson) coupling, so how much a contracting wall thickens depends on the volume
+/// term and the cross-fibre springs; shear along the fibre is resisted only by the passive
+/// springs; the weights use the rest geometry, and the force does not scale with the fibre
+/// stretch λ (FemSolid's second Piola–Kirchhoff active stress T f ⊗ f pulls with T λ per
+/// reference area), so a shortened wall keeps more active force than FemSolid's; and only
+/// the force across a section normal to the fibres matches
 /// the stress T f ⊗ f exactly (oblique sections see the mesh's edge directions).
 ///
 /// *Cavities.* A cavity (e.g. the endocardium) is a set of boundary faces, capped at an open
