@@ -10,6 +10,7 @@
 #include <string>
 
 #include "gipsi/base/error.h"
+#include "gipsi/base/json_node.h"
 #include "gipsi/geometry/generators.h"
 #include "gipsi/models/fem/fem_solid.h"
 #include "gipsi/models/fibres/rule_based_fibres.h"
@@ -73,7 +74,6 @@ TEST(MassSpringCavity, VolumeFieldIsTheEnclosedVolume) {
   // (the cap's centroid maps with the rim), to round-off.
   auto ms = MassSpringVentricle();
   FemParams fem_params;
-  fem_params.material = nullptr;
   const double v = Read(*ms, "lumen_volume");
   {
     TypeRegistry registry;
