@@ -62,10 +62,11 @@ constexpr const char* kHeartDefaults = R"({
 /// `"muscle_model": "mass_spring"`: the muscle part becomes a MassSpring on the same mesh, with
 /// the same fibres, cavity and held base, and every part steps at its 0.1 ms (the explicit wall
 /// solves its cavity pressure with the blood each of its steps, so the blood steps with it).
-/// Stiffness 20 N/m per spring with the exponential law b = 7: fitted to the Guccione
-/// ventricle's static pressure–volume curve (docs/heart.md: within 2 mL from 4 to 15 mmHg);
-/// drag 100 /s and spring damping 0.002 N·s/m damp the wall's slow and fast modes; 0.1 ms is
-/// below the explicit stability limit at diastolic stretch. docs/heart.md has the numbers.
+/// Springs of 11 N/m with the exponential law b = 10 and a volume term of 50 kPa (the Guccione
+/// law's bulk modulus): fitted to the Guccione ventricle's static pressure–volume curve
+/// (docs/heart.md: within 0.4 mL from 2 to 12 mmHg, 1 mL at 15). Drag 100 /s and spring damping
+/// 0.002 N·s/m damp the wall's ringing; 0.1 ms is 40 % of the explicit stability estimate at
+/// rest (0.25 ms), a margin for the springs' stiffening with filling.
 constexpr const char* kMassSpringMuscle = R"({
   "type": "MassSpring", "domain": "lv", "dt": "0.1 ms",
   "stiffness": 11, "material": {"law": "Exponential", "b": 10}, "volume_stiffness": 50000,
