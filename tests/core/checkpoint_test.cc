@@ -219,6 +219,13 @@ TEST(Resume, HeartIsBitwiseIdentical) {
   ExpectBitwiseResume("heart.json", "heart", 0.1, 0.12, 0.25);
 }
 
+TEST(Resume, MassSpringHeartIsBitwiseIdentical) {
+  // The mass-spring heart: the explicit wall's state, active tension, fibres and the cavity's
+  // pressure and blood-compliance estimate (the pressure solve's starting point) are saved, so
+  // the continuation is bitwise identical; checkpoint at 0.1 s, in the first contraction.
+  ExpectBitwiseResume("heart_mass_spring.json", "heart_ms", 0.1, 0.12, 0.25);
+}
+
 TEST(Resume, ACheckpointOfAnotherSceneIsRefused) {
   const fs::path dir = testing::TempDir("gipsi_resume_", "other");
   const std::string scenes = std::string(GIPSI_SOURCE_DIR) + "/scenes/";

@@ -8,7 +8,6 @@
 #include <fmt/format.h>
 
 #include "gipsi/base/error.h"
-#include "gipsi/base/log.h"
 #include "gipsi/geometry/quality.h"
 
 namespace gipsi {
@@ -120,6 +119,21 @@ void MassSpring::Finish() {
   external_force_ = Points::Zero(3, n);
   force_.resize(3 * n);
   integrator_->Prepare(ode_size());
+  symplectic_ = dynamic_cast<const SymplecticEuler*>(integrator_.get()) != nullptr;
+  nodal_active_tension_ = VecX::Zero(n);
+  fibres_ = Points(3, mesh.num_tets());
+  const Vec3 fibre = params_.fibre.normalized();
+  if (!fibre.allFinite())
+    throw InputError(fmt::format("object '{}': the fibre direction must be non-zero", name()));
+  fibres_.colwise() = fibre;
+  tet_rest_volume_.resize(mesh.num_tets());
+  for (Index e = 0; e < mesh.num_tets(); ++e)
+    tet_rest_volume_[e] =
+        TetSignedVolume(mesh.nodes.col(mesh.tets(0, e)), mesh.nodes.col(mesh.tets(1, e)),
+                        mesh.nodes.col(mesh.tets(2, e)), mesh.nodes.col(mesh.tets(3, e)));
+  if (params_.volume_stiffness > 0 && mesh.num_tets() == 0)
+    throw InputError(fmt::format("object '{}': volume_stiffness needs a tet domain", this->name()));
+  UpdateActiveWeights();
 
   using L = FieldLocation;
   using A = FieldAccess;
@@ -129,6 +143,15 @@ void MassSpring::Finish() {
   f_potential_ = DeclareField(
       {"potential_energy", L::kGlobal, 1, "J", A::kRead, "spring plus gravitational energy"});
   f_momentum_ = DeclareField({"momentum", L::kGlobal, 3, "kg·m/s", A::kRead, "Σ m v"});
+  if (mesh.num_tets() > 0)
+    f_fibre_ = DeclareField({"fibre", L::kElement, 3, "1", A::kReadWrite,
+                             "fibre direction per tet in the reference configuration (unit)"});
+  f_nodal_active_ = DeclareField(
+      {"nodal_active_tension", L::kNode, 1, "Pa", A::kReadWrite,
+       "active tension per node; springs contract with the mean of their nodes' (fibre-weighted)"});
+  if (!params_.cavities.empty() && mesh.num_tets() == 0)
+    throw InputError(fmt::format("object '{}': cavities need a tet domain", name()));
+  SetUpCavities();
 }
 
 void MassSpring::CalcForces(double /*t*/, Eigen::Ref<const VecX> x, Eigen::Ref<VecX> f) const {
@@ -150,7 +173,11 @@ void MassSpring::CalcForces(double /*t*/, Eigen::Ref<const VecX> x, Eigen::Ref<V
     // Hooke is the common case: inline it rather than pay a virtual call per spring.
     const double tension = hooke_ ? params_.stiffness * (length - rest_length_[s])
                                   : law.Tension(length, rest_length_[s], params_.stiffness);
-    const Vec3 fs = (tension + params_.damping * rate) * dir;
+    const double active =
+        any_active_
+            ? 0.5 * (nodal_active_tension_[a] + nodal_active_tension_[b]) * active_weight_[s]
+            : 0.0;
+    const Vec3 fs = (tension + active + params_.damping * rate) * dir;
     f.segment<3>(3 * a) += fs;
     f.segment<3>(3 * b) -= fs;
   }
@@ -173,6 +200,8 @@ void MassSpring::CalcForces(double /*t*/, Eigen::Ref<const VecX> x, Eigen::Ref<V
       f.segment<3>(3 * i2) += load;
     }
   }
+  AddVolumeForces(q, f);
+  AddCavityForces(q, f, !coupled_predictor_);
 }
 
 void MassSpring::CalcDerivative(double t, Eigen::Ref<const VecX> x, Eigen::Ref<VecX> xdot) const {
@@ -234,12 +263,28 @@ StepStatus MassSpring::CheckState() const {
           s, length / rest_length_[s]);
   }
   (void)n;
+  if (const Index e = FirstInvertedTet(); e >= 0)
+    return StepStatus::Diverged(
+        "a tet was inverted (volume <= 0; time step too large, or a load the volume term cannot "
+        "hold); tet",
+        e);
   return StepStatus::Ok();
 }
 
 StepStatus MassSpring::DoStep(double t, double dt) {
+  failure_detail_.clear();
   ApplyConstraints(dt);
+  const bool coupled = std::any_of(cavities_.begin(), cavities_.end(),
+                                   [](const Cavity& c) { return c.law != nullptr; });
+  if (coupled) {
+    // The step with p = 0 for the coupled cavities, then their pressures (mass_spring.h).
+    BeginCoupledStep();
+    coupled_predictor_ = true;
+  }
   integrator_->Step(OdeView(*this), t, dt, x_);
+  coupled_predictor_ = false;
+  if (coupled && !SolveCoupledCavities(t, dt))
+    return StepStatus::Failed("the cavity pressure could not be solved with the blood");
   const Index n = num_nodes();
   positions_ = Eigen::Map<const Points>(x_.data(), 3, n);
   return CheckState();
@@ -251,6 +296,17 @@ double MassSpring::stable_dt_estimate() const {
     k_sum[springs_(0, s)] += params_.stiffness;
     k_sum[springs_(1, s)] += params_.stiffness;
   }
+  // The volume term's stiffness at node a of tet e: K |∂V/∂x_a|² / V0.
+  const Mesh& mesh = domain();
+  for (Index e = 0; e < mesh.num_tets() && params_.volume_stiffness > 0; ++e)
+    for (int a = 0; a < 4; ++a) {
+      const Vec3 p = mesh.nodes.col(mesh.tets((a + 1) % 4, e)),
+                 q = mesh.nodes.col(mesh.tets((a + 2) % 4, e)),
+                 r = mesh.nodes.col(mesh.tets((a + 3) % 4, e));
+      const double grad = (q - p).cross(r - p).norm() / 6.0;
+      k_sum[mesh.tets(a, e)] +=
+          params_.volume_stiffness * grad * grad / std::abs(tet_rest_volume_[e]);
+    }
   double omega2 = 0;
   for (Index i = 0; i < num_nodes(); ++i) omega2 = std::max(omega2, 4.0 * k_sum[i] / mass_[i]);
   return omega2 > 0 ? 2.0 / std::sqrt(omega2) : std::numeric_limits<double>::infinity();
@@ -272,7 +328,7 @@ double MassSpring::PotentialEnergy() const {
   }
   for (Index i = 0; i < num_nodes(); ++i)
     e -= mass_[i] * params_.gravity.dot(x_.segment<3>(3 * i) - domain().nodes.col(i));
-  return e;
+  return e + VolumeEnergy();
 }
 
 Vec3 MassSpring::Momentum() const {
@@ -314,6 +370,15 @@ void MassSpring::DoReadField(FieldId id, Eigen::Ref<Eigen::MatrixXd> out) const 
     out(0, 0) = PotentialEnergy();
   } else if (id == f_momentum_) {
     out.col(0) = Momentum();
+  } else if (id == f_fibre_) {
+    out = fibres_;
+  } else if (id == f_nodal_active_) {
+    out = nodal_active_tension_.transpose();
+  } else {
+    for (std::size_t i = 0; i < cavities_.size(); ++i) {
+      if (id == cavities_[i].f_volume) out(0, 0) = CavityVolume(i);
+      if (id == cavities_[i].f_pressure) out(0, 0) = cavities_[i].pressure;
+    }
   }
 }
 
@@ -326,36 +391,20 @@ void MassSpring::DoWriteField(FieldId id, const Eigen::Ref<const Eigen::MatrixXd
     Eigen::Map<Points>(x_.data() + 3 * n, 3, n) = in;
   } else if (id == mech_.external_force) {
     external_force_ = in;
+  } else if (id == f_fibre_) {
+    for (Index e = 0; e < fibres_.cols(); ++e) {
+      const Vec3 f = in.col(e);
+      if (f.squaredNorm() > 0 && f.allFinite()) fibres_.col(e) = f.normalized();
+    }
+    UpdateActiveWeights();  // allocates: fibres are set up before a run, not per step
+  } else if (id == f_nodal_active_) {
+    nodal_active_tension_ = in.row(0).transpose();
+    any_active_ = (nodal_active_tension_.array() != 0).any();
+  } else {
+    // A coupled cavity's pressure is solved each step; writes to it are ignored.
+    for (Cavity& cavity : cavities_)
+      if (id == cavity.f_pressure && cavity.law == nullptr) cavity.pressure = in(0, 0);
   }
-}
-
-void RegisterMassSpring(TypeRegistry& registry) {
-  registry.objects.Register(
-      "MassSpring",
-      [](const ObjectBuildContext& ctx) -> std::unique_ptr<SimObject> {
-        const JsonNode& p = ctx.params;
-        ctx.CheckKeys({"density", "thickness", "stiffness", "damping", "drag", "gravity",
-                       "max_stretch", "material"});
-        MassSpringParams params;
-        params.density = p.Positive("density", params.density);
-        params.thickness = p.Positive("thickness", params.thickness);
-        params.stiffness = p.Positive("stiffness", params.stiffness);
-        params.damping = p.NonNegative("damping", params.damping);
-        params.drag = p.NonNegative("drag", params.drag);
-        params.gravity = p.Vector3("gravity", params.gravity);
-        params.max_stretch = p.Positive("max_stretch", params.max_stretch);
-        if (auto material = p.Find("material"))
-          params.law = ctx.registry.CreateMaterialAs<SpringLaw>(*material, "spring");
-        auto integrator = p.Has("integrator") ? ctx.registry.CreateIntegrator(p.At("integrator"))
-                                              : std::make_unique<SymplecticEuler>();
-        auto object =
-            std::make_unique<MassSpring>(ctx.name, ctx.DomainMesh(), params, std::move(integrator));
-        if (auto dt = p.Find("dt"); dt && dt->AsPositive() > object->stable_dt_estimate())
-          Log().warn("{}: dt = {:.3g} s exceeds the estimated explicit stability limit {:.3g} s",
-                     dt->path(), dt->AsPositive(), object->stable_dt_estimate());
-        return object;
-      },
-      "mass-spring-damper tissue on the edges of a tet or triangle mesh");
 }
 
 }  // namespace gipsi

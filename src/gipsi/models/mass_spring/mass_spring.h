@@ -10,16 +10,78 @@
 ///   spring s = (a, b), d = q_b − q_a, L = |d|, n = d / L:
 ///   f_s on a = [T(L; L0, k) + c ((v_b − v_a)·n)] n, and −f_s on b,
 /// with T the spring law's tension (Hooke: k (L − L0); see spring_law.h).
-/// Units: SI (m, kg, s, N).
+/// Units: SI (m, kg, s, N, Pa).
+///
+/// Heart-muscle extensions (a mass-spring variant of the GiPSi heart's muscle):
+///
+/// *Volume term.* With `volume_stiffness` K > 0 each tet e adds the energy
+/// (K/2) |V0_e| (ln J_e)², J_e = V_e/V0_e: FemSolid's volumetric Guccione term, as a volume
+/// spring (after the volume constraints of Teschner et al., "A versatile and robust model for
+/// geometrically complex deformable solids", CGI 2004). Muscle is nearly
+/// incompressible: without this a contracting spring wall shrinks as a whole instead of
+/// thickening, and the thick-wall Laplace balance that ends ejection (the pressure a wall of
+/// tension T holds grows like T ln(r_epi/r_endo) as the endocardium moves in and the wall
+/// thickens) never comes: the cavity either barely ejects or collapses.
+///
+/// *Active tension.* A per-node field "nodal_active_tension" T [Pa] (written by an
+/// excitation–contraction connector) and a fibre direction f_e per tet (the "fibre" field, uniform
+/// or rule-based like FemSolid's). Spring s = (a, b) pulls its nodes together with the extra
+/// tension T_s w_s along its current direction, T_s = (T_a + T_b)/2 and the weight
+///   w_s = Σ_{tets e ∋ s} c_e (V_e/6) (d̂_s·f_e)² / L_s,   c_e = 6 / Σ_{edges r of e} (d̂_r·f_e)⁴
+/// (d̂, L the rest direction and length, V_e the tet's rest volume). Why c_e: cut a block whose
+/// tets each lie between two node planes x = x_i, x_{i+1} (spacing h) with the fibre along x;
+/// the springs crossing the cut are exactly the edges of that layer not lying in a plane, each
+/// with d̂·x̂ = h/L, so the force across the cut is Σ T w_s (d̂·x̂) = (T/h) Σ_e c_e (V_e/6)
+/// Σ_r (d̂_r·f)⁴ = (T/h) Σ_e V_e = T × (cut area): the stress T f ⊗ f exactly, on any such mesh
+/// (tests/models/mass_spring/mass_spring_active_test.cc checks it). For edge directions spread
+/// uniformly over the sphere ⟨(d̂·f)⁴⟩ = 1/5, so c_e ≈ 5 on average.
+/// Limits: this is a force model, not a stress model. Besides the volume term there is no
+/// transverse (Poisson) coupling, so how much a contracting wall thickens depends on the volume
+/// term and the cross-fibre springs; shear along the fibre is resisted only by the passive
+/// springs; the weights use the rest geometry, and the force does not scale with the fibre
+/// stretch λ (FemSolid's second Piola–Kirchhoff active stress T f ⊗ f pulls with T λ per
+/// reference area), so a shortened wall keeps more active force than FemSolid's; and only
+/// the force across a section normal to the fibres matches
+/// the stress T f ⊗ f exactly (oblique sections see the mesh's edge directions).
+///
+/// *Cavities.* A cavity (e.g. the endocardium) is a set of boundary faces, capped at an open
+/// rim like FemSolid's (enclosed_volume.h); fields "<name>_volume" [m³] and "<name>_pressure"
+/// [Pa]. The pressure acts as the follower load p ∂V/∂x on the cavity's nodes (the cap's share
+/// goes to the rim, so a cavity's pressure has no resultant: the cap stands for the closed
+/// valves, which hand the pressure on the valve plane to the rim). A written pressure is
+/// evaluated at the integrator's stage positions. Coupled to blood (AttachCavityLaw, the
+/// CavityCoupling connector), each step solves for p with the wall: with ∂V/∂x evaluated at the
+/// *start* of the step (g, zero on held axes) and q*, v* the symplectic-Euler step with p = 0,
+///   v⁺ = v* + p dt M⁻¹ g,   q⁺ = q* + p dt² M⁻¹ g        (exact for symplectic Euler, whose
+/// forces are those of the start state), and p solves the scalar equation V(q⁺(p)) = V_b(p),
+/// V_b the law's end volume (bracketed Illinois iteration to 1e-13 of the volume). This is
+/// implicit in the pressure, so the near-incompressible blood of the isovolumetric phases does
+/// not limit the explicit step. Only SymplecticEuler is supported for coupled cavities (for
+/// explicit Euler q⁺ does not depend on p; for RK4 it is not affine in p), and coupled cavities
+/// must not share nodes (each is solved on its own). The law answers for the object's own step
+/// [t, t + dt]: the blood must step with the same dt right after the wall (the CavityCoupling's
+/// order), so a MassSpring coupled to blood runs at the blood's rate; it does not sub-step
+/// inside the blood's step (a law asked at a time the blood is not at fails the step with a
+/// diagnostic).
 
 #include <memory>
+#include <string>
+#include <vector>
 
 #include "gipsi/core/registry.h"
 #include "gipsi/core/sim_object.h"
+#include "gipsi/geometry/enclosed_volume.h"
+#include "gipsi/geometry/region.h"
 #include "gipsi/models/mass_spring/spring_law.h"
 #include "gipsi/numerics/ode.h"
 
 namespace gipsi {
+
+/// A cavity bounded by part of the boundary (an endocardium). Plain struct.
+struct MassSpringCavitySpec {
+  std::string name;  ///< fields "<name>_volume" [m³] and "<name>_pressure" [Pa]
+  Region region;     ///< selects the boundary faces that bound the cavity
+};
 
 /// Parameters; plain struct with defaults.
 struct MassSpringParams {
@@ -34,6 +96,16 @@ struct MassSpringParams {
   double max_stretch = 100;
   /// The spring law; null means Hooke.
   std::shared_ptr<const SpringLaw> law;
+  /// K [Pa]: each tet resists a change of its volume with the energy (K/2) |V0| (ln J)²,
+  /// J = V/V0 (a bulk modulus, the volumetric term of FemSolid's Guccione law; 0: off, the
+  /// classic spring network). A tet inverted by a step (J ≤ 0) stops the run as diverged.
+  /// Tet domains only.
+  double volume_stiffness = 0;
+  /// Uniform fibre direction of every tet (reference configuration; normalised); per-tet fibres
+  /// can be written to the "fibre" field. Only used by the active tension.
+  Vec3 fibre = Vec3::UnitX();
+  /// Cavities bounded by boundary faces (tet domains), as FemSolid's.
+  std::vector<MassSpringCavitySpec> cavities;
 };
 
 /// Not copyable or movable (a SimObject).
@@ -76,6 +148,19 @@ class MassSpring final : public SimObject {
   /// (a strain-stiffening law lowers the limit as springs stretch).
   [[nodiscard]] double stable_dt_estimate() const;
 
+  /// Active weight w_s [m²] of every spring (see the file comment); zero for element-free
+  /// networks.
+  [[nodiscard]] const VecX& active_weights() const { return active_weight_; }
+  /// Volume of cavity i (MassSpringParams::cavities order) at the current positions [m³].
+  [[nodiscard]] double CavityVolume(std::size_t i) const;
+  /// The pressure of cavity i [Pa]: written, or solved when coupled to a CavityLaw.
+  [[nodiscard]] double CavityPressure(std::size_t i) const;
+  /// Couples cavity `cavity` to blood (see the file comment). Throws InputError if there is no
+  /// such cavity, it is already coupled, it shares a node with another coupled cavity, or the
+  /// integrator is not SymplecticEuler.
+  void AttachCavityLaw(std::string_view cavity, CavityLaw* law) override;
+  [[nodiscard]] std::string failure_detail() const override { return failure_detail_; }
+
   [[nodiscard]] double KineticEnergy() const;
   /// Spring energy plus gravitational energy (relative to the rest configuration).
   [[nodiscard]] double PotentialEnergy() const;
@@ -94,6 +179,24 @@ class MassSpring final : public SimObject {
   StepStatus CheckState() const;
   /// Rest lengths, state, buffers and fields, once springs_ and mass_ are set.
   void Finish();
+  /// Recomputes active_weight_ from the tets, rest geometry and fibres_ (mass_spring_muscle.cc).
+  void UpdateActiveWeights();
+  /// Adds the tets' volume forces at positions q (3N) to f (mass_spring_muscle.cc).
+  void AddVolumeForces(Eigen::Ref<const VecX> q, Eigen::Ref<VecX> f) const;
+  /// Σ_e (K/2) |V0| (ln J)² at the current positions [J].
+  [[nodiscard]] double VolumeEnergy() const;
+  /// The first tet with J ≤ 0 at the current positions if volume_stiffness > 0, else −1.
+  [[nodiscard]] Index FirstInvertedTet() const;
+  /// Declares the cavities of params_ and their fields (mass_spring_cavity.cc).
+  void SetUpCavities();
+  /// Adds p ∂V/∂x of every cavity at positions q (3N) to f; coupled ones only if
+  /// `include_coupled`.
+  void AddCavityForces(Eigen::Ref<const VecX> q, Eigen::Ref<VecX> f, bool include_coupled) const;
+  /// ∂V/∂x at the start of the step (g) of every coupled cavity, zero on held axes.
+  void BeginCoupledStep();
+  /// Solves each coupled cavity's pressure after the p = 0 step and moves x_ by it; false (with
+  /// failure_detail_ set) if a law cannot answer or no pressure fits.
+  bool SolveCoupledCavities(double t, double dt);
 
   MassSpringParams params_;
   bool hooke_ = true;  // params_.law is HookeSpring (inlined in CalcForces)
@@ -108,6 +211,29 @@ class MassSpring final : public SimObject {
   MechanicalFieldIds mech_;
   FieldId f_mass_;
   FieldId f_kinetic_, f_potential_, f_momentum_;
+  FieldId f_fibre_, f_nodal_active_;
+
+  VecX tet_rest_volume_;       // signed, per tet
+  Points fibres_;              // 3 by E unit fibre per tet (E = 0 for element-free networks)
+  VecX active_weight_;         // per spring [m²]
+  VecX nodal_active_tension_;  // per node [Pa]
+  bool any_active_ = false;    // some node has non-zero tension
+
+  struct Cavity {
+    std::vector<int> nodes;         // domain node of each cavity vertex
+    EnclosedVolume volume;          // over the faces, oriented out of the cavity
+    mutable Points positions;       // work buffer, 3 by nodes.size()
+    mutable Points local_gradient;  // work buffer, 3 by nodes.size()
+    Points step_gradient;           // g at the start of the step, zero on held axes
+    double pressure = 0;            // Pa
+    double compliance = 0;          // −dV_b/dp of the law at the last solve [m³/Pa]
+    FieldId f_volume, f_pressure;
+    CavityLaw* law = nullptr;
+  };
+  std::vector<Cavity> cavities_;
+  bool symplectic_ = false;                 // the integrator is SymplecticEuler
+  mutable bool coupled_predictor_ = false;  // CalcForces leaves the coupled pressures out
+  std::string failure_detail_;
 };
 
 /// Registers "MassSpring" with the registry.

@@ -1,0 +1,256 @@
+// MassSpring's cavities: volume, follower pressure p ∂V/∂x, and the step solved together with a
+// blood law (cavity_law.h). The equations are in mass_spring.h.
+
+#include <algorithm>
+#include <cmath>
+
+#include <fmt/format.h>
+
+#include "gipsi/base/error.h"
+#include "gipsi/models/mass_spring/mass_spring.h"
+
+namespace gipsi {
+
+void MassSpring::SetUpCavities() {
+  using L = FieldLocation;
+  using A = FieldAccess;
+  const Mesh& mesh = domain();
+  const BoundarySurface& bnd = boundary();
+  for (const MassSpringCavitySpec& spec : params_.cavities) {
+    const std::vector<int> faces = SelectBoundaryFaces(spec.region, mesh, bnd);
+    if (faces.empty())
+      throw InputError(
+          fmt::format("object '{}': cavity '{}' selects no boundary face", name(), spec.name));
+    // Triangles reversed so that they face out of the cavity (boundary normals point out of the
+    // tissue, into the cavity), which makes its volume positive — as FemSolid does.
+    std::vector<int> local(static_cast<std::size_t>(bnd.num_vertices()), -1);
+    std::vector<int> nodes;
+    Triangles tris(3, static_cast<Index>(faces.size()));
+    for (std::size_t k = 0; k < faces.size(); ++k)
+      for (int v = 0; v < 3; ++v) {
+        const int bv = bnd.triangles(v, faces[k]);
+        int& id = local[static_cast<std::size_t>(bv)];
+        if (id < 0) {
+          id = static_cast<int>(nodes.size());
+          nodes.push_back(bnd.vertex_to_node[static_cast<std::size_t>(bv)]);
+        }
+        tris(v == 0 ? 0 : 3 - v, static_cast<Index>(k)) = id;
+      }
+    const auto nc = static_cast<Index>(nodes.size());
+    EnclosedVolume volume = [&] {
+      try {
+        return EnclosedVolume(tris, nc);
+      } catch (const InputError& e) {
+        throw InputError(fmt::format("object '{}': cavity '{}': {}", name(), spec.name, e.what()));
+      }
+    }();
+    const FieldId f_volume = DeclareField({spec.name + "_volume", L::kGlobal, 1, "m^3", A::kRead,
+                                           "volume enclosed by the cavity's faces (rim capped)"});
+    const FieldId f_pressure = DeclareField(
+        {spec.name + "_pressure", L::kGlobal, 1, "Pa", A::kReadWrite,
+         "pressure in the cavity, the follower load p dV/dx on its nodes (solved if coupled)"});
+    cavities_.push_back(Cavity{.nodes = std::move(nodes),
+                               .volume = std::move(volume),
+                               .positions = Points::Zero(3, nc),
+                               .local_gradient = Points::Zero(3, nc),
+                               .step_gradient = Points::Zero(3, nc),
+                               .f_volume = f_volume,
+                               .f_pressure = f_pressure});
+  }
+}
+
+double MassSpring::CavityVolume(std::size_t i) const {
+  GIPSI_CHECK(i < cavities_.size());
+  const Cavity& cavity = cavities_[i];
+  for (std::size_t k = 0; k < cavity.nodes.size(); ++k)
+    cavity.positions.col(static_cast<Index>(k)) = positions_.col(cavity.nodes[k]);
+  return cavity.volume.Compute(cavity.positions);
+}
+
+double MassSpring::CavityPressure(std::size_t i) const {
+  GIPSI_CHECK(i < cavities_.size());
+  return cavities_[i].pressure;
+}
+
+void MassSpring::AttachCavityLaw(std::string_view cavity, CavityLaw* law) {
+  GIPSI_CHECK(law != nullptr);
+  for (std::size_t i = 0; i < cavities_.size(); ++i) {
+    if (params_.cavities[i].name != cavity) continue;
+    if (cavities_[i].law != nullptr)
+      throw InputError(
+          fmt::format("object '{}': cavity '{}' is already coupled to blood", name(), cavity));
+    if (!symplectic_)
+      throw InputError(fmt::format(
+          "object '{}' (MassSpring): a cavity coupled to blood needs \"integrator\": "
+          "\"SymplecticEuler\" (its end positions are affine in the pressure), not '{}'",
+          name(), integrator_->name()));
+    for (const Cavity& other : cavities_) {
+      if (other.law == nullptr) continue;
+      for (int node : cavities_[i].nodes)
+        if (std::find(other.nodes.begin(), other.nodes.end(), node) != other.nodes.end())
+          throw InputError(fmt::format(
+              "object '{}': cavity '{}' shares node {} with another cavity coupled to blood; "
+              "coupled cavities must be disjoint",
+              name(), cavity, node));
+    }
+    cavities_[i].law = law;
+    return;
+  }
+  std::string names;
+  for (const MassSpringCavitySpec& spec : params_.cavities)
+    names += (names.empty() ? "" : ", ") + spec.name;
+  throw InputError(fmt::format("object '{}' (MassSpring) has no cavity '{}'; its cavities: {}",
+                               name(), cavity, names.empty() ? "none" : names));
+}
+
+void MassSpring::AddCavityForces(Eigen::Ref<const VecX> q, Eigen::Ref<VecX> f,
+                                 bool include_coupled) const {
+  for (const Cavity& cavity : cavities_) {
+    if ((cavity.law != nullptr && !include_coupled) || cavity.pressure == 0) continue;
+    for (std::size_t k = 0; k < cavity.nodes.size(); ++k)
+      cavity.positions.col(static_cast<Index>(k)) = q.segment<3>(3 * cavity.nodes[k]);
+    cavity.volume.Compute(cavity.positions, &cavity.local_gradient);
+    for (std::size_t k = 0; k < cavity.nodes.size(); ++k)
+      f.segment<3>(3 * cavity.nodes[k]) +=
+          cavity.pressure * cavity.local_gradient.col(static_cast<Index>(k));
+  }
+}
+
+void MassSpring::BeginCoupledStep() {
+  const BoundaryConditions& bcs = boundary_conditions();
+  const auto& v2n = boundary().vertex_to_node;
+  for (Cavity& cavity : cavities_) {
+    if (cavity.law == nullptr) continue;
+    for (std::size_t k = 0; k < cavity.nodes.size(); ++k)
+      cavity.positions.col(static_cast<Index>(k)) = x_.segment<3>(3 * cavity.nodes[k]);
+    cavity.volume.Compute(cavity.positions, &cavity.step_gradient);
+    // Held axes do not accelerate (CalcDerivative): the pressure cannot move them either. Cavity
+    // nodes are boundary vertices; v2n is sorted, so find each one's vertex by bisection.
+    for (std::size_t k = 0; k < cavity.nodes.size(); ++k) {
+      const auto it = std::lower_bound(v2n.begin(), v2n.end(), cavity.nodes[k]);
+      const auto j = static_cast<Index>(it - v2n.begin());
+      for (int a = 0; a < 3; ++a)
+        if (bcs.kind(j, a) != ConstraintKind::kFree)
+          cavity.step_gradient(a, static_cast<Index>(k)) = 0;
+    }
+  }
+}
+
+namespace {
+
+/// Root of h(p) (increasing) near `guess` by a bracketed Illinois iteration; `slope` > 0
+/// estimates h' for the first step. False if h cannot be evaluated or no root is bracketed.
+template <class H>
+bool SolveIncreasing(H&& h, double guess, double slope, double tolerance, double& root,
+                     double& compliance_estimate) {
+  double a = guess, ha = 0;
+  if (!h(a, ha)) return false;
+  if (std::abs(ha) <= tolerance) {
+    root = a;
+    return true;
+  }
+  double step = -ha / slope;
+  if (!(std::abs(step) > 0) || !std::isfinite(step)) step = ha > 0 ? -1.0 : 1.0;
+  double b = a, hb = ha;
+  bool bracketed = false;
+  for (int k = 0; k < 80; ++k) {
+    b = a + step;
+    if (!h(b, hb)) return false;
+    if (std::abs(hb) <= tolerance) {
+      root = b;
+      compliance_estimate = (hb - ha) / (b - a);
+      return true;
+    }
+    if ((hb > 0) != (ha > 0)) {
+      bracketed = true;
+      break;
+    }
+    a = b;
+    ha = hb;
+    step *= 2;
+  }
+  if (!bracketed) return false;
+  compliance_estimate = (hb - ha) / (b - a);
+  // Illinois (modified regula falsi): superlinear, and never leaves the bracket.
+  int side = 0;
+  for (int k = 0; k < 200; ++k) {
+    const double c = (a * hb - b * ha) / (hb - ha);
+    double hc = 0;
+    if (!h(c, hc)) return false;
+    if (std::abs(hc) <= tolerance || std::abs(b - a) <= 1e-10 * (std::abs(c) + 1.0)) {
+      root = c;
+      return true;
+    }
+    if ((hc > 0) == (hb > 0)) {
+      b = c;
+      hb = hc;
+      if (side == -1) ha *= 0.5;
+      side = -1;
+    } else {
+      a = c;
+      ha = hc;
+      if (side == 1) hb *= 0.5;
+      side = 1;
+    }
+  }
+  root = 0.5 * (a + b);
+  return true;
+}
+
+}  // namespace
+
+bool MassSpring::SolveCoupledCavities(double t, double dt) {
+  const Index n = num_nodes();
+  for (std::size_t i = 0; i < cavities_.size(); ++i) {
+    Cavity& cavity = cavities_[i];
+    if (cavity.law == nullptr) continue;
+    const auto nc = static_cast<Index>(cavity.nodes.size());
+    // q⁺(p) = q* + p dt² M⁻¹ g on the cavity's nodes (the others do not change V).
+    double wall_slope = 0;  // dV/dp of the wall at p = 0, gᵀ dt² M⁻¹ g
+    for (Index k = 0; k < nc; ++k)
+      wall_slope += dt * dt / mass_[cavity.nodes[static_cast<std::size_t>(k)]] *
+                    cavity.step_gradient.col(k).squaredNorm();
+    bool law_failed = false;
+    double blood_volume = 0;
+    auto h = [&](double p, double& out) {
+      for (Index k = 0; k < nc; ++k) {
+        const int node = cavity.nodes[static_cast<std::size_t>(k)];
+        cavity.positions.col(k) =
+            x_.segment<3>(3 * node) + (p * dt * dt / mass_[node]) * cavity.step_gradient.col(k);
+      }
+      if (!cavity.law->EndVolume(t, dt, p, blood_volume) || !std::isfinite(blood_volume)) {
+        law_failed = true;
+        return false;
+      }
+      out = cavity.volume.Compute(cavity.positions) - blood_volume;
+      return true;
+    };
+    const double v_now = CavityVolume(i);
+    double p = cavity.pressure, slope = 0;
+    if (!SolveIncreasing(h, cavity.pressure, wall_slope + cavity.compliance, 1e-13 * v_now, p,
+                         slope)) {
+      const std::string& cname = params_.cavities[i].name;
+      failure_detail_ =
+          law_failed ? fmt::format(
+                           "the blood coupled to cavity '{}' could not answer at t = {} s (it "
+                           "must step with this object's dt, {} s, right after it)",
+                           cname, t, dt)
+                     : fmt::format(
+                           "no pressure makes cavity '{}' enclose the blood's volume at t = {} "
+                           "s (dt {} s)",
+                           cname, t, dt);
+      return false;
+    }
+    if (slope > wall_slope) cavity.compliance = slope - wall_slope;
+    cavity.pressure = p;
+    for (Index k = 0; k < nc; ++k) {
+      const int node = cavity.nodes[static_cast<std::size_t>(k)];
+      const Vec3 dv = (p * dt / mass_[node]) * cavity.step_gradient.col(k);
+      x_.segment<3>(3 * n + 3 * node) += dv;
+      x_.segment<3>(3 * node) += dt * dv;
+    }
+  }
+  return true;
+}
+
+}  // namespace gipsi

@@ -1,0 +1,70 @@
+/// @file
+/// Scene-file factory of "MassSpring" (its keys are documented in docs/scene-format.md).
+
+#include <optional>
+
+#include <fmt/format.h>
+
+#include "gipsi/base/error.h"
+#include "gipsi/base/log.h"
+#include "gipsi/base/units.h"
+#include "gipsi/geometry/region_json.h"
+#include "gipsi/models/fibres/rule_based_fibres.h"
+#include "gipsi/models/mass_spring/mass_spring.h"
+
+namespace gipsi {
+
+void RegisterMassSpring(TypeRegistry& registry) {
+  registry.objects.Register(
+      "MassSpring",
+      [](const ObjectBuildContext& ctx) -> std::unique_ptr<SimObject> {
+        const JsonNode& p = ctx.params;
+        ctx.CheckKeys({"density", "thickness", "stiffness", "damping", "drag", "gravity",
+                       "max_stretch", "material", "volume_stiffness", "fibres", "cavities"});
+        MassSpringParams params;
+        params.density = p.Positive("density", params.density);
+        params.thickness = p.Positive("thickness", params.thickness);
+        params.stiffness = p.Positive("stiffness", params.stiffness);
+        params.damping = p.NonNegative("damping", params.damping);
+        params.drag = p.NonNegative("drag", params.drag);
+        params.gravity = p.Vector3("gravity", params.gravity);
+        params.max_stretch = p.Positive("max_stretch", params.max_stretch);
+        if (auto k = p.Find("volume_stiffness")) params.volume_stiffness = k->AsNonNegative();
+        if (auto material = p.Find("material"))
+          params.law = ctx.registry.CreateMaterialAs<SpringLaw>(*material, "spring");
+        std::optional<TransmuralFibreRule> fibre_rule;
+        if (auto fibres = p.Find("fibres"); fibres && fibres->Has("rule")) {
+          fibre_rule = ParseTransmuralFibreRule(*fibres);
+        } else if (fibres) {
+          fibres->CheckKeys({"direction"});
+          params.fibre = fibres->Vector3("direction");
+          if (params.fibre.norm() == 0) fibres->At("direction").Expected("a non-zero vector");
+        }
+        if (auto cavities = p.Find("cavities"))
+          for (const auto& [name, region] : cavities->Members())
+            params.cavities.push_back(MassSpringCavitySpec{name, ParseRegion(region)});
+        auto integrator = p.Has("integrator") ? ctx.registry.CreateIntegrator(p.At("integrator"))
+                                              : std::make_unique<SymplecticEuler>();
+        std::unique_ptr<MassSpring> object;
+        try {
+          auto mesh = ctx.DomainMesh();
+          object = std::make_unique<MassSpring>(ctx.name, mesh, params, std::move(integrator));
+          if (fibre_rule)
+            object->WriteField(object->FindField("fibre"),
+                               MakeTransmuralFibres(*mesh, *fibre_rule).fibre);
+        } catch (const InputError& e) {
+          p.Fail(e.what());
+        }
+        if (auto dt = p.Find("dt")) {
+          const double value = ReadPositiveQuantity(*dt, "s");
+          if (value > object->stable_dt_estimate())
+            Log().warn("{}: dt = {:.3g} s exceeds the estimated explicit stability limit {:.3g} s",
+                       dt->path(), value, object->stable_dt_estimate());
+        }
+        return object;
+      },
+      "mass-spring-damper tissue on the edges of a tet or triangle mesh, with optional fibre "
+      "active tension and cavities");
+}
+
+}  // namespace gipsi
