@@ -18,6 +18,7 @@
 #include "gipsi/base/error.h"
 #include "gipsi/base/log.h"
 #include "gipsi/models/fem/fem_solid.h"
+#include "gipsi/numerics/bracketed_root.h"
 
 namespace gipsi {
 namespace {
@@ -32,51 +33,13 @@ bool SolvePressure(CavityLaw& law, double t, double dt, double v, double guess, 
     out = v - vb;
     return true;
   };
-  double a = guess, ha = 0;
-  if (!h(a, ha)) return false;
-  const double tolerance = 1e-13 * std::abs(v);
-  if (std::abs(ha) <= tolerance) {
-    p = a;
-    return true;
-  }
-  // Bracket: step away from the guess in the direction that reduces |h|, doubling the step.
-  const double first = stiffness > 0 ? std::max(2 * std::abs(ha) * stiffness, 1e-3)
-                                     : std::max(1.0, 0.01 * std::abs(a));
-  double step = ha > 0 ? -first : first;
-  double b = a, hb = ha;
-  for (int k = 0; k < 80; ++k) {
-    b = a + step;
-    if (!h(b, hb)) return false;
-    if ((hb > 0) != (ha > 0) || hb == 0) break;
-    a = b;
-    ha = hb;
-    step *= 2;
-  }
-  if ((hb > 0) == (ha > 0) && hb != 0) return false;
-  // Illinois (modified regula falsi): superlinear, and never leaves the bracket.
-  int side = 0;
-  for (int k = 0; k < 200; ++k) {
-    const double c = (a * hb - b * ha) / (hb - ha);
-    double hc = 0;
-    if (!h(c, hc)) return false;
-    if (std::abs(hc) <= tolerance || std::abs(b - a) <= 1e-10 * (std::abs(c) + 1.0)) {
-      p = c;
-      return true;
-    }
-    if ((hc > 0) == (hb > 0)) {
-      b = c;
-      hb = hc;
-      if (side == -1) ha *= 0.5;
-      side = -1;
-    } else {
-      a = c;
-      ha = hc;
-      if (side == 1) hb *= 0.5;
-      side = 1;
-    }
-  }
-  p = 0.5 * (a + b);
-  return true;
+  // Step away from the guess in the direction that reduces |h|.
+  auto first_step = [&](double h0) {
+    const double first = stiffness > 0 ? std::max(2 * std::abs(h0) * stiffness, 1e-3)
+                                       : std::max(1.0, 0.01 * std::abs(guess));
+    return h0 > 0 ? -first : first;
+  };
+  return SolveIncreasingRoot(h, guess, first_step, 1e-13 * std::abs(v), p);
 }
 
 }  // namespace

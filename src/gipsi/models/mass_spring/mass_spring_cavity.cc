@@ -8,6 +8,7 @@
 
 #include "gipsi/base/error.h"
 #include "gipsi/models/mass_spring/mass_spring.h"
+#include "gipsi/numerics/bracketed_root.h"
 
 namespace gipsi {
 
@@ -136,69 +137,6 @@ void MassSpring::BeginCoupledStep() {
   }
 }
 
-namespace {
-
-/// Root of h(p) (increasing) near `guess` by a bracketed Illinois iteration; `slope` > 0
-/// estimates h' for the first step. False if h cannot be evaluated or no root is bracketed.
-template <class H>
-bool SolveIncreasing(H&& h, double guess, double slope, double tolerance, double& root,
-                     double& compliance_estimate) {
-  double a = guess, ha = 0;
-  if (!h(a, ha)) return false;
-  if (std::abs(ha) <= tolerance) {
-    root = a;
-    return true;
-  }
-  double step = -ha / slope;
-  if (!(std::abs(step) > 0) || !std::isfinite(step)) step = ha > 0 ? -1.0 : 1.0;
-  double b = a, hb = ha;
-  bool bracketed = false;
-  for (int k = 0; k < 80; ++k) {
-    b = a + step;
-    if (!h(b, hb)) return false;
-    if (std::abs(hb) <= tolerance) {
-      root = b;
-      compliance_estimate = (hb - ha) / (b - a);
-      return true;
-    }
-    if ((hb > 0) != (ha > 0)) {
-      bracketed = true;
-      break;
-    }
-    a = b;
-    ha = hb;
-    step *= 2;
-  }
-  if (!bracketed) return false;
-  compliance_estimate = (hb - ha) / (b - a);
-  // Illinois (modified regula falsi): superlinear, and never leaves the bracket.
-  int side = 0;
-  for (int k = 0; k < 200; ++k) {
-    const double c = (a * hb - b * ha) / (hb - ha);
-    double hc = 0;
-    if (!h(c, hc)) return false;
-    if (std::abs(hc) <= tolerance || std::abs(b - a) <= 1e-10 * (std::abs(c) + 1.0)) {
-      root = c;
-      return true;
-    }
-    if ((hc > 0) == (hb > 0)) {
-      b = c;
-      hb = hc;
-      if (side == -1) ha *= 0.5;
-      side = -1;
-    } else {
-      a = c;
-      ha = hc;
-      if (side == 1) hb *= 0.5;
-      side = 1;
-    }
-  }
-  root = 0.5 * (a + b);
-  return true;
-}
-
-}  // namespace
-
 bool MassSpring::SolveCoupledCavities(double t, double dt) {
   const Index n = num_nodes();
   for (std::size_t i = 0; i < cavities_.size(); ++i) {
@@ -227,8 +165,12 @@ bool MassSpring::SolveCoupledCavities(double t, double dt) {
     };
     const double v_now = CavityVolume(i);
     double p = cavity.pressure, slope = 0;
-    if (!SolveIncreasing(h, cavity.pressure, wall_slope + cavity.compliance, 1e-13 * v_now, p,
-                         slope)) {
+    const double estimate = wall_slope + cavity.compliance;  // dh/dp
+    auto first_step = [estimate](double h0) {  // a Newton step on the estimate, else ±1 Pa
+      const double step = -h0 / estimate;
+      return std::abs(step) > 0 && std::isfinite(step) ? step : (h0 > 0 ? -1.0 : 1.0);
+    };
+    if (!SolveIncreasingRoot(h, cavity.pressure, first_step, 1e-13 * v_now, p, &slope)) {
       const std::string& cname = params_.cavities[i].name;
       failure_detail_ =
           law_failed ? fmt::format(
