@@ -9,6 +9,23 @@
 
 namespace gipsi {
 
+CavitySurface MakeCavitySurface(const BoundarySurface& boundary, const std::vector<int>& faces) {
+  CavitySurface surface;
+  std::vector<int> local(static_cast<std::size_t>(boundary.num_vertices()), -1);
+  surface.triangles.resize(3, static_cast<Index>(faces.size()));
+  for (std::size_t k = 0; k < faces.size(); ++k)
+    for (int v = 0; v < 3; ++v) {
+      const int bv = boundary.triangles(v, faces[k]);
+      int& id = local[static_cast<std::size_t>(bv)];
+      if (id < 0) {
+        id = static_cast<int>(surface.nodes.size());
+        surface.nodes.push_back(boundary.vertex_to_node[static_cast<std::size_t>(bv)]);
+      }
+      surface.triangles(v == 0 ? 0 : 3 - v, static_cast<Index>(k)) = id;
+    }
+  return surface;
+}
+
 EnclosedVolume::EnclosedVolume(const Triangles& triangles, Index num_vertices)
     : triangles_(triangles), num_vertices_(num_vertices) {
   std::map<std::pair<int, int>, int> half_edges;  // directed edge → count

@@ -11,8 +11,21 @@
 #include <vector>
 
 #include "gipsi/base/math.h"
+#include "gipsi/geometry/boundary.h"
 
 namespace gipsi {
+
+/// A cavity's wall as its own surface: boundary faces of a tissue, renumbered. Plain struct.
+struct CavitySurface {
+  std::vector<int> nodes;  ///< domain node of each surface vertex, in order of first use
+  /// 3 by F over the surface vertices, each face reversed so that it faces out of the cavity
+  /// (a boundary's normals point out of the tissue, into the cavity): the enclosed volume is
+  /// then positive.
+  Triangles triangles;
+};
+
+/// The surface of the cavity bounded by `faces` (indices into `boundary`'s triangles).
+CavitySurface MakeCavitySurface(const BoundarySurface& boundary, const std::vector<int>& faces);
 
 /// Precomputed capping of one surface. Immutable; copyable.
 class EnclosedVolume {

@@ -125,22 +125,9 @@ FemSolid::FemSolid(std::string name, std::shared_ptr<const Mesh> domain, FemPara
     if (faces.empty())
       throw InputError(fmt::format("object '{}': cavity '{}' selects no boundary face",
                                    this->name(), spec.name));
-    // Local vertices; triangles reversed so that they face out of the cavity (the boundary's
-    // normals point out of the tissue, i.e. into the cavity), which makes its volume positive.
-    std::vector<int> local(static_cast<std::size_t>(bnd.num_vertices()), -1);
-    std::vector<int> nodes;
-    Triangles tris(3, static_cast<Index>(faces.size()));
-    for (std::size_t k = 0; k < faces.size(); ++k)
-      for (int v = 0; v < 3; ++v) {
-        const int bv = bnd.triangles(v, faces[k]);
-        int& id = local[static_cast<std::size_t>(bv)];
-        if (id < 0) {
-          id = static_cast<int>(nodes.size());
-          nodes.push_back(bnd.vertex_to_node[static_cast<std::size_t>(bv)]);
-        }
-        tris(v == 0 ? 0 : 3 - v, static_cast<Index>(k)) = id;
-      }
-    EnclosedVolume volume(tris, static_cast<Index>(nodes.size()));
+    CavitySurface surface = MakeCavitySurface(bnd, faces);
+    std::vector<int> nodes = std::move(surface.nodes);
+    EnclosedVolume volume(surface.triangles, static_cast<Index>(nodes.size()));
     Points positions(3, static_cast<Index>(nodes.size()));
     const FieldId f_volume = DeclareField({spec.name + "_volume", L::kGlobal, 1, "m^3", A::kRead,
                                            "volume enclosed by the cavity's faces (rim capped)"});

@@ -22,21 +22,9 @@ void MassSpring::SetUpCavities() {
     if (faces.empty())
       throw InputError(
           fmt::format("object '{}': cavity '{}' selects no boundary face", name(), spec.name));
-    // Triangles reversed so that they face out of the cavity (boundary normals point out of the
-    // tissue, into the cavity), which makes its volume positive — as FemSolid does.
-    std::vector<int> local(static_cast<std::size_t>(bnd.num_vertices()), -1);
-    std::vector<int> nodes;
-    Triangles tris(3, static_cast<Index>(faces.size()));
-    for (std::size_t k = 0; k < faces.size(); ++k)
-      for (int v = 0; v < 3; ++v) {
-        const int bv = bnd.triangles(v, faces[k]);
-        int& id = local[static_cast<std::size_t>(bv)];
-        if (id < 0) {
-          id = static_cast<int>(nodes.size());
-          nodes.push_back(bnd.vertex_to_node[static_cast<std::size_t>(bv)]);
-        }
-        tris(v == 0 ? 0 : 3 - v, static_cast<Index>(k)) = id;
-      }
+    CavitySurface surface = MakeCavitySurface(bnd, faces);  // as FemSolid's cavities
+    std::vector<int> nodes = std::move(surface.nodes);
+    const Triangles& tris = surface.triangles;
     const auto nc = static_cast<Index>(nodes.size());
     EnclosedVolume volume = [&] {
       try {
