@@ -31,6 +31,7 @@
 #include "gipsi/io/scene.h"
 #include "gipsi/models/builtins.h"
 #include "haptics/no_allocation_guard.h"
+#include "io/scene_test_util.h"
 
 namespace gipsi {
 namespace {
@@ -333,16 +334,7 @@ std::string SceneText(const std::string& device, const std::string& extra_connec
 })";
 }
 
-std::string LoadError(const std::string& text) {
-  TypeRegistry registry;
-  RegisterBuiltins(registry);
-  try {
-    (void)LoadSceneFromString(text, "igtl.json", ".", registry);
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "(no error)";
-}
+std::string LoadError(const std::string& text) { return testing::SceneLoadError(text); }
 
 TEST(IgtlDeviceScene, SendsTheDeformedBoundaryOfTheNamedObject) {
   LoopbackServer server;

@@ -14,6 +14,7 @@
 #include "gipsi/io/scene.h"
 #include "gipsi/models/builtins.h"
 #include "haptics/no_allocation_guard.h"
+#include "io/scene_test_util.h"
 
 namespace gipsi {
 namespace {
@@ -116,16 +117,7 @@ std::string ProbeScene(const std::string& probe_keys) {
 })";
 }
 
-std::string LoadError(const std::string& text) {
-  TypeRegistry registry;
-  RegisterBuiltins(registry);
-  try {
-    (void)LoadSceneFromString(text, "mouse.json", ".", registry);
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "(no error)";
-}
+std::string LoadError(const std::string& text) { return testing::SceneLoadError(text); }
 
 TEST(MouseDeviceScene, HeadlessTheToolStaysAtItsStart) {
   // Synchronous probe, no viewer: the tool rests 5 mm above the cube's top for the whole run.
