@@ -8,6 +8,7 @@
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include "apps/cli_test_util.h"
 
@@ -191,15 +192,23 @@ TEST(GipsiRun, ResourceLimitsRefuseOversizedRunsBeforeWriting) {
 }
 
 TEST(GipsiRun, CheckpointingASceneThatCannotSaveItsStateIsRefusedBeforeRunning) {
-  // The haptic probe of liver_palpation.json keeps no checkpointable state: the run must say so
-  // at once, before writing anything, not fail at its first checkpoint.
-  fs::path out = TempDir("no_checkpoints");
+  // A synchronous probe moved by the viewer's mouse cannot be reproduced, so it keeps no
+  // checkpointable state: the run must say so at once, before writing anything, not fail at its
+  // first checkpoint. The scene is liver_palpation_mouse.json without "realtime" (a real-time
+  // probe is refused earlier, for another reason), its meshes named by absolute paths.
+  const fs::path dir = TempDir("no_checkpoints");
+  nlohmann::json scene = nlohmann::json::parse(std::ifstream(Scene("liver_palpation_mouse.json")));
+  ASSERT_EQ(scene["objects"]["probe"].erase("realtime"), 1u);
+  for (auto& mesh : scene["meshes"]) mesh["file"] = Scene(mesh["file"].get<std::string>());
+  std::ofstream(dir / "mouse.json") << scene.dump(2);
+  const fs::path out = dir / "out";
   fs::remove_all(out);
-  Result r = Gipsi("run " + Scene("liver_palpation.json") + " --checkpoint-every 0.1 --out " +
+  Result r = Gipsi("run " + (dir / "mouse.json").string() + " --checkpoint-every 0.1 --out " +
                    out.string());
   EXPECT_EQ(r.code, 1) << r.output;
-  EXPECT_THAT(r.output, HasSubstr("--checkpoint-every: this scene cannot be checkpointed: object"));
-  EXPECT_THAT(r.output, HasSubstr("does not support checkpoints"));
+  EXPECT_THAT(r.output, HasSubstr("--checkpoint-every: this scene cannot be checkpointed: "
+                                  "haptic probe 'probe' cannot be checkpointed or rolled back: "
+                                  "its Mouse device is moved by the viewer's user"));
   EXPECT_FALSE(fs::exists(out));
 }
 

@@ -226,6 +226,14 @@ TEST(Resume, MassSpringHeartIsBitwiseIdentical) {
   ExpectBitwiseResume("heart_mass_spring.json", "heart_ms", 0.1, 0.12, 0.25);
 }
 
+TEST(Resume, HapticPalpationIsBitwiseIdentical) {
+  // The multi-rate haptic demo: an FEM liver, a synchronous probe on a scripted path ticking at
+  // 1 kHz and the coupling that publishes local models. The contact starts at about 1.18 s;
+  // checkpoint at 1.3 s, pressing, with the tick's local state, hand-over blend and safety
+  // stage, the bridge's kept contact and both buffers (with an unfetched model) to restore.
+  ExpectBitwiseResume("liver_palpation.json", "palpation", 0.65, 1.35, 1.5);
+}
+
 TEST(Resume, ACheckpointOfAnotherSceneIsRefused) {
   const fs::path dir = testing::TempDir("gipsi_resume_", "other");
   const std::string scenes = std::string(GIPSI_SOURCE_DIR) + "/scenes/";

@@ -9,6 +9,9 @@
 
 namespace gipsi {
 
+class StateWriter;
+class StateReader;
+
 /// Parameters. Plain struct with defaults.
 struct ForceSafetyParams {
   double max_force = 3.0;     ///< N, magnitude limit
@@ -35,6 +38,9 @@ class ForceSafety {
   [[nodiscard]] const ForceSafetyParams& params() const { return params_; }
   /// Number of ticks whose force was clamped or rate limited.
   [[nodiscard]] std::int64_t num_limited() const { return limited_; }
+  /// Checkpoints (haptic_state.cc): the watchdog gain, the last output and the count.
+  void SaveState(StateWriter& out) const;
+  void RestoreState(StateReader& in);
 
  private:
   ForceSafetyParams params_;

@@ -21,6 +21,9 @@
 
 namespace gipsi {
 
+class StateWriter;
+class StateReader;
+
 /// Parameters. Plain struct with defaults.
 struct HapticBridgeParams {
   double period = 1e-3;            ///< haptic period the models are discretised for [s]
@@ -52,6 +55,12 @@ class HapticBridge {
   /// Contact vertex of the last published model (−1: none).
   [[nodiscard]] Index contact_vertex() const { return contact_; }
   [[nodiscard]] LocalModelBuilder& builder() { return builder_; }
+  /// Checkpoints (haptic_state.cc): the feedback taken, the contact kept, the vertex carrying
+  /// the tool force, and both buffers whole (all three slots and their layout, so a model
+  /// published but not yet fetched is handed over as it would have been). Only while the
+  /// haptic side does not run (a synchronous probe).
+  void SaveState(StateWriter& out) const;
+  void RestoreState(StateReader& in);
 
  private:
   LocalModelBuilder& builder_;

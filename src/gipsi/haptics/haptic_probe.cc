@@ -51,7 +51,9 @@ HapticProbe::HapticProbe(std::string name, const HapticProbeSpec& spec)
     mouse_ = mouse.get();
     device_ = std::move(mouse);
   } else {
-    device_ = std::make_unique<VirtualDevice>(spec.path);
+    auto scripted = std::make_unique<VirtualDevice>(spec.path);
+    virtual_ = scripted.get();
+    device_ = std::move(scripted);
   }
   if (!(spec.rate > 0 && spec.rate <= 10000))
     throw InputError(

@@ -103,6 +103,13 @@ class HapticProbe final : public SimObject {
   /// can tick it on its own thread while the loop is stopped (e.g. under an allocation guard).
   [[nodiscard]] HapticRenderer* loop_renderer();
 
+  /// Checkpoints and roll-back (haptic_state.cc) of a synchronous probe on a scripted path: its
+  /// fields, tick count, the tick's state and the virtual device's. A real-time probe (ticks on
+  /// the wall clock), a Mouse or an OpenIGTLink device (moved by a person or a tracker) makes a
+  /// run that cannot be reproduced: InputError saying so.
+  void SaveObjectState(StateWriter& out) const override;
+  void RestoreObjectState(StateReader& in) override;
+
  protected:
   StepStatus DoStep(double t, double dt) override;
   void DoReadField(FieldId id, Eigen::Ref<Eigen::MatrixXd> out) const override;
@@ -120,8 +127,9 @@ class HapticProbe final : public SimObject {
 
   HapticProbeSpec spec_;
   std::unique_ptr<HapticDevice> device_;
-  IgtlDevice* igtl_ = nullptr;    // device_, when it is an OpenIGTLink device
-  MouseDevice* mouse_ = nullptr;  // device_, when it is a mouse device
+  IgtlDevice* igtl_ = nullptr;        // device_, when it is an OpenIGTLink device
+  MouseDevice* mouse_ = nullptr;      // device_, when it is a mouse device
+  VirtualDevice* virtual_ = nullptr;  // device_, when it is a scripted virtual device
   Vec3 initial_ = Vec3::Zero();
   std::unique_ptr<LocalModelTick> tick_;
   Points no_positions_ = Points(3, 0);
@@ -148,6 +156,9 @@ class HapticCoupling final : public Connector {
   /// Stops the probe's real-time loop (it reads this connector's buffers).
   ~HapticCoupling() override;
   [[nodiscard]] HapticBridge& bridge() { return *bridge_; }
+  /// Checkpoints and roll-back (haptic_state.cc): the bridge's state and buffers.
+  void SaveConnectorState(StateWriter& out) const override;
+  void RestoreConnectorState(StateReader& in) override;
 
  protected:
   StepStatus DoFire(double t) override;

@@ -42,6 +42,33 @@ class LatestValue {
   /// The value the consumer reads (stable until its next Fetch).
   [[nodiscard]] const T& front() const { return slots_[front_]; }
 
+  // --- checkpoints: only while neither side runs ---
+  /// Which slot each side holds, and whether the exchanged slot holds an unfetched value.
+  /// Plain struct.
+  struct Layout {
+    int back = 0, middle = 1, front = 2;
+    bool fresh = false;
+  };
+  [[nodiscard]] Layout layout() const {
+    const std::uint8_t middle = middle_.load(std::memory_order_relaxed);
+    return {back_, middle & kIndex, front_, (middle & kFresh) != 0};
+  }
+  /// Restores a layout; returns false (changing nothing) unless the three indices are a
+  /// permutation of 0, 1, 2.
+  bool set_layout(const Layout& layout) {
+    for (int i : {layout.back, layout.middle, layout.front})
+      if (i < 0 || i > 2) return false;
+    if (((1 << layout.back) | (1 << layout.middle) | (1 << layout.front)) != 7) return false;
+    back_ = static_cast<std::uint8_t>(layout.back);
+    front_ = static_cast<std::uint8_t>(layout.front);
+    middle_.store(static_cast<std::uint8_t>(layout.middle | (layout.fresh ? kFresh : 0)),
+                  std::memory_order_relaxed);
+    return true;
+  }
+  /// Slot `i` (0, 1 or 2), whichever side holds it.
+  [[nodiscard]] T& slot(int i) { return slots_[static_cast<std::size_t>(i)]; }
+  [[nodiscard]] const T& slot(int i) const { return slots_[static_cast<std::size_t>(i)]; }
+
  private:
   static constexpr std::uint8_t kIndex = 3, kFresh = 4;
   std::array<T, 3> slots_;

@@ -56,6 +56,11 @@ class LocalModelTick final : public HapticRenderer {
   [[nodiscard]] const LocalDynamicModel& model() const { return models_.front(); }
   [[nodiscard]] const ForceSafety& safety() const { return safety_; }
   [[nodiscard]] std::int64_t num_handovers() const { return handovers_; }
+  /// Checkpoints (haptic_state.cc): everything the next ticks depend on (local state, hand-over
+  /// blend, depth history, safety stage). The models it renders live in the buffer, which its
+  /// producer (HapticBridge) saves.
+  void SaveState(StateWriter& out) const;
+  void RestoreState(StateReader& in);
 
  private:
   HapticDevice& device_;

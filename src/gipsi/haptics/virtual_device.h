@@ -11,6 +11,9 @@
 
 namespace gipsi {
 
+class StateWriter;
+class StateReader;
+
 /// One keyframe of a trajectory. Plain struct.
 struct DeviceKeyframe {
   double time = 0;  ///< s
@@ -36,6 +39,10 @@ class VirtualDevice final : public HapticDevice {
   [[nodiscard]] const Vec3& last_force() const { return force_; }
   [[nodiscard]] const Vec3& last_torque() const { return torque_; }
   [[nodiscard]] std::int64_t num_commands() const { return commands_; }
+  /// Checkpoints (haptic_state.cc): the connection flag and the commands received. The pose is
+  /// a function of time.
+  void SaveState(StateWriter& out) const;
+  void RestoreState(StateReader& in);
 
  private:
   std::vector<DeviceKeyframe> path_;
