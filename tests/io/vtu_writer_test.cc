@@ -1,11 +1,15 @@
 #include "gipsi/io/vtu_writer.h"
 
 #include <cstring>
+#include <filesystem>
+#include <fstream>
 #include <random>
 #include <string>
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
+
+#include <fmt/format.h>
 
 #include "gipsi/io/base64.h"
 #include "gipsi/io/gmsh_reader.h"
@@ -17,6 +21,7 @@ namespace {
 
 using test::Scratch;
 using ::testing::HasSubstr;
+using ::testing::Not;
 
 /// The liver tet mesh with a few boundary-like triangles and irrational coordinates.
 Mesh MixedMesh() {
@@ -100,6 +105,56 @@ TEST(PvdWriter, KeepsAValidCollectionAfterEveryFrame) {
   EXPECT_THAT(xml, HasSubstr("</VTKFile>"));
   EXPECT_EQ(pvd.num_frames(), 2u);
   EXPECT_FALSE(std::filesystem::exists(path.string() + ".tmp"));
+}
+
+TEST(PvdWriter, FramesWrittenInPlaceGiveTheSameFileAsAWholeRewrite) {
+  // Each frame after the first write goes over the closing tags; the result must be the file a
+  // whole rewrite of the same frames gives, byte for byte, after every frame.
+  auto path = Scratch("appended.pvd");
+  auto whole = Scratch("whole.pvd");
+  PvdWriter pvd(path);
+  // A second name for the file: writes in place show through it, a rewrite (a new file renamed
+  // over the old name) would leave it behind.
+  const auto link = Scratch("link.pvd");
+  std::filesystem::create_hard_link(path, link);
+  std::vector<std::pair<double, std::string>> frames;
+  for (int i = 0; i < 40; ++i) {
+    frames.emplace_back(0.1 * i, fmt::format("run/run_{:06d}.vtu", i));
+    pvd.AddFrame(frames.back().first, frames.back().second);
+    PvdWriter reference(whole, false);
+    reference.SetFrames(frames);
+    ASSERT_EQ(test::ReadBytes(path), test::ReadBytes(whole)) << "after frame " << i;
+    ASSERT_EQ(test::ReadBytes(link), test::ReadBytes(path)) << "rewritten at frame " << i;
+  }
+  // A file name with XML metacharacters is escaped in place as in a rewrite.
+  frames.emplace_back(4.0, "a&b<c>\"d\".vtu");
+  pvd.AddFrame(frames.back().first, frames.back().second);
+  PvdWriter reference(whole, false);
+  reference.SetFrames(frames);
+  EXPECT_EQ(test::ReadBytes(path), test::ReadBytes(whole));
+  EXPECT_THAT(test::ReadBytes(path), HasSubstr("a&amp;b&lt;c&gt;&quot;d&quot;.vtu"));
+}
+
+TEST(PvdWriter, AFileChangedBehindItsBackIsWrittenWhole) {
+  auto path = Scratch("changed.pvd");
+  PvdWriter pvd(path);
+  pvd.AddFrame(0.0, "f0.vtu");
+  pvd.AddFrame(1.0, "f1.vtu");
+  std::ofstream(path, std::ios::trunc) << "something else";  // another program's doing
+  pvd.AddFrame(2.0, "f2.vtu");
+  std::string xml = test::ReadBytes(path);
+  for (const char* f : {"f0.vtu", "f1.vtu", "f2.vtu"}) EXPECT_THAT(xml, HasSubstr(f));
+  EXPECT_THAT(xml, HasSubstr("</VTKFile>\n"));
+  EXPECT_THAT(xml, Not(HasSubstr("something else")));
+  std::filesystem::remove(path);
+  pvd.AddFrame(3.0, "f3.vtu");
+  xml = test::ReadBytes(path);
+  for (const char* f : {"f0.vtu", "f1.vtu", "f2.vtu", "f3.vtu"}) EXPECT_THAT(xml, HasSubstr(f));
+  pvd.AddFrame(4.0, "f4.vtu");  // in place again
+  PvdWriter reference(Scratch("changed_whole.pvd"), false);
+  reference.SetFrames(
+      {{0.0, "f0.vtu"}, {1.0, "f1.vtu"}, {2.0, "f2.vtu"}, {3.0, "f3.vtu"}, {4.0, "f4.vtu"}});
+  EXPECT_EQ(test::ReadBytes(path), test::ReadBytes(Scratch("changed_whole.pvd")));
 }
 
 }  // namespace

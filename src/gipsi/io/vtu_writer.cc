@@ -1,5 +1,10 @@
 #include "gipsi/io/vtu_writer.h"
 
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cerrno>
 #include <cstdint>
 #include <cstring>
 #include <utility>
@@ -172,20 +177,66 @@ PvdWriter::PvdWriter(std::filesystem::path path, bool write) : path_(std::move(p
 
 void PvdWriter::AddFrame(double time, const std::string& file) {
   frames_.push_back({time, file});
-  Rewrite();
+  if (!Append()) Rewrite();
 }
 
-void PvdWriter::Rewrite() const {
+namespace {
+
+constexpr std::string_view kPvdClosing = "  </Collection>\n</VTKFile>\n";
+
+std::string PvdDataSet(double time, const std::string& file) {
+  return fmt::format("    <DataSet timestep=\"{}\" group=\"\" part=\"0\" file=\"{}\"/>\n", time,
+                     EscapeXml(file));
+}
+
+/// Writes all of `bytes` at `offset`; false if the file took fewer.
+bool WriteAllAt(int fd, std::string_view bytes, std::uintmax_t offset) {
+  while (!bytes.empty()) {
+    const ssize_t n = ::pwrite(fd, bytes.data(), bytes.size(), static_cast<off_t>(offset));
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) return false;
+    bytes.remove_prefix(static_cast<std::size_t>(n));
+    offset += static_cast<std::uintmax_t>(n);
+  }
+  return true;
+}
+
+}  // namespace
+
+void PvdWriter::Rewrite() {
+  written_ = false;
   std::string xml = "<?xml version=\"1.0\"?>\n";
   xml += fmt::format("<VTKFile type=\"Collection\" version=\"0.1\" byte_order=\"{}\">\n",
                      internal::HostIsLittleEndian() ? "LittleEndian" : "BigEndian");
   xml += "  <Collection>\n";
-  for (const Frame& f : frames_) {
-    xml += fmt::format("    <DataSet timestep=\"{}\" group=\"\" part=\"0\" file=\"{}\"/>\n", f.time,
-                       EscapeXml(f.file));
-  }
-  xml += "  </Collection>\n</VTKFile>\n";
+  for (const Frame& f : frames_) xml += PvdDataSet(f.time, f.file);
+  tail_ = xml.size();
+  xml += kPvdClosing;
   internal::WriteFileAtomically(path_, xml);
+  written_ = true;
+}
+
+bool PvdWriter::Append() {
+  if (!written_) return false;
+  const int fd = ::open(path_.c_str(), O_WRONLY | O_CLOEXEC);
+  if (fd < 0) return false;
+  struct stat info {};
+  bool ok = ::fstat(fd, &info) == 0 &&
+            static_cast<std::uintmax_t>(info.st_size) == tail_ + kPvdClosing.size();
+  if (ok) {
+    const std::string line = PvdDataSet(frames_.back().time, frames_.back().file);
+    ok = WriteAllAt(fd, line + std::string(kPvdClosing), tail_);
+    if (ok) {
+      tail_ += line.size();
+    } else {  // a short write (e.g. a full disk): put the old end back before rewriting whole
+      WriteAllAt(fd, kPvdClosing, tail_);
+      [[maybe_unused]] const int r =
+          ::ftruncate(fd, static_cast<off_t>(tail_ + kPvdClosing.size()));
+    }
+  }
+  ::close(fd);
+  if (!ok) written_ = false;
+  return ok;
 }
 
 }  // namespace gipsi

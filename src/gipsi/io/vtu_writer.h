@@ -59,9 +59,14 @@ std::uintmax_t VtuFileBytes(Index num_nodes, Index num_tets, Index num_triangles
 /// `WriteVtu(path, mesh.nodes, mesh.tets, mesh.triangles, fields)`.
 void WriteVtu(const std::filesystem::path& path, const Mesh& mesh, const VtuFields& fields = {});
 
-/// Maintains a ParaView `.pvd` collection: a list of (time, file) frames. The `.pvd` file is
-/// rewritten after each added frame by writing a temporary file and renaming it over the old
-/// one, so that the file on disk is always a complete, valid collection (also after a crash).
+/// Maintains a ParaView `.pvd` collection: a list of (time, file) frames, complete and valid on
+/// disk after every added frame. The file is first written whole (a temporary file renamed over
+/// the old one); each later frame is then written in place over the closing tags, as its
+/// `<DataSet>` line followed by the closing tags again, in one write: a frame costs its own
+/// bytes, not the whole collection's (rewriting it would write O(frames²) bytes in a long run),
+/// and a killed process leaves the file as it was before or after that write. If the file is
+/// not as this writer left it (changed or removed by someone else), or the write fails part
+/// way (the old closing tags are then put back), the collection is written whole instead.
 /// Movable, not copyable (it stands for one file).
 class PvdWriter {
  public:
@@ -91,10 +96,15 @@ class PvdWriter {
     double time;
     std::string file;
   };
-  void Rewrite() const;
+  void Rewrite();
+  /// Writes the last frame over the closing tags; false if the file is not as Rewrite or the
+  /// previous Append left it, or the write failed (the file is then as before).
+  bool Append();
 
   std::filesystem::path path_;
   std::vector<Frame> frames_;
+  std::uintmax_t tail_ = 0;  ///< offset of the closing tags in the file
+  bool written_ = false;     ///< whether tail_ describes the file on disk
 };
 
 }  // namespace gipsi
