@@ -479,6 +479,15 @@ inline void ApplyInverse(const double* __restrict m, const double s[3], double* 
 
 }  // namespace
 
+bool SmoothedAggregationAmg::Multiply(const VecX& x, VecX& y) const {
+  if (levels_.empty() || !levels_.front()->blocked) return false;
+  const Level& level = *levels_.front();
+  GIPSI_CHECK(x.size() == level.a->rows() && y.size() == x.size() && x.data() != y.data(),
+              "AMG Multiply: sizes do not match or x and y alias");
+  LevelMultiply(level, x, y);
+  return true;
+}
+
 double SmoothedAggregationAmg::JacobiWeight(Level& level, double point_rho) {
   // ω = 4 / (3 λ), λ ≈ λ_max(D⁻¹A) for the smoother's D (3×3 blocks or the point diagonal),
   // raised by 10 % over the power iteration's estimate (which approaches it from below) so

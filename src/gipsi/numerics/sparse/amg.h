@@ -71,6 +71,12 @@ class SmoothedAggregationAmg {
   /// z = B r, one V-cycle from a zero initial guess. r and z must have A's size.
   void Apply(const VecX& r, VecX& z);
 
+  /// y = A x with the finest matrix of the last Setup/Refresh, from the hierarchy's 3×3-block
+  /// copy of it (less index traffic than SymmetricSpMV; rows summed by one thread each, so
+  /// the bits do not depend on the thread count). Returns false, leaving y alone, if the
+  /// finest level has no block copy (no 3×3 node-block pattern). x and y must not alias.
+  [[nodiscard]] bool Multiply(const VecX& x, VecX& y) const;
+
   [[nodiscard]] bool ready() const { return ready_; }
   [[nodiscard]] int num_levels() const { return static_cast<int>(levels_.size()); }
   /// Rows of level l (0 = finest).

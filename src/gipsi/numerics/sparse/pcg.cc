@@ -207,9 +207,11 @@ class PcgSolver final : public LinearSolver {
     return positive;
   }
 
-  /// y = A x: NodeBlockSpMV for a matrix of 3×3 node blocks (an FEM tangent), else
-  /// SymmetricSpMV.
+  /// y = A x: from the AMG hierarchy's block copy of A when it has one (9 contiguous values
+  /// per block: measured faster than NodeBlockSpMV's three column streams), else NodeBlockSpMV
+  /// for a matrix of 3×3 node blocks (an FEM tangent), else SymmetricSpMV.
   void Multiply(const VecX& x, VecX& y) {
+    if (kind_ == Preconditioner::kAmg && amg_.Multiply(x, y)) return;
     if (node_blocks_)
       NodeBlockSpMV(*matrix_, x, y);
     else
