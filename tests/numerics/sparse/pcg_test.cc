@@ -6,6 +6,7 @@
 #include <limits>
 #include <map>
 #include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 #include <Eigen/IterativeLinearSolvers>
@@ -238,6 +239,42 @@ TEST(LaggedCholeskyPcg, StronglyChangedMatrixTriggersRefactorizationOnNextFactor
   EXPECT_TRUE(refreshed.refactorized);
   EXPECT_TRUE(refreshed.converged);
   EXPECT_EQ(refreshed.iterations, 1);
+}
+
+// A matrix that drifts further from the factorised one every step (springs stiffer along x by
+// a factor 1 + 0.2 step x): CG iterations with the old factor rise slowly, far below
+// refactor_iterations, yet the amortised rule refactorises once a solve costs more than the mean
+// per solve since the last factorisation (the factorisation's cost included), and CG is then back
+// to ~1 iteration.
+TEST(LaggedCholeskyPcg, SlowlyRisingIterationsTriggerAnAmortisedRefactorization) {
+  LinearSolverOptions options = Cg("cholesky");
+  options.refactor_iterations = 1000;  // only the amortised rule can refactorise
+  const SparseMatrix A0 = testing::TestLattice();
+  auto solver = ReadySolver(options, A0);
+  std::vector<int> iterations;
+  int refactorized_at = -1;
+  std::vector<SparseMatrix> matrices;
+  for (int step = 1; step <= 40 && refactorized_at < 0; ++step) {
+    matrices.push_back(MakeSpringLattice3D(12, 1e-2, [step](const Vec3& p) {
+      return (p.z() > 0.5 ? 20.0 : 1.0) * (1.0 + 0.2 * step * p.x());
+    }));
+    const SparseMatrix& A = matrices.back();
+    ASSERT_TRUE(solver->Factorize(A));
+    const auto problem = Manufacture(A);
+    VecX x = VecX::Zero(A.rows());
+    const LinearSolveStats stats = solver->Solve(problem.b, x);
+    ASSERT_TRUE(stats.converged);
+    if (stats.refactorized) {
+      refactorized_at = step;
+      EXPECT_LE(stats.iterations, 2);  // the factor of this very matrix
+    }
+    iterations.push_back(stats.iterations);
+  }
+  ASSERT_GT(refactorized_at, 1) << "never refactorised";
+  // Before the refactorisation the iterations rose but stayed far below the cap (measured: 5
+  // rising to 13, refactorised at step 16).
+  EXPECT_GT(iterations[static_cast<std::size_t>(refactorized_at) - 2], iterations.front());
+  EXPECT_LT(iterations[static_cast<std::size_t>(refactorized_at) - 2], 100);
 }
 
 TEST(LaggedCholeskyPcg, UnconvergedSolveAlsoTriggersRefactorization) {

@@ -127,6 +127,52 @@ TEST(SymmetricSpMV, HandlesEmptyColumnsAndATinyMatrix) {
   EXPECT_EQ(y, VecX((VecX(3) << 2.0, 0.0, -5.0).finished()));
 }
 
+TEST(NodeBlockSpMV, RecognisesOnlyWholeNodeBlockPatterns) {
+  EXPECT_TRUE(HasNodeBlockPattern(MakeSpringLattice3D(4, 0.1)));
+  // 21³ = 9,261 rows, a multiple of 3, but a point (7-entry) pattern.
+  EXPECT_FALSE(HasNodeBlockPattern(MakeLaplacian3D(21, 0.5)));
+  // A lattice with one off-diagonal block entry (and its mirror) missing.
+  SparseMatrix A = MakeSpringLattice3D(4, 0.1);
+  SparseMatrix B(A.rows(), A.cols());
+  std::vector<Eigen::Triplet<double>> entries;
+  for (int j = 0; j < A.outerSize(); ++j)
+    for (SparseMatrix::InnerIterator it(A, j); it; ++it)
+      if (!((it.row() == 4 && j == 0) || (it.row() == 0 && j == 4)))
+        entries.emplace_back(static_cast<int>(it.row()), j, it.value());
+  B.setFromTriplets(entries.begin(), entries.end());
+  B.makeCompressed();
+  ASSERT_LT(B.nonZeros(), A.nonZeros());
+  EXPECT_FALSE(HasNodeBlockPattern(B));
+}
+
+// Each y entry sums at most 27 blocks × 3 products in its own fixed order; the difference to
+// Eigen's order is a few ulps of the entry's magnitude, far below 1e-14 of the norm.
+TEST(NodeBlockSpMV, MatchesEigenProductToRoundOff) {
+  const SparseMatrix A = MakeSpringLattice3D(14, 1e-2, [](const Vec3& p) { return 1.0 + p.x(); });
+  ASSERT_GE(A.rows(), kMinParallelLength);  // the parallel path
+  ASSERT_TRUE(HasNodeBlockPattern(A));
+  const VecX x = RandomVector(A.cols(), 21);
+  VecX y(A.rows());
+  NodeBlockSpMV(A, x, y);
+  const VecX expected = A * x;
+  EXPECT_LE((y - expected).norm(), 1e-14 * expected.norm());
+}
+
+TEST(NodeBlockSpMV, BitsDoNotDependOnThreadCount) {
+  ThreadCountGuard guard;
+  const SparseMatrix A = MakeSpringLattice3D(14, 1e-2, [](const Vec3& p) { return 1.0 + p.z(); });
+  const VecX x = RandomVector(A.cols(), 22);
+  omp_set_num_threads(1);
+  VecX serial(A.rows());
+  NodeBlockSpMV(A, x, serial);
+  for (int threads : {2, 3}) {
+    omp_set_num_threads(threads);
+    VecX parallel(A.rows());
+    NodeBlockSpMV(A, x, parallel);
+    EXPECT_TRUE(SameBits(serial, parallel)) << threads << " threads";
+  }
+}
+
 TEST(ParallelDot, MatchesSerialDotAndRepeatsBitForBit) {
   ThreadCountGuard guard;
   omp_set_num_threads(3);  // an uneven split of the range

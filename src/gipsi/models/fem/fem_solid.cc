@@ -163,19 +163,20 @@ bool FemSolid::AssembleElements(const double* u, VecX& f, double* k_values) cons
   std::atomic<bool> any_invalid{false};
   double* fp = f.data();
   assembly_.ForEachElementColoured([&](Index e) {
-    const auto g = assembly_.gradients(e);
+    const TetGradients g = assembly_.gradients(e);
     const Mat3 F = assembly_.DeformationGradient(e, u);
     const MaterialPoint mp = PointOf(e);
+    const double vol = assembly_.volume(e);
     Mat3 P;
-    Mat9 C;
-    const bool ok = k_values ? law_->StressAndTangent(F, mp, P, C) : law_->Stress(F, mp, P);
+    Mat12 K;
+    const bool ok =
+        k_values ? law_->ElementStressAndStiffness(F, mp, g, vol, P, K) : law_->Stress(F, mp, P);
     invalid_[static_cast<std::size_t>(e)] = ok ? 0 : 1;
     element_force_sum_[e] = 0;
     if (!ok) {
       any_invalid.store(true, std::memory_order_relaxed);
       return;
     }
-    const double vol = assembly_.volume(e);
     const Eigen::Matrix<double, 3, 4> fe = vol * P * g;
     element_force_sum_[e] = fe.cwiseAbs().sum();
     for (int a = 0; a < 4; ++a) {
@@ -185,23 +186,14 @@ bool FemSolid::AssembleElements(const double* u, VecX& f, double* k_values) cons
       fa[2] += fe(2, a);
     }
     if (!k_values) return;
-    // T_b(:, k) = Σ_l C(:, k + 3l) g_b[l]  (9 by 3 per node b), then
-    // K_ab(i, k) = V Σ_j g_a[j] T_b(i + 3j, k).
-    for (int b = 0; b < 4; ++b) {
-      Eigen::Matrix<double, 9, 3> t;
-      for (int k = 0; k < 3; ++k)
-        t.col(k) = C.col(k) * g(0, b) + C.col(k + 3) * g(1, b) + C.col(k + 6) * g(2, b);
-      for (int a = 0; a < 4; ++a) {
-        const Mat3 block = vol * (g(0, a) * t.block<3, 3>(0, 0) + g(1, a) * t.block<3, 3>(3, 0) +
-                                  g(2, a) * t.block<3, 3>(6, 0));
+    for (int b = 0; b < 4; ++b)
+      for (int a = 0; a < 4; ++a)
         for (int k = 0; k < 3; ++k) {
           double* col = k_values + assembly_.ValueIndex(e, a, b, 0, k);
-          col[0] += block(0, k);
-          col[1] += block(1, k);
-          col[2] += block(2, k);
+          col[0] += K(3 * a, 3 * b + k);
+          col[1] += K(3 * a + 1, 3 * b + k);
+          col[2] += K(3 * a + 2, 3 * b + k);
         }
-      }
-    }
   });
   // Assembling contributions of magnitude |f| into a residual loses ~ε|f| each, and forces
   // evaluated at a displacement u carry ~ε ‖K‖ ‖u‖: 100 ε times their sum bounds what any

@@ -1,6 +1,7 @@
 #include "gipsi/models/fem/solid_laws.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <memory>
@@ -106,17 +107,20 @@ void SignedSvd(const Mat3& F, Mat3& U, Vec3& sigma, Mat3& V) {
 namespace {
 
 bool FastPolar(const Mat3& F, Mat3& R) {
-  // Scaled Newton iteration X ← ½(γX + (γX)⁻ᵀ), γ = |det X|^(−1/3) (Higham, "Computing the
-  // polar decomposition — with applications", SIAM J. Sci. Stat. Comput. 7, 1986): quadratic
-  // convergence to the rotation of F = R S for det F > 0, in 3–7 iterations of a 3×3 inverse
-  // (much cheaper than a Jacobi SVD) and to full precision near F = I.
+  // Scaled Newton iteration X ← ½(γX + γ⁻¹X⁻ᵀ) with the Frobenius-norm scaling
+  // γ = (‖X⁻¹‖_F / ‖X‖_F)^½ (Higham, "Computing the polar decomposition — with applications",
+  // SIAM J. Sci. Stat. Comput. 7, 1986; it needs only the inverse the step computes anyway, where
+  // the determinant scaling |det X|^(−1/3) cost a cube root): quadratic convergence to the
+  // rotation of F = R S for det F > 0, in 3–7 iterations of a 3×3 inverse (much cheaper than a
+  // Jacobi SVD) and to full precision near F = I.
   const double det = F.determinant();
   if (!(det > 1e-6 * F.squaredNorm() * F.norm())) return false;  // near or past inversion
   R = F;
   for (int it = 0; it < 30; ++it) {
-    const double d = R.determinant();
-    const double gamma = it < 4 ? std::cbrt(1.0 / d) : 1.0;
-    const Mat3 next = 0.5 * (gamma * R + (gamma * R).inverse().transpose());
+    const Mat3 inverse_t = R.inverse().transpose();
+    const double gamma =
+        it < 4 ? std::sqrt(std::sqrt(inverse_t.squaredNorm() / R.squaredNorm())) : 1.0;
+    const Mat3 next = 0.5 * (gamma * R + inverse_t / gamma);
     const double change = (next - R).lpNorm<Eigen::Infinity>();
     R = next;
     if (change <= 1e-15) return true;
@@ -125,6 +129,25 @@ bool FastPolar(const Mat3& F, Mat3& R) {
 }
 
 }  // namespace
+
+bool SolidMaterial::ElementStressAndStiffness(const Mat3& F, const MaterialPoint& mp,
+                                              const TetGradients& g, double volume, Mat3& P,
+                                              Mat12& K) const {
+  Mat9 C;
+  if (!StressAndTangent(F, mp, P, C)) return false;
+  // T_b(:, k) = Σ_l C(:, k + 3l) g_b[l]  (9 by 3 per node b), then
+  // K_ab(i, k) = V Σ_j g_a[j] T_b(i + 3j, k).
+  for (int b = 0; b < 4; ++b) {
+    Eigen::Matrix<double, 9, 3> t;
+    for (int k = 0; k < 3; ++k)
+      t.col(k) = C.col(k) * g(0, b) + C.col(k + 3) * g(1, b) + C.col(k + 6) * g(2, b);
+    for (int a = 0; a < 4; ++a)
+      K.block<3, 3>(3 * a, 3 * b) =
+          volume * (g(0, a) * t.block<3, 3>(0, 0) + g(1, a) * t.block<3, 3>(3, 0) +
+                    g(2, a) * t.block<3, 3>(6, 0));
+  }
+  return true;
+}
 
 IsotropicSolid::IsotropicSolid(double youngs_modulus, double poisson_ratio)
     : youngs_modulus_(youngs_modulus),
@@ -204,11 +227,8 @@ bool CorotationalSolid::Stress(const Mat3& F, const MaterialPoint& mp, Mat3& P) 
   return P.allFinite();
 }
 
-bool CorotationalSolid::StressAndTangent(const Mat3& F, const MaterialPoint& mp, Mat3& P,
-                                         Mat9& dPdF) const {
+bool CorotationalSolid::RotationAndInverse(const Mat3& F, Mat3& R, double& tr, Mat3& inv) const {
   if (!F.allFinite()) return false;
-  Mat3 R, inv;
-  double tr = 0;
   if (FastPolar(F, R)) {
     // S = RᵀF is symmetric positive definite here, so tr(S) I − S is too (its eigenvalues are
     // sums of two singular values): invert it directly.
@@ -228,6 +248,14 @@ bool CorotationalSolid::StressAndTangent(const Mat3& F, const MaterialPoint& mp,
                     std::max(sigma(0) + sigma(1), kMinSingularSum));
     inv = V * sums.cwiseInverse().asDiagonal() * V.transpose();
   }
+  return true;
+}
+
+bool CorotationalSolid::StressAndTangent(const Mat3& F, const MaterialPoint& mp, Mat3& P,
+                                         Mat9& dPdF) const {
+  Mat3 R, inv;
+  double tr = 0;
+  if (!RotationAndInverse(F, R, tr, inv)) return false;
   P = (2 * lame_.mu) * (F - R) + (lame_.lambda * tr) * R;
 
   // δP = 2μ δF + λ (R:δF) R + (λ tr(S − I) − 2μ) δR.
@@ -254,6 +282,45 @@ bool CorotationalSolid::StressAndTangent(const Mat3& F, const MaterialPoint& mp,
     AddGeometricTangent(sa, dPdF);
   }
   return P.allFinite() && dPdF.allFinite();
+}
+
+bool CorotationalSolid::ElementStressAndStiffness(const Mat3& F, const MaterialPoint& mp,
+                                                  const TetGradients& g, double volume, Mat3& P,
+                                                  Mat12& K) const {
+  Mat3 R, inv;
+  double tr = 0;
+  if (!RotationAndInverse(F, R, tr, inv)) return false;
+  P = (2 * lame_.mu) * (F - R) + (lame_.lambda * tr) * R;
+  const double c = volume * (lame_.lambda * tr - 2 * lame_.mu);
+  const double lambda = volume * lame_.lambda;
+  const double two_mu = volume * 2 * lame_.mu;
+  Mat3 sa = Mat3::Zero();
+  if (mp.active_tension != 0) {
+    sa = volume * ActivePk2(mp);
+    P.noalias() += F * ActivePk2(mp);
+  }
+  Eigen::Matrix<double, 3, 4> q;
+  std::array<Mat3, 4> x, y;  // X_a = R [g_a]×, Y_a = c X_a M
+  for (int a = 0; a < 4; ++a) {
+    const Vec3 ga = g.col(a);
+    q.col(a) = R * ga;
+    // Column j of R [g]× is R (g × e_j).
+    x[a].col(0) = R.col(2) * ga(1) - R.col(1) * ga(2);
+    x[a].col(1) = R.col(0) * ga(2) - R.col(2) * ga(0);
+    x[a].col(2) = R.col(1) * ga(0) - R.col(0) * ga(1);
+    y[a].noalias() = c * (x[a] * inv);
+  }
+  for (int b = 0; b < 4; ++b) {
+    for (int a = 0; a <= b; ++a) {
+      Mat3 block;
+      block.noalias() = y[a] * x[b].transpose();
+      block.noalias() += lambda * (q.col(a) * q.col(b).transpose());
+      block.diagonal().array() += two_mu * g.col(a).dot(g.col(b)) + g.col(a).dot(sa * g.col(b));
+      K.block<3, 3>(3 * a, 3 * b) = block;
+      if (a != b) K.block<3, 3>(3 * b, 3 * a) = block.transpose();
+    }
+  }
+  return P.allFinite() && K.allFinite();
 }
 
 // ---------------------------------------------------------------------------------------------

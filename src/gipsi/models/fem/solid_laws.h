@@ -116,6 +116,19 @@ class CorotationalSolid final : public IsotropicSolid {
   [[nodiscard]] bool Stress(const Mat3& F, const MaterialPoint& mp, Mat3& P) const override;
   [[nodiscard]] bool StressAndTangent(const Mat3& F, const MaterialPoint& mp, Mat3& P,
                                       Mat9& dPdF) const override;
+  /// Closed form of the element stiffness (no 9×9 tangent): with q_a = R g_a, X_a = R [g_a]×,
+  /// M = (tr(S) I − S)⁻¹ (clamped as above) and c = λ tr(S − I) − 2μ,
+  ///   K_ab = V [(2μ g_a·g_b + g_a·S_a g_b) I + λ q_a q_bᵀ + c X_a M X_bᵀ]
+  /// (S_a the active PK2 stress), from δR g_a = −R [g_a]× M [g_b]× Rᵀ δx_b; symmetric
+  /// blocks, so only a ≤ b are formed.
+  [[nodiscard]] bool ElementStressAndStiffness(const Mat3& F, const MaterialPoint& mp,
+                                               const TetGradients& g, double volume, Mat3& P,
+                                               Mat12& K) const override;
+
+ private:
+  /// R of the polar decomposition, tr(S) − 3 and M = (tr(S) I − S)⁻¹ (clamped); false for a
+  /// non-finite F.
+  [[nodiscard]] bool RotationAndInverse(const Mat3& F, Mat3& R, double& tr, Mat3& inv) const;
 };
 
 /// "StVenantKirchhoff" (Bonet & Wood 2008, ch. 6): E = ½(FᵀF − I),

@@ -17,6 +17,10 @@
 namespace gipsi {
 
 using Mat9 = Eigen::Matrix<double, 9, 9>;
+/// Stiffness matrix of one P1 tetrahedron: row 3a + i, column 3b + k (a, b local nodes).
+using Mat12 = Eigen::Matrix<double, 12, 12>;
+/// Shape-function gradients of a P1 tetrahedron, column a = ∇N_a [1/m].
+using TetGradients = Eigen::Matrix<double, 3, 4>;
 
 /// Per-element data a law may use besides F. Plain struct; copyable.
 struct MaterialPoint {
@@ -42,6 +46,15 @@ class SolidMaterial : public Material {
   /// P(F) and dP/dF. Returns false when F is outside the law's domain.
   [[nodiscard]] virtual bool StressAndTangent(const Mat3& F, const MaterialPoint& mp, Mat3& P,
                                               Mat9& dPdF) const = 0;
+
+  /// P(F) and the stiffness of a P1 tetrahedron of rest volume `volume` [m³] and shape-function
+  /// gradients `g`: K(3a + i, 3b + k) = V Σ_jl g(j, a) dPdF(i + 3j, k + 3l) g(l, b) = ∂f_a,i/∂x_b,k
+  /// for the nodal forces f_a = V P g_a. Returns false when F is outside the law's domain. The
+  /// default contracts StressAndTangent; a law with a cheaper closed form overrides it (the
+  /// result must be the same matrix up to round-off).
+  [[nodiscard]] virtual bool ElementStressAndStiffness(const Mat3& F, const MaterialPoint& mp,
+                                                       const TetGradients& g, double volume,
+                                                       Mat3& P, Mat12& K) const;
 
   /// True if the law reads MaterialPoint::axes (a fibre field is required).
   [[nodiscard]] virtual bool needs_fibres() const { return false; }

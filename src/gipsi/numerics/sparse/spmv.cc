@@ -1,5 +1,8 @@
-// Symmetric sparse matrix-vector product, row-parallel over the columns of a full symmetric
-// CSC matrix (column j of a symmetric matrix is row j).
+// Symmetric sparse matrix-vector products, row-parallel over the columns of a full symmetric
+// CSC matrix (column j of a symmetric matrix is row j): a general one, and one for matrices
+// made of 3×3 node blocks (FEM tangents) that loads one row index per block.
+
+#include <algorithm>
 
 #include "gipsi/base/error.h"
 #include "gipsi/numerics/sparse/linear_solver.h"
@@ -38,6 +41,72 @@ void SymmetricSpMV(const SparseMatrix& A, const VecX& x, VecX& y) {
     }
     for (; k < end; ++k) s0 += values[k] * px[inner[k]];
     py[j] = (s0 + s1) + (s2 + s3);
+  }
+}
+
+bool HasNodeBlockPattern(const SparseMatrix& A) {
+  if (A.rows() != A.cols() || !A.isCompressed() || A.rows() % 3 != 0) return false;
+  const int* outer = A.outerIndexPtr();
+  const int* inner = A.innerIndexPtr();
+  const int nodes = static_cast<int>(A.rows() / 3);
+  for (int node = 0; node < nodes; ++node) {
+    const int c0 = outer[3 * node];
+    const int length = outer[3 * node + 1] - c0;
+    if (length % 3 != 0) return false;
+    for (int a = 1; a < 3; ++a) {
+      const int ca = outer[3 * node + a];
+      if (outer[3 * node + a + 1] - ca != length ||
+          !std::equal(inner + c0, inner + c0 + length, inner + ca))
+        return false;
+    }
+    bool diagonal = false;
+    for (int t = 0; t < length; t += 3) {
+      const int row = inner[c0 + t];
+      if (row % 3 != 0 || inner[c0 + t + 1] != row + 1 || inner[c0 + t + 2] != row + 2)
+        return false;
+      if (t > 0 && row <= inner[c0 + t - 1]) return false;
+      diagonal = diagonal || row == 3 * node;
+    }
+    if (!diagonal) return false;
+  }
+  return true;
+}
+
+void NodeBlockSpMV(const SparseMatrix& A, const VecX& x, VecX& y) {
+  GIPSI_CHECK(A.rows() == A.cols() && A.rows() % 3 == 0 && x.size() == A.cols() &&
+                  y.size() == A.rows() && (x.data() != y.data() || x.size() == 0),
+              "NodeBlockSpMV: sizes do not match (A {}x{}, x {}, y {}) or x and y alias", A.rows(),
+              A.cols(), x.size(), y.size());
+  const int nodes = static_cast<int>(A.cols() / 3);
+  const int* __restrict outer = A.outerIndexPtr();
+  const int* __restrict inner = A.innerIndexPtr();
+  const double* __restrict values = A.valuePtr();
+  const double* __restrict px = x.data();
+  double* __restrict py = y.data();
+  // Column 3I + k of a symmetric matrix is its row 3I + k; the three columns of node I share
+  // one row list, so one index load serves the nine entries of a block.
+#pragma omp parallel for schedule(static) if (3 * nodes >= kMinParallelLength)
+  for (int node = 0; node < nodes; ++node) {
+    const int c0 = outer[3 * node];
+    const int length = outer[3 * node + 1] - c0;
+    const double* __restrict v0 = values + c0;
+    const double* __restrict v1 = values + outer[3 * node + 1];
+    const double* __restrict v2 = values + outer[3 * node + 2];
+    const int* __restrict rows = inner + c0;
+    double a0 = 0.0, a1 = 0.0, a2 = 0.0, b0 = 0.0, b1 = 0.0, b2 = 0.0;
+    for (int t = 0; t < length; t += 3) {
+      const double* xj = px + rows[t];
+      const double x0 = xj[0], x1 = xj[1], x2 = xj[2];
+      a0 += v0[t] * x0 + v0[t + 1] * x1;
+      a1 += v1[t] * x0 + v1[t + 1] * x1;
+      a2 += v2[t] * x0 + v2[t + 1] * x1;
+      b0 += v0[t + 2] * x2;
+      b1 += v1[t + 2] * x2;
+      b2 += v2[t + 2] * x2;
+    }
+    py[3 * node] = a0 + b0;
+    py[3 * node + 1] = a1 + b1;
+    py[3 * node + 2] = a2 + b2;
   }
 }
 
