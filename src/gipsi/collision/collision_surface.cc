@@ -38,6 +38,14 @@ CollisionSurface::CollisionSurface(Triangles triangles, Index num_vertices, bool
   vertex_owner_.assign(static_cast<std::size_t>(num_vertices), -1);
   for (Index t = T; t-- > 0;)
     for (int k = 0; k < 3; ++k) vertex_owner_[static_cast<std::size_t>(triangles_(k, t))] = int(t);
+  owned_.assign(static_cast<std::size_t>(T), 0);
+  for (Index t = 0; t < T; ++t)
+    for (int k = 0; k < 3; ++k) {
+      if (vertex_owner_[static_cast<std::size_t>(triangles_(k, t))] == t)
+        owned_[static_cast<std::size_t>(t)] |= static_cast<std::uint8_t>(1u << k);
+      if (edge_owner_[static_cast<std::size_t>(tri_edges_(k, t))] == t)
+        owned_[static_cast<std::size_t>(t)] |= static_cast<std::uint8_t>(1u << (3 + k));
+    }
   face_normals_.resize(3, T);
 }
 

@@ -1,7 +1,9 @@
 #include "gipsi/collision/proximity.h"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <numbers>
 
@@ -87,6 +89,63 @@ void OfferTriangle(const Vec3& p, int v, const CollisionSurface& s, int t, doubl
   }
 }
 
+// The same with the triangle's corners already loaded.
+template <class BestT>
+void OfferCorners(const Vec3& p, int v, const Vec3 (&c)[3], int t, double thickness,
+                  std::vector<BestT>& best, std::vector<int>& touched) {
+  const PointTriangleResult r = ClosestPointOnTriangle(p, c[0], c[1], c[2]);
+  if (!(r.distance < thickness)) return;
+  BestT& b = best[static_cast<std::size_t>(v)];
+  if (b.distance == kInf) touched.push_back(v);
+  if (r.distance < b.distance || (r.distance == b.distance && t < b.triangle)) {
+    b.distance = r.distance;
+    b.triangle = t;
+    b.bary = r.bary;
+    b.closest = r.point;
+  }
+}
+
+// Triangle t of a surface with its corners loaded: vertex ids, positions, owned features.
+struct LoadedTriangle {
+  int id;
+  unsigned owned;  // CollisionSurface::owned_features bits
+  int vertex[3];
+  Vec3 corner[3];
+  LoadedTriangle(const CollisionSurface& s, int t)
+      : id(t), owned(s.owned_features()[static_cast<std::size_t>(t)]) {
+    for (int k = 0; k < 3; ++k) {
+      vertex[k] = s.triangles()(k, t);
+      corner[k] = s.positions().col(vertex[k]);
+    }
+  }
+  // Bit k set: owns vertex k and the vertex lies within `gap` of `box`.
+  [[nodiscard]] unsigned VerticesNear(const Box3& box, double gap) const {
+    unsigned m = 0;
+    for (int k = 0; k < 3; ++k)
+      m |= (((owned >> k) & 1u) & static_cast<unsigned>(box.NearPoint(corner[k], gap))) << k;
+    return m;
+  }
+  // Bit k set: owns edge k (from corner k to corner k + 1) and its box is near `box`; the
+  // edge boxes are stored in `edge_box`.
+  [[nodiscard]] unsigned EdgesNear(const Box3& box, double gap, Box3 (&edge_box)[3]) const {
+    unsigned m = 0;
+    for (int k = 0; k < 3; ++k) {
+      edge_box[k] = EdgeBox(corner[k], corner[k == 2 ? 0 : k + 1]);
+      m |= (((owned >> (3 + k)) & 1u) & static_cast<unsigned>(box.Near(edge_box[k], gap))) << k;
+    }
+    return m;
+  }
+  // Edge k's end points in the orientation of CollisionSurface::edges (smaller vertex first).
+  [[nodiscard]] const Vec3& EdgeStart(int k) const {
+    const int k1 = k == 2 ? 0 : k + 1;
+    return vertex[k] < vertex[k1] ? corner[k] : corner[k1];
+  }
+  [[nodiscard]] const Vec3& EdgeEnd(int k) const {
+    const int k1 = k == 2 ? 0 : k + 1;
+    return vertex[k] < vertex[k1] ? corner[k1] : corner[k];
+  }
+};
+
 }  // namespace
 
 void ProximityQuery::Query(const CollisionSurface& a, const CollisionSurface& b, double thickness,
@@ -100,63 +159,89 @@ void ProximityQuery::Query(const CollisionSurface& a, const CollisionSurface& b,
   const AabbTree& tb = b.tree();
   if (ta.empty() || tb.empty()) return;
   const double d = thickness;
-  const Points& xa = a.positions();
-  const Points& xb = b.positions();
-  const Triangles& fa = a.triangles();
-  const Triangles& fb = b.triangles();
+  const Box3* box_a = ta.ordered_boxes().data();
+  const Box3* box_b = tb.ordered_boxes().data();
+  const int* order_a = ta.order().data();
+  const int* order_b = tb.order().data();
 
-  auto process = [&](int i, int j) {
-    const Box3& box_i = ta.triangle_box(i);
-    const Box3& box_j = tb.triangle_box(j);
-    if (!box_i.Near(box_j, d)) return;
+  // Triangles at leaf positions p of a and q of b, whose boxes are near. Every test below is
+  // a conservative filter in front of the exact closest-point computation, so the contact set
+  // is exactly that of the brute force; the masks keep the branches few (see Box3::Near).
+  auto process = [&](int p, int q) {
+    const Box3& box_i = box_a[p];
+    const Box3& box_j = box_b[q];
     ++triangle_pairs_;
-    for (int k = 0; k < 3; ++k) {
-      const int v = fa(k, i);
-      if (a.vertex_owner()[static_cast<std::size_t>(v)] == i && PointNearBox(xa.col(v), box_j, d))
-        OfferTriangle(xa.col(v), v, b, j, d, best_a_, touched_a_);
-      const int w = fb(k, j);
-      if (b.vertex_owner()[static_cast<std::size_t>(w)] == j && PointNearBox(xb.col(w), box_i, d))
-        OfferTriangle(xb.col(w), w, a, i, d, best_b_, touched_b_);
+    const LoadedTriangle ti(a, order_a[p]), tj(b, order_b[q]);
+    // A vertex can only be within d of a triangle if it is within d of the triangle's box.
+    unsigned m = ti.VerticesNear(box_j, d) | (tj.VerticesNear(box_i, d) << 3);
+    for (; m != 0; m &= m - 1) {
+      const int bit = std::countr_zero(m);
+      if (bit < 3)
+        OfferCorners(ti.corner[bit], ti.vertex[bit], tj.corner, tj.id, d, best_a_, touched_a_);
+      else
+        OfferCorners(tj.corner[bit - 3], tj.vertex[bit - 3], ti.corner, ti.id, d, best_b_,
+                     touched_b_);
     }
     if (!edge_edge) return;
-    for (int ka = 0; ka < 3; ++ka) {
-      const int ea = a.triangle_edges()(ka, i);
-      if (a.edge_owner()[static_cast<std::size_t>(ea)] != i) continue;
-      const Vec3 a0 = xa.col(a.edges()(0, ea)), a1 = xa.col(a.edges()(1, ea));
-      const Box3 box_ea = EdgeBox(a0, a1);
-      if (!box_ea.Near(box_j, d)) continue;
-      for (int kb = 0; kb < 3; ++kb) {
-        const int eb = b.triangle_edges()(kb, j);
-        if (b.edge_owner()[static_cast<std::size_t>(eb)] != j) continue;
-        const Vec3 b0 = xb.col(b.edges()(0, eb)), b1 = xb.col(b.edges()(1, eb));
-        if (!box_ea.Near(EdgeBox(b0, b1), d)) continue;
+    // An edge pair can only be within d if each edge's box is near the other's triangle box.
+    Box3 edge_i[3], edge_j[3];
+    const unsigned mi = ti.EdgesNear(box_j, d, edge_i);
+    if (mi == 0) return;
+    const unsigned mj = tj.EdgesNear(box_i, d, edge_j);
+    for (unsigned ei = mi; ei != 0; ei &= ei - 1) {
+      const int ka = std::countr_zero(ei);
+      for (unsigned ej = mj; ej != 0; ej &= ej - 1) {
+        const int kb = std::countr_zero(ej);
+        if (!edge_i[ka].Near(edge_j[kb], d)) continue;
         SegmentSegmentResult r;
-        if (EdgeContact(a0, a1, b0, b1, d, r)) out.edges.push_back({ea, eb, r.s, r.t, r.distance});
+        if (EdgeContact(ti.EdgeStart(ka), ti.EdgeEnd(ka), tj.EdgeStart(kb), tj.EdgeEnd(kb), d, r))
+          out.edges.push_back(
+              {a.triangle_edges()(ka, ti.id), b.triangle_edges()(kb, tj.id), r.s, r.t, r.distance});
       }
     }
   };
 
-  const auto& na = ta.nodes();
-  const auto& nb = tb.nodes();
-  stack_.clear();
-  stack_.emplace_back(0, 0);
-  while (!stack_.empty()) {
-    const auto [i, j] = stack_.back();
-    stack_.pop_back();
-    const AabbTree::Node& ni = na[static_cast<std::size_t>(i)];
-    const AabbTree::Node& nj = nb[static_cast<std::size_t>(j)];
-    ++node_pairs_;
-    if (!ni.box.Near(nj.box, d)) continue;
+  const AabbTree::Node* na = ta.nodes().data();
+  const AabbTree::Node* nb = tb.nodes().data();
+  node_pairs_ = 1;
+  if (!na[0].box.Near(nb[0].box, d)) return;
+  // The stack holds node pairs whose boxes are near; children are tested before they are
+  // pushed, and pushed without a branch (written always, kept if near).
+  if (stack_.size() < 64) stack_.resize(64);
+  std::size_t top = 0;
+  stack_[top++] = {0, 0};
+  while (top > 0) {
+    const auto [i, j] = stack_[--top];
+    const AabbTree::Node& ni = na[i];
+    const AabbTree::Node& nj = nb[j];
     if (ni.is_leaf() && nj.is_leaf()) {
-      for (int p = ni.first; p < ni.first + ni.count; ++p)
-        for (int q = nj.first; q < nj.first + nj.count; ++q)
-          process(ta.order()[static_cast<std::size_t>(p)], tb.order()[static_cast<std::size_t>(q)]);
-    } else if (nj.is_leaf() || (!ni.is_leaf() && ni.box.SurfaceArea() >= nj.box.SurfaceArea())) {
-      stack_.emplace_back(ni.first + 1, j);
-      stack_.emplace_back(ni.first, j);
+      // All triangle pairs of the two leaves (at most 8 × 8) as one bit mask.
+      std::uint64_t mask = 0;
+      for (int p = 0; p < ni.count; ++p)
+        for (int q = 0; q < nj.count; ++q)
+          mask |= static_cast<std::uint64_t>(box_a[ni.first + p].Near(box_b[nj.first + q], d))
+                  << (8 * p + q);
+      for (; mask != 0; mask &= mask - 1) {
+        const int bit = std::countr_zero(mask);
+        process(ni.first + bit / 8, nj.first + bit % 8);
+      }
+      continue;
+    }
+    if (top + 2 > stack_.size()) stack_.resize(2 * stack_.size());
+    node_pairs_ += 2;
+    // Descend the larger node (by surface area) unless it is a leaf.
+    if (nj.is_leaf() || (!ni.is_leaf() && ni.area >= nj.area)) {
+      const int c = ni.first;
+      stack_[top] = {c + 1, j};
+      top += static_cast<std::size_t>(na[c + 1].box.Near(nj.box, d));
+      stack_[top] = {c, j};
+      top += static_cast<std::size_t>(na[c].box.Near(nj.box, d));
     } else {
-      stack_.emplace_back(i, nj.first + 1);
-      stack_.emplace_back(i, nj.first);
+      const int c = nj.first;
+      stack_[top] = {i, c + 1};
+      top += static_cast<std::size_t>(ni.box.Near(nb[c + 1].box, d));
+      stack_[top] = {i, c};
+      top += static_cast<std::size_t>(ni.box.Near(nb[c].box, d));
     }
   }
   Emit(best_a_, touched_a_, out.a_on_b);
@@ -181,11 +266,13 @@ void ProximityQuery::QuerySelf(const CollisionSurface& s, double thickness, bool
   const Points& vn = s.vertex_normals();
   const Points& en = s.edge_normals();
   const auto& edges = s.edges();
+  const auto& order = tree.order();
 
-  // One unordered pair of distinct triangles.
-  auto process = [&](int i, int j) {
-    const Box3& box_i = tree.triangle_box(i);
-    const Box3& box_j = tree.triangle_box(j);
+  // One unordered pair of distinct triangles, at leaf positions p and q.
+  auto process = [&](int p, int q) {
+    const int i = order[static_cast<std::size_t>(p)], j = order[static_cast<std::size_t>(q)];
+    const Box3& box_i = tree.ordered_box(p);
+    const Box3& box_j = tree.ordered_box(q);
     if (!box_i.Near(box_j, d)) return;
     ++triangle_pairs_;
     for (int k = 0; k < 3; ++k) {
@@ -219,7 +306,6 @@ void ProximityQuery::QuerySelf(const CollisionSurface& s, double thickness, bool
   };
 
   const auto& nodes = tree.nodes();
-  const auto& order = tree.order();
   stack_.clear();
   stack_.emplace_back(0, 0);
   while (!stack_.empty()) {
@@ -232,8 +318,7 @@ void ProximityQuery::QuerySelf(const CollisionSurface& s, double thickness, bool
       if (cones && 2 * tree.cone(i).half_angle < 0.5 * std::numbers::pi) continue;
       if (ni.is_leaf()) {
         for (int p = ni.first; p < ni.first + ni.count; ++p)
-          for (int q = p + 1; q < ni.first + ni.count; ++q)
-            process(order[static_cast<std::size_t>(p)], order[static_cast<std::size_t>(q)]);
+          for (int q = p + 1; q < ni.first + ni.count; ++q) process(p, q);
       } else {
         stack_.emplace_back(ni.first, ni.first + 1);
         stack_.emplace_back(ni.first + 1, ni.first + 1);
@@ -245,9 +330,8 @@ void ProximityQuery::QuerySelf(const CollisionSurface& s, double thickness, bool
     if (cones && ConesAgree(tree.cone(i), tree.cone(j))) continue;
     if (ni.is_leaf() && nj.is_leaf()) {
       for (int p = ni.first; p < ni.first + ni.count; ++p)
-        for (int q = nj.first; q < nj.first + nj.count; ++q)
-          process(order[static_cast<std::size_t>(p)], order[static_cast<std::size_t>(q)]);
-    } else if (nj.is_leaf() || (!ni.is_leaf() && ni.box.SurfaceArea() >= nj.box.SurfaceArea())) {
+        for (int q = nj.first; q < nj.first + nj.count; ++q) process(p, q);
+    } else if (nj.is_leaf() || (!ni.is_leaf() && ni.area >= nj.area)) {
       stack_.emplace_back(ni.first + 1, j);
       stack_.emplace_back(ni.first, j);
     } else {
