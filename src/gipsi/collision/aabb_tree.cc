@@ -27,18 +27,6 @@ NormalCone MergeCones(const NormalCone& a, const NormalCone& b) {
   return {axis.normalized(), std::min(half + 1e-12, std::numbers::pi)};
 }
 
-namespace {
-
-// Union of two boxes with scalar min/max (cheaper than Eigen's on unaligned 3-vectors).
-void Merge(Box3& into, const Box3& b) {
-  for (int k = 0; k < 3; ++k) {
-    into.lo[k] = std::min(into.lo[k], b.lo[k]);
-    into.hi[k] = std::max(into.hi[k], b.hi[k]);
-  }
-}
-
-}  // namespace
-
 void AabbTree::Build(const Points& positions, const Triangles& triangles, int leaf_size) {
   GIPSI_CHECK(leaf_size >= 1 && leaf_size <= 8, "leaf size must be in [1, 8]");
   leaf_size_ = leaf_size;
@@ -60,6 +48,12 @@ void AabbTree::Build(const Points& positions, const Triangles& triangles, int le
   nodes_.reserve(2 * num / static_cast<std::size_t>(leaf_size) + 2);
   nodes_.emplace_back();
   BuildRange(0, 0, static_cast<int>(num));
+  // The corners in leaf order: the refit then streams through them instead of gathering
+  // triangles in a permuted order.
+  corners_.resize(3 * num);
+  for (std::size_t p = 0; p < num; ++p)
+    for (int k = 0; k < 3; ++k)
+      corners_[3 * p + static_cast<std::size_t>(k)] = triangles(k, order_[p]);
   Refit(positions, triangles);
   built_area_ = inner_area_;
 }
@@ -103,33 +97,49 @@ void AabbTree::Refit(const Points& positions, const Triangles& triangles) {
   GIPSI_CHECK(triangles.cols() == static_cast<Index>(box_.size()));
   const double* x = positions.data();
   for (std::size_t p = 0; p < box_.size(); ++p) {
-    const Index t = order_[p];
-    const double* v0 = x + 3 * triangles(0, t);
-    const double* v1 = x + 3 * triangles(1, t);
-    const double* v2 = x + 3 * triangles(2, t);
+    const double* v0 = x + 3 * static_cast<std::ptrdiff_t>(corners_[3 * p]);
+    const double* v1 = x + 3 * static_cast<std::ptrdiff_t>(corners_[3 * p + 1]);
+    const double* v2 = x + 3 * static_cast<std::ptrdiff_t>(corners_[3 * p + 2]);
     Box3& b = box_[p];
     for (int k = 0; k < 3; ++k) {
       b.lo[k] = std::min(std::min(v0[k], v1[k]), v2[k]);
       b.hi[k] = std::max(std::max(v0[k], v1[k]), v2[k]);
     }
   }
-  // Children always have larger indices than their parent: a reverse sweep is bottom-up.
+  // Children always have larger indices than their parent: a reverse sweep is bottom-up. The
+  // box is accumulated in locals (accumulating into a Box3 on the stack stalled on
+  // store-to-load forwarding).
   double inner = 0;
   for (std::size_t i = nodes_.size(); i-- > 0;) {
     Node& n = nodes_[i];
+    double lo[3], hi[3];
     if (n.is_leaf()) {
-      Box3 b = box_[static_cast<std::size_t>(n.first)];
-      for (int k = n.first + 1; k < n.first + n.count; ++k)
-        Merge(b, box_[static_cast<std::size_t>(k)]);
-      n.box = b;
-      n.area = b.SurfaceArea();
+      const Box3* b = &box_[static_cast<std::size_t>(n.first)];
+      for (int k = 0; k < 3; ++k) {
+        lo[k] = b[0].lo[k];
+        hi[k] = b[0].hi[k];
+      }
+      for (int m = 1; m < n.count; ++m)
+        for (int k = 0; k < 3; ++k) {
+          lo[k] = std::min(lo[k], b[m].lo[k]);
+          hi[k] = std::max(hi[k], b[m].hi[k]);
+        }
     } else {
-      Box3 b = nodes_[static_cast<std::size_t>(n.first)].box;
-      Merge(b, nodes_[static_cast<std::size_t>(n.first) + 1].box);
-      n.box = b;
-      n.area = b.SurfaceArea();
-      inner += n.area;
+      const Box3& c0 = nodes_[static_cast<std::size_t>(n.first)].box;
+      const Box3& c1 = nodes_[static_cast<std::size_t>(n.first) + 1].box;
+      for (int k = 0; k < 3; ++k) {
+        lo[k] = std::min(c0.lo[k], c1.lo[k]);
+        hi[k] = std::max(c0.hi[k], c1.hi[k]);
+      }
     }
+    const double ex = hi[0] - lo[0], ey = hi[1] - lo[1], ez = hi[2] - lo[2];
+    for (int k = 0; k < 3; ++k) {
+      n.box.lo[k] = lo[k];
+      n.box.hi[k] = hi[k];
+    }
+    // Boxes are never inverted here, so this equals Box3::SurfaceArea.
+    n.area = 2 * (ex * ey + ey * ez + ez * ex);
+    if (!n.is_leaf()) inner += n.area;
   }
   inner_area_ = inner;
 }

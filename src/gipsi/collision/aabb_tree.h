@@ -113,6 +113,7 @@ class AabbTree {
   std::vector<Node> nodes_;
   std::vector<int> order_;
   std::vector<Box3> box_;       // triangle boxes in leaf order
+  std::vector<int> corners_;    // vertex ids of the triangles in leaf order, 3 per triangle
   std::vector<Vec3> centroid_;  // build scratch, by triangle id
   std::vector<NormalCone> cones_;
   double inner_area_ = 0;  // at the last refit

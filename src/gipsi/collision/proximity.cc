@@ -22,10 +22,12 @@ bool PointNearBox(const Vec3& p, const Box3& b, double gap) {
          p[1] <= b.hi[1] + gap && p[2] >= b.lo[2] - gap && p[2] <= b.hi[2] + gap;
 }
 
-Box3 EdgeBox(const Vec3& p, const Vec3& q) {
+inline Box3 EdgeBox(const Vec3& p, const Vec3& q) {
   Box3 b;
-  b.lo = p.cwiseMin(q);
-  b.hi = p.cwiseMax(q);
+  for (int k = 0; k < 3; ++k) {
+    b.lo[k] = std::min(p[k], q[k]);
+    b.hi[k] = std::max(p[k], q[k]);
+  }
   return b;
 }
 
@@ -39,6 +41,31 @@ bool EdgeContact(const Vec3& a0, const Vec3& a1, const Vec3& b0, const Vec3& b1,
   r = ClosestPointsOfSegments(a0, a1, b0, b1);
   return !r.parallel && r.distance < thickness && r.s > kInterior && r.s < 1 - kInterior &&
          r.t > kInterior && r.t < 1 - kInterior;
+}
+
+// A cheap, conservative rejection in front of EdgeContact: true when the infinite lines
+// through the segments are provably farther apart than `thickness` (then so are the segments,
+// and EdgeContact would reject the pair). The line distance is |n · r| / |n| with
+// n = (a1 − a0) × (b1 − b0) and r = a0 − b0; both sides are squared (no square root), and the
+// bound is widened by margins 10⁶ times the rounding errors of the computation here and of
+// the exact closest points, so it never rejects a pair that EdgeContact would accept.
+// Near-parallel edges (|n| small) are never rejected.
+bool LinesApart(const Vec3& a0, const Vec3& a1, const Vec3& b0, const Vec3& b1, double thickness) {
+  const double d1[3] = {a1[0] - a0[0], a1[1] - a0[1], a1[2] - a0[2]};
+  const double d2[3] = {b1[0] - b0[0], b1[1] - b0[1], b1[2] - b0[2]};
+  const double r[3] = {a0[0] - b0[0], a0[1] - b0[1], a0[2] - b0[2]};
+  const double n[3] = {d1[1] * d2[2] - d1[2] * d2[1], d1[2] * d2[0] - d1[0] * d2[2],
+                       d1[0] * d2[1] - d1[1] * d2[0]};
+  const double nr = std::abs(n[0] * r[0] + n[1] * r[1] + n[2] * r[2]);
+  const double n2 = n[0] * n[0] + n[1] * n[1] + n[2] * n[2];
+  auto l1 = [](const double* v) { return std::abs(v[0]) + std::abs(v[1]) + std::abs(v[2]); };
+  // |error of n · r| <= ~10 eps |d1| |d2| |r|; the exact closest points err by ~eps times the
+  // coordinates' size. Margins: 1e-10 (about 10⁶ eps) times those scales.
+  const double scale = l1(d1) * l1(d2);
+  const double lower = nr - 1e-10 * scale * l1(r);
+  const double reach =
+      thickness + 1e-10 * (thickness + l1(a0.data()) + l1(b0.data()) + l1(d1) + l1(d2));
+  return lower > 0 && lower * lower > reach * reach * (n2 + 1e-10 * scale * scale);
 }
 
 // True if every normal of cone a makes an angle below 90° with every normal of cone b: then no
@@ -118,22 +145,32 @@ struct LoadedTriangle {
       corner[k] = s.positions().col(vertex[k]);
     }
   }
-  // Bit k set: owns vertex k and the vertex lies within `gap` of `box`.
-  [[nodiscard]] unsigned VerticesNear(const Box3& box, double gap) const {
-    unsigned m = 0;
-    for (int k = 0; k < 3; ++k)
-      m |= (((owned >> k) & 1u) & static_cast<unsigned>(box.NearPoint(corner[k], gap))) << k;
-    return m;
-  }
-  // Bit k set: owns edge k (from corner k to corner k + 1) and its box is near `box`; the
-  // edge boxes are stored in `edge_box`.
-  [[nodiscard]] unsigned EdgesNear(const Box3& box, double gap, Box3 (&edge_box)[3]) const {
-    unsigned m = 0;
+  // Which owned features of this triangle can be within `gap` of `box` (so of anything
+  // inside it): bit k of `vertices` for vertex k (inside the box grown by gap), bit k of
+  // `edges` for edge k, from corner k to corner k + 1 (its box meets the grown box, i.e. its
+  // end points are not both beyond the same face). One classification of the three corners
+  // serves both: no branches, and no edge boxes for the edges that cannot be near.
+  void NearFeatures(const Box3& box, double gap, unsigned& vertices, unsigned& edges) const {
+    const double lo[3] = {box.lo[0] - gap, box.lo[1] - gap, box.lo[2] - gap};
+    const double hi[3] = {box.hi[0] + gap, box.hi[1] + gap, box.hi[2] + gap};
+    unsigned beyond[3];  // bit 2a: below face a; bit 2a + 1: above it
     for (int k = 0; k < 3; ++k) {
-      edge_box[k] = EdgeBox(corner[k], corner[k == 2 ? 0 : k + 1]);
-      m |= (((owned >> (3 + k)) & 1u) & static_cast<unsigned>(box.Near(edge_box[k], gap))) << k;
+      const Vec3& p = corner[k];
+      beyond[k] =
+          static_cast<unsigned>(p[0] < lo[0]) | static_cast<unsigned>(p[0] > hi[0]) << 1 |
+          static_cast<unsigned>(p[1] < lo[1]) << 2 | static_cast<unsigned>(p[1] > hi[1]) << 3 |
+          static_cast<unsigned>(p[2] < lo[2]) << 4 | static_cast<unsigned>(p[2] > hi[2]) << 5;
     }
-    return m;
+    vertices = static_cast<unsigned>(beyond[0] == 0) | static_cast<unsigned>(beyond[1] == 0) << 1 |
+               static_cast<unsigned>(beyond[2] == 0) << 2;
+    edges = static_cast<unsigned>((beyond[0] & beyond[1]) == 0) |
+            static_cast<unsigned>((beyond[1] & beyond[2]) == 0) << 1 |
+            static_cast<unsigned>((beyond[2] & beyond[0]) == 0) << 2;
+    vertices &= owned & 7u;
+    edges &= owned >> 3;
+  }
+  [[nodiscard]] Box3 EdgeBoxOf(int k) const {
+    return EdgeBox(corner[k], corner[k == 2 ? 0 : k + 1]);
   }
   // Edge k's end points in the orientation of CollisionSurface::edges (smaller vertex first).
   [[nodiscard]] const Vec3& EdgeStart(int k) const {
@@ -172,9 +209,13 @@ void ProximityQuery::Query(const CollisionSurface& a, const CollisionSurface& b,
     const Box3& box_j = box_b[q];
     ++triangle_pairs_;
     const LoadedTriangle ti(a, order_a[p]), tj(b, order_b[q]);
-    // A vertex can only be within d of a triangle if it is within d of the triangle's box.
-    unsigned m = ti.VerticesNear(box_j, d) | (tj.VerticesNear(box_i, d) << 3);
-    for (; m != 0; m &= m - 1) {
+    // A vertex can only be within d of a triangle if it is within d of the triangle's box; an
+    // edge pair only if each edge's box is near the other's triangle box and the edge boxes
+    // are near each other.
+    unsigned vi, ei, vj, ej;
+    ti.NearFeatures(box_j, d, vi, ei);
+    tj.NearFeatures(box_i, d, vj, ej);
+    for (unsigned m = vi | (vj << 3); m != 0; m &= m - 1) {
       const int bit = std::countr_zero(m);
       if (bit < 3)
         OfferCorners(ti.corner[bit], ti.vertex[bit], tj.corner, tj.id, d, best_a_, touched_a_);
@@ -182,19 +223,18 @@ void ProximityQuery::Query(const CollisionSurface& a, const CollisionSurface& b,
         OfferCorners(tj.corner[bit - 3], tj.vertex[bit - 3], ti.corner, ti.id, d, best_b_,
                      touched_b_);
     }
-    if (!edge_edge) return;
-    // An edge pair can only be within d if each edge's box is near the other's triangle box.
-    Box3 edge_i[3], edge_j[3];
-    const unsigned mi = ti.EdgesNear(box_j, d, edge_i);
-    if (mi == 0) return;
-    const unsigned mj = tj.EdgesNear(box_i, d, edge_j);
-    for (unsigned ei = mi; ei != 0; ei &= ei - 1) {
+    if (!edge_edge || ei == 0 || ej == 0) return;
+    for (; ei != 0; ei &= ei - 1) {
       const int ka = std::countr_zero(ei);
-      for (unsigned ej = mj; ej != 0; ej &= ej - 1) {
-        const int kb = std::countr_zero(ej);
-        if (!edge_i[ka].Near(edge_j[kb], d)) continue;
+      const Box3 edge_i = ti.EdgeBoxOf(ka);
+      for (unsigned m = ej; m != 0; m &= m - 1) {
+        const int kb = std::countr_zero(m);
+        if (!edge_i.Near(tj.EdgeBoxOf(kb), d)) continue;
+        const Vec3 &a0 = ti.EdgeStart(ka), &a1 = ti.EdgeEnd(ka);
+        const Vec3 &b0 = tj.EdgeStart(kb), &b1 = tj.EdgeEnd(kb);
+        if (LinesApart(a0, a1, b0, b1, d)) continue;
         SegmentSegmentResult r;
-        if (EdgeContact(ti.EdgeStart(ka), ti.EdgeEnd(ka), tj.EdgeStart(kb), tj.EdgeEnd(kb), d, r))
+        if (EdgeContact(a0, a1, b0, b1, d, r))
           out.edges.push_back(
               {a.triangle_edges()(ka, ti.id), b.triangle_edges()(kb, tj.id), r.s, r.t, r.distance});
       }
