@@ -315,32 +315,38 @@ void ProximityQuery::QuerySelf(const CollisionSurface& s, double thickness, bool
     const Box3& box_j = tree.ordered_box(q);
     if (!box_i.Near(box_j, d)) return;
     ++triangle_pairs_;
-    for (int k = 0; k < 3; ++k) {
-      const int v = f(k, i);
-      if (s.vertex_owner()[static_cast<std::size_t>(v)] == i && !SharesVertex(f, j, v) &&
-          vn.col(v).dot(fn.col(j)) < 0 && PointNearBox(x.col(v), box_j, d))
-        OfferTriangle(x.col(v), v, s, j, d, best_a_, touched_a_);
-      const int w = f(k, j);
-      if (s.vertex_owner()[static_cast<std::size_t>(w)] == j && !SharesVertex(f, i, w) &&
-          vn.col(w).dot(fn.col(i)) < 0 && PointNearBox(x.col(w), box_i, d))
-        OfferTriangle(x.col(w), w, s, i, d, best_a_, touched_a_);
+    // The box filters of Query first (see there), then the self-collision rules.
+    const LoadedTriangle ti(s, i), tj(s, j);
+    unsigned vi, ei, vj, ej;
+    ti.NearFeatures(box_j, d, vi, ei);
+    tj.NearFeatures(box_i, d, vj, ej);
+    for (unsigned m = vi | (vj << 3); m != 0; m &= m - 1) {
+      const int bit = std::countr_zero(m);
+      const LoadedTriangle& from = bit < 3 ? ti : tj;
+      const LoadedTriangle& to = bit < 3 ? tj : ti;
+      const int v = from.vertex[bit % 3];
+      if (!SharesVertex(f, to.id, v) && vn.col(v).dot(fn.col(to.id)) < 0)
+        OfferCorners(from.corner[bit % 3], v, to.corner, to.id, d, best_a_, touched_a_);
     }
-    if (!edge_edge) return;
-    for (int ka = 0; ka < 3; ++ka) {
+    if (!edge_edge || ei == 0 || ej == 0) return;
+    for (; ei != 0; ei &= ei - 1) {
+      const int ka = std::countr_zero(ei);
       const int e1 = s.triangle_edges()(ka, i);
-      if (s.edge_owner()[static_cast<std::size_t>(e1)] != i) continue;
-      for (int kb = 0; kb < 3; ++kb) {
+      const Box3 edge_i = ti.EdgeBoxOf(ka);
+      for (unsigned m = ej; m != 0; m &= m - 1) {
+        const int kb = std::countr_zero(m);
+        if (!edge_i.Near(tj.EdgeBoxOf(kb), d)) continue;
         const int e2 = s.triangle_edges()(kb, j);
-        if (s.edge_owner()[static_cast<std::size_t>(e2)] != j) continue;
         const int ea = std::min(e1, e2), eb = std::max(e1, e2);
         if (edges(0, ea) == edges(0, eb) || edges(0, ea) == edges(1, eb) ||
             edges(1, ea) == edges(0, eb) || edges(1, ea) == edges(1, eb))
           continue;
         if (!(en.col(ea).dot(en.col(eb)) < 0)) continue;
+        const Vec3 a0 = x.col(edges(0, ea)), a1 = x.col(edges(1, ea));
+        const Vec3 b0 = x.col(edges(0, eb)), b1 = x.col(edges(1, eb));
+        if (LinesApart(a0, a1, b0, b1, d)) continue;
         SegmentSegmentResult r;
-        if (EdgeContact(x.col(edges(0, ea)), x.col(edges(1, ea)), x.col(edges(0, eb)),
-                        x.col(edges(1, eb)), d, r))
-          out.edges.push_back({ea, eb, r.s, r.t, r.distance});
+        if (EdgeContact(a0, a1, b0, b1, d, r)) out.edges.push_back({ea, eb, r.s, r.t, r.distance});
       }
     }
   };
