@@ -13,6 +13,10 @@
 #include <cstdint>
 #include <vector>
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 #include "gipsi/base/math.h"
 
 namespace gipsi {
@@ -31,11 +35,22 @@ struct Box3 {
   /// True if the boxes are within `gap` of each other along every axis (so points of the two
   /// boxes closer than `gap` in Euclidean distance are never missed).
   [[nodiscard]] bool Near(const Box3& b, double gap) const {
-    // Scalar comparisons combined with `&`, not `&&`: one (often unpredictable) branch for the
-    // caller instead of up to six. The results of the box tests in the queries are close to
-    // random, and mispredicted branches were half of the query's time.
+    // The six comparisons are combined without branches (`&`, not `&&`): one (often
+    // unpredictable) branch for the caller instead of up to six. The results of the box tests
+    // in the queries are close to random, and mispredicted branches were half of the query's
+    // time. With SSE2 (every x86-64) two axes at a time; the same operations, same results.
+#if defined(__SSE2__)
+    const __m128d g = _mm_set1_pd(gap);
+    const __m128d xy =
+        _mm_and_pd(_mm_cmple_pd(_mm_sub_pd(_mm_loadu_pd(lo.data()), g), _mm_loadu_pd(b.hi.data())),
+                   _mm_cmple_pd(_mm_sub_pd(_mm_loadu_pd(b.lo.data()), g), _mm_loadu_pd(hi.data())));
+    const __m128d z =
+        _mm_cmple_pd(_mm_sub_pd(_mm_set_pd(b.lo[2], lo[2]), g), _mm_set_pd(hi[2], b.hi[2]));
+    return _mm_movemask_pd(_mm_and_pd(xy, z)) == 3;
+#else
     return (lo[0] - gap <= b.hi[0]) & (b.lo[0] - gap <= hi[0]) & (lo[1] - gap <= b.hi[1]) &
            (b.lo[1] - gap <= hi[1]) & (lo[2] - gap <= b.hi[2]) & (b.lo[2] - gap <= hi[2]);
+#endif
   }
   /// True if point p is within `gap` of the box along every axis. Branch-free like Near.
   [[nodiscard]] bool NearPoint(const Vec3& p, double gap) const {
