@@ -97,26 +97,8 @@ void ProximityQuery::Emit(const std::vector<Best>& best, std::vector<int>& touch
 
 namespace {
 
-// Offers triangle t of `s` as the closest to point p (vertex v); keeps the better one.
-template <class BestT>
-void OfferTriangle(const Vec3& p, int v, const CollisionSurface& s, int t, double thickness,
-                   std::vector<BestT>& best, std::vector<int>& touched) {
-  const Points& x = s.positions();
-  const Triangles& tris = s.triangles();
-  const PointTriangleResult r =
-      ClosestPointOnTriangle(p, x.col(tris(0, t)), x.col(tris(1, t)), x.col(tris(2, t)));
-  if (!(r.distance < thickness)) return;
-  BestT& b = best[static_cast<std::size_t>(v)];
-  if (b.distance == kInf) touched.push_back(v);
-  if (r.distance < b.distance || (r.distance == b.distance && t < b.triangle)) {
-    b.distance = r.distance;
-    b.triangle = t;
-    b.bary = r.bary;
-    b.closest = r.point;
-  }
-}
-
-// The same with the triangle's corners already loaded.
+// Offers the triangle t with corners c as the closest to point p (vertex v); keeps the better
+// one (ties: the lower triangle id, so the order of the offers does not matter).
 template <class BestT>
 void OfferCorners(const Vec3& p, int v, const Vec3 (&c)[3], int t, double thickness,
                   std::vector<BestT>& best, std::vector<int>& touched) {
