@@ -27,55 +27,56 @@ NormalCone MergeCones(const NormalCone& a, const NormalCone& b) {
   return {axis.normalized(), std::min(half + 1e-12, std::numbers::pi)};
 }
 
-void AabbTree::ComputeTriangleBoxes(const Points& positions, const Triangles& tris) {
-  for (Index t = 0; t < tris.cols(); ++t) {
-    Box3 b;
-    for (int k = 0; k < 3; ++k) b.Add(Vec3(positions.col(tris(k, t))));
-    tri_box_[static_cast<std::size_t>(t)] = b;
-  }
-}
-
 void AabbTree::Build(const Points& positions, const Triangles& triangles, int leaf_size) {
-  GIPSI_CHECK(leaf_size >= 1);
+  GIPSI_CHECK(leaf_size >= 1 && leaf_size <= 8, "leaf size must be in [1, 8]");
   leaf_size_ = leaf_size;
   const auto num = static_cast<std::size_t>(triangles.cols());
-  tri_box_.resize(num);
   centroid_.resize(num);
   order_.resize(num);
-  ComputeTriangleBoxes(positions, triangles);
+  box_.resize(num);
   for (std::size_t t = 0; t < num; ++t) {
-    centroid_[t] = 0.5 * (tri_box_[t].lo + tri_box_[t].hi);
+    Box3 b;
+    for (int k = 0; k < 3; ++k) b.Add(Vec3(positions.col(triangles(k, static_cast<Index>(t)))));
+    centroid_[t] = 0.5 * (b.lo + b.hi);
     order_[t] = static_cast<int>(t);
   }
   nodes_.clear();
   cones_.clear();
   ++num_builds_;
+  inner_area_ = built_area_ = 0;
   if (num == 0) return;
   nodes_.reserve(2 * num / static_cast<std::size_t>(leaf_size) + 2);
   nodes_.emplace_back();
   BuildRange(0, 0, static_cast<int>(num));
-  built_area_ = InnerArea();
+  // The corners in leaf order: the refit then streams through them instead of gathering
+  // triangles in a permuted order.
+  corners_.resize(3 * num);
+  for (std::size_t p = 0; p < num; ++p)
+    for (int k = 0; k < 3; ++k)
+      corners_[3 * p + static_cast<std::size_t>(k)] = triangles(k, order_[p]);
+  Refit(positions, triangles);
+  built_area_ = inner_area_;
 }
 
-// Fills node `self` for order_[begin, end); children are appended as a pair, so a child's
-// index is always larger than its parent's.
+// Fills the topology of node `self` for order_[begin, end) (Refit computes the boxes); children
+// are appended as a pair, so a child's index is always larger than its parent's.
 void AabbTree::BuildRange(int self, int begin, int end) {
-  Box3 box, cbox;
-  for (int i = begin; i < end; ++i) {
-    const auto t = static_cast<std::size_t>(order_[static_cast<std::size_t>(i)]);
-    box.Add(tri_box_[t]);
-    cbox.Add(centroid_[t]);
-  }
-  nodes_[static_cast<std::size_t>(self)].box = box;
-  if (end - begin <= leaf_size_) {
+  const int n = end - begin;
+  if (n <= leaf_size_) {
     nodes_[static_cast<std::size_t>(self)].first = begin;
-    nodes_[static_cast<std::size_t>(self)].count = end - begin;
+    nodes_[static_cast<std::size_t>(self)].count = n;
     return;
   }
+  Box3 cbox;
+  for (int i = begin; i < end; ++i)
+    cbox.Add(centroid_[static_cast<std::size_t>(order_[static_cast<std::size_t>(i)])]);
   int axis = 0;
   (cbox.hi - cbox.lo).maxCoeff(&axis);
-  const int mid = begin + (end - begin) / 2;
-  // Median split; ties broken by triangle id so the tree does not depend on the sort's order.
+  // Split near the median at a multiple of the leaf size: the left part gets half the leaves
+  // (rounded up), all full; only the last leaf of the whole tree can be partly filled.
+  const int leaves = (n + leaf_size_ - 1) / leaf_size_;
+  const int mid = begin + leaf_size_ * ((leaves + 1) / 2);
+  // Ties broken by triangle id so the tree does not depend on the sort's order.
   std::nth_element(order_.begin() + begin, order_.begin() + mid, order_.begin() + end,
                    [&](int a, int b) {
                      const double ca = centroid_[static_cast<std::size_t>(a)][axis];
@@ -93,31 +94,57 @@ void AabbTree::BuildRange(int self, int begin, int end) {
 
 void AabbTree::Refit(const Points& positions, const Triangles& triangles) {
   if (nodes_.empty()) return;
-  GIPSI_CHECK(triangles.cols() == static_cast<Index>(tri_box_.size()));
-  ComputeTriangleBoxes(positions, triangles);
-  // Children always have larger indices than their parent: a reverse sweep is bottom-up.
+  GIPSI_CHECK(triangles.cols() == static_cast<Index>(box_.size()));
+  const double* x = positions.data();
+  for (std::size_t p = 0; p < box_.size(); ++p) {
+    const double* v0 = x + 3 * static_cast<std::ptrdiff_t>(corners_[3 * p]);
+    const double* v1 = x + 3 * static_cast<std::ptrdiff_t>(corners_[3 * p + 1]);
+    const double* v2 = x + 3 * static_cast<std::ptrdiff_t>(corners_[3 * p + 2]);
+    Box3& b = box_[p];
+    for (int k = 0; k < 3; ++k) {
+      b.lo[k] = std::min(std::min(v0[k], v1[k]), v2[k]);
+      b.hi[k] = std::max(std::max(v0[k], v1[k]), v2[k]);
+    }
+  }
+  // Children always have larger indices than their parent: a reverse sweep is bottom-up. The
+  // box is accumulated in locals (accumulating into a Box3 on the stack stalled on
+  // store-to-load forwarding).
+  double inner = 0;
   for (std::size_t i = nodes_.size(); i-- > 0;) {
     Node& n = nodes_[i];
-    Box3 b;
+    double lo[3], hi[3];
     if (n.is_leaf()) {
-      for (int k = n.first; k < n.first + n.count; ++k)
-        b.Add(tri_box_[static_cast<std::size_t>(order_[static_cast<std::size_t>(k)])]);
+      const Box3* b = &box_[static_cast<std::size_t>(n.first)];
+      for (int k = 0; k < 3; ++k) {
+        lo[k] = b[0].lo[k];
+        hi[k] = b[0].hi[k];
+      }
+      for (int m = 1; m < n.count; ++m)
+        for (int k = 0; k < 3; ++k) {
+          lo[k] = std::min(lo[k], b[m].lo[k]);
+          hi[k] = std::max(hi[k], b[m].hi[k]);
+        }
     } else {
-      b = nodes_[static_cast<std::size_t>(n.first)].box;
-      b.Add(nodes_[static_cast<std::size_t>(n.first) + 1].box);
+      const Box3& c0 = nodes_[static_cast<std::size_t>(n.first)].box;
+      const Box3& c1 = nodes_[static_cast<std::size_t>(n.first) + 1].box;
+      for (int k = 0; k < 3; ++k) {
+        lo[k] = std::min(c0.lo[k], c1.lo[k]);
+        hi[k] = std::max(c0.hi[k], c1.hi[k]);
+      }
     }
-    n.box = b;
+    const double ex = hi[0] - lo[0], ey = hi[1] - lo[1], ez = hi[2] - lo[2];
+    for (int k = 0; k < 3; ++k) {
+      n.box.lo[k] = lo[k];
+      n.box.hi[k] = hi[k];
+    }
+    // Boxes are never inverted here, so this equals Box3::SurfaceArea.
+    n.area = 2 * (ex * ey + ey * ez + ez * ex);
+    if (!n.is_leaf()) inner += n.area;
   }
+  inner_area_ = inner;
 }
 
-double AabbTree::InnerArea() const {
-  double area = 0;
-  for (const Node& n : nodes_)
-    if (!n.is_leaf()) area += n.box.SurfaceArea();
-  return area;
-}
-
-double AabbTree::quality_ratio() const { return built_area_ > 0 ? InnerArea() / built_area_ : 1.0; }
+double AabbTree::quality_ratio() const { return built_area_ > 0 ? inner_area_ / built_area_ : 1.0; }
 
 bool AabbTree::Update(const Points& positions, const Triangles& triangles, double rebuild_ratio) {
   Refit(positions, triangles);

@@ -4,6 +4,7 @@
 /// positions, its edges, which triangle *owns* each vertex and each edge (so every feature is
 /// tested once even though several triangles share it), per-step normals, and its AABB tree.
 
+#include <cstdint>
 #include <vector>
 
 #include "gipsi/base/math.h"
@@ -44,6 +45,9 @@ class CollisionSurface {
   /// Owning triangle of each vertex (−1 if none) and of each edge: the lowest triangle id.
   [[nodiscard]] const std::vector<int>& vertex_owner() const { return vertex_owner_; }
   [[nodiscard]] const std::vector<int>& edge_owner() const { return edge_owner_; }
+  /// The same ownership per triangle as a bit mask: bit k (k = 0, 1, 2) is set if triangle t
+  /// owns its vertex k, bit 3 + k if it owns its edge k (see `triangle_edges`).
+  [[nodiscard]] const std::vector<std::uint8_t>& owned_features() const { return owned_; }
   /// Unit outward normals at the last Update (3 by T); vertex and edge normals (angle-free
   /// area-weighted means of the incident faces) only when Update ran with cones.
   [[nodiscard]] const Points& face_normals() const { return face_normals_; }
@@ -58,6 +62,7 @@ class CollisionSurface {
   Eigen::Matrix2Xi edges_;
   Triangles tri_edges_;
   std::vector<int> vertex_owner_, edge_owner_;
+  std::vector<std::uint8_t> owned_;
   bool closed_ = false;
   Points positions_;
   Points face_normals_, vertex_normals_, edge_normals_;

@@ -83,7 +83,7 @@ class ProximityQuery {
 
   /// Triangle pairs whose boxes were near in the last query (a cost measure).
   [[nodiscard]] std::int64_t last_triangle_pairs() const { return triangle_pairs_; }
-  /// Node pairs visited in the last two-surface query (a cost measure).
+  /// Node pairs whose boxes were tested in the last two-surface query (a cost measure).
   [[nodiscard]] std::int64_t last_node_pairs() const { return node_pairs_; }
 
  private:
