@@ -78,58 +78,63 @@ TEST(RealtimeHapticProbe, TicksOnItsOwnThreadAndRendersTheSameContactAsTheSynchr
   auto& sync_probe = dynamic_cast<HapticProbe&>(sync.kernel->FindObject("probe"));
   const Vec3 f_sync = ReadVec(sync_probe, "tool_force");
 
-  Scene scene = Load(BlockScene(R"(, "realtime": true)"));
-  auto& probe = dynamic_cast<HapticProbe&>(scene.kernel->FindObject("probe"));
-  ASSERT_TRUE(probe.realtime());
-  HapticLoopStats stats;
-  {
-    const auto wall_start = std::chrono::steady_clock::now();
-    RealtimeHaptics haptics(*scene.kernel);
-    ASSERT_EQ(haptics.probes().size(), 1u);
-    haptics.Start();
-    EXPECT_TRUE(probe.loop_running());
-    const RunResult run = scene.kernel->Run(0.2);
-    ASSERT_TRUE(run.ok()) << run.diagnostic;
-    // The simulation never runs ahead of the wall clock: the probe's last step sleeps until
-    // 0.2 s have passed on the loop's clock, which started after wall_start (a lower bound
-    // from sleep_for's guarantee, not a timing measurement).
-    EXPECT_GE(std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count(),
-              0.2);
-    const auto loops = haptics.Stop();
-    ASSERT_EQ(loops.size(), 1u);
-    EXPECT_EQ(loops[0].first, "probe");
-    stats = loops[0].second;
-  }
-  EXPECT_FALSE(probe.loop_running());  // joined
-  EXPECT_GT(stats.ticks, 0);
-  EXPECT_LE(stats.p50, stats.p99);
-  EXPECT_LE(stats.p99, stats.max);
-  EXPECT_GT(probe.num_ticks(), 0);
-  EXPECT_LE(probe.num_ticks(), stats.ticks);
+  // Sleeping until each deadline, and sleeping until 0.2 ms before it and spinning the rest.
+  for (const char* realtime : {R"(, "realtime": true)", R"(, "realtime": {"spin": 0.0002})"}) {
+    SCOPED_TRACE(realtime);
+    Scene scene = Load(BlockScene(realtime));
+    auto& probe = dynamic_cast<HapticProbe&>(scene.kernel->FindObject("probe"));
+    ASSERT_TRUE(probe.realtime());
+    HapticLoopStats stats;
+    {
+      const auto wall_start = std::chrono::steady_clock::now();
+      RealtimeHaptics haptics(*scene.kernel);
+      ASSERT_EQ(haptics.probes().size(), 1u);
+      haptics.Start();
+      EXPECT_TRUE(probe.loop_running());
+      const RunResult run = scene.kernel->Run(0.2);
+      ASSERT_TRUE(run.ok()) << run.diagnostic;
+      // The simulation never runs ahead of the wall clock: the probe's last step sleeps until
+      // 0.2 s have passed on the loop's clock, which started after wall_start (a lower bound
+      // from sleep_for's guarantee, not a timing measurement).
+      EXPECT_GE(
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count(),
+          0.2);
+      const auto loops = haptics.Stop();
+      ASSERT_EQ(loops.size(), 1u);
+      EXPECT_EQ(loops[0].first, "probe");
+      stats = loops[0].second;
+    }
+    EXPECT_FALSE(probe.loop_running());  // joined
+    EXPECT_GT(stats.ticks, 0);
+    EXPECT_LE(stats.p50, stats.p99);
+    EXPECT_LE(stats.p99, stats.max);
+    EXPECT_GT(probe.num_ticks(), 0);
+    EXPECT_LE(probe.num_ticks(), stats.ticks);
 
-  // Physics: the tool is held 2 mm inside; the force on it points out of the top face (+z, the
-  // contact vertex is the face's centre, whose normal is +z by symmetry) and, through the
-  // coupling spring in series with the tissue, is positive and at most k_c · depth = 0.4 N
-  // (and below the 3 N limit).
-  const Vec3 f = ReadVec(probe, "tool_force");
-  std::printf("tool force: real-time %.6f N (%lld ticks), synchronous %.6f N\n", f.z(),
-              static_cast<long long>(stats.ticks), f_sync.z());
-  EXPECT_GT(f.z(), 0.1 * kCoupling * kDepth);
-  EXPECT_LE(f.z(), kCoupling * kDepth * (1 + 1e-12));
-  EXPECT_LE(f.norm(), kMaxForce);
-  EXPECT_LT(f.head<2>().norm(), 1e-9 * f.z());  // along the normal up to roundoff
-  // The same quasi-static contact as the synchronous path: both render the same local model of
-  // the same held block; what differs (which sim times the ticks fall on) has decayed. 2 %.
-  EXPECT_NEAR(f.z(), f_sync.z(), 0.02 * f_sync.z());
-  // The probe's proxy stays on the local surface, above the tool.
-  EXPECT_GT(ReadVec(probe, "proxy_position").z(), 0.018);
-  // What the loop handed back reached the block as a boundary force (opposite to the force on
-  // the tool, up to the safety stage's rate limit, idle at a steady hold), and the block is in
-  // equilibrium: the base carries it (no gravity; the momentum rate is small after the
-  // damped transient: 2 % of the load).
-  const auto [tool_on_block, support] = BlockLoads(scene.kernel->FindObject("block"));
-  EXPECT_LT((tool_on_block + f).norm(), 0.02 * f.norm());
-  EXPECT_LT((tool_on_block + support).norm(), 0.02 * tool_on_block.norm());
+    // Physics: the tool is held 2 mm inside; the force on it points out of the top face (+z, the
+    // contact vertex is the face's centre, whose normal is +z by symmetry) and, through the
+    // coupling spring in series with the tissue, is positive and at most k_c · depth = 0.4 N
+    // (and below the 3 N limit).
+    const Vec3 f = ReadVec(probe, "tool_force");
+    std::printf("tool force: real-time %.6f N (%lld ticks), synchronous %.6f N\n", f.z(),
+                static_cast<long long>(stats.ticks), f_sync.z());
+    EXPECT_GT(f.z(), 0.1 * kCoupling * kDepth);
+    EXPECT_LE(f.z(), kCoupling * kDepth * (1 + 1e-12));
+    EXPECT_LE(f.norm(), kMaxForce);
+    EXPECT_LT(f.head<2>().norm(), 1e-9 * f.z());  // along the normal up to roundoff
+    // The same quasi-static contact as the synchronous path: both render the same local model of
+    // the same held block; what differs (which sim times the ticks fall on) has decayed. 2 %.
+    EXPECT_NEAR(f.z(), f_sync.z(), 0.02 * f_sync.z());
+    // The probe's proxy stays on the local surface, above the tool.
+    EXPECT_GT(ReadVec(probe, "proxy_position").z(), 0.018);
+    // What the loop handed back reached the block as a boundary force (opposite to the force on
+    // the tool, up to the safety stage's rate limit, idle at a steady hold), and the block is in
+    // equilibrium: the base carries it (no gravity; the momentum rate is small after the
+    // damped transient: 2 % of the load).
+    const auto [tool_on_block, support] = BlockLoads(scene.kernel->FindObject("block"));
+    EXPECT_LT((tool_on_block + f).norm(), 0.02 * f.norm());
+    EXPECT_LT((tool_on_block + support).norm(), 0.02 * tool_on_block.norm());
+  }
 }
 
 TEST(RealtimeHapticProbe, TheLoopTickAllocatesNothingWhileModelsArePublished) {
@@ -198,6 +203,9 @@ TEST(RealtimeHapticProbe, BadKeysAreErrorsNamingTheJsonPath) {
               HasSubstr("objects.probe.realtime.priority: expected an integer in 1-99"));
   EXPECT_THAT(error(R"({"cpu": -2})"), HasSubstr("objects.probe.realtime.cpu: expected a CPU"));
   EXPECT_THAT(error(R"({"fifo": 3})"), HasSubstr("objects.probe.realtime.fifo"));
+  EXPECT_THAT(error(R"({"spin": 0.001})"),
+              HasSubstr("objects.probe.realtime.spin: expected a time in [0, 0.001) s"));
+  EXPECT_THAT(error(R"({"spin": -1e-4})"), HasSubstr("objects.probe.realtime.spin"));
   EXPECT_EQ(error("false"), "(no error)");
 }
 

@@ -24,6 +24,8 @@ HapticLoop::HapticLoop(HapticRenderer& tick, double rate, std::size_t max_record
   GIPSI_CHECK(rate > 0 && rate <= 10000, "haptic rate {} Hz out of (0, 10000]", rate);
   GIPSI_CHECK(!realtime.fifo || (realtime.priority >= 1 && realtime.priority <= 99),
               "SCHED_FIFO priority {} out of 1-99", realtime.priority);
+  GIPSI_CHECK(realtime.spin >= 0 && realtime.spin < period_, "spin {} s outside [0, {}) s",
+              realtime.spin, period_);
   periods_.resize(max_records);
 }
 
@@ -83,8 +85,16 @@ void HapticLoop::Run() {
   const auto start = start_;
   auto previous = Clock::now();
   auto next = previous + period;
+  const auto spin =
+      std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(realtime_.spin));
   while (!stop_.load(std::memory_order_relaxed)) {
-    std::this_thread::sleep_until(next);
+    if (spin.count() > 0) {
+      std::this_thread::sleep_until(next - spin);
+      while (Clock::now() < next) {  // spin out the rest: no timer wake-up latency
+      }
+    } else {
+      std::this_thread::sleep_until(next);
+    }
     const auto now = Clock::now();
     if (ticks_ > 0 && recorded_ < periods_.size())
       periods_[recorded_++] = std::chrono::duration<double>(now - previous).count();

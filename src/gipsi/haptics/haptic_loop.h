@@ -23,6 +23,10 @@ struct HapticRealtime {
   bool fifo = false;  ///< request SCHED_FIFO (needs root or CAP_SYS_NICE)
   int priority = 80;  ///< SCHED_FIFO priority, 1–99
   int cpu = -1;       ///< pin the thread to this CPU (−1: no pinning)
+  /// s, in [0, period): sleep until this long before each tick's deadline, then spin on the
+  /// clock, so a late timer wake-up within it does not delay the tick; costs that share of a
+  /// core. 0: sleep only.
+  double spin = 0;
 };
 
 /// Period statistics of a finished run [s]. Plain struct.

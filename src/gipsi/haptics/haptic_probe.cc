@@ -209,9 +209,9 @@ MouseDeviceParams ParseMouseDevice(const JsonNode& node) {
 
 std::optional<HapticRealtime> ParseRealtime(const JsonNode& node) {
   const char* const expected =
-      "true, false or an object {\"fifo\": false, \"priority\": 80, \"cpu\": -1}";
+      "true, false or an object {\"fifo\": false, \"priority\": 80, \"cpu\": -1, \"spin\": 0}";
   if (node.is_object()) {
-    node.CheckKeys({"fifo", "priority", "cpu"});
+    node.CheckKeys({"fifo", "priority", "cpu", "spin"});
     HapticRealtime realtime;
     realtime.fifo = node.Bool("fifo", realtime.fifo);
     const std::int64_t priority = node.Int("priority", realtime.priority);
@@ -222,6 +222,7 @@ std::optional<HapticRealtime> ParseRealtime(const JsonNode& node) {
       node.At("cpu").Expected(
           fmt::format("a CPU number in 0-{}, or -1 (no pinning)", CPU_SETSIZE - 1));
     realtime.cpu = static_cast<int>(cpu);
+    realtime.spin = node.NonNegative("spin", realtime.spin);  // checked against the rate later
     return realtime;
   }
   if (node.raw().is_boolean())
@@ -279,6 +280,11 @@ void RegisterHaptics(TypeRegistry& registry) {
         spec.tick.safety.stale_after = p.Positive("stale_after", spec.tick.safety.stale_after);
         spec.tick.safety.fade_time = p.NonNegative("fade_time", spec.tick.safety.fade_time);
         if (p.Has("realtime")) spec.realtime = ParseRealtime(p.At("realtime"));
+        if (spec.realtime && !(spec.realtime->spin < 1 / spec.rate))
+          p.At("realtime")
+              .At("spin")
+              .Expected(
+                  fmt::format("a time in [0, {}) s, less than the haptic period", 1 / spec.rate));
         if (!spec.igtl) return std::make_unique<HapticProbe>(ctx.name, spec);
         try {
           return std::make_unique<HapticProbe>(ctx.name, spec);

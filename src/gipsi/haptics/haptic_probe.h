@@ -22,7 +22,8 @@
 ///             "coupling_stiffness": 5000, "coupling_damping": 0, "blend_time": 0.01,
 ///             "max_force": 3, "max_rate": 1000, "stale_after": 0.05, "fade_time": 0.1,
 ///             "workspace_scale": 1, "workspace_offset": [0, 0, 0],
-///             "realtime": {"fifo": false, "priority": 80, "cpu": -1}}  (or "realtime": true)
+///             "realtime": {"fifo": false, "priority": 80, "cpu": -1, "spin": 0}}
+///             (or "realtime": true)
 ///   or, instead of "path", "device": {"type": "OpenIGTLink", "host": "127.0.0.1",
 ///             "port": 18944, "name": "Tool", "length_unit": 0.001, "connect_timeout": 2,
 ///             "reconnect_interval": 0.5}
