@@ -128,6 +128,19 @@ void ReadBuffer(StateReader& in, LatestValue<T>& buffer, Read read, std::string_
   if (!buffer.set_layout(layout)) in.Fail(fmt::format("the {} buffer's layout is corrupted", what));
 }
 
+/// Throws InputError, with the reason, for a probe whose run cannot be reproduced.
+void RefuseUnreproducible(const std::string& probe, bool realtime, bool igtl, bool mouse) {
+  const char* why = realtime ? "it is real-time (\"realtime\"): its ticks follow the wall clock"
+                    : igtl   ? "its OpenIGTLink device is moved by a tracker"
+                    : mouse  ? "its Mouse device is moved by the viewer's user"
+                             : nullptr;
+  if (why != nullptr)
+    throw InputError(fmt::format(
+        "haptic probe '{}' cannot be checkpointed or rolled back: {}, so the run cannot be "
+        "reproduced (a probe on a scripted \"path\" can)",
+        probe, why));
+}
+
 }  // namespace
 
 // --- The haptic side ---
@@ -224,18 +237,7 @@ void HapticBridge::RestoreState(StateReader& in) {
 }
 
 void HapticProbe::SaveObjectState(StateWriter& out) const {
-  const char* why = nullptr;
-  if (realtime())
-    why = "it is real-time (\"realtime\"): its ticks follow the wall clock";
-  else if (igtl_ != nullptr)
-    why = "its OpenIGTLink device is moved by a tracker";
-  else if (mouse_ != nullptr)
-    why = "its Mouse device is moved by the viewer's user";
-  if (why != nullptr)
-    throw InputError(fmt::format(
-        "haptic probe '{}' cannot be checkpointed or rolled back: {}, so the run cannot be "
-        "reproduced (a probe on a scripted \"path\" can)",
-        name(), why));
+  RefuseUnreproducible(name(), realtime(), igtl_ != nullptr, mouse_ != nullptr);
   WriteVec3(out, force_);
   WriteVec3(out, position_);
   WriteVec3(out, proxy_);
@@ -247,10 +249,7 @@ void HapticProbe::SaveObjectState(StateWriter& out) const {
 }
 
 void HapticProbe::RestoreObjectState(StateReader& in) {
-  if (realtime() || virtual_ == nullptr) {
-    StateWriter refused;
-    SaveObjectState(refused);  // throws the reason
-  }
+  RefuseUnreproducible(name(), realtime(), igtl_ != nullptr, mouse_ != nullptr);
   force_ = ReadVec3(in, "the tool force");
   position_ = ReadVec3(in, "the tool position");
   proxy_ = ReadVec3(in, "the proxy position");
