@@ -15,6 +15,7 @@
 #include "gipsi/numerics/sparse/amg.h"
 #include "gipsi/numerics/sparse/serial_openmp.h"
 #include "gipsi/numerics/sparse/solvers.h"
+#include "gipsi/numerics/sparse/team_barrier.h"
 #include "gipsi/numerics/sparse/vector_ops.h"
 
 namespace gipsi {
@@ -59,7 +60,7 @@ class PcgSolver final : public LinearSolver {
     matrix_ = nullptr;
     has_factor_ = false;
     refactor_pending_ = false;
-    for (VecX* v : {&r_, &z_, &p_, &q_}) v->setZero(rows_);
+    for (VecX* v : {&r_, &z_, &p_, &q_, &w_}) v->setZero(rows_);
     switch (kind_) {
       case Preconditioner::kNone:
         break;
@@ -158,7 +159,8 @@ class PcgSolver final : public LinearSolver {
           break;
         }
         if (stats.iterations >= options_.max_iterations || stuck) break;
-        stuck = !Iterate(target, stats.iterations, x);
+        stuck = fused() ? !IterateFused(target, stats.iterations, x)
+                        : !Iterate(target, stats.iterations, x);
         r_norm = TrueResidual(b, x);
       }
     }
@@ -275,6 +277,133 @@ class PcgSolver final : public LinearSolver {
     return ParallelDot(r_, z_, scratch_);
   }
 
+  /// Jacobi (or no) preconditioning runs the fused iteration below.
+  [[nodiscard]] bool fused() const {
+    return kind_ == Preconditioner::kJacobi || kind_ == Preconditioner::kNone;
+  }
+
+  /// The same contract as Iterate, for the element-wise preconditioners: the Chronopoulos–Gear
+  /// form of PCG (Chronopoulos & Gear, "s-step iterative methods for symmetric linear
+  /// systems", J. Comput. Appl. Math. 25, 1989), which keeps s = A p by the recurrence
+  /// s ← w + β s with w = A z, so that both inner products of an iteration, (r, z) and (w, z),
+  /// are taken together. An iteration is then two sweeps, each one pass over the team's own
+  /// rows: (1) p ← z + βp, s ← w + βs, x += αp, r −= αs, z = M⁻¹r with the partial sums of
+  /// (r, r) and (r, z); (2) w = A z with the partial sum of (w, z). One OpenMP region covers
+  /// all iterations, its threads meeting at a TeamBarrier after each sweep (two per
+  /// iteration, against five region starts for Iterate). Rows are split into one contiguous
+  /// range per thread (whole nodes for a node-block matrix) and partial sums are added in
+  /// thread order, so the bits depend on the thread count only. In exact arithmetic the
+  /// iterates are those of Iterate; the recurred s can drift from A p in floating point,
+  /// which Solve's true-residual check catches (it restarts CG from the true residual).
+  bool IterateFused(double target, int& iterations, VecX& x) {
+    const int n = static_cast<int>(rows_);
+    const int threads = n >= kMinParallelLength ? omp_get_max_threads() : 1;
+    // Per thread and round parity: (r, r), (r, z), (w, z), padded to a cache line. Two rounds
+    // alternate, so a thread that runs ahead never overwrites sums another is still reading.
+    constexpr int kStride = 8;
+    partials_.assign(static_cast<std::size_t>(2 * threads * kStride), 0.0);
+    TeamBarrier barrier;
+    const double* __restrict inverse = inverse_diagonal_.data();
+    const bool jacobi = kind_ == Preconditioner::kJacobi;
+    const SparseMatrix& A = *matrix_;
+    const bool blocks = node_blocks_;
+    double* __restrict px = x.data();
+    double* __restrict pr = r_.data();
+    double* __restrict pz = z_.data();
+    double* __restrict pp = p_.data();
+    double* __restrict ps = q_.data();
+    double* __restrict pw = w_.data();
+    double* partials = partials_.data();
+    int done = iterations;
+    bool ok = false;
+#pragma omp parallel num_threads(threads) if (threads > 1)
+    {
+      const int team = omp_get_num_threads();
+      const int t = omp_get_thread_num();
+      // Row range of this thread: whole nodes when the SpMV works on node blocks.
+      const int unit = blocks ? 3 : 1;
+      const int units = n / unit;
+      const int begin = unit * static_cast<int>(std::int64_t{units} * t / team);
+      const int end = unit * static_cast<int>(std::int64_t{units} * (t + 1) / team);
+      auto slot = [&](int round, int thread) {
+        return partials + static_cast<std::ptrdiff_t>(((round & 1) * team + thread) * kStride);
+      };
+      auto total = [&](int round, int which) {
+        double sum = 0.0;
+        for (int k = 0; k < team; ++k) sum += slot(round, k)[which];
+        return sum;
+      };
+      auto spmv_and_wz = [&](int round) {  // sweep (2): w = A z, partial (w, z)
+        if (blocks)
+          NodeBlockSpMVNodes(A, pz, pw, begin / 3, end / 3);
+        else
+          SymmetricSpMVRows(A, pz, pw, begin, end);
+        double wz = 0.0;
+        for (int i = begin; i < end; ++i) wz += pw[i] * pz[i];
+        slot(round, t)[2] = wz;
+      };
+      // Start: z = M⁻¹ r, then w = A z, (r, z) and (w, z).
+      {
+        double rz = 0.0;
+        for (int i = begin; i < end; ++i) {
+          pz[i] = jacobi ? inverse[i] * pr[i] : pr[i];
+          rz += pr[i] * pz[i];
+        }
+        slot(0, t)[1] = rz;
+      }
+      barrier.Wait(team);
+      spmv_and_wz(0);
+      barrier.Wait(team);
+      double gamma = total(0, 1), delta = total(0, 2);
+      double alpha = 0.0, beta = 0.0;
+      int local = done;
+      bool converged = false;
+      for (int round = 1; local < options_.max_iterations; ++round) {
+        // Scalars from the sums of the last round: every thread computes the same bits.
+        if (round == 1) {
+          beta = 0.0;
+          alpha = gamma / delta;
+        } else {
+          const double gamma_next = total(round - 1, 1);
+          beta = gamma_next / gamma;
+          gamma = gamma_next;
+          delta = total(round - 1, 2);
+          alpha = gamma / (delta - beta * gamma / alpha);
+        }
+        if (!(gamma > 0.0) || !(alpha > 0.0) || !std::isfinite(alpha)) break;  // not SPD, NaN
+        double rr = 0.0, rz = 0.0;
+        for (int i = begin; i < end; ++i) {
+          pp[i] = pz[i] + beta * pp[i];
+          ps[i] = pw[i] + beta * ps[i];
+          px[i] += alpha * pp[i];
+          pr[i] -= alpha * ps[i];
+          pz[i] = jacobi ? inverse[i] * pr[i] : pr[i];
+          rr += pr[i] * pr[i];
+          rz += pr[i] * pz[i];
+        }
+        double* mine = slot(round, t);
+        mine[0] = rr;
+        mine[1] = rz;
+        barrier.Wait(team);
+        ++local;
+        const double rr_total = total(round, 0);
+        if (!std::isfinite(rr_total)) break;
+        if (std::sqrt(rr_total) <= target) {
+          converged = true;
+          break;
+        }
+        spmv_and_wz(round);
+        barrier.Wait(team);
+      }
+      if (t == 0) {
+        done = local;
+        ok = converged;
+      }
+    }
+    iterations = done;
+    return ok;
+  }
+
   /// CG from the current r_ (= b − A x) until the recursive residual norm is ≤ target (returns
   /// true), or the iteration budget is spent, or a breakdown or non-finite value (false).
   bool Iterate(double target, int& iterations, VecX& x) {
@@ -325,6 +454,8 @@ class PcgSolver final : public LinearSolver {
   std::int64_t lagged_solves_ = 0;  ///< Solves since the last CHOLMOD factorisation
   std::int64_t lagged_iterations_ = 0;  ///< their CG iterations
   VecX r_, z_, p_, q_;                  ///< residual, preconditioned residual, direction, A p
+  VecX w_;                              ///< A z (IterateFused)
+  std::vector<double> partials_;        ///< IterateFused: per thread and round, padded
   VecX inverse_diagonal_;
   ReductionScratch scratch_;
   Eigen::IncompleteCholesky<double, Eigen::Lower, Eigen::AMDOrdering<int>> incomplete_;
