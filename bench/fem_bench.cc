@@ -76,7 +76,7 @@ void BM_ImplicitStep(benchmark::State& state, const char* law) {
 void Sizes(benchmark::internal::Benchmark* b) {
   for (int n : {10, 16, 25}) b->Args({n, 3});
   for (int n : {10, 16, 25}) b->Args({n, 2});
-  for (int n : {10, 16}) b->Args({n, 0});
+  for (int n : {10, 16, 25}) b->Args({n, 0});
   b->Args({10, 1});
   b->Unit(benchmark::kMillisecond)->UseRealTime();
 }

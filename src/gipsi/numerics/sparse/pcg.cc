@@ -63,6 +63,7 @@ class PcgSolver final : public LinearSolver {
     for (VecX* v : {&r_, &z_, &p_, &q_, &w_}) v->setZero(rows_);
     switch (kind_) {
       case Preconditioner::kNone:
+        inverse_diagonal_.setOnes(rows_);  // IterateFused scales by it: M = I
         break;
       case Preconditioner::kJacobi:
         inverse_diagonal_.setZero(rows_);
@@ -309,7 +310,6 @@ class PcgSolver final : public LinearSolver {
     partials_.assign(static_cast<std::size_t>(2 * threads * kStride), 0.0);
     TeamBarrier barrier;
     const double* __restrict inverse = inverse_diagonal_.data();
-    const bool jacobi = kind_ == Preconditioner::kJacobi;
     const SparseMatrix& A = *matrix_;
     const bool blocks = node_blocks_;
     double* __restrict px = x.data();
@@ -326,10 +326,27 @@ class PcgSolver final : public LinearSolver {
       const int team = omp_get_num_threads();
       const int t = omp_get_thread_num();
       // Row range of this thread: whole nodes when the SpMV works on node blocks.
+      // Row range of this thread: whole nodes when the SpMV works on node blocks, split so
+      // that every thread gets about the same work, counted as nonzeros plus 8 per row (the
+      // vector updates' loads and stores).
       const int unit = blocks ? 3 : 1;
       const int units = n / unit;
-      const int begin = unit * static_cast<int>(std::int64_t{units} * t / team);
-      const int end = unit * static_cast<int>(std::int64_t{units} * (t + 1) / team);
+      const int* outer = A.outerIndexPtr();
+      auto first_row = [&](int k) {
+        if (k == team) return n;
+        const std::int64_t goal = (std::int64_t{outer[n]} + 8 * std::int64_t{n}) * k / team;
+        int lo = 0, hi = units;  // the first unit whose start reaches the goal
+        while (lo < hi) {
+          const int mid = lo + (hi - lo) / 2;
+          if (outer[unit * mid] + 8 * std::int64_t{unit} * mid < goal)
+            lo = mid + 1;
+          else
+            hi = mid;
+        }
+        return unit * lo;
+      };
+      const int begin = first_row(t);
+      const int end = first_row(t + 1);
       auto slot = [&](int round, int thread) {
         return partials + static_cast<std::ptrdiff_t>(((round & 1) * team + thread) * kStride);
       };
@@ -343,15 +360,21 @@ class PcgSolver final : public LinearSolver {
           NodeBlockSpMVNodes(A, pz, pw, begin / 3, end / 3);
         else
           SymmetricSpMVRows(A, pz, pw, begin, end);
-        double wz = 0.0;
-        for (int i = begin; i < end; ++i) wz += pw[i] * pz[i];
+        double wz0 = 0.0, wz1 = 0.0;  // two chains: the adds' latency, not the loads, bound it
+        int i = begin;
+        for (; i + 2 <= end; i += 2) {
+          wz0 += pw[i] * pz[i];
+          wz1 += pw[i + 1] * pz[i + 1];
+        }
+        if (i < end) wz0 += pw[i] * pz[i];
+        const double wz = wz0 + wz1;
         slot(round, t)[2] = wz;
       };
       // Start: z = M⁻¹ r, then w = A z, (r, z) and (w, z).
       {
         double rz = 0.0;
         for (int i = begin; i < end; ++i) {
-          pz[i] = jacobi ? inverse[i] * pr[i] : pr[i];
+          pz[i] = inverse[i] * pr[i];
           rz += pr[i] * pz[i];
         }
         slot(0, t)[1] = rz;
@@ -376,19 +399,25 @@ class PcgSolver final : public LinearSolver {
           alpha = gamma / (delta - beta * gamma / alpha);
         }
         if (!(gamma > 0.0) || !(alpha > 0.0) || !std::isfinite(alpha)) break;  // not SPD, NaN
-        double rr = 0.0, rz = 0.0;
-        for (int i = begin; i < end; ++i) {
+        double rr[2] = {0.0, 0.0}, rz[2] = {0.0, 0.0};  // two chains each, as above
+        auto update = [&](int i, int chain) {
           pp[i] = pz[i] + beta * pp[i];
           ps[i] = pw[i] + beta * ps[i];
           px[i] += alpha * pp[i];
           pr[i] -= alpha * ps[i];
-          pz[i] = jacobi ? inverse[i] * pr[i] : pr[i];
-          rr += pr[i] * pr[i];
-          rz += pr[i] * pz[i];
+          pz[i] = inverse[i] * pr[i];
+          rr[chain] += pr[i] * pr[i];
+          rz[chain] += pr[i] * pz[i];
+        };
+        int i = begin;
+        for (; i + 2 <= end; i += 2) {
+          update(i, 0);
+          update(i + 1, 1);
         }
+        if (i < end) update(i, 0);
         double* mine = slot(round, t);
-        mine[0] = rr;
-        mine[1] = rz;
+        mine[0] = rr[0] + rr[1];
+        mine[1] = rz[0] + rz[1];
         barrier.Wait(team);
         ++local;
         const double rr_total = total(round, 0);
