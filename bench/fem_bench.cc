@@ -14,6 +14,9 @@
 #include "gipsi/base/json_node.h"
 #include "gipsi/geometry/generators.h"
 #include "gipsi/models/fem/fem_solid.h"
+#include "gipsi/numerics/sparse/linear_solver.h"
+#include "gipsi/numerics/sparse/node_block_copy.h"
+#include "stream_triad.h"
 
 namespace gipsi {
 namespace {
@@ -82,6 +85,51 @@ void Sizes(benchmark::internal::Benchmark* b) {
 }
 BENCHMARK_CAPTURE(BM_ImplicitStep, corotational, "Corotational")->Apply(Sizes);
 BENCHMARK_CAPTURE(BM_ImplicitStep, neo_hookean, "NeoHookean")->Apply(Sizes);
+
+// The memory bandwidth CG's product with the FEM tangent reaches (NodeBlockSpMV, as in every
+// CG iteration above), beside a STREAM triad measured in the same run. The tangent is the
+// corotational stiffness of the benchmark cube at rest (the values do not change the traffic).
+// Bytes as for the triad, each array element read or written once: 8 B per nonzero, one 4 B
+// row index per 3×3 block, 4 B per column pointer, 8 B per entry of x and of y.
+void BM_StreamTriad(benchmark::State& state) { RunStreamTriad(state); }
+BENCHMARK(BM_StreamTriad)->UseRealTime()->Unit(benchmark::kMillisecond);
+
+void BM_TangentSpMV(benchmark::State& state) {
+  const int cells = static_cast<int>(state.range(0));
+  auto mesh = std::make_shared<const Mesh>(
+      MakeTetBox(Vec3::Zero(), Vec3(0.1, 0.1, 0.1), {cells, cells, cells}, HexSplit::kFive));
+  FemParams params;
+  params.material = Law("Corotational");
+  const FemSolid fem("cube", mesh, params);
+  SparseMatrix K;
+  if (!fem.CalcStiffness(Eigen::Map<const VecX>(mesh->nodes.data(), mesh->nodes.size()), K) ||
+      !HasNodeBlockPattern(K)) {
+    state.SkipWithError("no node-block tangent");
+    return;
+  }
+  const VecX x = VecX::Ones(K.cols());
+  VecX y(K.rows());
+  NodeBlockCopy copy;
+  if (state.range(1)) copy.Assign(K);
+  for (auto _ : state) {
+    if (state.range(1))
+      copy.Multiply(x, y);
+    else
+      NodeBlockSpMV(K, x, y);
+    benchmark::DoNotOptimize(y.data());
+    benchmark::ClobberMemory();
+  }
+  const std::int64_t nnz = K.nonZeros();
+  const std::int64_t bytes = 8 * nnz + 4 * (nnz / 9) + 4 * (K.cols() + 1) + 16 * K.rows();
+  state.SetBytesProcessed(static_cast<std::int64_t>(state.iterations()) * bytes);
+  state.counters["rows"] = static_cast<double>(K.rows());
+  state.counters["nnz"] = static_cast<double>(nnz);
+  state.counters["MB"] = 1e-6 * static_cast<double>(bytes);
+}
+BENCHMARK(BM_TangentSpMV)
+    ->ArgsProduct({{10, 16, 25}, {0, 1}})
+    ->UseRealTime()
+    ->Unit(benchmark::kMicrosecond);
 
 }  // namespace
 }  // namespace gipsi

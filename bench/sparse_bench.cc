@@ -25,6 +25,7 @@
 
 #include "gipsi/numerics/sparse/linear_solver.h"
 #include "gipsi/numerics/sparse/model_problems.h"
+#include "stream_triad.h"
 
 namespace gipsi {
 namespace {
@@ -61,32 +62,8 @@ void SetThreadCounter(benchmark::State& state) {
   state.counters["threads"] = static_cast<double>(omp_get_max_threads());
 }
 
-// a = b + s·c over three arrays of 8 Mi doubles (64 MiB each, 192 MiB in all: 6× the 32 MiB
-// last-level cache of the project's machine class), first touched by the threads that use them.
-void BM_StreamTriad(benchmark::State& state) {
-  const std::ptrdiff_t n = std::ptrdiff_t{8} << 20;
-  std::unique_ptr<double[]> a(new double[static_cast<std::size_t>(n)]);
-  std::unique_ptr<double[]> b(new double[static_cast<std::size_t>(n)]);
-  std::unique_ptr<double[]> c(new double[static_cast<std::size_t>(n)]);
-  double* __restrict pa = a.get();
-  double* __restrict pb = b.get();
-  double* __restrict pc = c.get();
-#pragma omp parallel for schedule(static)
-  for (std::ptrdiff_t i = 0; i < n; ++i) {
-    pa[i] = 0.0;
-    pb[i] = 1.0;
-    pc[i] = 2.0;
-  }
-  const double s = 3.0;
-  for (auto _ : state) {
-#pragma omp parallel for schedule(static)
-    for (std::ptrdiff_t i = 0; i < n; ++i) pa[i] = pb[i] + s * pc[i];
-    benchmark::DoNotOptimize(pa);
-    benchmark::ClobberMemory();
-  }
-  state.SetBytesProcessed(static_cast<std::int64_t>(state.iterations()) * 3 * 8 * n);
-  SetThreadCounter(state);
-}
+// The STREAM triad (stream_triad.h).
+void BM_StreamTriad(benchmark::State& state) { RunStreamTriad(state); }
 BENCHMARK(BM_StreamTriad)->UseRealTime()->Unit(benchmark::kMillisecond);
 
 // y = A x on the lattice with n³ nodes: 26 → 52,728 rows and 3.95 M nonzeros (47 MB of values

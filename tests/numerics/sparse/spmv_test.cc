@@ -1,3 +1,4 @@
+#include <algorithm>
 #include <cstring>
 #include <vector>
 
@@ -6,6 +7,7 @@
 
 #include "gipsi/numerics/sparse/linear_solver.h"
 #include "gipsi/numerics/sparse/model_problems.h"
+#include "gipsi/numerics/sparse/node_block_copy.h"
 #include "gipsi/numerics/sparse/vector_ops.h"
 #include "numerics/sparse/sparse_test_util.h"
 
@@ -169,6 +171,47 @@ TEST(NodeBlockSpMV, BitsDoNotDependOnThreadCount) {
     omp_set_num_threads(threads);
     VecX parallel(A.rows());
     NodeBlockSpMV(A, x, parallel);
+    EXPECT_TRUE(SameBits(serial, parallel)) << threads << " threads";
+  }
+}
+
+// The block-row copy the fused CG multiplies with: the same product as Eigen's to round-off
+// (a different summation order than NodeBlockSpMV's), after new values are copied into the
+// same pattern too, and with the same bits for any thread count and any split of the nodes.
+TEST(NodeBlockCopy, MatchesEigenProductAndFollowsNewValues) {
+  ThreadCountGuard guard;
+  SparseMatrix A = MakeSpringLattice3D(14, 1e-2, [](const Vec3& p) { return 1.0 + p.x(); });
+  ASSERT_GE(A.rows(), kMinParallelLength);  // the parallel path
+  NodeBlockCopy copy;
+  copy.Assign(A);
+  ASSERT_EQ(copy.nodes(), A.cols() / 3);
+  const VecX x = RandomVector(A.cols(), 23);
+  VecX y(A.rows());
+  copy.Multiply(x, y);
+  VecX expected = A * x;
+  EXPECT_LE((y - expected).norm(), 1e-14 * expected.norm());
+
+  const SparseMatrix B =
+      MakeSpringLattice3D(14, 2e-2, [](const Vec3& p) { return 2.0 + p.y() * p.z(); });
+  ASSERT_EQ(B.nonZeros(), A.nonZeros());
+  copy.CopyValues(B);
+  copy.Multiply(x, y);
+  expected = B * x;
+  EXPECT_LE((y - expected).norm(), 1e-14 * expected.norm());
+
+  omp_set_num_threads(1);
+  VecX serial(B.rows());
+  copy.Multiply(x, serial);
+  EXPECT_TRUE(SameBits(serial, y));
+  VecX pieces(B.rows());
+  const int nodes = copy.nodes();
+  for (int begin = 0; begin < nodes; begin += 997)  // an uneven split
+    copy.MultiplyNodes(x.data(), pieces.data(), begin, std::min(begin + 997, nodes));
+  EXPECT_TRUE(SameBits(serial, pieces));
+  for (int threads : {2, 3}) {
+    omp_set_num_threads(threads);
+    VecX parallel(B.rows());
+    copy.Multiply(x, parallel);
     EXPECT_TRUE(SameBits(serial, parallel)) << threads << " threads";
   }
 }

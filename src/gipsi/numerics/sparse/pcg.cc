@@ -13,6 +13,7 @@
 
 #include "gipsi/base/error.h"
 #include "gipsi/numerics/sparse/amg.h"
+#include "gipsi/numerics/sparse/node_block_copy.h"
 #include "gipsi/numerics/sparse/serial_openmp.h"
 #include "gipsi/numerics/sparse/solvers.h"
 #include "gipsi/numerics/sparse/team_barrier.h"
@@ -56,6 +57,9 @@ class PcgSolver final : public LinearSolver {
     rows_ = A.rows();
     nonzeros_ = A.nonZeros();
     node_blocks_ = HasNodeBlockPattern(A);
+    // The fused CG multiplies by a block-row copy of a node-block matrix (node_block_copy.h).
+    block_copy_ready_ = false;
+    if (node_blocks_ && fused()) block_copy_.Assign(A);
     analysed_ = true;
     matrix_ = nullptr;
     has_factor_ = false;
@@ -92,6 +96,7 @@ class PcgSolver final : public LinearSolver {
     if (!analysed_) AnalyzePattern(A);
     CheckAnalysedShape(A, rows_, nonzeros_, "PCG Factorize");
     matrix_ = nullptr;
+    block_copy_ready_ = false;
     refactorized_ = false;
     if (!AllValuesFinite(A)) return false;
     switch (kind_) {
@@ -128,6 +133,10 @@ class PcgSolver final : public LinearSolver {
           return false;
         }
         break;
+    }
+    if (node_blocks_ && fused()) {
+      block_copy_.CopyValues(A);
+      block_copy_ready_ = true;
     }
     matrix_ = &A;
     return true;
@@ -215,6 +224,10 @@ class PcgSolver final : public LinearSolver {
   /// for a matrix of 3×3 node blocks (an FEM tangent), else SymmetricSpMV.
   void Multiply(const VecX& x, VecX& y) {
     if (kind_ == Preconditioner::kAmg && amg_.Multiply(x, y)) return;
+    if (block_copy_ready_) {
+      block_copy_.Multiply(x, y);
+      return;
+    }
     if (node_blocks_)
       NodeBlockSpMV(*matrix_, x, y);
     else
@@ -311,7 +324,7 @@ class PcgSolver final : public LinearSolver {
     TeamBarrier barrier;
     const double* __restrict inverse = inverse_diagonal_.data();
     const SparseMatrix& A = *matrix_;
-    const bool blocks = node_blocks_;
+    const bool blocks = block_copy_ready_;
     double* __restrict px = x.data();
     double* __restrict pr = r_.data();
     double* __restrict pz = z_.data();
@@ -357,7 +370,7 @@ class PcgSolver final : public LinearSolver {
       };
       auto spmv_and_wz = [&](int round) {  // sweep (2): w = A z, partial (w, z)
         if (blocks)
-          NodeBlockSpMVNodes(A, pz, pw, begin / 3, end / 3);
+          block_copy_.MultiplyNodes(pz, pw, begin / 3, end / 3);
         else
           SymmetricSpMVRows(A, pz, pw, begin, end);
         double wz0 = 0.0, wz1 = 0.0;  // two chains: the adds' latency, not the loads, bound it
@@ -479,6 +492,8 @@ class PcgSolver final : public LinearSolver {
   Index nonzeros_ = 0;
   bool analysed_ = false;
   bool node_blocks_ = false;              ///< the analysed pattern has HasNodeBlockPattern
+  NodeBlockCopy block_copy_;              ///< block-row copy of A for the fused CG
+  bool block_copy_ready_ = false;         ///< block_copy_ holds the values of matrix_
   const SparseMatrix* matrix_ = nullptr;  ///< the last successfully factorised A
   bool refactorized_ = false;
   bool has_factor_ = false;         ///< cholesky_ / amg_ holds a valid factorisation / hierarchy
