@@ -246,39 +246,17 @@ double SmoothedAggregationAmg::operator_complexity() const {
 void SmoothedAggregationAmg::DetectBlocks(Level& level) {
   const SparseMatrix& A = *level.a;
   level.blocked = false;
-  if (!level.sorted || A.rows() % 3 != 0) return;
+  if (!level.sorted || !HasNodeBlockPattern(A)) return;
   const int* outer = A.outerIndexPtr();
   const int* inner = A.innerIndexPtr();
   const int nodes = static_cast<int>(A.rows() / 3);
   std::vector<int> offsets(static_cast<std::size_t>(nodes), -1);
-  for (int node = 0; node < nodes; ++node) {
-    const int c0 = outer[3 * node];
-    const int length = outer[3 * node + 1] - c0;
-    if (length % 3 != 0) return;
-    for (int a = 1; a < 3; ++a) {
-      const int ca = outer[3 * node + a];
-      if (outer[3 * node + a + 1] - ca != length ||
-          !std::equal(inner + c0, inner + c0 + length, inner + ca))
-        return;
-    }
-    for (int t = 0; t < length; t += 3) {
-      const int row = inner[c0 + t];
-      if (row % 3 != 0 || inner[c0 + t + 1] != row + 1 || inner[c0 + t + 2] != row + 2) return;
-      if (row == 3 * node) offsets[static_cast<std::size_t>(node)] = t;
-    }
-    if (offsets[static_cast<std::size_t>(node)] < 0) return;  // no diagonal block
-  }
+  for (int node = 0; node < nodes; ++node)
+    for (int t = outer[3 * node]; t < outer[3 * node + 1]; t += 3)
+      if (inner[t] == 3 * node) offsets[static_cast<std::size_t>(node)] = t - outer[3 * node];
   level.block_diagonal = std::move(offsets);
   level.block_inverse.assign(static_cast<std::size_t>(9 * nodes), 0.0);
-  level.block_start.assign(static_cast<std::size_t>(nodes) + 1, 0);
-  level.block_column.clear();
-  for (int node = 0; node < nodes; ++node) {
-    for (int k = outer[3 * node]; k < outer[3 * node + 1]; k += 3)
-      level.block_column.push_back(inner[k] / 3);
-    level.block_start[static_cast<std::size_t>(node) + 1] =
-        static_cast<int>(level.block_column.size());
-  }
-  level.block_values.assign(static_cast<std::size_t>(A.nonZeros()), 0.0);
+  level.copy.Assign(A);
   level.blocked = true;
 }
 
@@ -288,18 +266,7 @@ bool SmoothedAggregationAmg::UpdateDiagonal(Level& level) const {
   if (level.blocked) {
     const int* outer = A.outerIndexPtr();
     const int nodes = static_cast<int>(level.block_diagonal.size());
-    // The block (BSR) copy: block m of node I holds B(i, a) = A(3J + i, 3I + a) at 9m + i + 3a.
-    const int* start = level.block_start.data();
-    double* blocks = level.block_values.data();
-#pragma omp parallel for schedule(static) if (3 * nodes >= kMinParallelLength)
-    for (int node = 0; node < nodes; ++node)
-      for (int a = 0; a < 3; ++a) {
-        const double* column = values + outer[3 * node + a];
-        double* out = blocks + 9 * start[node] + 3 * a;
-        const int count = start[node + 1] - start[node];
-        for (int m = 0; m < count; ++m)
-          for (int i = 0; i < 3; ++i) out[9 * m + i] = column[3 * m + i];
-      }
+    level.copy.CopyValues(A);
     bool positive = true;
     for (int node = 0; node < nodes; ++node) {
       Mat3 block;
@@ -439,27 +406,6 @@ void SmoothedAggregationAmg::Apply(const VecX& r, VecX& z) {
 
 namespace {
 
-/// s −= Σ_{m ∈ [begin, end)} B_mᵀ x_{J_m} over the 3×3 blocks B_m (column-major, 9 doubles)
-/// of one block row, with two partial sums per component (shorter add chains).
-inline void SubtractBlocks(const double* __restrict blocks, const int* __restrict columns,
-                           const double* __restrict x, int begin, int end, double s[3]) {
-  double a0 = 0.0, a1 = 0.0, a2 = 0.0, b0 = 0.0, b1 = 0.0, b2 = 0.0;
-  for (int m = begin; m < end; ++m) {
-    const double* B = blocks + 9 * m;
-    const double* xj = x + 3 * columns[m];
-    const double x0 = xj[0], x1 = xj[1], x2 = xj[2];
-    a0 += B[0] * x0 + B[1] * x1;
-    a1 += B[3] * x0 + B[4] * x1;
-    a2 += B[6] * x0 + B[7] * x1;
-    b0 += B[2] * x2;
-    b1 += B[5] * x2;
-    b2 += B[8] * x2;
-  }
-  s[0] -= a0 + b0;
-  s[1] -= a1 + b1;
-  s[2] -= a2 + b2;
-}
-
 /// x_I = M s for the symmetric 3×3 M (column-major); `add` accumulates instead.
 inline void ApplyInverse(const double* __restrict m, const double s[3], double* __restrict x,
                          bool add) {
@@ -533,20 +479,7 @@ void SmoothedAggregationAmg::ApplyBlockInverse(const Level& level, const VecX& r
 
 void SmoothedAggregationAmg::LevelMultiply(const Level& level, const VecX& x, VecX& y) {
   if (level.blocked) {
-    const int nodes = static_cast<int>(level.block_diagonal.size());
-    const int* __restrict start = level.block_start.data();
-    const int* __restrict columns = level.block_column.data();
-    const double* __restrict blocks = level.block_values.data();
-    const double* __restrict px = x.data();
-    double* __restrict py = y.data();
-#pragma omp parallel for schedule(static) if (3 * nodes >= kMinParallelLength)
-    for (int node = 0; node < nodes; ++node) {
-      double s[3] = {0.0, 0.0, 0.0};
-      SubtractBlocks(blocks, columns, px, start[node], start[node + 1], s);
-      py[3 * node] = -s[0];
-      py[3 * node + 1] = -s[1];
-      py[3 * node + 2] = -s[2];
-    }
+    level.copy.Multiply(x, y);
     return;
   }
   SymmetricSpMV(*level.a, x, y);

@@ -40,6 +40,7 @@
 #include <Eigen/Dense>
 
 #include "gipsi/numerics/sparse/linear_solver.h"
+#include "gipsi/numerics/sparse/node_block_copy.h"
 
 namespace gipsi {
 
@@ -98,9 +99,7 @@ class SmoothedAggregationAmg {
     bool blocked = false;
     std::vector<int> block_diagonal;    ///< per node: offset of its diagonal block in its columns
     std::vector<double> block_inverse;  ///< per node: the inverse of its diagonal block (9)
-    std::vector<int> block_start;       ///< block copy: first block of each node
-    std::vector<int> block_column;      ///< block copy: neighbour node of each block
-    std::vector<double> block_values;   ///< block copy: 9 values per block (see UpdateDiagonal)
+    NodeBlockCopy copy;                 ///< block-row copy of A (node_block_copy.h)
     double jacobi_weight = 0.0;         ///< ω of the damped-Jacobi smoother
     RowMatrix p;                        ///< prolongator to this level from the next coarser one
     RowMatrix r;                        ///< restriction pᵀ
