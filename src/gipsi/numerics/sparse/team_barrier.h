@@ -12,10 +12,13 @@
 /// that keeps one region open and meets here twice per iteration waits only as long as the
 /// slower thread needs, and still sleeps (C++20 atomic wait, a futex) when its partner was
 /// descheduled for longer than the spin budget, so a loaded machine loses at most the budget
-/// per wait.
+/// per wait. After a short pause-spin the waiting thread yields between checks: with four
+/// threads on the two cores, pause-spinning alone made the 5k-tet step 18.6 ms (4.9 ms with two
+/// threads), yielding 7.3 ms.
 
 #include <atomic>
 #include <chrono>
+#include <thread>
 
 #if defined(__x86_64__) || defined(__i386__)
 #include <immintrin.h>
@@ -32,6 +35,8 @@ class TeamBarrier {
   /// How long a waiting thread spins before it sleeps [µs]: about ten CG kernels of a
   /// 5,000-row vector; an imbalance longer than that is a descheduled partner.
   static constexpr int kSpinMicroseconds = 50;
+  /// Checks with a pause instruction before the spinning thread starts to yield its core.
+  static constexpr int kPauseSpins = 256;
 
   TeamBarrier() = default;
   TeamBarrier(const TeamBarrier&) = delete;
@@ -48,12 +53,19 @@ class TeamBarrier {
     }
     using Clock = std::chrono::steady_clock;
     const auto give_up = Clock::now() + std::chrono::microseconds(kSpinMicroseconds);
+    // Pause-spin first (a partner a few kernels behind arrives within microseconds), then
+    // yield between checks: when the team has more threads than the machine has free cores,
+    // the partner we wait for may need this very core to arrive.
     for (int spin = 1;; ++spin) {
       if (round_.load(std::memory_order_acquire) != round) return;
+      if (spin < kPauseSpins) {
 #if defined(__x86_64__) || defined(__i386__)
-      _mm_pause();
+        _mm_pause();
 #endif
-      if (spin % 64 == 0 && Clock::now() > give_up) break;
+        continue;
+      }
+      std::this_thread::yield();
+      if (spin % 16 == 0 && Clock::now() > give_up) break;
     }
     while (round_.load(std::memory_order_acquire) == round)
       round_.wait(round, std::memory_order_acquire);
