@@ -86,11 +86,14 @@ void Sizes(benchmark::internal::Benchmark* b) {
 BENCHMARK_CAPTURE(BM_ImplicitStep, corotational, "Corotational")->Apply(Sizes);
 BENCHMARK_CAPTURE(BM_ImplicitStep, neo_hookean, "NeoHookean")->Apply(Sizes);
 
-// The memory bandwidth CG's product with the FEM tangent reaches (NodeBlockSpMV, as in every
-// CG iteration above), beside a STREAM triad measured in the same run. The tangent is the
-// corotational stiffness of the benchmark cube at rest (the values do not change the traffic).
-// Bytes as for the triad, each array element read or written once: 8 B per nonzero, one 4 B
-// row index per 3×3 block, 4 B per column pointer, 8 B per entry of x and of y.
+// The memory bandwidth of the product with the FEM tangent, beside a STREAM triad measured in
+// the same run: second argument 0 is NodeBlockSpMV on the compressed columns (what CG with the
+// lagged CHOLMOD factor uses), 1 the block-row copy NodeBlockCopy (Jacobi-CG and the AMG). The
+// tangent is the corotational stiffness of the benchmark cube at rest (the values do not change the
+// traffic). Bytes as for the triad, each array element read or written once: 8 B per nonzero, one 4
+// B row index per 3×3 block, 4 B per column pointer (the copy reads one block start per node
+// instead of three column pointers: counted the same, an overcount of 8 B per node), 8 B per
+// entry of x and of y.
 void BM_StreamTriad(benchmark::State& state) { RunStreamTriad(state); }
 BENCHMARK(BM_StreamTriad)->UseRealTime()->Unit(benchmark::kMillisecond);
 

@@ -242,6 +242,40 @@ TEST(Pcg, FusedIterationMatchesTextbookPcgForAnyThreadCount) {
   }
 }
 
+// The fused CG keeps a block-row copy of a node-block matrix (pcg.cc): it must follow the
+// matrix through a failed Factorize, a successful one, and a new pattern without node blocks.
+TEST(Pcg, JacobiFollowsFailedFactorizeAndNewPattern) {
+  EXPECT_EQ(LinearSolverOptions{}.preconditioner, "jacobi");  // the documented default
+  const SparseMatrix A = testing::TestLattice();
+  ASSERT_TRUE(HasNodeBlockPattern(A));
+  const auto problem = Manufacture(A);
+  auto solver = ReadySolver(Cg("jacobi"), A);
+  VecX x = VecX::Zero(A.rows());
+  ASSERT_TRUE(solver->Solve(problem.b, x).converged);
+
+  SparseMatrix broken = A;
+  broken.valuePtr()[7] = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_FALSE(solver->Factorize(broken));
+  x.setZero();
+  EXPECT_FALSE(solver->Solve(problem.b, x).converged);
+
+  const SparseMatrix stiffer = testing::TestLattice(3.0);  // same pattern, new values
+  const auto stiff_problem = Manufacture(stiffer);
+  ASSERT_TRUE(solver->Factorize(stiffer));
+  x.setZero();
+  ASSERT_TRUE(solver->Solve(stiff_problem.b, x).converged);
+  EXPECT_LE(IndependentRelativeResidual(stiffer, stiff_problem.b, x), 1e-6);
+
+  const SparseMatrix L = MakeLaplacian3D(12, 1e-2);  // no node blocks
+  ASSERT_FALSE(HasNodeBlockPattern(L));
+  const auto laplace = Manufacture(L);
+  solver->AnalyzePattern(L);
+  ASSERT_TRUE(solver->Factorize(L));
+  VecX y = VecX::Zero(L.rows());
+  ASSERT_TRUE(solver->Solve(laplace.b, y).converged);
+  EXPECT_LE(IndependentRelativeResidual(L, laplace.b, y), 1e-6);
+}
+
 TEST(LaggedCholeskyPcg, FirstFactorizeFactorizesAndConvergesInOneIteration) {
   const SparseMatrix A = testing::TestLattice();
   auto solver = ReadySolver(Cg("cholesky"), A);

@@ -256,7 +256,7 @@ void SmoothedAggregationAmg::DetectBlocks(Level& level) {
       if (inner[t] == 3 * node) offsets[static_cast<std::size_t>(node)] = t - outer[3 * node];
   level.block_diagonal = std::move(offsets);
   level.block_inverse.assign(static_cast<std::size_t>(9 * nodes), 0.0);
-  level.copy.Assign(A);
+  level.copy.AssignPattern(A);  // the values come with UpdateDiagonal
   level.blocked = true;
 }
 

@@ -7,7 +7,7 @@
 
 namespace gipsi {
 
-void NodeBlockCopy::Assign(const SparseMatrix& A) {
+void NodeBlockCopy::AssignPattern(const SparseMatrix& A) {
   GIPSI_CHECK(HasNodeBlockPattern(A), "NodeBlockCopy: the matrix is not made of 3x3 node blocks");
   const int nodes = static_cast<int>(A.cols() / 3);
   const int* outer = A.outerIndexPtr();
@@ -20,8 +20,7 @@ void NodeBlockCopy::Assign(const SparseMatrix& A) {
     for (int k = outer[3 * node]; k < outer[3 * node + 1]; k += 3) column_.push_back(inner[k]);
     start_[static_cast<std::size_t>(node) + 1] = static_cast<int>(column_.size());
   }
-  values_.resize(static_cast<std::size_t>(A.nonZeros()));
-  CopyValues(A);
+  values_.assign(static_cast<std::size_t>(A.nonZeros()), 0.0);
 }
 
 void NodeBlockCopy::CopyValues(const SparseMatrix& A) {

@@ -19,9 +19,14 @@ namespace gipsi {
 
 class NodeBlockCopy {
  public:
-  /// Builds the block pattern of A (HasNodeBlockPattern(A) must hold: checked) and copies its
-  /// values.
-  void Assign(const SparseMatrix& A);
+  /// Builds the block pattern of A (HasNodeBlockPattern(A) must hold: checked); the values
+  /// come with the next CopyValues.
+  void AssignPattern(const SparseMatrix& A);
+  /// AssignPattern(A), then CopyValues(A).
+  void Assign(const SparseMatrix& A) {
+    AssignPattern(A);
+    CopyValues(A);
+  }
   /// Copies the values of A, which has the pattern of the last Assign (only the sizes are
   /// checked). Parallel over nodes.
   void CopyValues(const SparseMatrix& A);
@@ -31,7 +36,9 @@ class NodeBlockCopy {
   /// y = A x, parallel over nodes (OpenMP). x and y must have 3·nodes() entries.
   void Multiply(const VecX& x, VecX& y) const;
 
-  [[nodiscard]] int nodes() const { return static_cast<int>(start_.size()) - 1; }
+  [[nodiscard]] int nodes() const {
+    return start_.empty() ? 0 : static_cast<int>(start_.size()) - 1;
+  }
   /// First block of each node (nodes() + 1 entries): the work of a node range for splits.
   [[nodiscard]] const std::vector<int>& block_start() const { return start_; }
 

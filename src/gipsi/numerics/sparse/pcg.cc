@@ -59,7 +59,7 @@ class PcgSolver final : public LinearSolver {
     node_blocks_ = HasNodeBlockPattern(A);
     // The fused CG multiplies by a block-row copy of a node-block matrix (node_block_copy.h).
     block_copy_ready_ = false;
-    if (node_blocks_ && fused()) block_copy_.Assign(A);
+    if (node_blocks_ && fused()) block_copy_.AssignPattern(A);
     analysed_ = true;
     matrix_ = nullptr;
     has_factor_ = false;
@@ -219,9 +219,11 @@ class PcgSolver final : public LinearSolver {
     return positive;
   }
 
-  /// y = A x: from the AMG hierarchy's block copy of A when it has one (9 contiguous values
-  /// per block: measured faster than NodeBlockSpMV's three column streams), else NodeBlockSpMV
-  /// for a matrix of 3×3 node blocks (an FEM tangent), else SymmetricSpMV.
+  /// y = A x: from a block-row copy of A when there is one (the AMG hierarchy's finest level,
+  /// or the fused CG's block_copy_; 9 contiguous values per block, measured faster than
+  /// NodeBlockSpMV's three column streams), else NodeBlockSpMV for a matrix of 3×3 node
+  /// blocks (an FEM tangent), else SymmetricSpMV. The same values and summation order as
+  /// IterateFused's products.
   void Multiply(const VecX& x, VecX& y) {
     if (kind_ == Preconditioner::kAmg && amg_.Multiply(x, y)) return;
     if (block_copy_ready_) {
@@ -319,8 +321,7 @@ class PcgSolver final : public LinearSolver {
     const int threads = n >= kMinFusedParallelRows ? omp_get_max_threads() : 1;
     // Per thread and round parity: (r, r), (r, z), (w, z), padded to a cache line. Two rounds
     // alternate, so a thread that runs ahead never overwrites sums another is still reading.
-    constexpr int kStride = 8;
-    partials_.assign(static_cast<std::size_t>(2 * threads * kStride), 0.0);
+    partials_.assign(static_cast<std::size_t>(2 * threads), PartialSums{});
     TeamBarrier barrier;
     const double* __restrict inverse = inverse_diagonal_.data();
     const SparseMatrix& A = *matrix_;
@@ -331,14 +332,13 @@ class PcgSolver final : public LinearSolver {
     double* __restrict pp = p_.data();
     double* __restrict ps = q_.data();
     double* __restrict pw = w_.data();
-    double* partials = partials_.data();
+    PartialSums* partials = partials_.data();
     int done = iterations;
     bool ok = false;
 #pragma omp parallel num_threads(threads) if (threads > 1)
     {
       const int team = omp_get_num_threads();
       const int t = omp_get_thread_num();
-      // Row range of this thread: whole nodes when the SpMV works on node blocks.
       // Row range of this thread: whole nodes when the SpMV works on node blocks, split so
       // that every thread gets about the same work, counted as nonzeros plus 8 per row (the
       // vector updates' loads and stores).
@@ -360,9 +360,7 @@ class PcgSolver final : public LinearSolver {
       };
       const int begin = first_row(t);
       const int end = first_row(t + 1);
-      auto slot = [&](int round, int thread) {
-        return partials + static_cast<std::ptrdiff_t>(((round & 1) * team + thread) * kStride);
-      };
+      auto slot = [&](int round, int thread) { return partials[(round & 1) * team + thread].sum; };
       auto total = [&](int round, int which) {
         double sum = 0.0;
         for (int k = 0; k < team; ++k) sum += slot(round, k)[which];
@@ -389,6 +387,8 @@ class PcgSolver final : public LinearSolver {
         for (int i = begin; i < end; ++i) {
           pz[i] = inverse[i] * pr[i];
           rz += pr[i] * pz[i];
+          pp[i] = 0.0;  // round 1 takes p = z, s = w (β = 0): no value left from an earlier
+          ps[i] = 0.0;  // solve may survive, not even a non-finite one (0 · ∞ is NaN)
         }
         slot(0, t)[1] = rz;
       }
@@ -439,6 +439,7 @@ class PcgSolver final : public LinearSolver {
           converged = true;
           break;
         }
+        if (local >= options_.max_iterations) break;  // every thread agrees: no product wasted
         spmv_and_wz(round);
         barrier.Wait(team);
       }
@@ -504,7 +505,11 @@ class PcgSolver final : public LinearSolver {
   std::int64_t lagged_iterations_ = 0;  ///< their CG iterations
   VecX r_, z_, p_, q_;                  ///< residual, preconditioned residual, direction, A p
   VecX w_;                              ///< A z (IterateFused)
-  std::vector<double> partials_;        ///< IterateFused: per thread and round, padded
+  /// IterateFused's partial sums of one thread and round, alone on their cache line.
+  struct alignas(64) PartialSums {
+    double sum[3] = {0.0, 0.0, 0.0};
+  };
+  std::vector<PartialSums> partials_;
   VecX inverse_diagonal_;
   ReductionScratch scratch_;
   Eigen::IncompleteCholesky<double, Eigen::Lower, Eigen::AMDOrdering<int>> incomplete_;

@@ -11,10 +11,10 @@
 /// had five regions: 42 ms of solve per step against 23 ms with OMP_WAIT_POLICY=active. A CG
 /// that keeps one region open and meets here twice per iteration waits only as long as the
 /// slower thread needs, and still sleeps (C++20 atomic wait, a futex) when its partner was
-/// descheduled for longer than the spin budget, so a loaded machine loses at most the budget
-/// per wait. After a short pause-spin the waiting thread yields between checks: with four
-/// threads on the two cores, pause-spinning alone made the 5k-tet step 18.6 ms (4.9 ms with two
-/// threads), yielding 7.3 ms.
+/// descheduled for longer than the spin budget, so on a loaded machine a wait holds its core
+/// for about the budget at most (its yields give the core to anyone runnable). After a short
+/// pause-spin the waiting thread yields between checks: with four threads on the two cores,
+/// pause-spinning alone made the 5k-tet step 18.6 ms (4.9 ms with two threads), yielding 7.3 ms.
 
 #include <atomic>
 #include <chrono>
