@@ -159,7 +159,11 @@ MaterialPoint FemSolid::PointOf(Index e) const {
 
 bool FemSolid::AssembleElements(const double* u, VecX& f, double* k_values) const {
   f.setZero(3 * num_nodes());
-  if (k_values) std::fill(k_values, k_values + jac_.nonZeros(), 0.0);
+  if (k_values) {
+    const Index nnz = jac_.nonZeros();
+#pragma omp parallel for schedule(static) if (nnz >= 65536)
+    for (Index j = 0; j < nnz; ++j) k_values[j] = 0.0;
+  }
   std::atomic<bool> any_invalid{false};
   double* fp = f.data();
   assembly_.ForEachElementColoured([&](Index e) {
@@ -321,41 +325,45 @@ bool FemSolid::CalcResidualAndJacobian(const VecX& d, VecX& r, SparseMatrix& J) 
     AddFaceLoadTangent(f, work_.data(), p, t, jv);
   }
   AddCoupledCavityTangent(work_.data(), jv);
-  // Inertia and damping: J += (c_a + c_v α) M + c_v β K_n.
-  if (params_.scheme != ImplicitSchemeKind::kStatic) {
-    const double cm = scheme_.c_a() + scheme_.c_v() * params_.rayleigh_mass;
-    const double ck = scheme_.c_v() * params_.rayleigh_stiffness;
-    if (params_.lumped_mass) {
-      const auto& diag = assembly_.diagonal_index();
-      for (std::size_t i = 0; i < diag.size(); ++i)
-        jv[diag[i]] += cm * lumped_mass_[static_cast<Index>(i / 3)];
-    } else {
-      const double* mv = mass_.valuePtr();
-      for (Index j = 0; j < nnz; ++j) jv[j] += cm * mv[j];
-    }
-    if (ck > 0) {
-      const double* kv = damping_k_.valuePtr();
-      for (Index j = 0; j < nnz; ++j) jv[j] += ck * kv[j];
-    }
+  // Inertia and damping: J += (c_a + c_v α) M + c_v β K_n, added in the same parallel pass
+  // over the values as the constraints below (one sweep of the matrix instead of three).
+  const bool dynamic = params_.scheme != ImplicitSchemeKind::kStatic;
+  const double cm = dynamic ? scheme_.c_a() + scheme_.c_v() * params_.rayleigh_mass : 0.0;
+  const double ck = dynamic ? scheme_.c_v() * params_.rayleigh_stiffness : 0.0;
+  if (dynamic && params_.lumped_mass) {
+    const auto& diag = assembly_.diagonal_index();
+    for (std::size_t i = 0; i < diag.size(); ++i)
+      jv[diag[i]] += cm * lumped_mass_[static_cast<Index>(i / 3)];
   }
+  const double* mv = dynamic && !params_.lumped_mass ? mass_.valuePtr() : nullptr;
+  const double* kv = ck > 0 ? damping_k_.valuePtr() : nullptr;
+  auto with_inertia = [=](Index j) {
+    double v = jv[j];
+    if (mv) v += cm * mv[j];
+    if (kv) v += ck * kv[j];
+    return v;
+  };
   // Constrained dofs: rows and columns of the identity times the mean diagonal (keeps J
   // symmetric and well scaled; their increment is 0). Also the largest absolute row sum, which
   // bounds the round-off of any solve with J: a backward-stable solve leaves a residual of
   // ~ε ‖J‖ ‖Δ‖, which no further Newton step can remove.
   const int* outer = J.outerIndexPtr();
   const int* inner = J.innerIndexPtr();
-  const Index ncols = J.cols();
+  const int ncols = static_cast<int>(J.cols());
   double diag_sum = 0;
-  for (int index : assembly_.diagonal_index()) diag_sum += std::abs(jv[index]);
+  for (int index : assembly_.diagonal_index()) diag_sum += std::abs(with_inertia(index));
   const double unit = diag_sum > 0 ? diag_sum / static_cast<double>(ncols) : 1.0;
+  const std::uint8_t* constraint = constraint_.data();
   double max_row_sum = 0;
-  for (Index c = 0; c < ncols; ++c) {
-    const bool fixed_col = constraint_[static_cast<std::size_t>(c)] != 0;
+#pragma omp parallel for schedule(static) reduction(max : max_row_sum) if (nnz >= 65536)
+  for (int c = 0; c < ncols; ++c) {
+    const bool fixed_col = constraint[c] != 0;
     double row_sum = 0;
     for (int j = outer[c]; j < outer[c + 1]; ++j) {
-      if (fixed_col || constraint_[static_cast<std::size_t>(inner[j])] != 0)
-        jv[j] = inner[j] == c ? unit : 0.0;
-      row_sum += std::abs(jv[j]);
+      double v = with_inertia(j);
+      if (fixed_col || constraint[inner[j]] != 0) v = inner[j] == c ? unit : 0.0;
+      jv[j] = v;
+      row_sum += std::abs(v);
     }
     max_row_sum = std::max(max_row_sum, row_sum);
   }

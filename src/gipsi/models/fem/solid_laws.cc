@@ -111,7 +111,7 @@ bool FastPolar(const Mat3& F, Mat3& R) {
   // γ = (‖X⁻¹‖_F / ‖X‖_F)^½ (Higham, "Computing the polar decomposition — with applications",
   // SIAM J. Sci. Stat. Comput. 7, 1986; it needs only the inverse the step computes anyway, where
   // the determinant scaling |det X|^(−1/3) cost a cube root): quadratic convergence to the
-  // rotation of F = R S for det F > 0, in 3–7 iterations of a 3×3 inverse (much cheaper than a
+  // rotation of F = R S for det F > 0, in 3–5 iterations of a 3×3 inverse (much cheaper than a
   // Jacobi SVD) and to full precision near F = I.
   const double det = F.determinant();
   if (!(det > 1e-6 * F.squaredNorm() * F.norm())) return false;  // near or past inversion
@@ -123,7 +123,12 @@ bool FastPolar(const Mat3& F, Mat3& R) {
     const Mat3 next = 0.5 * (gamma * R + inverse_t / gamma);
     const double change = (next - R).lpNorm<Eigen::Infinity>();
     R = next;
-    if (change <= 1e-15) return true;
+    // Newton's iteration for the polar factor converges quadratically: a step that changed X
+    // by δ leaves an error of about δ²/2 (in the singular values, σ ← (σ + 1/σ)/2), so after a
+    // change of 1e-8 the new iterate is within ~5e-17 of R, round-off. Waiting for a change
+    // below 1e-15 cost one more iteration in most elements (4.6 on average in the FEM
+    // benchmark).
+    if (change <= 1e-8) return true;
   }
   return (R.transpose() * R - Mat3::Identity()).lpNorm<Eigen::Infinity>() < 1e-12;
 }

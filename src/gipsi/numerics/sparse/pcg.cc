@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <limits>
 #include <string>
+#include <vector>
 
 #include <Eigen/CholmodSupport>
 #include <Eigen/IterativeLinearSolvers>
@@ -57,6 +58,7 @@ class PcgSolver final : public LinearSolver {
     rows_ = A.rows();
     nonzeros_ = A.nonZeros();
     node_blocks_ = HasNodeBlockPattern(A);
+    diagonal_index_.clear();  // found again by the next ComputeInverseDiagonal
     // The fused CG multiplies by a block-row copy of a node-block matrix (node_block_copy.h).
     block_copy_ready_ = false;
     if (node_blocks_ && fused()) block_copy_.AssignPattern(A);
@@ -201,18 +203,24 @@ class PcgSolver final : public LinearSolver {
 
  private:
   /// inverse_diagonal_ = 1 / diag(A); false if a diagonal entry is missing or ≤ 0 (not SPD).
+  /// The diagonal's positions are found once per pattern (diagonal_index_).
   bool ComputeInverseDiagonal(const SparseMatrix& A) {
     const int* outer = A.outerIndexPtr();
     const int* inner = A.innerIndexPtr();
+    const int n = static_cast<int>(rows_);
+    if (static_cast<int>(diagonal_index_.size()) != n) {
+      diagonal_index_.assign(static_cast<std::size_t>(n), -1);
+      for (int j = 0; j < n; ++j)
+        for (int k = outer[j]; k < outer[j + 1]; ++k)
+          if (inner[k] == j) diagonal_index_[static_cast<std::size_t>(j)] = k;
+    }
+    const int* diagonal = diagonal_index_.data();
     const double* values = A.valuePtr();
     double* inverse = inverse_diagonal_.data();
-    const int n = static_cast<int>(rows_);
     bool positive = true;
 #pragma omp parallel for schedule(static) reduction(&& : positive) if (n >= kMinParallelLength)
     for (int j = 0; j < n; ++j) {
-      double d = 0.0;
-      for (int k = outer[j]; k < outer[j + 1]; ++k)
-        if (inner[k] == j) d += values[k];
+      const double d = diagonal[j] >= 0 ? values[diagonal[j]] : 0.0;
       positive = positive && d > 0.0;
       inverse[j] = d > 0.0 ? 1.0 / d : 0.0;
     }
@@ -511,6 +519,7 @@ class PcgSolver final : public LinearSolver {
   };
   std::vector<PartialSums> partials_;
   VecX inverse_diagonal_;
+  std::vector<int> diagonal_index_;  ///< value index of each diagonal entry (−1: none)
   ReductionScratch scratch_;
   Eigen::IncompleteCholesky<double, Eigen::Lower, Eigen::AMDOrdering<int>> incomplete_;
   Eigen::CholmodSupernodalLLT<SparseMatrix, Eigen::Lower> cholesky_;

@@ -12,19 +12,26 @@
 /// that keeps one region open and meets here twice per iteration waits only as long as the
 /// slower thread needs, and still sleeps (C++20 atomic wait, a futex) when its partner was
 /// descheduled for longer than the spin budget, so on a loaded machine a wait holds its core
-/// for about the budget at most (its yields give the core to anyone runnable). After a short
-/// pause-spin the waiting thread yields between checks: with four threads on the two cores,
-/// pause-spinning alone made the 5k-tet step 18.6 ms (4.9 ms with two threads), yielding 7.3 ms.
+/// for about the budget at most. Two measured choices (5k / 20k-tet FEM steps, medians of 3):
+///  - No yielding between checks: with two busy processes beside the benchmark, a version that
+///    yielded after a short spin measured 154 / 39 ms and then 7.9 / 784 ms (a thread that
+///    yielded waits out the other processes' time slices), spin-then-sleep 16 / 57 and
+///    16 / 110 ms, and the five regions per iteration before 14.5 / 230 ms. A sleeper that is
+///    woken is scheduled promptly; a thread that yielded is not.
+///  - No spinning when the team is larger than the cores the process may use (four threads on
+///    two cores): spinning made the 5k-tet step 18.6 ms against 4.9 ms with two threads.
 
 #include <atomic>
 #include <chrono>
-#include <thread>
 
 #if defined(__x86_64__) || defined(__i386__)
 #include <immintrin.h>
 #endif
 
 namespace gipsi {
+
+/// The number of cores this process may run on (its affinity mask; at least 1), read once.
+int AvailableCores();
 
 /// A reusable barrier for the threads of one OpenMP team; not copyable. Every participant
 /// passes the team size (omp_get_num_threads(), which may be smaller than the team that was
@@ -35,8 +42,6 @@ class TeamBarrier {
   /// How long a waiting thread spins before it sleeps [µs]: about ten CG kernels of a
   /// 5,000-row vector; an imbalance longer than that is a descheduled partner.
   static constexpr int kSpinMicroseconds = 50;
-  /// Checks with a pause instruction before the spinning thread starts to yield its core.
-  static constexpr int kPauseSpins = 256;
 
   TeamBarrier() = default;
   TeamBarrier(const TeamBarrier&) = delete;
@@ -51,21 +56,18 @@ class TeamBarrier {
       round_.notify_all();
       return;
     }
-    using Clock = std::chrono::steady_clock;
-    const auto give_up = Clock::now() + std::chrono::microseconds(kSpinMicroseconds);
-    // Pause-spin first (a partner a few kernels behind arrives within microseconds), then
-    // yield between checks: when the team has more threads than the machine has free cores,
-    // the partner we wait for may need this very core to arrive.
-    for (int spin = 1;; ++spin) {
-      if (round_.load(std::memory_order_acquire) != round) return;
-      if (spin < kPauseSpins) {
+    // Spin only while the team fits the cores this process may use: a team larger than that
+    // waits for a partner that may need this very core to arrive, so it sleeps at once.
+    if (team <= AvailableCores()) {
+      using Clock = std::chrono::steady_clock;
+      const auto give_up = Clock::now() + std::chrono::microseconds(kSpinMicroseconds);
+      for (int spin = 1;; ++spin) {
+        if (round_.load(std::memory_order_acquire) != round) return;
 #if defined(__x86_64__) || defined(__i386__)
         _mm_pause();
 #endif
-        continue;
+        if (spin % 64 == 0 && Clock::now() > give_up) break;
       }
-      std::this_thread::yield();
-      if (spin % 16 == 0 && Clock::now() > give_up) break;
     }
     while (round_.load(std::memory_order_acquire) == round)
       round_.wait(round, std::memory_order_acquire);
