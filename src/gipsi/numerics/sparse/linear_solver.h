@@ -49,12 +49,10 @@ void SymmetricSpMV(const SparseMatrix& A, const VecX& x, VecX& y);
 /// nothing.
 void NodeBlockSpMV(const SparseMatrix& A, const VecX& x, VecX& y);
 
-/// The serial kernels of SymmetricSpMV and NodeBlockSpMV, for callers that split the work
-/// themselves (the fused CG uses SymmetricSpMVRows for matrices without node blocks): y_j for rows
-/// j in [begin, end), respectively y of nodes [begin, end) (rows 3·begin to 3·end). Same
-/// preconditions as the vector versions, not checked; each y entry gets the same bits as there.
+/// The serial kernel of SymmetricSpMV, for callers that split the work themselves (the fused
+/// CG): y_j for rows j in [begin, end). Same preconditions as SymmetricSpMV, not checked; each
+/// y entry gets the same bits as there.
 void SymmetricSpMVRows(const SparseMatrix& A, const double* x, double* y, int begin, int end);
-void NodeBlockSpMVNodes(const SparseMatrix& A, const double* x, double* y, int begin, int end);
 
 /// Which solver and how hard it works. Plain struct.
 struct LinearSolverOptions {

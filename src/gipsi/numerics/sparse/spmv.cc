@@ -13,32 +13,8 @@ namespace gipsi {
 namespace {
 /// Rows per scheduling unit of the parallel loops (keeps one function call per batch).
 constexpr int kSpMVRowBatch = 64;
-}  // namespace
 
-void SymmetricSpMVRows(const SparseMatrix& A, const double* x, double* y, int begin, int end) {
-  const int* __restrict outer = A.outerIndexPtr();
-  const int* __restrict inner = A.innerIndexPtr();
-  const double* __restrict values = A.valuePtr();
-  const double* __restrict px = x;
-  double* __restrict py = y;
-  // Four partial sums per row break the floating-point add dependency chain, which otherwise
-  // bounds one core at ~12 GB/s (measured 16-17 GB/s with four, single-threaded, 40³ lattice).
-  // The combination order is fixed, so each y[j] does not depend on the thread count.
-  for (int j = begin; j < end; ++j) {
-    double s0 = 0.0, s1 = 0.0, s2 = 0.0, s3 = 0.0;
-    int k = outer[j];
-    const int last = outer[j + 1];
-    for (; k + 4 <= last; k += 4) {
-      s0 += values[k] * px[inner[k]];
-      s1 += values[k + 1] * px[inner[k + 1]];
-      s2 += values[k + 2] * px[inner[k + 2]];
-      s3 += values[k + 3] * px[inner[k + 3]];
-    }
-    for (; k < last; ++k) s0 += values[k] * px[inner[k]];
-    py[j] = (s0 + s1) + (s2 + s3);
-  }
-}
-
+/// y of nodes [begin, end) for NodeBlockSpMV (rows 3·begin to 3·end); serial.
 void NodeBlockSpMVNodes(const SparseMatrix& A, const double* x, double* y, int begin, int end) {
   const int* __restrict outer = A.outerIndexPtr();
   const int* __restrict inner = A.innerIndexPtr();
@@ -68,6 +44,32 @@ void NodeBlockSpMVNodes(const SparseMatrix& A, const double* x, double* y, int b
     py[3 * node] = a0 + b0;
     py[3 * node + 1] = a1 + b1;
     py[3 * node + 2] = a2 + b2;
+  }
+}
+
+}  // namespace
+
+void SymmetricSpMVRows(const SparseMatrix& A, const double* x, double* y, int begin, int end) {
+  const int* __restrict outer = A.outerIndexPtr();
+  const int* __restrict inner = A.innerIndexPtr();
+  const double* __restrict values = A.valuePtr();
+  const double* __restrict px = x;
+  double* __restrict py = y;
+  // Four partial sums per row break the floating-point add dependency chain, which otherwise
+  // bounds one core at ~12 GB/s (measured 16-17 GB/s with four, single-threaded, 40³ lattice).
+  // The combination order is fixed, so each y[j] does not depend on the thread count.
+  for (int j = begin; j < end; ++j) {
+    double s0 = 0.0, s1 = 0.0, s2 = 0.0, s3 = 0.0;
+    int k = outer[j];
+    const int last = outer[j + 1];
+    for (; k + 4 <= last; k += 4) {
+      s0 += values[k] * px[inner[k]];
+      s1 += values[k + 1] * px[inner[k + 1]];
+      s2 += values[k + 2] * px[inner[k + 2]];
+      s3 += values[k + 3] * px[inner[k + 3]];
+    }
+    for (; k < last; ++k) s0 += values[k] * px[inner[k]];
+    py[j] = (s0 + s1) + (s2 + s3);
   }
 }
 
