@@ -99,6 +99,17 @@ TEST(VtkLegacyReader, RejectsCountLargerThanFileBeforeAllocating) {
   EXPECT_THAT(message, HasSubstr("line 5: declares 2000000000 points, but only"));
 }
 
+TEST(VtkLegacyReader, RejectsCellCountLargerThanItsArrayBeforeAllocating) {
+  // A fuzzer finding: a cell count of 2e16 with a one-value array used to size an allocation.
+  std::string s = test::ReadBytes(MeshData("two_tets_ascii.vtk"));
+  s.replace(s.find("CELLS 4 17"), 10, "CELLS 20000000000000000 17");
+  auto path = WriteBytes(Scratch("cells.vtk"), s);
+  EXPECT_EQ(InputErrorMessage([&] { ReadVtkLegacy(path); }),
+            path.string() +
+                ": line 8 (CELLS): expected at most 17 cells in 17 values, got a count of "
+                "20000000000000000");
+}
+
 TEST(VtkLegacyReader, RejectsOutOfRangePointIndexNamingLineAndSection) {
   std::string s = test::ReadBytes(MeshData("two_tets_ascii.vtk"));
   s.replace(s.find("4 1 2 3 4"), 9, "4 1 2 3 7");

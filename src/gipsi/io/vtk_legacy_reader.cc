@@ -227,6 +227,12 @@ class VtkLegacyParser {
       return cells;
     }
     std::vector<std::int64_t> data = ReadInts(size, DataType{4, false, true}, "a cell entry");
+    // Each cell takes at least one value (its point count), so a larger count cannot be true;
+    // checked before it sizes any allocation.
+    if (static_cast<std::uint64_t>(n) > data.size())
+      FailIn(cells.line, cells.keyword,
+             fmt::format("expected at most {} cells in {} values, got a count of {}", data.size(),
+                         size, n));
     std::size_t pos = 0;
     cells.offsets.reserve(static_cast<std::size_t>(n) + 1);
     for (std::int64_t c = 0; c < n; ++c) {
