@@ -4,6 +4,7 @@
 /// GiPSi's volume-coupling interface (e.g. excitation → active stress) and also how probes and
 /// output writers see an object.
 
+#include <optional>
 #include <string>
 #include <string_view>
 
@@ -39,6 +40,10 @@ struct FieldInfo {
   std::string units;   ///< SI unit string, e.g. "m", "N", "m/s", "1"
   FieldAccess access = FieldAccess::kRead;
   std::string description;  ///< one line for `gipsi validate` and the docs
+  /// A value that marks an item without data (e.g. -1 for "never activated"). Probes neither
+  /// interpolate nor reduce it: a point whose interpolation touches such an item reads this
+  /// value, and region reductions skip such items (reading this value when all are such).
+  std::optional<double> no_data = std::nullopt;
 
   [[nodiscard]] bool readable() const { return access != FieldAccess::kWrite; }
   [[nodiscard]] bool writable() const { return access != FieldAccess::kRead; }

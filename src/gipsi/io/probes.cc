@@ -19,6 +19,23 @@ std::size_t ProbeWidth(const Probe& probe) {
   return width;
 }
 
+/// `map` applied to `values`, except that a target whose interpolation gives weight to an item
+/// holding the field's no-data marker reads the marker (an unactivated node must not pull an
+/// activation time towards -1).
+void Interpolate(const PointMap& map, const FieldInfo& info, const Eigen::MatrixXd& values,
+                 Eigen::MatrixXd& out) {
+  map.Apply(values, out);
+  if (!info.no_data) return;
+  const double marker = *info.no_data;
+  for (Index j = 0; j < map.num_targets(); ++j)
+    for (int k = 0; k < 4; ++k) {
+      if (map.weights()(k, j) == 0) continue;
+      const Index item = map.indices()(k, j);
+      for (int c = 0; c < info.components; ++c)
+        if (values(c, item) == marker) out(c, j) = marker;
+    }
+}
+
 }  // namespace
 
 std::string Probe::Header() const {
@@ -54,7 +71,7 @@ void Probe::Sample(std::vector<double>& out) const {
       Eigen::MatrixXd values(info.components, object->FieldCount(id));
       object->ReadField(id, values);
       Eigen::MatrixXd at_points(info.components, n);
-      point->Apply(values, at_points);
+      Interpolate(*point, info, values, at_points);
       for (Index j = 0; j < n; ++j)
         for (int c = 0; c < info.components; ++c)
           out[width * std::size_t(j) + column + std::size_t(c)] = at_points(c, j);
@@ -70,15 +87,18 @@ void Probe::Sample(std::vector<double>& out) const {
       for (int c = 0; c < info.components; ++c) out.push_back(values(c, 0));
     } else if (point) {
       Eigen::MatrixXd at(info.components, 1);
-      point->Apply(values, at);
+      Interpolate(*point, info, values, at);
       for (int c = 0; c < info.components; ++c) out.push_back(at(c, 0));
     } else {
       for (int c = 0; c < info.components; ++c) {
         double acc = reduce == Reduce::kMin   ? std::numeric_limits<double>::infinity()
                      : reduce == Reduce::kMax ? -std::numeric_limits<double>::infinity()
                                               : 0.0;
+        std::size_t counted = 0;
         for (int i : items) {
           double v = values(c, i);
+          if (info.no_data && v == *info.no_data) continue;
+          ++counted;
           if (reduce == Reduce::kMin)
             acc = std::min(acc, v);
           else if (reduce == Reduce::kMax)
@@ -86,7 +106,10 @@ void Probe::Sample(std::vector<double>& out) const {
           else
             acc += v;
         }
-        if (reduce == Reduce::kMean) acc /= static_cast<double>(items.size());
+        if (counted == 0 && info.no_data)
+          acc = *info.no_data;
+        else if (reduce == Reduce::kMean)
+          acc /= static_cast<double>(counted);
         out.push_back(acc);
       }
     }

@@ -13,7 +13,8 @@
 /// A point probe interpolates node fields at the point (barycentric in the domain at rest). A
 /// region probe reduces node or boundary-vertex fields over the region ("mean", "sum", "min",
 /// "max", per component). Global fields need neither. `every` is in seconds of simulated time
-/// (default: every macro step).
+/// (default: every macro step). A field's no-data marker (FieldInfo::no_data) is never blended:
+/// a point touching a marked item reads the marker, and reductions skip marked items.
 ///
 /// A line probe samples node fields at `points` evenly spaced points from `from` to `to`
 /// (interpolated like a point probe, through SimObject::MapFromNodes) at the times `at` [s] (at

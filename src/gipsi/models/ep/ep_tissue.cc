@@ -72,11 +72,12 @@ EpTissue::EpTissue(std::string name, EpTissueParams params)
   }
   f_activation_ =
       DeclareField({"activation_time", FieldLocation::kNode, 1, "ms", FieldAccess::kRead,
-                    "first time V rose through the activation threshold (-1: never)"});
-  f_last_activation_ = DeclareField({"last_activation_time", FieldLocation::kNode, 1, "ms",
-                                     FieldAccess::kRead, "latest activation time (-1: never)"});
+                    "first time V rose through the activation threshold (-1: never)", -1.0});
+  f_last_activation_ =
+      DeclareField({"last_activation_time", FieldLocation::kNode, 1, "ms", FieldAccess::kRead,
+                    "latest activation time (-1: never)", -1.0});
   f_apd_ = DeclareField({"apd", FieldLocation::kNode, 1, "ms", FieldAccess::kRead,
-                         "last completed action potential duration (-1: none yet)"});
+                         "last completed action potential duration (-1: none yet)", -1.0});
   f_activated_ = DeclareField({"activated_fraction", FieldLocation::kGlobal, 1, "1",
                                FieldAccess::kRead, "fraction of nodes activated at least once"});
   f_integral_ = DeclareField({"voltage_integral", FieldLocation::kGlobal, 1, "mV*m^3",
