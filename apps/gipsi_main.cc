@@ -322,6 +322,7 @@ int Types(const std::vector<std::string>& plugins) {
   print("integrators", registry.integrators.List());
   print("material laws", registry.materials.List());
   print("cell models", registry.cell_models.List());
+  print("haptic local models (by object type)", registry.local_models.List());
   return 0;
 }
 

@@ -13,9 +13,12 @@
 
 #include "gipsi/base/error.h"
 #include "gipsi/haptics/haptic_probe.h"
+#include "gipsi/haptics/local_model_builders.h"
 #include "gipsi/haptics/realtime_haptics.h"
 #include "gipsi/io/scene.h"
 #include "gipsi/models/builtins.h"
+#include "gipsi/models/fem/fem_solid.h"
+#include "gipsi/models/fem/solid_material.h"
 #include "haptics/no_allocation_guard.h"
 
 namespace gipsi {
@@ -210,4 +213,70 @@ TEST(RealtimeHapticProbe, BadKeysAreErrorsNamingTheJsonPath) {
 }
 
 }  // namespace
+/// A local-model builder registered from outside the framework (as a plugin would): it
+/// delegates to the FEM condensation and counts its builds.
+class CountingCondensation final : public LocalModelBuilder {
+ public:
+  CountingCondensation(FemSolid& fem, int* builds) : inner_(fem), builds_(builds) {}
+  SimObject& object() override { return inner_.object(); }
+  bool Build(Index vertex, const Vec3& normal, double anchor_force, double period,
+             LocalDynamicModel& out) override {
+    ++*builds_;
+    return inner_.Build(vertex, normal, anchor_force, period, out);
+  }
+
+ private:
+  FemCondensation inner_;
+  int* builds_;
+};
+
+// A HapticCoupling finds its object's local model by the object's type in the registry, not by
+// knowing the framework's classes: a registry whose "FemSolid" entry is the counting builder
+// renders exactly (bit for bit) the built-in condensation's contact, and that builder did the
+// building (once per coupling firing, 20 in 0.2 s, and at the start).
+TEST(HapticLocalModels, TheCouplingUsesTheModelRegisteredForTheObjectsType) {
+  Scene builtin = Load(BlockScene(""));
+  ASSERT_TRUE(builtin.kernel->Run(0.2).ok());
+  const Vec3 f_builtin = ReadVec(builtin.kernel->FindObject("probe"), "tool_force");
+
+  int builds = 0;
+  TypeRegistry registry;
+  RegisterIntegrators(registry);
+  RegisterSolidLaws(registry);
+  RegisterFemSolid(registry);
+  RegisterHaptics(registry);
+  registry.local_models.Register(
+      "FemSolid",
+      [&builds](SimObject& object, int) -> std::unique_ptr<LocalModelBuilder> {
+        return std::make_unique<CountingCondensation>(dynamic_cast<FemSolid&>(object), &builds);
+      },
+      "counting condensation");
+  Scene scene = LoadSceneFromString(BlockScene(""), "registered.json", ".", registry);
+  ASSERT_TRUE(scene.kernel->Run(0.2).ok());
+  const Vec3 f = ReadVec(scene.kernel->FindObject("probe"), "tool_force");
+  std::printf("tool force %.6f N with the registered builder (%d builds), %.6f N built in\n",
+              f.norm(), builds, f_builtin.norm());
+  EXPECT_GT(f_builtin.norm(), 0.1);  // in contact
+  EXPECT_EQ(f, f_builtin);
+  EXPECT_GE(builds, 20);
+}
+
+TEST(HapticLocalModels, AnObjectWhoseTypeHasNoneIsAClearError) {
+  std::string text = BlockScene("");
+  const std::string fem = R"("block": {"type": "FemSolid")";
+  text.replace(
+      text.find(fem), fem.size(),
+      R"("other": {"type": "Circulation", "dt": 0.01, "compartments": {"lv": {"type": "reservoir", "pressure": 0}}},
+    "block": {"type": "FemSolid")");
+  text.replace(text.find(R"("object": "block")"), 17, R"("object": "other")");
+  try {
+    (void)Load(text);
+    ADD_FAILURE() << "expected an InputError";
+  } catch (const InputError& e) {
+    EXPECT_THAT(e.what(),
+                HasSubstr("connectors.haptics.object: object 'other' is a Circulation, which has "
+                          "no haptic local model (types with one: FemSolid, MassSpring)"));
+  }
+}
+
 }  // namespace gipsi

@@ -95,6 +95,7 @@ template class FactoryTable<ConnectorFactory>;
 template class FactoryTable<IntegratorFactory>;
 template class FactoryTable<MaterialFactory>;
 template class FactoryTable<CellModelFactory>;
+template class FactoryTable<LocalModelFactory>;
 
 std::unique_ptr<SimObject> TypeRegistry::CreateObject(const std::string& name,
                                                       const JsonNode& params,

@@ -18,13 +18,14 @@
 #include "gipsi/numerics/ode.h"
 
 /// Version of the plugin interface; a plugin built against another version is refused.
-#define GIPSI_PLUGIN_ABI_VERSION 2  // 2: SimObject/Connector checkpoint hooks
+#define GIPSI_PLUGIN_ABI_VERSION 3  // 2: checkpoint hooks; 3: haptic local models by type
 
 namespace gipsi {
 
 class TypeRegistry;
 class Coordinator;
 class CellModel;
+class LocalModelBuilder;
 
 /// Looks up meshes declared in the scene by name (implemented by the scene loader).
 class MeshProvider {
@@ -87,6 +88,11 @@ using MaterialFactory = std::function<std::shared_ptr<const Material>(const Json
 /// Builds a cardiac cell model from its JSON object ({"model": name, ...parameters}; see
 /// gipsi/models/ep/cell_models.h); throws InputError naming the JSON path of a bad parameter.
 using CellModelFactory = std::function<std::shared_ptr<const CellModel>(const JsonNode& params)>;
+/// Builds the haptic local-model builder (gipsi/haptics/local_model_builders.h) of an object of
+/// the type it is registered under; `rings` is the HapticCoupling's neighbourhood size (0-5),
+/// for builders that use one. May throw InputError (e.g. an object without a boundary).
+using LocalModelFactory =
+    std::function<std::unique_ptr<LocalModelBuilder>(SimObject& object, int rings)>;
 
 /// Factories by type name, for one kind of product. Not copyable; movable.
 template <class Factory>
@@ -124,6 +130,9 @@ class TypeRegistry {
   FactoryTable<IntegratorFactory> integrators{"integrator"};
   FactoryTable<MaterialFactory> materials{"material law"};
   FactoryTable<CellModelFactory> cell_models{"cell model"};
+  /// Haptic local models, keyed by the object type (SimObject::type_name()) they describe: a
+  /// HapticCoupling can render any object whose type has one (plugins register their own).
+  FactoryTable<LocalModelFactory> local_models{"haptic local model"};
 
   /// Builds the object described by `params` (its "type" picks the factory).
   [[nodiscard]] std::unique_ptr<SimObject> CreateObject(const std::string& name,

@@ -7,6 +7,7 @@
 #include <thread>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include "gipsi/base/error.h"
 #include "gipsi/haptics/igtl_surface_sender.h"
@@ -163,19 +164,11 @@ void HapticProbe::DoWriteField(FieldId /*id*/, const Eigen::Ref<const Eigen::Mat
 
 // ---------------------------------------------------------------------------------------------
 
-HapticCoupling::HapticCoupling(std::string name, SimObject& object, HapticProbe& probe,
-                               const HapticBridgeParams& params, int rings)
-    : Connector(std::move(name)), probe_(probe) {
-  if (auto* fem = dynamic_cast<FemSolid*>(&object)) {
-    builder_ = std::make_unique<FemCondensation>(*fem);
-  } else if (auto* ms = dynamic_cast<MassSpring*>(&object)) {
-    builder_ = std::make_unique<MassSpringNeighbourhood>(*ms, rings);
-  } else {
-    throw InputError(
-        fmt::format("object '{}' is a {}; haptic coupling needs a FemSolid or a "
-                    "MassSpring",
-                    object.name(), object.type_name()));
-  }
+HapticCoupling::HapticCoupling(std::string name, std::unique_ptr<LocalModelBuilder> builder,
+                               HapticProbe& probe, const HapticBridgeParams& params)
+    : Connector(std::move(name)), probe_(probe), builder_(std::move(builder)) {
+  GIPSI_CHECK(builder_ != nullptr);
+  const SimObject& object = builder_->object();
   if (object.boundary().num_vertices() == 0)
     throw InputError(fmt::format("object '{}' has no boundary surface", object.name()));
   bridge_ = std::make_unique<HapticBridge>(*builder_, params);
@@ -307,9 +300,19 @@ void RegisterHaptics(TypeRegistry& registry) {
         params.capture_distance = p.NonNegative("capture_distance", params.capture_distance);
         const std::int64_t rings = p.Int("rings", 1);
         if (rings < 0 || rings > 5) p.At("rings").Expected("an integer in [0, 5]");
+        const std::string type(object.type_name());
+        if (!ctx.registry.local_models.Contains(type)) {
+          std::vector<std::string> known;
+          for (const auto& entry : ctx.registry.local_models.List()) known.push_back(entry.first);
+          p.At("object").Fail(fmt::format(
+              "object '{}' is a {}, which has no haptic local model (types with one: {})",
+              object.name(), type, fmt::join(known, ", ")));
+        }
         try {
-          return std::make_unique<HapticCoupling>(ctx.name, object, *probe, params,
-                                                  static_cast<int>(rings));
+          return std::make_unique<HapticCoupling>(
+              ctx.name,
+              ctx.registry.local_models.Get(type, p.At("object"))(object, static_cast<int>(rings)),
+              *probe, params);
         } catch (const InputError& e) {
           p.Fail(e.what());
         }
@@ -335,6 +338,21 @@ void RegisterHaptics(TypeRegistry& registry) {
         }
       },
       "sends an object's deformed boundary surface as OpenIGTLink POLYDATA (e.g. to 3D Slicer)");
+}
+
+void RegisterHapticLocalModels(TypeRegistry& registry) {
+  registry.local_models.Register(
+      "FemSolid",
+      [](SimObject& object, int /*rings*/) -> std::unique_ptr<LocalModelBuilder> {
+        return std::make_unique<FemCondensation>(dynamic_cast<FemSolid&>(object));
+      },
+      "the tangent stiffness condensed at the contact node (FemCondensation)");
+  registry.local_models.Register(
+      "MassSpring",
+      [](SimObject& object, int rings) -> std::unique_ptr<LocalModelBuilder> {
+        return std::make_unique<MassSpringNeighbourhood>(dynamic_cast<MassSpring&>(object), rings);
+      },
+      "the springs within `rings` of the contact node, linearised (MassSpringNeighbourhood)");
 }
 
 }  // namespace gipsi

@@ -148,11 +148,11 @@ class HapticProbe final : public SimObject {
 /// Not copyable or movable (a Connector).
 class HapticCoupling final : public Connector {
  public:
-  /// Builds the local-model builder for `object` (FemSolid or MassSpring; InputError
-  /// otherwise), attaches `probe` to the bridge and publishes a first model at the object's
-  /// current state.
-  HapticCoupling(std::string name, SimObject& object, HapticProbe& probe,
-                 const HapticBridgeParams& params, int rings);
+  /// Renders the local models `builder` makes of its object (see TypeRegistry::local_models):
+  /// attaches `probe` to the bridge and publishes a first model at the object's current state.
+  /// Throws InputError if the object has no boundary surface.
+  HapticCoupling(std::string name, std::unique_ptr<LocalModelBuilder> builder, HapticProbe& probe,
+                 const HapticBridgeParams& params);
   [[nodiscard]] std::string_view type_name() const override { return "HapticCoupling"; }
   /// Stops the probe's real-time loop (it reads this connector's buffers).
   ~HapticCoupling() override;
@@ -173,5 +173,9 @@ class HapticCoupling final : public Connector {
 /// Registers the object "HapticProbe" and the connectors "HapticCoupling" and
 /// "OpenIGTLinkSurface" (igtl_surface_sender.h).
 void RegisterHaptics(TypeRegistry& registry);
+/// Registers the haptic local models of "FemSolid" (FemCondensation) and "MassSpring"
+/// (MassSpringNeighbourhood). A HapticCoupling finds an object's local model by its type in
+/// TypeRegistry::local_models; a plugin registers one there for its own object types.
+void RegisterHapticLocalModels(TypeRegistry& registry);
 
 }  // namespace gipsi

@@ -37,6 +37,7 @@ void RegisterBuiltins(TypeRegistry& registry) {
   RegisterRigidTool(registry);
   RegisterContact(registry);
   RegisterHaptics(registry);
+  RegisterHapticLocalModels(registry);
 }
 
 }  // namespace gipsi
