@@ -49,6 +49,48 @@ Scene LoadText(const std::string& text, TypeRegistry& registry) {
   return LoadSceneFromString(text, "scene.json", ".", registry);
 }
 
+/// An object type the viewer knows nothing about (as a plugin's would be): three nodes joined
+/// by its own segments (0, 2) and (2, 1), e.g. a rod model drawn as its centre line.
+class Rod final : public SimObject {
+ public:
+  Rod() : SimObject("rod") {
+    Mesh mesh;
+    mesh.nodes = Points(3, 3);
+    mesh.nodes << 0, 2, 1,  //
+        0, 0, 0,            //
+        0, 0, 1;
+    positions_ = mesh.nodes;
+    SetGeometry(std::make_shared<const Mesh>(std::move(mesh)), BoundarySurface{});
+  }
+  std::string_view type_name() const override { return "Rod"; }
+  const Points& domain_positions() const override { return positions_; }
+  Eigen::Matrix2Xi DisplaySegments() const override {
+    Eigen::Matrix2Xi s(2, 2);
+    s << 0, 2,  //
+        2, 1;
+    return s;
+  }
+
+ protected:
+  StepStatus DoStep(double, double) override { return StepStatus::Ok(); }
+  void DoReadField(FieldId, Eigen::Ref<Eigen::MatrixXd>) const override {}
+  void DoWriteField(FieldId, const Eigen::Ref<const Eigen::MatrixXd>&) override {}
+
+ private:
+  Points positions_;
+};
+
+TEST(LineDisplay, AnyObjectWithItsOwnSegmentsIsDrawnAsThemByDefault) {
+  Rod rod;
+  EXPECT_TRUE(DisplayManager::HasDefaultGeometry(rod));
+  DisplayManager manager(rod, ColorSpec{});
+  EXPECT_EQ(manager.primitive(), Primitive::kLines);
+  SurfaceBuffers out;
+  manager.Fill(out);
+  EXPECT_THAT(out.positions, ElementsAre(0, 0, 0, 2, 0, 0, 1, 0, 1));
+  EXPECT_THAT(out.indices, ElementsAre(0, 2, 2, 1));
+}
+
 TEST(LineDisplay, ASpringNetworkIsDrawnAsItsSpringsByDefault) {
   auto chain = MakeChain();
   ASSERT_EQ(chain->display().triangles.cols(), 0);  // nothing else to draw

@@ -81,6 +81,10 @@ class SimObject {
   /// triangles for surface domains; objects on other geometries (e.g. a structured grid)
   /// override it. Throws InputError as the PointMap builders do.
   [[nodiscard]] virtual PointMap MapFromNodes(const Points& targets) const;
+  /// The node pairs the object is drawn with as lines when it has its own (a spring network's
+  /// springs), 2 by S; empty (the default) to draw the domain's edges. An object with segments
+  /// and no display surface is drawn as lines by default.
+  [[nodiscard]] virtual Eigen::Matrix2Xi DisplaySegments() const { return Eigen::Matrix2Xi(2, 0); }
 
   // --- Boundary conditions ---
   [[nodiscard]] BoundaryConditions& boundary_conditions() { return bcs_; }

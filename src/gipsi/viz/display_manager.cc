@@ -9,7 +9,6 @@
 
 #include "gipsi/base/error.h"
 #include "gipsi/geometry/normals.h"
-#include "gipsi/models/mass_spring/mass_spring.h"
 
 namespace gipsi::viz {
 namespace {
@@ -32,12 +31,15 @@ std::string FieldLabel(const FieldInfo& info, int component) {
 /// Default line width and point diameter [pixels].
 constexpr float kDefaultLineWidth = 2.0f, kDefaultPointSize = 6.0f;
 
-/// Line segments of an object: a MassSpring's springs, else the unique edges of the domain's
-/// tets (or, without tets, its triangles), as node pairs (lower index first, sorted).
+/// Line segments of an object: its own (SimObject::DisplaySegments, e.g. a spring network's
+/// springs), else the unique edges of the domain's tets (or, without tets, its triangles), as
+/// node pairs (lower index first, sorted).
 std::vector<std::uint32_t> Segments(const SimObject& object) {
   std::vector<std::pair<std::uint32_t, std::uint32_t>> edges;
-  if (const auto* springs = dynamic_cast<const MassSpring*>(&object)) {
-    const Eigen::Matrix2Xi& s = springs->springs();
+  if (const Eigen::Matrix2Xi s = object.DisplaySegments(); s.cols() > 0) {
+    GIPSI_CHECK(s.minCoeff() >= 0 && s.maxCoeff() < object.domain_positions().cols(),
+                "object '{}': a display segment refers to a node outside [0, {})", object.name(),
+                object.domain_positions().cols());
     for (Index k = 0; k < s.cols(); ++k)
       edges.emplace_back(std::uint32_t(s(0, k)), std::uint32_t(s(1, k)));
   } else {
@@ -62,10 +64,7 @@ std::vector<std::uint32_t> Segments(const SimObject& object) {
   return out;
 }
 
-bool IsSpringNetwork(const SimObject& object) {
-  const auto* springs = dynamic_cast<const MassSpring*>(&object);
-  return springs && springs->num_springs() > 0;
-}
+bool HasOwnSegments(const SimObject& object) { return object.DisplaySegments().cols() > 0; }
 
 }  // namespace
 
@@ -160,7 +159,7 @@ std::pair<std::string, ColorSpec> ParseColorOption(std::string_view text, std::s
 }
 
 bool DisplayManager::HasDefaultGeometry(const SimObject& object) {
-  return object.display().triangles.cols() > 0 || IsSpringNetwork(object);
+  return object.display().triangles.cols() > 0 || HasOwnSegments(object);
 }
 
 DisplayManager::DisplayManager(const SimObject& object, ColorSpec spec)
@@ -170,7 +169,7 @@ DisplayManager::DisplayManager(const SimObject& object, DrawSpec spec)
     : object_(&object), draw_(std::move(spec)), map_(ColorMap::Named("viridis")) {
   if (draw_.as) {
     primitive_ = *draw_.as;
-  } else if (object.display().triangles.cols() == 0 && IsSpringNetwork(object)) {
+  } else if (object.display().triangles.cols() == 0 && HasOwnSegments(object)) {
     primitive_ = Primitive::kLines;
   }
   auto fail_geometry = [&](const std::string& what) {

@@ -34,9 +34,10 @@ struct ColorSpec {
 /// mesh edges as lines, its nodes as points), wireframe, visibility. Plain struct.
 struct DrawSpec {
   ColorSpec color;
-  /// Triangles: the display surface; lines: a MassSpring's springs, else the unique edges of
-  /// the domain's tets (or triangles); points: the domain nodes. Absent: the display surface
-  /// if the object has one, else the springs of a spring network, else nothing is drawn.
+  /// Triangles: the display surface; lines: the object's own segments (a MassSpring's springs;
+  /// SimObject::DisplaySegments), else the unique edges of the domain's tets (or triangles);
+  /// points: the domain nodes. Absent: the display surface if the object has one, else its
+  /// own segments if it has some, else nothing is drawn.
   std::optional<Primitive> as;
   bool wireframe = false;  ///< draw the surface's triangle edges too
   bool visible = true;     ///< initially shown (the viewer can toggle it)

@@ -139,6 +139,8 @@ class MassSpring final : public SimObject {
   [[nodiscard]] Index num_springs() const { return springs_.cols(); }
   /// 2 by S node pairs.
   [[nodiscard]] const Eigen::Matrix2Xi& springs() const { return springs_; }
+  /// The springs.
+  [[nodiscard]] Eigen::Matrix2Xi DisplaySegments() const override { return springs_; }
   [[nodiscard]] const VecX& masses() const { return mass_; }
   [[nodiscard]] const VecX& rest_lengths() const { return rest_length_; }
   [[nodiscard]] const MassSpringParams& params() const { return params_; }
