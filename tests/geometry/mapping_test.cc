@@ -73,6 +73,34 @@ Points Reproduce(const PointMap& map, const Points& source) {
   return out;
 }
 
+// Target 0 blends items 0 and 1 (weights 0.5, 0.5), target 1 items 1 and 2 with item 2 at zero
+// weight. A marked item (-1) with weight makes the target read -1, per component; one with zero
+// weight does not matter; unmarked components blend as Apply does.
+TEST(PointMap, ApplyMarkedNeverBlendsTheMarker) {
+  Eigen::Matrix4Xi indices(4, 2);
+  indices << 0, 1,  //
+      1, 2,         //
+      0, 1,         //
+      0, 1;
+  Eigen::Matrix4Xd weights(4, 2);
+  weights << 0.5, 1,  //
+      0.5, 0,         //
+      0, 0,           //
+      0, 0;
+  const PointMap map = PointMap::FromWeights(indices, weights, 0);
+  Eigen::MatrixXd source(2, 3);
+  source << 10, -1, -1,  //
+      10, 20, 30;
+  Eigen::MatrixXd out(2, 2), plain(2, 2);
+  map.ApplyMarked(source, out, -1);
+  map.Apply(source, plain);
+  EXPECT_EQ(out(0, 0), -1);  // 0.5 * 10 + 0.5 * (-1) = 4.5 before
+  EXPECT_EQ(plain(0, 0), 4.5);
+  EXPECT_EQ(out(0, 1), -1);  // item 1 alone
+  EXPECT_EQ(out(1, 0), 15);  // the unmarked component blends
+  EXPECT_EQ(out(1, 1), 20);  // item 2 (marked in row 0, weight 0) does not matter
+}
+
 TEST(PointMap, BarycentricInTetsReproducesLinearFieldsInside) {
   const Mesh box = JitteredBox();
   ASSERT_TRUE(CheckTetQuality(box.nodes, box.tets).inverted.empty());

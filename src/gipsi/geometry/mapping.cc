@@ -256,6 +256,18 @@ void PointMap::Apply(const Eigen::Ref<const Eigen::MatrixXd>& source,
   }
 }
 
+void PointMap::ApplyMarked(const Eigen::Ref<const Eigen::MatrixXd>& source,
+                           Eigen::Ref<Eigen::MatrixXd> out, double marker) const {
+  Apply(source, out);
+  for (Index j = 0; j < num_targets(); ++j)
+    for (int k = 0; k < 4; ++k) {
+      if (weights_(k, j) == 0) continue;
+      const Index item = indices_(k, j);
+      for (Index c = 0; c < source.rows(); ++c)
+        if (source(c, item) == marker) out(c, j) = marker;
+    }
+}
+
 PointMap PointMap::FromWeights(Eigen::Matrix4Xi indices, Eigen::Matrix4Xd weights,
                                double max_distance) {
   GIPSI_CHECK(indices.cols() == weights.cols());

@@ -46,6 +46,10 @@ class PointMap {
   /// num_targets() (preconditions checked). Allocates nothing.
   void Apply(const Eigen::Ref<const Eigen::MatrixXd>& source,
              Eigen::Ref<Eigen::MatrixXd> out) const;
+  /// Apply, except that a target component whose weights touch a source item holding `marker`
+  /// (a field's no-data value, FieldInfo::no_data) reads `marker` instead of a blend with it.
+  void ApplyMarked(const Eigen::Ref<const Eigen::MatrixXd>& source, Eigen::Ref<Eigen::MatrixXd> out,
+                   double marker) const;
 
  private:
   Eigen::Matrix4Xi indices_ = Eigen::Matrix4Xi(4, 0);

@@ -19,21 +19,13 @@ std::size_t ProbeWidth(const Probe& probe) {
   return width;
 }
 
-/// `map` applied to `values`, except that a target whose interpolation gives weight to an item
-/// holding the field's no-data marker reads the marker (an unactivated node must not pull an
-/// activation time towards -1).
+/// Interpolation at the probe's points that never blends the field's no-data marker.
 void Interpolate(const PointMap& map, const FieldInfo& info, const Eigen::MatrixXd& values,
                  Eigen::MatrixXd& out) {
-  map.Apply(values, out);
-  if (!info.no_data) return;
-  const double marker = *info.no_data;
-  for (Index j = 0; j < map.num_targets(); ++j)
-    for (int k = 0; k < 4; ++k) {
-      if (map.weights()(k, j) == 0) continue;
-      const Index item = map.indices()(k, j);
-      for (int c = 0; c < info.components; ++c)
-        if (values(c, item) == marker) out(c, j) = marker;
-    }
+  if (info.no_data)
+    map.ApplyMarked(values, out, *info.no_data);
+  else
+    map.Apply(values, out);
 }
 
 }  // namespace
