@@ -13,7 +13,7 @@ packages=(
   zlib1g-dev             # compressed VTU payloads
   libgmsh-dev gmsh       # Gmsh C++ API: shell (left-ventricle) mesh generation
   libsuitesparse-dev     # CHOLMOD sparse Cholesky
-  libopenblas-serial-dev # its BLAS: single-threaded OpenBLAS (GiPSi threads above it)
+  libopenblas-serial-dev # its BLAS: OpenBLAS (run single-threaded; GiPSi threads above it)
   libudunits2-dev        # UDUNITS-2: quantities with units in scene files
   libosmesa6-dev         # off-screen OpenGL (software) for gipsi snapshot
   libstb-dev             # PNG files and font rasterisation (stb_image_write, stb_truetype)
@@ -42,15 +42,6 @@ else
   DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
 fi
 
-# Use the single-threaded OpenBLAS even where a threaded build is installed too: CHOLMOD makes
-# many small BLAS calls, and waking BLAS threads for each (pthread build: spinning against
-# GiPSi's OpenMP threads; OpenMP build: sleeping and waking) made its solves 50x slower.
-arch_dir="/usr/lib/$(dpkg-architecture -qDEB_HOST_MULTIARCH 2>/dev/null || echo x86_64-linux-gnu)"
-for lib in libblas.so.3 liblapack.so.3; do
-  name="${lib}-$(basename "$arch_dir")"
-  want="$arch_dir/openblas-serial/$lib"
-  if [ -e "$want" ] && [ "$(readlink -f "$arch_dir/$lib")" != "$(readlink -f "$want")" ]; then
-    echo "install-deps: selecting $want for $lib"
-    $SUDO update-alternatives --quiet --set "$name" "$want"
-  fi
-done
+# The system's BLAS choice (the libblas.so.3 alternative) is left as the user has it: GiPSi asks
+# the loaded BLAS for one thread at run time (numerics/sparse/blas_threads.h), and this script
+# never changes system-wide settings.

@@ -11,6 +11,7 @@
 #include <Eigen/SparseCholesky>
 
 #include "gipsi/base/error.h"
+#include "gipsi/numerics/sparse/blas_threads.h"
 #include "gipsi/numerics/sparse/serial_openmp.h"
 #include "gipsi/numerics/sparse/solvers.h"
 #include "gipsi/numerics/sparse/vector_ops.h"
@@ -143,6 +144,7 @@ class CholmodSolver final : public DirectSolver {
     // CHOLMOD prints "matrix not positive definite" at any print level > 0; Factorize reports
     // it by returning false instead, so keep CHOLMOD quiet.
     llt_.cholmod().print = 0;
+    UseSingleThreadedBlasOnce();
   }
   [[nodiscard]] std::string name() const override { return "cholmod"; }
   bool AcceptIndefinite() override {
