@@ -6,8 +6,8 @@
 #include <fmt/format.h>
 
 #include "gipsi/base/error.h"
+#include "gipsi/io/builtins.h"
 #include "gipsi/io/scene.h"
-#include "gipsi/models/builtins.h"
 #include "gipsi/viz/csv_table.h"
 #include "gipsi/viz/render/offscreen.h"
 #include "gipsi/viz/render/plot.h"

@@ -4,8 +4,8 @@
 
 #include <benchmark/benchmark.h>
 
+#include "gipsi/io/builtins.h"
 #include "gipsi/io/scene.h"
-#include "gipsi/models/builtins.h"
 #include "gipsi/viz/display_manager.h"
 #include "gipsi/viz/triple_buffer.h"
 

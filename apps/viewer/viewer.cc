@@ -16,7 +16,7 @@
 
 #include <fmt/format.h>
 
-#include "gipsi/models/builtins.h"
+#include "gipsi/io/builtins.h"
 #include "gipsi/viz/mouse_tool.h"
 #include "gipsi/viz/render/image.h"
 #include "viewer/simulation_thread.h"

@@ -12,10 +12,10 @@
 #include <numbers>
 
 #include "gipsi/base/error.h"
+#include "gipsi/base/state.h"
 #include "gipsi/core/coordinator.h"
 #include "gipsi/core/registry.h"
 #include "gipsi/core/sim_object.h"
-#include "gipsi/core/state.h"
 #include "gipsi/geometry/region_json.h"
 
 namespace example {

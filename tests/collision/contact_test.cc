@@ -11,8 +11,8 @@
 #include "gipsi/collision/tool_surface.h"
 #include "gipsi/geometry/enclosed_volume.h"
 #include "gipsi/geometry/generators.h"
+#include "gipsi/io/builtins.h"
 #include "gipsi/io/scene.h"
-#include "gipsi/models/builtins.h"
 #include "gipsi/models/mass_spring/mass_spring.h"
 #include "test_paths.h"
 

@@ -16,8 +16,8 @@
 
 #include "apps/cli_test_util.h"
 #include "gipsi/base/error.h"
+#include "gipsi/base/state.h"
 #include "gipsi/core/kernel.h"
-#include "gipsi/core/state.h"
 #include "test_paths.h"
 
 namespace gipsi {

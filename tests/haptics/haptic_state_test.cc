@@ -5,7 +5,7 @@
 
 #include <gtest/gtest.h>
 
-#include "gipsi/core/state.h"
+#include "gipsi/base/state.h"
 #include "gipsi/geometry/generators.h"
 #include "gipsi/haptics/haptic_bridge.h"
 #include "gipsi/haptics/virtual_device.h"

@@ -28,8 +28,8 @@
 #include "gipsi/haptics/haptic_tick.h"
 #include "gipsi/haptics/igtl_device.h"
 #include "gipsi/haptics/igtl_surface_sender.h"
+#include "gipsi/io/builtins.h"
 #include "gipsi/io/scene.h"
-#include "gipsi/models/builtins.h"
 #include "haptics/no_allocation_guard.h"
 #include "io/scene_test_util.h"
 

@@ -11,8 +11,8 @@
 
 #include "gipsi/base/error.h"
 #include "gipsi/haptics/haptic_probe.h"
+#include "gipsi/io/builtins.h"
 #include "gipsi/io/scene.h"
-#include "gipsi/models/builtins.h"
 #include "gipsi/models/fem/fem_solid.h"
 #include "test_paths.h"
 

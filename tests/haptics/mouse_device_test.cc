@@ -11,8 +11,8 @@
 #include "gipsi/base/error.h"
 #include "gipsi/haptics/haptic_probe.h"
 #include "gipsi/haptics/mouse_device.h"
+#include "gipsi/io/builtins.h"
 #include "gipsi/io/scene.h"
-#include "gipsi/models/builtins.h"
 #include "haptics/no_allocation_guard.h"
 #include "io/scene_test_util.h"
 

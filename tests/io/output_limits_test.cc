@@ -8,10 +8,10 @@
 #include <gtest/gtest.h>
 
 #include "gipsi/base/error.h"
+#include "gipsi/io/builtins.h"
 #include "gipsi/io/outputs.h"
 #include "gipsi/io/scene.h"
 #include "gipsi/io/vtu_writer.h"
-#include "gipsi/models/builtins.h"
 #include "temp_dir.h"
 
 namespace gipsi {

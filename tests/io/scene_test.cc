@@ -7,7 +7,7 @@
 #include <gtest/gtest.h>
 
 #include "gipsi/base/error.h"
-#include "gipsi/models/builtins.h"
+#include "gipsi/io/builtins.h"
 #include "gipsi/models/mass_spring/mass_spring.h"
 #include "io/scene_test_util.h"
 #include "temp_dir.h"

@@ -4,8 +4,8 @@
 #include <string>
 
 #include "gipsi/base/error.h"
+#include "gipsi/io/builtins.h"
 #include "gipsi/io/scene.h"
-#include "gipsi/models/builtins.h"
 
 namespace gipsi::testing {
 

@@ -8,8 +8,8 @@
 #include <gtest/gtest.h>
 
 #include "gipsi/base/error.h"
+#include "gipsi/io/builtins.h"
 #include "gipsi/io/scene.h"
-#include "gipsi/models/builtins.h"
 #include "gipsi/models/mass_spring/mass_spring.h"
 #include "gipsi/numerics/ode.h"
 #include "gipsi/viz/display_manager.h"

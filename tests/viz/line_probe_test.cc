@@ -10,9 +10,9 @@
 #include <gtest/gtest.h>
 
 #include "apps/cli_test_util.h"
+#include "gipsi/io/builtins.h"
 #include "gipsi/io/outputs.h"
 #include "gipsi/io/scene.h"
-#include "gipsi/models/builtins.h"
 #include "gipsi/viz/csv_table.h"
 #include "gipsi/viz/plot_spec.h"
 #include "gipsi/viz/render/plot.h"

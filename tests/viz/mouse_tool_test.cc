@@ -2,8 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include "gipsi/io/builtins.h"
 #include "gipsi/io/scene.h"
-#include "gipsi/models/builtins.h"
 #include "gipsi/viz/display_manager.h"
 
 namespace gipsi::viz {

@@ -10,8 +10,8 @@
 
 #include "apps/cli_test_util.h"
 #include "gipsi/base/error.h"
+#include "gipsi/io/builtins.h"
 #include "gipsi/io/scene.h"
-#include "gipsi/models/builtins.h"
 #include "gipsi/viz/render/image.h"
 
 namespace gipsi::viz {

@@ -9,8 +9,8 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include "gipsi/io/builtins.h"
 #include "gipsi/io/scene.h"
-#include "gipsi/models/builtins.h"
 #include "gipsi/viz/plot_spec.h"
 #include "io/scene_test_util.h"
 

@@ -6,8 +6,8 @@
 #include <gtest/gtest.h>
 
 #include "apps/cli_test_util.h"
+#include "gipsi/io/builtins.h"
 #include "gipsi/io/scene.h"
-#include "gipsi/models/builtins.h"
 #include "gipsi/viz/render/offscreen.h"
 #include "test_paths.h"
 

@@ -7,9 +7,9 @@
 #include <fmt/format.h>
 
 #include "gipsi/base/error.h"
+#include "gipsi/base/state.h"
 #include "gipsi/collision/rigid_tool.h"
 #include "gipsi/core/coordinator.h"
-#include "gipsi/core/state.h"
 
 namespace gipsi {
 

@@ -1,8 +1,8 @@
 /// @file
 /// RigidTool checkpoints: the translation and velocity (the rest is the scene's motion law).
 
+#include "gipsi/base/state.h"
 #include "gipsi/collision/rigid_tool.h"
-#include "gipsi/core/state.h"
 
 namespace gipsi {
 

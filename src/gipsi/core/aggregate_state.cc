@@ -1,8 +1,8 @@
 /// @file
 /// AggregateObject checkpoints: every part, then every connector, in the coordinator's order.
 
+#include "gipsi/base/state.h"
 #include "gipsi/core/aggregate.h"
-#include "gipsi/core/state.h"
 
 namespace gipsi {
 

@@ -34,7 +34,7 @@ class Connector {
     return DoFire(t);
   }
   [[nodiscard]] std::int64_t fire_count() const { return fire_count_; }
-  /// Checkpoints and roll-back (gipsi/core/state.h): the fire count, then the type's own state
+  /// Checkpoints and roll-back (gipsi/base/state.h): the fire count, then the type's own state
   /// (SaveConnectorState). RestoreState throws InputError for state from another scene.
   void SaveState(StateWriter& out) const;
   void RestoreState(StateReader& in);

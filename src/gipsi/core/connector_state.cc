@@ -4,8 +4,8 @@
 #include <fmt/format.h>
 
 #include "gipsi/base/error.h"
+#include "gipsi/base/state.h"
 #include "gipsi/core/connector.h"
-#include "gipsi/core/state.h"
 
 namespace gipsi {
 

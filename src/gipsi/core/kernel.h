@@ -117,7 +117,7 @@ class Kernel {
   /// Restores what SaveState wrote for the same scene (after Initialize and AddObserver, before
   /// Run); throws InputError naming what differs for a checkpoint of another scene.
   void RestoreState(StateReader& in);
-  /// SaveState into a checkpoint file (gipsi/core/state.h: atomic, checksummed).
+  /// SaveState into a checkpoint file (gipsi/base/state.h: atomic, checksummed).
   void WriteCheckpoint(const std::filesystem::path& file);
   /// RestoreState from a checkpoint file.
   void ReadCheckpoint(const std::filesystem::path& file);

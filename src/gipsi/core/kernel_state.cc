@@ -5,8 +5,8 @@
 
 #include "gipsi/base/error.h"
 #include "gipsi/base/log.h"
+#include "gipsi/base/state.h"
 #include "gipsi/core/kernel.h"
-#include "gipsi/core/state.h"
 
 namespace gipsi {
 namespace {

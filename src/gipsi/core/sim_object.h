@@ -135,7 +135,7 @@ class SimObject {
   /// enclosed volume equal `law`'s end volume (cavity_law.h). `law` must outlive the object's
   /// steps. Throws InputError if the object has no such cavity (the default: no cavities).
   virtual void AttachCavityLaw(std::string_view cavity, CavityLaw* law);
-  /// Checkpoints and roll-back (gipsi/core/state.h): writes the clock, step count and applied
+  /// Checkpoints and roll-back (gipsi/base/state.h): writes the clock, step count and applied
   /// boundary conditions, then the type's own state (SaveObjectState); coupling loads must have
   /// been cleared (BeginMacroStep). RestoreState reads it back; the object then continues
   /// bitwise identically. Throw InputError for state from another scene or object type.

@@ -5,8 +5,8 @@
 #include <fmt/format.h>
 
 #include "gipsi/base/error.h"
+#include "gipsi/base/state.h"
 #include "gipsi/core/sim_object.h"
-#include "gipsi/core/state.h"
 
 namespace gipsi {
 

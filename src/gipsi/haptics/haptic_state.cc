@@ -1,5 +1,5 @@
 /// @file
-/// Checkpoints and roll-back of multi-rate haptics (gipsi/core/state.h). A synchronous probe on
+/// Checkpoints and roll-back of multi-rate haptics (gipsi/base/state.h). A synchronous probe on
 /// a scripted path is deterministic, so its run can be continued bit for bit. That needs more
 /// than the fields: the tick's local state and hand-over blend, the safety stage, the bridge's
 /// kept contact, and both lock-free buffers whole. An inactive model only overwrites `active`
@@ -9,7 +9,7 @@
 #include <fmt/format.h>
 
 #include "gipsi/base/error.h"
-#include "gipsi/core/state.h"
+#include "gipsi/base/state.h"
 #include "gipsi/haptics/haptic_bridge.h"
 #include "gipsi/haptics/haptic_probe.h"
 #include "gipsi/haptics/local_model_tick.h"

@@ -7,7 +7,7 @@
 
 #include "gipsi/base/error.h"
 
-#include "gipsi/core/state.h"
+#include "gipsi/base/state.h"
 
 namespace gipsi {
 

@@ -116,7 +116,7 @@ class AdaptiveOde {
   /// Sets the step-size guess (0: choose one): a second integrator started like this one
   /// repeats its steps exactly (trial integrations).
   void SetStepSize(double h) { h_ = h; }
-  /// Checkpoints (gipsi/core/state.h; defined in circulation_state.cc).
+  /// Checkpoints (gipsi/base/state.h; defined in circulation_state.cc).
   void SaveState(StateWriter& out) const;
   void RestoreState(StateReader& in);
 

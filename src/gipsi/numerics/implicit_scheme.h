@@ -65,7 +65,7 @@ class ImplicitScheme {
   void SetPositions(const VecX& x);
   /// Overwrites the current accelerations (Newmark's initial a_0).
   void SetAcceleration(const VecX& a) { a_ = a; }
-  /// Checkpoints (gipsi/core/state.h): the state and the multistep history.
+  /// Checkpoints (gipsi/base/state.h): the state and the multistep history.
   void SaveState(StateWriter& out) const;
   void RestoreState(StateReader& in);
 

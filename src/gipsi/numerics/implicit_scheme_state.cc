@@ -2,7 +2,7 @@
 /// ImplicitScheme checkpoints: x_n, v_n, a_n and the BDF2 history (x_n − x_{n−1}, v_{n−1}, the
 /// previous step size). The per-step coefficients are rebuilt by Begin.
 
-#include "gipsi/core/state.h"
+#include "gipsi/base/state.h"
 #include "gipsi/numerics/implicit_scheme.h"
 
 namespace gipsi {

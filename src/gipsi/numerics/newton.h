@@ -106,7 +106,7 @@ class NewtonSolver {
   [[nodiscard]] LinearSolver& linear_solver() { return *linear_; }
   /// The residual at the last accepted iterate (valid unless fixed_iterations).
   [[nodiscard]] const VecX& residual() const { return r_; }
-  /// Checkpoints (gipsi/core/state.h): what one Solve hands to the next — the warm start and,
+  /// Checkpoints (gipsi/base/state.h): what one Solve hands to the next — the warm start and,
   /// with reuse_factorization, whether a factorisation is kept and the values of `J`, the
   /// matrix given to Solve (it holds the factorised values then). RestoreState writes the
   /// values back into `J` (same pattern) and factorises it again (deterministic: the same

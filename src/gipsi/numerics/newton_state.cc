@@ -13,7 +13,7 @@
 #include <span>
 #include <vector>
 
-#include "gipsi/core/state.h"
+#include "gipsi/base/state.h"
 #include "gipsi/numerics/newton.h"
 
 namespace gipsi {

@@ -5,8 +5,8 @@
 #include <string>
 
 #include "gipsi/base/error.h"
+#include "gipsi/io/builtins.h"
 #include "gipsi/io/scene.h"
-#include "gipsi/models/builtins.h"
 #include "gipsi/models/circulation/circulation.h"
 #include "io/scene_test_util.h"
 

@@ -9,8 +9,8 @@
 #include <gtest/gtest.h>
 
 #include "gipsi/base/error.h"
+#include "gipsi/io/builtins.h"
 #include "gipsi/io/scene.h"
-#include "gipsi/models/builtins.h"
 
 namespace gipsi {
 namespace {

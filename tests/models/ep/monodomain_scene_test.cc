@@ -6,8 +6,8 @@
 
 #include "gipsi/base/error.h"
 #include "gipsi/base/units.h"
+#include "gipsi/io/builtins.h"
 #include "gipsi/io/scene.h"
-#include "gipsi/models/builtins.h"
 #include "gipsi/models/ep/monodomain.h"
 #include "io/scene_test_util.h"
 

@@ -6,8 +6,8 @@
 
 #include "gipsi/base/error.h"
 #include "gipsi/core/kernel.h"
+#include "gipsi/io/builtins.h"
 #include "gipsi/io/scene.h"
-#include "gipsi/models/builtins.h"
 #include "gipsi/models/fem/fem_solid.h"
 #include "models/fem/fem_test_util.h"
 

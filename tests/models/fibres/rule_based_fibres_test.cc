@@ -11,8 +11,8 @@
 
 #include "gipsi/base/error.h"
 #include "gipsi/geometry/generators.h"
+#include "gipsi/io/builtins.h"
 #include "gipsi/io/scene.h"
-#include "gipsi/models/builtins.h"
 
 namespace gipsi {
 namespace {

@@ -7,8 +7,8 @@
 #include <string>
 #include <vector>
 
+#include "gipsi/io/builtins.h"
 #include "gipsi/io/scene.h"
-#include "gipsi/models/builtins.h"
 #include "gipsi/models/circulation/circulation.h"
 #include "gipsi/models/fem/fem_solid.h"
 #include "gipsi/models/heart/heart.h"

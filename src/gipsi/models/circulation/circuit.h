@@ -139,7 +139,7 @@ class Circuit {
   }
   /// Field-driven source connection c.
   void SetSourceFlow(int c, double q) { source_value_[static_cast<std::size_t>(c)] = q; }
-  /// Checkpoints (gipsi/core/state.h; defined in circulation_state.cc).
+  /// Checkpoints (gipsi/base/state.h; defined in circulation_state.cc).
   void SaveState(StateWriter& out) const;
   void RestoreState(StateReader& in);
 

@@ -5,7 +5,7 @@
 /// event log and the counters. Pressures and flows are outputs recomputed from the state but
 /// are saved too, so probes read the same values before the first step after a restore.
 
-#include "gipsi/core/state.h"
+#include "gipsi/base/state.h"
 #include "gipsi/models/circulation/circuit.h"
 #include "gipsi/models/circulation/circulation.h"
 #include "gipsi/models/circulation/valve.h"

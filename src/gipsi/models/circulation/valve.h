@@ -57,7 +57,7 @@ class ValveEventLog {
   /// The kept events with index ≥ `first` in the total numbering (for "what is new since").
   [[nodiscard]] std::vector<ValveEvent> EventsSince(std::int64_t first) const;
   [[nodiscard]] std::size_t capacity() const { return ring_.size(); }
-  /// Checkpoints (gipsi/core/state.h; defined in circulation_state.cc).
+  /// Checkpoints (gipsi/base/state.h; defined in circulation_state.cc).
   void SaveState(StateWriter& out) const;
   void RestoreState(StateReader& in);
 

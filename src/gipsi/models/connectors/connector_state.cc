@@ -3,7 +3,7 @@
 /// (their buffers are rewritten by every Fire), so they have no state of their own;
 /// ExcitationContraction keeps the tension it integrates over time.
 
-#include "gipsi/core/state.h"
+#include "gipsi/base/state.h"
 #include "gipsi/models/connectors/boundary_coupling.h"
 #include "gipsi/models/connectors/excitation_contraction.h"
 #include "gipsi/models/connectors/field_copy.h"

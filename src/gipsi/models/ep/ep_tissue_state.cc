@@ -5,7 +5,7 @@
 /// nothing else carries over between steps. The diffusion matrix is refactorised at the first
 /// step after a restore (it depends on the step size only), which gives the same factors.
 
-#include "gipsi/core/state.h"
+#include "gipsi/base/state.h"
 #include "gipsi/models/ep/ep_tissue.h"
 
 namespace gipsi {

@@ -7,7 +7,7 @@
 /// last Jacobian norm (it sets the round-off floor of the next step's first residual).
 /// Constraint targets and the current loads are gathered afresh at the start of every step.
 
-#include "gipsi/core/state.h"
+#include "gipsi/base/state.h"
 #include "gipsi/models/fem/fem_solid.h"
 
 namespace gipsi {

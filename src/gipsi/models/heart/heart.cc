@@ -7,8 +7,8 @@
 
 #include "gipsi/base/error.h"
 #include "gipsi/base/log.h"
+#include "gipsi/base/state.h"
 #include "gipsi/base/units.h"
-#include "gipsi/core/state.h"
 
 namespace gipsi {
 namespace {

@@ -6,7 +6,7 @@
 
 #include <vector>
 
-#include "gipsi/core/state.h"
+#include "gipsi/base/state.h"
 #include "gipsi/models/mass_spring/mass_spring.h"
 
 namespace gipsi {

@@ -1,4 +1,4 @@
-#include "gipsi/core/state.h"
+#include "gipsi/base/state.h"
 
 #include <fcntl.h>
 #include <unistd.h>

@@ -1,6 +1,8 @@
 #pragma once
 /// @file
-/// Registration of every type GiPSi ships.
+/// Registration of every type GiPSi ships: the catalogue the scene loader builds objects from.
+/// It lives in io, the first layer above models, collision and haptics, since it registers the
+/// types of all three (each of those layers registers only its own, e.g. `RegisterFemSolid`).
 
 #include "gipsi/core/registry.h"
 

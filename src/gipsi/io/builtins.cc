@@ -1,4 +1,4 @@
-#include "gipsi/models/builtins.h"
+#include "gipsi/io/builtins.h"
 
 #include "gipsi/collision/contact.h"
 #include "gipsi/collision/rigid_tool.h"
