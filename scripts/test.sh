@@ -1,12 +1,19 @@
 #!/usr/bin/env bash
-# Installs the dependencies, then builds and runs every test: the release build, the same suite
-# under AddressSanitizer + UndefinedBehaviorSanitizer (minus the slowest pure-physics tests, which
-# the release stage runs), the multi-threaded tests under ThreadSanitizer, a clang-format check,
-# and a bounded libFuzzer run of the scene loader and every mesh reader (scripts/fuzz.sh, 15 s
-# each). Each stage prints its wall time.
-# Usage: bash scripts/test.sh [--fast]   (--fast: release build and tests only)
+# Installs the dependencies, then checks formatting and the layer graph, builds the release
+# configuration and runs every test in it: the newcomer's command, about 25 minutes on a fresh
+# 2-core machine (docs/robustness.md, "Test stages and their cost").
+#   bash scripts/test.sh --full   adds the same suite under AddressSanitizer + UBSan (minus the
+#                                 slowest pure-physics tests, which the release stage runs), the
+#                                 multi-threaded tests under ThreadSanitizer and a bounded
+#                                 libFuzzer run of the scene loader and every mesh reader
+#                                 (scripts/fuzz.sh, 15 s each). CI (.ci/run) runs --full.
+# Each stage prints its wall time.
 set -euo pipefail
 cd "$(dirname "$0")/.."
+case "${1:-}" in
+  "" | --full) ;;
+  *) echo "test.sh: unknown option '$1' (expected --full or nothing)" >&2; exit 2 ;;
+esac
 bash scripts/install-deps.sh
 
 # ccache keys on paths relative to the checkout (the CMake launcher sets its base folder and
@@ -25,6 +32,9 @@ mapfile -t sources < <(git ls-files '*.h' '*.cc' 2>/dev/null || find src apps te
 clang-format --dry-run --Werror "${sources[@]}"
 echo "clang-format: ${#sources[@]} files formatted"
 
+echo "== layers"
+python3 scripts/check-layers.py
+
 stage_start=$SECONDS
 stage_done() { echo "== $1: $((SECONDS - stage_start)) s"; stage_start=$SECONDS; }
 
@@ -34,7 +44,7 @@ cmake --build --preset release
 ctest --preset release
 stage_done release
 
-if [ "${1:-}" != "--fast" ]; then
+if [ "${1:-}" = "--full" ]; then
   # The slowest pure-physics tests (convergence studies on refined meshes and long
   # integrations, 3.5-12 s each in the release build); the release stage runs them, and their
   # code paths are covered under the sanitizers by the smaller tests of the same solvers.
@@ -76,4 +86,6 @@ if [ "${1:-}" != "--fast" ]; then
   echo "== fuzz (libFuzzer, clang, ASan + UBSan; 15 s per target)"
   bash scripts/fuzz.sh 15
   stage_done fuzz
+else
+  echo "Release stage passed. 'bash scripts/test.sh --full' adds ASan + UBSan, TSan and fuzzing."
 fi
