@@ -14,9 +14,11 @@
 #include "gipsi/haptics/haptic_bridge.h"
 #include "gipsi/haptics/haptic_loop.h"
 #include "gipsi/haptics/virtual_device.h"
+#include "gipsi/models/fem/fem_local_model.h"
 #include "gipsi/models/fem/fem_solid.h"
 #include "gipsi/models/fem/solid_laws.h"
 #include "gipsi/models/mass_spring/mass_spring.h"
+#include "gipsi/models/mass_spring/mass_spring_local_model.h"
 
 namespace gipsi {
 namespace {

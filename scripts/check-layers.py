@@ -32,10 +32,6 @@ BELOW = {
 
 # Upward includes still to be removed (issue 18): (file, included layer) -> why it is there.
 KNOWN = {
-    ("src/gipsi/haptics/local_model_builders.cc", "models"):
-        "the built-in local-model builders know FemSolid and MassSpring",
-    ("src/gipsi/haptics/haptic_probe.cc", "models"):
-        "registers the built-in local-model builders by type",
     ("src/gipsi/io/scene.h", "viz"):
         "the scene loader validates display and plot specifications against viz",
 }

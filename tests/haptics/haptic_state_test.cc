@@ -9,6 +9,7 @@
 #include "gipsi/geometry/generators.h"
 #include "gipsi/haptics/haptic_bridge.h"
 #include "gipsi/haptics/virtual_device.h"
+#include "gipsi/models/fem/fem_local_model.h"
 #include "models/fem/fem_test_util.h"
 
 namespace gipsi {

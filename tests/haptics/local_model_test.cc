@@ -12,7 +12,9 @@
 #include "gipsi/geometry/generators.h"
 #include "gipsi/haptics/haptic_bridge.h"
 #include "gipsi/haptics/virtual_device.h"
+#include "gipsi/models/fem/fem_local_model.h"
 #include "gipsi/models/mass_spring/mass_spring.h"
+#include "gipsi/models/mass_spring/mass_spring_local_model.h"
 #include "haptics/no_allocation_guard.h"
 #include "models/fem/fem_test_util.h"
 

@@ -13,10 +13,10 @@
 
 #include "gipsi/base/error.h"
 #include "gipsi/haptics/haptic_probe.h"
-#include "gipsi/haptics/local_model_builders.h"
 #include "gipsi/haptics/realtime_haptics.h"
 #include "gipsi/io/builtins.h"
 #include "gipsi/io/scene.h"
+#include "gipsi/models/fem/fem_local_model.h"
 #include "gipsi/models/fem/fem_solid.h"
 #include "gipsi/models/fem/solid_material.h"
 #include "haptics/no_allocation_guard.h"

@@ -88,7 +88,7 @@ using MaterialFactory = std::function<std::shared_ptr<const Material>(const Json
 /// Builds a cardiac cell model from its JSON object ({"model": name, ...parameters}; see
 /// gipsi/models/ep/cell_models.h); throws InputError naming the JSON path of a bad parameter.
 using CellModelFactory = std::function<std::shared_ptr<const CellModel>(const JsonNode& params)>;
-/// Builds the haptic local-model builder (gipsi/haptics/local_model_builders.h) of an object of
+/// Builds the haptic local-model builder (gipsi/core/local_model.h) of an object of
 /// the type it is registered under; `rings` is the HapticCoupling's neighbourhood size (0-5),
 /// for builders that use one. May throw InputError (e.g. an object without a boundary).
 using LocalModelFactory =

@@ -15,8 +15,9 @@
 
 #include <memory>
 
+#include "gipsi/core/local_model.h"
 #include "gipsi/haptics/latest_value.h"
-#include "gipsi/haptics/local_model_builders.h"
+#include "gipsi/haptics/local_model.h"
 #include "gipsi/haptics/local_model_tick.h"
 
 namespace gipsi {

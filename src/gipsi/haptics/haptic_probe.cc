@@ -11,8 +11,6 @@
 
 #include "gipsi/base/error.h"
 #include "gipsi/haptics/igtl_surface_sender.h"
-#include "gipsi/models/fem/fem_solid.h"
-#include "gipsi/models/mass_spring/mass_spring.h"
 
 namespace gipsi {
 
@@ -338,21 +336,6 @@ void RegisterHaptics(TypeRegistry& registry) {
         }
       },
       "sends an object's deformed boundary surface as OpenIGTLink POLYDATA (e.g. to 3D Slicer)");
-}
-
-void RegisterHapticLocalModels(TypeRegistry& registry) {
-  registry.local_models.Register(
-      "FemSolid",
-      [](SimObject& object, int /*rings*/) -> std::unique_ptr<LocalModelBuilder> {
-        return std::make_unique<FemCondensation>(dynamic_cast<FemSolid&>(object));
-      },
-      "the tangent stiffness condensed at the contact node (FemCondensation)");
-  registry.local_models.Register(
-      "MassSpring",
-      [](SimObject& object, int rings) -> std::unique_ptr<LocalModelBuilder> {
-        return std::make_unique<MassSpringNeighbourhood>(dynamic_cast<MassSpring&>(object), rings);
-      },
-      "the springs within `rings` of the contact node, linearised (MassSpringNeighbourhood)");
 }
 
 }  // namespace gipsi

@@ -173,9 +173,5 @@ class HapticCoupling final : public Connector {
 /// Registers the object "HapticProbe" and the connectors "HapticCoupling" and
 /// "OpenIGTLinkSurface" (igtl_surface_sender.h).
 void RegisterHaptics(TypeRegistry& registry);
-/// Registers the haptic local models of "FemSolid" (FemCondensation) and "MassSpring"
-/// (MassSpringNeighbourhood). A HapticCoupling finds an object's local model by its type in
-/// TypeRegistry::local_models; a plugin registers one there for its own object types.
-void RegisterHapticLocalModels(TypeRegistry& registry);
 
 }  // namespace gipsi

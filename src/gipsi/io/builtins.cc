@@ -37,7 +37,6 @@ void RegisterBuiltins(TypeRegistry& registry) {
   RegisterRigidTool(registry);
   RegisterContact(registry);
   RegisterHaptics(registry);
-  RegisterHapticLocalModels(registry);
 }
 
 }  // namespace gipsi

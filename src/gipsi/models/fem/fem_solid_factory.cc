@@ -5,6 +5,7 @@
 
 #include "gipsi/base/error.h"
 #include "gipsi/geometry/region_json.h"
+#include "gipsi/models/fem/fem_local_model.h"
 #include "gipsi/models/fem/fem_solid.h"
 #include "gipsi/models/fibres/rule_based_fibres.h"
 
@@ -39,6 +40,12 @@ ImplicitSchemeKind ParseScheme(const JsonNode& node) {
 }  // namespace
 
 void RegisterFemSolid(TypeRegistry& registry) {
+  registry.local_models.Register(
+      "FemSolid",
+      [](SimObject& object, int /*rings*/) -> std::unique_ptr<LocalModelBuilder> {
+        return std::make_unique<FemCondensation>(dynamic_cast<FemSolid&>(object));
+      },
+      "the tangent stiffness condensed at the contact node (FemCondensation)");
   registry.objects.Register(
       "FemSolid",
       [](const ObjectBuildContext& ctx) -> std::unique_ptr<SimObject> {

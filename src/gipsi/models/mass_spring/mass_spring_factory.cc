@@ -11,10 +11,17 @@
 #include "gipsi/geometry/region_json.h"
 #include "gipsi/models/fibres/rule_based_fibres.h"
 #include "gipsi/models/mass_spring/mass_spring.h"
+#include "gipsi/models/mass_spring/mass_spring_local_model.h"
 
 namespace gipsi {
 
 void RegisterMassSpring(TypeRegistry& registry) {
+  registry.local_models.Register(
+      "MassSpring",
+      [](SimObject& object, int rings) -> std::unique_ptr<LocalModelBuilder> {
+        return std::make_unique<MassSpringNeighbourhood>(dynamic_cast<MassSpring&>(object), rings);
+      },
+      "the springs within `rings` of the contact node, linearised (MassSpringNeighbourhood)");
   registry.objects.Register(
       "MassSpring",
       [](const ObjectBuildContext& ctx) -> std::unique_ptr<SimObject> {
