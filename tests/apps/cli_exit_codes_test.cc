@@ -201,7 +201,7 @@ std::string ReadAll(const fs::path& file) {
   return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
 }
 
-TEST(GipsiSignals, SigtermStopsARuningRunWithinAMacroStep) {
+TEST(GipsiSignals, SigtermStopsARunningRunWithinAMacroStep) {
   const fs::path dir = testing::TestTempDir();
   const pid_t pid = Spawn({"run", Scene("hanging_sheet.json"), "--until", "10000", "--no-vtu", "-q",
                            "--out", (dir / "out").string()},
@@ -214,7 +214,7 @@ TEST(GipsiSignals, SigtermStopsARuningRunWithinAMacroStep) {
   EXPECT_THAT(ReadAll(dir / "log"), HasSubstr("stopped on request at t = "));
 }
 
-TEST(GipsiSignals, SigintStopsALongBuild) {
+TEST(GipsiSignals, SigintStopsALongBuildThatReportsItsStages) {
   // A box of a million cells takes tens of seconds to build.
   const fs::path dir = testing::TestTempDir();
   std::ofstream(dir / "big.json") << R"({
@@ -228,6 +228,8 @@ TEST(GipsiSignals, SigintStopsALongBuild) {
   const auto [code, seconds] = WaitFor(pid, std::chrono::seconds(60));
   EXPECT_EQ(code, 130) << ReadAll(dir / "log");
   EXPECT_LT(seconds, 2.0);  // measured 0.2 s: at once, not at the end of the build
+  // Not a terminal: a plain line for the stage that has taken over 2 s.
+  EXPECT_THAT(ReadAll(dir / "log"), HasSubstr("building: [1/5] mesh 'box' (generate box) ...\n"));
   EXPECT_THAT(ReadAll(dir / "log"),
               HasSubstr("gipsi: stopped on request while building the scene"));
 }
