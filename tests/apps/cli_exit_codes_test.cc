@@ -314,6 +314,17 @@ TEST(GipsiInfo, NamesTetsByTheFilesOwnIds) {
   const Result r = Gipsi("info " + (dir / "two.msh").string());
   ASSERT_EQ(r.code, 0) << r.output;
   EXPECT_THAT(r.output, HasSubstr("inverted tets:  1 — ids: 9 (Gmsh element tags)"));
+  // A MassSpring accepted such a mesh silently; it warns now.
+  std::ofstream(dir / "two.json") << R"({"meshes": {"two": {"file": "two.msh"}},
+    "objects": {"tets": {"type": "MassSpring", "domain": "two", "dt": 0.001}},
+    "schedule": {"end": 1}})";
+  const Result validate = Gipsi("validate " + (dir / "two.json").string());
+  EXPECT_EQ(validate.code, 0) << validate.output;
+  EXPECT_THAT(validate.output,
+              HasSubstr("two.json: objects.tets: 1 of 2 tets of the domain are inverted "
+                        "(negative volume in node order 0-1-2-3; the first is tet 1, counting "
+                        "from 0): volume preservation would push them further inside out; fix "
+                        "the mesh's node order (`gipsi info` lists them)"));
   // A format without ids of its own says which ids it prints.
   std::ofstream(dir / "two.vtk")
       << "# vtk DataFile Version 3.0\ntwo\nASCII\nDATASET UNSTRUCTURED_GRID\nPOINTS 5 double\n"
