@@ -8,18 +8,28 @@
 
 #include <unistd.h>
 
+#include <algorithm>
+#include <atomic>
+#include <cerrno>
 #include <chrono>
 #include <cmath>
+#include <condition_variable>
 #include <csignal>
 #include <cstdio>
+#include <cstdlib>
+#include <cstring>
 #include <fstream>
 #include <iostream>
+#include <mutex>
 #include <optional>
+#include <thread>
 
 #include <fmt/format.h>
 #include <CLI/CLI.hpp>
 
+#include "cli_checks.h"
 #include "gipsi/base/error.h"
+#include "gipsi/base/file_io.h"
 #include "gipsi/base/log.h"
 #include "gipsi/base/state.h"
 #include "gipsi/haptics/realtime_haptics.h"
@@ -51,12 +61,56 @@ namespace {
 
 std::atomic<gipsi::Kernel*> g_running_kernel{nullptr};
 
+/// SIGINT/SIGTERM: a running kernel stops after its current macro step (Kernel::RequestStop,
+/// also when the request comes before its Run starts), flushing its outputs. Before there is a
+/// kernel — while the scene and its meshes are built, which writes nothing — the tool exits
+/// at once with 130.
 extern "C" void HandleStopSignal(int) {
-  if (gipsi::Kernel* kernel = g_running_kernel.load()) kernel->RequestStop();
+  if (gipsi::Kernel* kernel = g_running_kernel.load()) {
+    kernel->RequestStop();
+    return;
+  }
+  constexpr char kMessage[] = "\ngipsi: stopped on request while building the scene\n";
+  [[maybe_unused]] const ssize_t n = ::write(STDERR_FILENO, kMessage, sizeof(kMessage) - 1);
+  std::_Exit(130);
 }
 
-/// Progress on a terminal: a bar rewritten in place at most 10 times a second; otherwise a plain
-/// line at every 10 % of the run.
+/// Installs HandleStopSignal for SIGINT and SIGTERM while alive; restores the defaults after.
+class StopSignals {
+ public:
+  StopSignals() {
+    std::signal(SIGINT, HandleStopSignal);
+    std::signal(SIGTERM, HandleStopSignal);
+  }
+  StopSignals(const StopSignals&) = delete;
+  StopSignals& operator=(const StopSignals&) = delete;
+  ~StopSignals() {
+    std::signal(SIGINT, SIG_DFL);
+    std::signal(SIGTERM, SIG_DFL);
+  }
+};
+
+/// Makes `kernel` the one a stop signal asks to stop, while alive (declare it after the kernel's
+/// owner, so it is gone before the kernel is).
+class SignalTarget {
+ public:
+  explicit SignalTarget(gipsi::Kernel& kernel) { g_running_kernel.store(&kernel); }
+  SignalTarget(const SignalTarget&) = delete;
+  SignalTarget& operator=(const SignalTarget&) = delete;
+  ~SignalTarget() { g_running_kernel.store(nullptr); }
+};
+
+/// "1m05s" / "12s" / "3h02m" for a number of wall seconds.
+std::string Duration(double seconds) {
+  const auto s = static_cast<std::int64_t>(std::llround(std::max(0.0, seconds)));
+  if (s >= 3600) return fmt::format("{}h{:02d}m", s / 3600, (s % 3600) / 60);
+  if (s >= 60) return fmt::format("{}m{:02d}s", s / 60, s % 60);
+  return fmt::format("{}s", s);
+}
+
+/// Progress of a run. On a terminal: a bar rewritten in place at most 10 times a second, with
+/// the estimated wall time left (ETA, from the pace since the first step); otherwise a plain line
+/// at every 10 % of the run.
 class Progress {
  public:
   explicit Progress(bool quiet) : quiet_(quiet), tty_(isatty(STDERR_FILENO) != 0) {}
@@ -64,19 +118,30 @@ class Progress {
     if (quiet_ || end <= 0) return;
     const double fraction = std::min(1.0, t / end);
     auto now = std::chrono::steady_clock::now();
+    if (!started_) {  // the first step's time and wall clock: the pace is measured from here
+      started_ = true;
+      t0_ = t;
+      wall0_ = now;
+    }
+    const double elapsed = std::chrono::duration<double>(now - wall0_).count();
+    const std::string eta = t > t0_ && elapsed > 0.5
+                                ? fmt::format(", ETA {}", Duration(elapsed * (end - t) / (t - t0_)))
+                                : std::string();
     if (tty_) {
       if (now - last_ < std::chrono::milliseconds(100) && fraction < 1.0) return;
       last_ = now;
       const int width = 30, filled = static_cast<int>(fraction * width);
-      std::fprintf(stderr, "\r[%s%s] %5.1f%%  t = %.4g / %.4g s", std::string(filled, '#').c_str(),
-                   std::string(width - filled, ' ').c_str(), 100 * fraction, t, end);
+      std::fprintf(stderr, "\r[%s%s] %5.1f%%  t = %.4g / %.4g s%s\033[K",
+                   std::string(filled, '#').c_str(), std::string(width - filled, ' ').c_str(),
+                   100 * fraction, t, end, eta.c_str());
       std::fflush(stderr);
       dirty_ = true;
     } else {
       const int decile = static_cast<int>(fraction * 10 + 1e-9);
       if (decile <= last_decile_) return;
       last_decile_ = decile;
-      std::fprintf(stderr, "progress: %3d%%  t = %.6g s\n", decile * 10, t);
+      std::fprintf(stderr, "progress: %3d%%  t = %.6g s%s\n", decile * 10, t,
+                   decile < 10 ? eta.c_str() : "");
     }
   }
   void Done() {
@@ -86,16 +151,96 @@ class Progress {
 
  private:
   bool quiet_, tty_;
-  bool dirty_ = false;
+  bool dirty_ = false, started_ = false;
   int last_decile_ = 0;
-  std::chrono::steady_clock::time_point last_{};
+  double t0_ = 0;
+  std::chrono::steady_clock::time_point last_{}, wall0_{};
 };
 
+/// Progress of building a scene (gipsi::BuildProgressFn): which stage (mesh, object, ...) is
+/// being built and for how long, from a thread that looks every 100 ms. On a terminal a line
+/// rewritten in place once the build has taken 0.5 s; otherwise a plain line for each stage that
+/// takes over 2 s, when it has taken 2 s and when it ends. Nothing with -q.
+class BuildProgress {
+ public:
+  explicit BuildProgress(bool quiet) : quiet_(quiet), tty_(isatty(STDERR_FILENO) != 0) {
+    if (quiet_) return;
+    start_ = stage_start_ = std::chrono::steady_clock::now();
+    ticker_ = std::thread([this] { Tick(); });
+  }
+  BuildProgress(const BuildProgress&) = delete;
+  BuildProgress& operator=(const BuildProgress&) = delete;
+  ~BuildProgress() { Done(); }
+
+  /// The callback for LoadScene.
+  gipsi::BuildProgressFn Callback() {
+    if (quiet_) return {};
+    return [this](std::string_view stage, int done, int total) {
+      std::lock_guard lock(mutex_);
+      EndStage();
+      stage_ = fmt::format("[{}/{}] {}", done + 1, total, stage);
+      stage_start_ = std::chrono::steady_clock::now();
+    };
+  }
+
+  /// Stops the ticker and clears the line (idempotent).
+  void Done() {
+    if (quiet_) return;
+    {
+      std::lock_guard lock(mutex_);
+      if (finished_) return;
+      finished_ = true;
+      EndStage();
+      if (drawn_) std::fprintf(stderr, "\r\033[K");
+      std::fflush(stderr);
+    }
+    wake_.notify_all();
+    ticker_.join();
+  }
+
+ private:
+  using Clock = std::chrono::steady_clock;
+  static double Seconds(Clock::time_point since) {
+    return std::chrono::duration<double>(Clock::now() - since).count();
+  }
+  void EndStage() {  // mutex_ held
+    if (announced_)
+      std::fprintf(stderr, "building: %s: done in %.1f s\n", stage_.c_str(), Seconds(stage_start_));
+    announced_ = false;
+  }
+  void Tick() {
+    std::unique_lock lock(mutex_);
+    while (!wake_.wait_for(lock, std::chrono::milliseconds(100), [this] { return finished_; })) {
+      if (stage_.empty()) continue;
+      if (tty_) {
+        if (Seconds(start_) < 0.5) continue;
+        std::fprintf(stderr, "\rbuilding %s  %.1f s (total %.1f s)\033[K", stage_.c_str(),
+                     Seconds(stage_start_), Seconds(start_));
+        drawn_ = true;
+      } else if (!announced_ && Seconds(stage_start_) > 2.0) {
+        std::fprintf(stderr, "building: %s ...\n", stage_.c_str());
+        announced_ = true;
+      }
+      std::fflush(stderr);
+    }
+  }
+
+  bool quiet_, tty_;
+  std::mutex mutex_;
+  std::condition_variable wake_;
+  std::thread ticker_;
+  std::string stage_;
+  Clock::time_point start_, stage_start_;
+  bool finished_ = false, drawn_ = false, announced_ = false;
+};
+
+/// Loads the scene with its build progress (unless `quiet`).
 gipsi::Scene Load(const std::string& file, const std::vector<std::string>& plugins,
-                  gipsi::TypeRegistry& registry, const gipsi::SceneLimits& limits) {
+                  gipsi::TypeRegistry& registry, const gipsi::SceneLimits& limits, bool quiet) {
   gipsi::RegisterBuiltins(registry);
   for (const auto& plugin : plugins) registry.LoadPlugin(plugin);
-  return gipsi::LoadScene(file, registry, limits);
+  BuildProgress progress(quiet);
+  return gipsi::LoadScene(file, registry, limits, progress.Callback());
 }
 
 /// Adds the resource-limit options (SceneLimits) to a subcommand.
@@ -109,7 +254,7 @@ void AddLimitOptions(CLI::App& command, gipsi::SceneLimits& limits) {
   command
       .add_option("--max-mesh-cells", limits.max_mesh_cells,
                   "Refuse a scene mesh with more nodes or cells (tets + triangles) than N")
-      ->check(CLI::PositiveNumber)
+      ->check(gipsi::apps::IntegerIn(1, INT64_MAX, "a positive whole number"))
       ->capture_default_str();
 }
 
@@ -141,6 +286,74 @@ std::string ProfileTable(const gipsi::Kernel& kernel, double wall_seconds) {
   return table;
 }
 
+/// The VTU frames of `series` under `out` that GiPSi wrote: `<series>/<series>_NNNNNN.vtu`.
+std::vector<std::filesystem::path> FrameFiles(const std::filesystem::path& out,
+                                              const std::string& series) {
+  std::vector<std::filesystem::path> frames;
+  std::error_code error;
+  const std::filesystem::path dir = out / series;
+  if (!std::filesystem::is_directory(dir, error)) return frames;
+  for (const auto& entry : std::filesystem::directory_iterator(dir, error)) {
+    const std::string name = entry.path().filename().string();
+    const std::string prefix = series + "_";
+    if (!entry.is_regular_file(error) || !name.starts_with(prefix) || !name.ends_with(".vtu") ||
+        name.size() != prefix.size() + 6 + 4)
+      continue;
+    const std::string digits = name.substr(prefix.size(), 6);
+    if (std::all_of(digits.begin(), digits.end(), [](char c) { return c >= '0' && c <= '9'; }))
+      frames.push_back(entry.path());
+  }
+  return frames;
+}
+
+/// Before a fresh (not resumed) run writes VTU series into `out`: a series of the same name
+/// from an earlier run there would keep frames the new, perhaps shorter, run's `.pvd` no longer
+/// lists. Refuses (InputError naming the directory) unless `overwrite`; with it, deletes the
+/// earlier series' frames and collections — only files of the form GiPSi writes
+/// (`<out>/<series>.pvd`, `<out>/<series>/<series>_NNNNNN.vtu`), nothing else.
+void PrepareOutputDirectory(const gipsi::Scene& scene, const std::filesystem::path& out,
+                            bool resume, bool overwrite) {
+  if (resume || !scene.vtu.enabled) return;
+  std::vector<const gipsi::SimObject*> leaves;
+  const auto& coordinator = scene.kernel->coordinator();
+  if (scene.vtu.objects.empty()) {
+    for (std::size_t i = 0; i < coordinator.num_objects(); ++i)
+      coordinator.object(i).CollectLeaves(leaves);
+  } else {
+    for (const auto& name : scene.vtu.objects) scene.kernel->FindObject(name).CollectLeaves(leaves);
+  }
+  std::vector<std::filesystem::path> stale;
+  std::string first;
+  for (const gipsi::SimObject* leaf : leaves) {
+    for (const std::string& series : {leaf->name(), leaf->name() + "_display"}) {
+      std::vector<std::filesystem::path> frames = FrameFiles(out, series);
+      std::error_code error;
+      const std::filesystem::path pvd = out / (series + ".pvd");
+      if (std::filesystem::is_regular_file(pvd, error)) frames.push_back(pvd);
+      if (!frames.empty() && first.empty())
+        first = fmt::format("{} ({} files)", series, frames.size());
+      stale.insert(stale.end(), frames.begin(), frames.end());
+    }
+  }
+  if (stale.empty()) return;
+  if (!overwrite)
+    gipsi::ThrowInputError(
+        "command line", "--out",
+        fmt::format("{} holds VTU series of an earlier run (e.g. {}); a new run would leave "
+                    "frames its .pvd does not list: choose another --out, or add --overwrite to "
+                    "delete the earlier series there first",
+                    out.string(), first));
+  for (const auto& file : stale) {
+    std::error_code error;
+    std::filesystem::remove(file, error);
+    if (error)
+      throw gipsi::OutputError(
+          fmt::format("{}: cannot delete the earlier output: {}", file.string(), error.message()));
+  }
+  gipsi::Log().info("--overwrite: deleted {} files of earlier VTU series in {}", stale.size(),
+                    out.string());
+}
+
 /// Options of `gipsi run` about checkpoints.
 struct CheckpointOptions {
   double every = 0;    ///< simulated seconds between checkpoints; 0: none
@@ -149,15 +362,18 @@ struct CheckpointOptions {
 };
 
 int Run(const std::string& file, const std::string& out_dir, double until, bool quiet, bool no_vtu,
-        bool profile, const std::vector<std::string>& plugins, const CheckpointOptions& checkpoints,
-        const gipsi::SceneLimits& limits) {
+        bool profile, bool overwrite, const std::vector<std::string>& plugins,
+        const CheckpointOptions& checkpoints, const gipsi::SceneLimits& limits) {
+  StopSignals signals;  // while building: exit 130 at once; then: stop the run cleanly
   gipsi::TypeRegistry registry;
-  gipsi::Scene scene = Load(file, plugins, registry, limits);
+  gipsi::Scene scene = Load(file, plugins, registry, limits, quiet);
   if (until > 0) scene.end_time = until;
   if (no_vtu) scene.vtu.enabled = false;
   std::filesystem::path out =
       out_dir.empty() ? scene.output_directory : std::filesystem::path(out_dir);
   gipsi::Kernel& kernel = *scene.kernel;
+  // From here a signal asks the kernel to stop (it does after at most one macro step of Run).
+  const SignalTarget signal_target(kernel);
   // A real-time probe ticks on the wall clock: the run is not reproducible, so there is nothing
   // a checkpoint could restore bit for bit.
   if (checkpoints.every > 0 || !checkpoints.resume.empty())
@@ -188,21 +404,34 @@ int Run(const std::string& file, const std::string& out_dir, double until, bool 
                              fmt::format("this scene cannot be checkpointed: {}", e.what()));
     }
   }
+  PrepareOutputDirectory(scene, out, !checkpoints.resume.empty(), overwrite);
   gipsi::AttachOutputs(scene, out, !checkpoints.resume.empty());
-  if (!checkpoints.resume.empty()) kernel.ReadCheckpoint(checkpoints.resume);
+  if (!checkpoints.resume.empty()) {
+    kernel.ReadCheckpoint(checkpoints.resume);
+    const double tolerance = 1e-9 * kernel.macro_dt();
+    if (scene.end_time <= kernel.time() + tolerance)
+      gipsi::ThrowInputError(
+          "command line", until > 0 ? "--until" : "--resume",
+          fmt::format("the checkpoint {} is at t = {:.6g} s, not before the end of the run at "
+                      "{:.6g} s{}: nothing to run (give a later --until)",
+                      checkpoints.resume, kernel.time(), scene.end_time,
+                      until > 0 ? " (--until)" : " (schedule.end)"));
+  }
+  // The summary counts this run's steps: a resumed object's counter started at the checkpoint.
+  const auto& coordinator = kernel.coordinator();
+  std::vector<std::int64_t> steps_before(coordinator.num_objects());
+  for (std::size_t i = 0; i < coordinator.num_objects(); ++i)
+    steps_before[i] = coordinator.object(i).step_count();
+  std::vector<std::int64_t> fired_before(coordinator.num_connectors());
+  for (std::size_t i = 0; i < coordinator.num_connectors(); ++i)
+    fired_before[i] = coordinator.connector(i).fire_count();
 
   Progress progress(quiet);
-  g_running_kernel.store(&kernel);
-  std::signal(SIGINT, HandleStopSignal);
-  std::signal(SIGTERM, HandleStopSignal);
   gipsi::RealtimeHaptics haptics(kernel);  // joins the loops however the run ends
   haptics.Start();
   gipsi::RunResult result =
       kernel.Run(scene.end_time, [&](double t, double end) { progress.Update(t, end); });
   haptics.Stop();  // logs each loop's period percentiles
-  g_running_kernel.store(nullptr);
-  std::signal(SIGINT, SIG_DFL);
-  std::signal(SIGTERM, SIG_DFL);
   progress.Done();
 
   std::string summary;
@@ -212,16 +441,16 @@ int Run(const std::string& file, const std::string& out_dir, double until, bool 
   summary += fmt::format("real-time factor: {:.3g}\n", result.real_time_factor());
   summary +=
       fmt::format("macro steps:      {} of {:.6g} s\n", result.macro_steps, kernel.macro_dt());
-  const auto& coordinator = kernel.coordinator();
   for (std::size_t i = 0; i < coordinator.num_objects(); ++i) {
     const auto& object = coordinator.object(i);
-    summary += fmt::format("  {:<20} {:<14} {} steps of {:.6g} s\n", object.name(),
-                           object.type_name(), object.step_count(), coordinator.object_dt(i));
+    summary +=
+        fmt::format("  {:<20} {:<14} {} steps of {:.6g} s\n", object.name(), object.type_name(),
+                    object.step_count() - steps_before[i], coordinator.object_dt(i));
   }
   for (std::size_t i = 0; i < coordinator.num_connectors(); ++i) {
     const auto& connector = coordinator.connector(i);
     summary += fmt::format("  {:<20} {:<14} fired {} times\n", connector.name(),
-                           connector.type_name(), connector.fire_count());
+                           connector.type_name(), connector.fire_count() - fired_before[i]);
   }
   for (const auto& [t, what] : kernel.fired_events())
     summary += fmt::format("  event at {:.6g} s: {}\n", t, what);
@@ -263,7 +492,7 @@ int Run(const std::string& file, const std::string& out_dir, double until, bool 
 int Validate(const std::string& file, const std::vector<std::string>& plugins,
              const gipsi::SceneLimits& limits) {
   gipsi::TypeRegistry registry;
-  gipsi::Scene scene = Load(file, plugins, registry, limits);
+  gipsi::Scene scene = Load(file, plugins, registry, limits, false);
   const auto& coordinator = scene.kernel->coordinator();
   std::cout << fmt::format("{}: valid scene\n", file);
   std::cout << fmt::format("  end time {:.6g} s, macro step {:.6g} s\n", scene.end_time,
@@ -303,8 +532,9 @@ int Validate(const std::string& file, const std::vector<std::string>& plugins,
 }
 
 int Info(const std::string& file) {
-  gipsi::Mesh mesh = gipsi::ReadMesh(file);
-  std::cout << file << "\n" << gipsi::DescribeMesh(mesh);
+  gipsi::MeshFileIds ids;
+  gipsi::Mesh mesh = gipsi::ReadMesh(file, &ids);
+  std::cout << file << "\n" << gipsi::DescribeMesh(mesh, &ids);
   return 0;
 }
 
@@ -369,7 +599,8 @@ int Cell(CellOptions options, const std::vector<std::string>& plugins) {
   if (!options.out.empty()) {
     csv.open(options.out);
     if (!csv) {
-      std::cerr << "gipsi: error: cannot create " << options.out << "\n";
+      std::cerr << "gipsi: error: " << options.out
+                << ": cannot create the file: " << std::strerror(errno) << "\n";
       return 4;
     }
     csv << gipsi::CellTraceCsvHeader(*model) << '\n';
@@ -398,9 +629,12 @@ int Cell(CellOptions options, const std::vector<std::string>& plugins) {
     std::cout << fmt::format("{:>5} {:>10.6g} {:>9.3f} {:>9.3f} {:>10.2f} {:>10.3f} {:>9.2f}\n",
                              b.beat, b.start, b.rest, b.peak, b.dvdt_max, b.activation, b.apd);
   if (!options.out.empty()) {
-    csv.flush();
+    errno = 0;
+    csv.close();
     if (!csv) {
-      std::cerr << "gipsi: error: writing " << options.out << " failed\n";
+      std::cerr << "gipsi: error: " << options.out
+                << ": cannot write: " << (errno != 0 ? std::strerror(errno) : "the stream failed")
+                << "\n";
       return 4;
     }
     std::cout << "trace:    " << options.out << "\n";
@@ -416,7 +650,7 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   std::string scene_file, out_dir, mesh_file;
   double until = 0;
-  bool quiet = false, no_vtu = false, verbose = false, profile = false;
+  bool quiet = false, no_vtu = false, verbose = false, profile = false, overwrite = false;
   std::vector<std::string> plugins;
   app.add_flag("-v,--verbose", verbose, "Log more (debug level)");
 
@@ -425,7 +659,10 @@ int main(int argc, char** argv) {
   run->add_option("SCENE", scene_file, "Scene file (JSON)")->required();
   run->add_option("-o,--out", out_dir, "Output directory (default: the scene's, or out/<scene>)");
   run->add_option("--until", until, "End time in seconds, overriding schedule.end")
-      ->check(CLI::PositiveNumber);
+      ->check(gipsi::apps::PositiveNumber("a positive number of seconds"));
+  run->add_flag("--overwrite", overwrite,
+                "Delete the VTU series an earlier run left in the output directory (only the "
+                "files GiPSi writes) instead of refusing to run there");
   run->add_flag("-q,--quiet", quiet,
                 "No progress bar, no summary unless the run fails, and only warnings and errors "
                 "in the log");
@@ -440,7 +677,7 @@ int main(int argc, char** argv) {
   run->add_option("--checkpoint-every", checkpoints.every,
                   "Write a checkpoint every T seconds of simulated time (a whole number of macro "
                   "steps), and when stopped by SIGINT/SIGTERM")
-      ->check(CLI::PositiveNumber);
+      ->check(gipsi::apps::PositiveNumber("a positive number of seconds"));
   run->add_option("--checkpoint", checkpoints.file,
                   "Checkpoint file to write (default: <out>/checkpoint.gck)");
   run->add_option("--resume", checkpoints.resume,
@@ -474,43 +711,57 @@ int main(int argc, char** argv) {
                    "Model parameter key=value, e.g. g_ks=0.2 (repeatable)");
   cell->add_option("--bcl", cell_options.protocol.bcl, "Basic cycle length [ms]")
       ->capture_default_str()
-      ->check(CLI::PositiveNumber);
+      ->check(gipsi::apps::PositiveNumber("a positive number of milliseconds"));
   cell->add_option("--beats", cell_options.protocol.beats, "Number of beats")
       ->capture_default_str()
-      ->check(CLI::PositiveNumber);
+      ->check(gipsi::apps::IntegerIn(1, 1'000'000, "a whole number of beats from 1 to 1000000"));
   cell->add_option("--dt", cell_options.protocol.dt, "Time step [ms]")
       ->capture_default_str()
-      ->check(CLI::PositiveNumber);
+      ->check(gipsi::apps::PositiveNumber("a positive number of milliseconds"));
   cell->add_option("--stim-amplitude", cell_options.stim_amplitude,
-                   "Stimulus [uA/uF], positive depolarises (default: the model's)");
+                   "Stimulus [uA/uF], positive depolarises (default: the model's)")
+      ->check(gipsi::apps::FiniteNumber(-HUGE_VAL, false, HUGE_VAL, "a finite number"));
   cell->add_option("--stim-duration", cell_options.stim_duration,
                    "Stimulus duration [ms] (default: the model's)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(gipsi::apps::NonNegativeNumber("a non-negative number of milliseconds"));
   cell->add_option("--apd", cell_options.protocol.apd_percent,
                    "Repolarisation level of the APD [%]")
       ->capture_default_str()
-      ->check(CLI::Range(0.0, 100.0));
+      ->check(gipsi::apps::FiniteNumber(0, false, 100, "a percentage in (0, 100]"));
   cell->add_option("--threshold", cell_options.protocol.activation_threshold,
                    "Activation threshold [mV]")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(gipsi::apps::FiniteNumber(-HUGE_VAL, false, HUGE_VAL, "a finite number of mV"));
   cell->add_option("-o,--out", cell_options.out,
                    "Write a CSV trace: t_ms then every state variable");
   cell->add_option("--every", cell_options.every, "Write every K-th step to the CSV")
       ->capture_default_str()
-      ->check(CLI::PositiveNumber);
+      ->check(gipsi::apps::IntegerIn(1, INT64_MAX, "a positive whole number of steps"));
   cell->add_option("--plugin", plugins, "Load a plugin shared library (repeatable)");
 
   gipsi::apps::VizCommands viz_commands(app);
 
-  CLI11_PARSE(app, argc, argv);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    if (e.get_exit_code() == 0) return app.exit(e);  // --help, --version
+    // CLI11's own codes (105, 106, 109, ...) are not the tool's: a bad command line exits 2.
+    std::cerr << "gipsi: error: command line: " << e.what()
+              << "\nRun 'gipsi --help' or 'gipsi SUBCOMMAND --help' for the options.\n";
+    return 2;
+  }
   // -q (run): warnings and errors only; -v: debug lines too.
   gipsi::Log().set_level(quiet     ? spdlog::level::warn
                          : verbose ? spdlog::level::debug
                                    : spdlog::level::info);
   try {
     if (*run)
-      return Run(scene_file, out_dir, until, quiet, no_vtu, profile, plugins, checkpoints, limits);
-    if (*validate) return Validate(scene_file, plugins, limits);
+      return Run(scene_file, out_dir, until, quiet, no_vtu, profile, overwrite, plugins,
+                 checkpoints, limits);
+    if (*validate) {
+      StopSignals signals;  // Ctrl-C while building: exit 130 at once
+      return Validate(scene_file, plugins, limits);
+    }
     if (*info) return Info(mesh_file);
     if (*types) return Types(plugins);
     if (*cell) return Cell(cell_options, plugins);
@@ -518,6 +769,14 @@ int main(int argc, char** argv) {
   } catch (const gipsi::InputError& e) {
     std::cerr << "gipsi: error: " << e.what() << "\n";
     return 1;
+  } catch (const gipsi::OutputError& e) {
+    std::cerr << "gipsi: error: " << e.what() << "\n";
+    return 4;
+  } catch (const std::filesystem::filesystem_error& e) {
+    // Creating the output directory or files (the readers report their own errors as
+    // InputError): a write failure.
+    std::cerr << "gipsi: error: " << gipsi::DescribeFilesystemError(e) << "\n";
+    return 4;
   } catch (const std::exception& e) {
     std::cerr << "gipsi: error: " << e.what() << "\n";
     return 1;

@@ -1,5 +1,7 @@
 #include "viz_commands.h"
 
+#include "cli_checks.h"
+
 #include <charconv>
 #include <iostream>
 
@@ -53,7 +55,7 @@ VizCommands::VizCommands(CLI::App& app) {
   snapshot_->add_option("-o,--out", out_, "PNG file to write")->required();
   snapshot_->add_option("-t,--time", time_, "Simulated time to run to first [s] (0: initial state)")
       ->capture_default_str()
-      ->check(CLI::NonNegativeNumber);
+      ->check(NonNegativeNumber("a non-negative number of seconds"));
   snapshot_->add_option("--camera", camera_,
                         "AZIMUTH,ELEVATION[,DISTANCE]: degrees about +z (0 = from -y), degrees "
                         "above the xy plane, scene units (default -60,25 and fitted distance)");
@@ -92,13 +94,13 @@ VizCommands::VizCommands(CLI::App& app) {
   view_->add_flag("--play", play_, "Start playing");
   view_->add_option("--speed", speed_, "Target real-time factor (0: as fast as possible)")
       ->capture_default_str()
-      ->check(CLI::NonNegativeNumber);
+      ->check(NonNegativeNumber("a non-negative real-time factor"));
   view_->add_flag("--no-ui", no_ui_, "Hide the panel");
   view_->add_option("--screenshot", screenshot_,
                     "Run to --screenshot-time, save the window as this PNG and exit");
   view_->add_option("--screenshot-time", screenshot_time_, "Simulated time of the screenshot [s]")
       ->capture_default_str()
-      ->check(CLI::NonNegativeNumber);
+      ->check(NonNegativeNumber("a non-negative number of seconds"));
   view_->add_option("--drag", drag_,
                     "With --screenshot: X0,Y0,X1,Y1: at t = 0 pull the surface under window "
                     "pixel (X0, Y0) to (X1, Y1) with the mouse tool and hold it (for tests)");

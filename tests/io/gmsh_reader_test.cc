@@ -236,7 +236,7 @@ TEST(GmshReader, SurvivesEveryTruncationOfBinary) {
 
 TEST(GmshReader, RejectsMissingFile) {
   EXPECT_EQ(InputErrorMessage([] { ReadGmsh("/nonexistent/x.msh"); }),
-            "/nonexistent/x.msh: cannot open file");
+            "/nonexistent/x.msh: cannot open mesh file for reading: No such file or directory");
 }
 
 }  // namespace

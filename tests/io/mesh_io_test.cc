@@ -40,7 +40,7 @@ TEST(MeshIo, RejectsUnknownExtensionListingSupportedOnes) {
 
 TEST(MeshIo, RejectsMissingFile) {
   EXPECT_EQ(InputErrorMessage([] { ReadMesh("/nonexistent/organ.msh"); }),
-            "/nonexistent/organ.msh: cannot open file");
+            "/nonexistent/organ.msh: cannot open mesh file for reading: No such file or directory");
 }
 
 TEST(MeshIo, WriteMeshRoundTripsEveryWritableFormat) {

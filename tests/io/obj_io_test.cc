@@ -71,7 +71,7 @@ TEST(ObjWriter, RoundTripsExactly) {
 
 TEST(ObjReader, RejectsMissingFile) {
   EXPECT_EQ(InputErrorMessage([] { ReadObj("/nonexistent/x.obj"); }),
-            "/nonexistent/x.obj: cannot open file");
+            "/nonexistent/x.obj: cannot open mesh file for reading: No such file or directory");
 }
 
 }  // namespace

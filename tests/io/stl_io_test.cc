@@ -118,7 +118,7 @@ TEST(StlReader, ReportsLineOfMalformedAscii) {
 
 TEST(StlReader, RejectsMissingFile) {
   EXPECT_EQ(InputErrorMessage([] { ReadStl("/nonexistent/x.stl"); }),
-            "/nonexistent/x.stl: cannot open file");
+            "/nonexistent/x.stl: cannot open mesh file for reading: No such file or directory");
 }
 
 }  // namespace

@@ -78,7 +78,7 @@ TEST(TetGenReader, ReportsShortLineWithFileAndLine) {
 TEST(TetGenReader, RejectsMissingEleFile) {
   auto node = WriteBytes(Scratch("alone.node"), "1 3 0 0\n1 0 0 0\n");
   EXPECT_THAT(InputErrorMessage([&] { ReadTetGen(node); }),
-              HasSubstr("alone.ele: cannot open file"));
+              HasSubstr("alone.ele: cannot open mesh file for reading: No such file or directory"));
 }
 
 }  // namespace

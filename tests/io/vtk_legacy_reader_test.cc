@@ -149,7 +149,7 @@ TEST(VtkLegacyReader, SurvivesEveryTruncationOfBinary) {
 
 TEST(VtkLegacyReader, RejectsMissingFile) {
   EXPECT_EQ(InputErrorMessage([] { ReadVtkLegacy("/nonexistent/x.vtk"); }),
-            "/nonexistent/x.vtk: cannot open file");
+            "/nonexistent/x.vtk: cannot open mesh file for reading: No such file or directory");
 }
 
 }  // namespace

@@ -212,7 +212,7 @@ TEST(VtuReader, SurvivesEveryTruncationOfAppendedData) {
 
 TEST(VtuReader, RejectsMissingFile) {
   EXPECT_EQ(InputErrorMessage([] { ReadVtu("/nonexistent/x.vtu"); }),
-            "/nonexistent/x.vtu: cannot open file");
+            "/nonexistent/x.vtu: cannot open mesh file for reading: No such file or directory");
 }
 
 }  // namespace

@@ -1,5 +1,8 @@
 #include "gipsi/io/vtu_writer.h"
 
+#include <sys/resource.h>
+
+#include <csignal>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -11,6 +14,7 @@
 
 #include <fmt/format.h>
 
+#include "gipsi/base/file_io.h"
 #include "gipsi/io/base64.h"
 #include "gipsi/io/gmsh_reader.h"
 #include "gipsi/io/vtu_reader.h"
@@ -71,9 +75,42 @@ TEST(VtuWriter, WritesPointAndCellDataBitExactly) {
   EXPECT_EQ(ReadVtu(path).num_tets(), mesh.num_tets());  // still a readable grid
 }
 
-TEST(VtuWriter, RejectsUnwritablePath) {
-  EXPECT_THAT(test::InputErrorMessage([] { WriteVtu("/nonexistent/dir/x.vtu", Mesh{}); }),
-              HasSubstr("/nonexistent/dir/x.vtu: cannot open file for writing"));
+TEST(VtuWriter, RejectsUnwritablePathNamingTheReason) {
+  try {
+    WriteVtu("/nonexistent/dir/x.vtu", Mesh{});
+    ADD_FAILURE() << "no error";
+  } catch (const OutputError& e) {
+    EXPECT_EQ(std::string(e.what()),
+              "/nonexistent/dir/x.vtu: cannot create the file: No such file or directory");
+  }
+}
+
+TEST(VtuWriter, AFailedWriteLeavesNeitherAPartialFileNorItsTemporary) {
+  // A frame that does not fit (here: over the process's file size limit, as on a full disk)
+  // fails with the system's reason and leaves the old file whole.
+  const auto path = test::Scratch("limited.vtu");
+  std::filesystem::remove(path);
+  Mesh mesh;
+  mesh.nodes = Points::Random(3, 5000);
+  WriteVtu(path, Mesh{});
+  const auto old_size = std::filesystem::file_size(path);
+  rlimit old_limit{};
+  ASSERT_EQ(getrlimit(RLIMIT_FSIZE, &old_limit), 0);
+  std::signal(SIGXFSZ, SIG_IGN);  // the write fails with EFBIG instead of killing the process
+  rlimit limit = old_limit;
+  limit.rlim_cur = 4096;
+  ASSERT_EQ(setrlimit(RLIMIT_FSIZE, &limit), 0);
+  std::string message;
+  try {
+    WriteVtu(path, mesh);
+  } catch (const OutputError& e) {
+    message = e.what();
+  }
+  ASSERT_EQ(setrlimit(RLIMIT_FSIZE, &old_limit), 0);
+  std::signal(SIGXFSZ, SIG_DFL);
+  EXPECT_EQ(message, path.string() + ": cannot write: File too large");
+  EXPECT_EQ(std::filesystem::file_size(path), old_size);
+  EXPECT_FALSE(std::filesystem::exists(path.string() + ".tmp"));
 }
 
 TEST(VtuWriter, Base64RoundTripsEveryLengthAndSplitPadding) {

@@ -8,9 +8,13 @@
 #include <fmt/format.h>
 
 #include "gipsi/base/error.h"
+#include "gipsi/base/file_io.h"
 
 namespace gipsi {
 namespace {
+
+/// Largest JSON file JsonDocument::ParseFile reads [bytes].
+constexpr std::uintmax_t kMaxJsonFileBytes = 16u << 20;
 
 std::string Describe(const nlohmann::ordered_json& j) {
   std::string s = j.dump();
@@ -35,10 +39,16 @@ JsonNode::JsonNode(const nlohmann::ordered_json& value, std::string file, std::s
       path_(std::move(path)) {}
 
 void JsonNode::Fail(std::string_view what) const {
+  // A message that already names this file (an error from deeper in the same document, passed
+  // up through a caller that adds its own path) is complete: prefixing it again would print
+  // "scene.json: objects.cube: scene.json: objects.cube.domain: ...".
+  if (!file_->empty() && what.starts_with(*file_ + ": ")) throw InputError(std::string(what));
   ThrowInputError(*file_, path_.empty() ? "(document root)" : path_, what);
 }
 
 void JsonNode::Expected(std::string_view what) const {
+  // `what` may already say what it got ("a positive quantity, got -1 s"): do not repeat it.
+  if (what.find(", got ") != std::string_view::npos) Fail(fmt::format("expected {}", what));
   Fail(fmt::format("expected {}, got {}", what, Describe(*value_)));
 }
 
@@ -207,10 +217,78 @@ Vec3 JsonNode::Vector3(std::string_view key, const Vec3& fallback) const {
   return n ? n->AsVec3() : fallback;
 }
 
+namespace {
+
+/// Finds duplicate keys while nlohmann parses (it would keep one of them silently): a parser
+/// callback that tracks the path of the value being parsed and the keys of each open object.
+class DuplicateKeyCheck {
+ public:
+  explicit DuplicateKeyCheck(std::string name) : name_(std::move(name)) {}
+  bool operator()(int /*depth*/, nlohmann::ordered_json::parse_event_t event,
+                  nlohmann::ordered_json& parsed) {
+    using Event = nlohmann::ordered_json::parse_event_t;
+    switch (event) {
+      case Event::object_start:
+      case Event::array_start:
+        EnterValue();
+        frames_.push_back({event == Event::array_start, {}, {}, -1});
+        break;
+      case Event::object_end:
+      case Event::array_end:
+        frames_.pop_back();
+        break;
+      case Event::key: {
+        Frame& frame = frames_.back();
+        std::string key = parsed.get<std::string>();
+        if (std::find(frame.keys.begin(), frame.keys.end(), key) != frame.keys.end())
+          ThrowInputError(name_, frames_.size() == 1 ? "(document root)" : Path(frames_.size()),
+                          fmt::format("duplicate key '{}' (JSON keys must be unique: one of "
+                                      "the two would be ignored)",
+                                      key));
+        frame.keys.push_back(key);
+        frame.key = std::move(key);
+        break;
+      }
+      case Event::value:
+        EnterValue();
+        break;
+    }
+    return true;
+  }
+
+ private:
+  struct Frame {
+    bool array;
+    std::vector<std::string> keys;  // of an object, so far
+    std::string key;                // of an object: the current member
+    std::int64_t index;             // of an array: the current item
+  };
+  void EnterValue() {
+    if (!frames_.empty() && frames_.back().array) ++frames_.back().index;
+  }
+  /// The JSON path of the first `depth` frames, as JsonNode writes it ("objects.cube.fix[0]").
+  [[nodiscard]] std::string Path(std::size_t depth) const {
+    std::string path;
+    for (std::size_t i = 0; i + 1 < depth; ++i) {
+      const Frame& f = frames_[i];
+      if (f.array)
+        path += fmt::format("[{}]", f.index);
+      else
+        path += (path.empty() ? "" : ".") + f.key;
+    }
+    return path;
+  }
+
+  std::string name_;
+  std::vector<Frame> frames_;
+};
+
+}  // namespace
+
 JsonDocument JsonDocument::Parse(std::string_view text, std::string name) {
   auto json = std::make_unique<nlohmann::ordered_json>();
   try {
-    *json = nlohmann::ordered_json::parse(text.begin(), text.end());
+    *json = nlohmann::ordered_json::parse(text.begin(), text.end(), DuplicateKeyCheck(name));
   } catch (const nlohmann::ordered_json::parse_error& e) {
     // Translate the byte offset into line and column.
     std::size_t byte = std::min<std::size_t>(e.byte == 0 ? 0 : e.byte - 1, text.size());
@@ -223,10 +301,25 @@ JsonDocument JsonDocument::Parse(std::string_view text, std::string name) {
         ++col;
       }
     }
+    // nlohmann's message is "[json.exception.parse_error.101] parse error at line L, column C:
+    // X"; X may hold ": " itself ("last read: '{"a": N'"), so cut after the position's colon.
     std::string what = e.what();
-    // nlohmann's message is "[json.exception.parse_error.101] parse error at line ..., ...: X".
-    auto pos = what.rfind(": ");
-    std::string detail = pos == std::string::npos ? what : what.substr(pos + 2);
+    std::string detail = what;
+    if (const auto at = what.find("parse error"); at != std::string::npos)
+      if (const auto colon = what.find(": ", at); colon != std::string::npos)
+        detail = what.substr(colon + 2);
+    // "syntax error while parsing value - invalid literal; last read: '... N'": JSON has no NaN
+    // or infinity literals.
+    if ((detail.find("invalid literal") != std::string::npos ||
+         detail.find("invalid number") != std::string::npos) &&
+        byte < text.size()) {
+      const std::size_t start = text.find_last_of(" \t\r\n:,[", byte) + 1;
+      const char first = start < text.size() ? text[start] : ' ';
+      const char second = start + 1 < text.size() ? text[start + 1] : ' ';
+      if (std::string_view("NnIi").find(first) != std::string_view::npos ||
+          (first == '-' && std::string_view("NnIi").find(second) != std::string_view::npos))
+        detail += " (JSON has no NaN or infinity literals: give a finite number)";
+    }
     ThrowInputError(name, fmt::format("line {}, column {}", line, col),
                     fmt::format("invalid JSON: {}", detail));
   } catch (const nlohmann::ordered_json::exception& e) {
@@ -241,11 +334,7 @@ JsonDocument JsonDocument::Parse(std::string_view text, std::string name) {
 }
 
 JsonDocument JsonDocument::ParseFile(const std::filesystem::path& file) {
-  std::ifstream in(file, std::ios::binary);
-  if (!in) ThrowInputError(file.string(), "", "cannot open file for reading");
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return Parse(ss.str(), file.string());
+  return Parse(ReadRegularFile(file, kMaxJsonFileBytes, "JSON file"), file.string());
 }
 
 std::size_t EditDistance(std::string_view a, std::string_view b) {

@@ -62,7 +62,8 @@ RunResult Kernel::Run(double end_time, const ProgressFn& progress) {
   GIPSI_CHECK(macro_dt_ > 0, "Kernel::Initialize was not called");
   using Clock = std::chrono::steady_clock;
   const auto wall_start = Clock::now();
-  stop_requested_.store(false);
+  // A stop requested before this Run (e.g. by a signal while the outputs were being attached)
+  // stops it after its first macro step; the request is used up when the run ends.
   RunResult result;
   result.start_time = time();
   const auto last_step =
@@ -79,6 +80,7 @@ RunResult Kernel::Run(double end_time, const ProgressFn& progress) {
         }
       }
     }
+    stop_requested_.store(false);
     result.outcome = outcome;
     result.diagnostic = std::move(diagnostic);
     result.end_time = time();

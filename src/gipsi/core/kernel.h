@@ -125,7 +125,7 @@ class Kernel {
   /// Runs until `end_time` (rounded to a whole number of macro steps). Never throws for a
   /// numerical failure: the outcome and diagnostic say what happened.
   RunResult Run(double end_time, const ProgressFn& progress = {});
-  /// Asks a running `Run` to stop after the current macro step (thread- and signal-safe).
+  /// Asks `Run` to stop after its current macro step, also when asked before it (signal-safe).
   void RequestStop() { stop_requested_.store(true); }
 
   [[nodiscard]] double time() const { return start_time_ + macro_index_ * macro_dt_; }

@@ -104,6 +104,9 @@ class GmshParser {
  public:
   explicit GmshParser(TextReader& r) : r_(r) {}
 
+  /// The element tag of every tet read, in order.
+  [[nodiscard]] const std::vector<std::int64_t>& tet_tags() const { return tet_tags_; }
+
   Mesh Parse() {
     std::string_view line;
     while (r_.NextContentLine(&line)) {
@@ -521,7 +524,10 @@ class GmshParser {
             Fail(fmt::format("element {} repeats node {}", tag, tags_[std::size_t(a)]));
     }
     int item = -1;
-    if (tet) item = b_.AddTet(idx_[0], idx_[1], idx_[2], idx_[3]);
+    if (tet) {
+      item = b_.AddTet(idx_[0], idx_[1], idx_[2], idx_[3]);
+      tet_tags_.push_back(tag);
+    }
     if (tri) item = b_.AddTriangle(idx_[0], idx_[1], idx_[2]);
     for (const Key& key : keys_) {
       auto& items = members_[key];
@@ -570,14 +576,20 @@ class GmshParser {
   std::map<Key, std::vector<int>> entity_physicals_;  // (entity dim, entity tag) -> tags
   std::vector<std::int64_t> tags_;                    // scratch: node tags of one element
   std::vector<int> idx_;                              // scratch: node indices of one element
+  std::vector<std::int64_t> tet_tags_;                // element tag of every tet, in order
   std::vector<Key> keys_;                             // scratch: physical groups of one element
 };
 
 }  // namespace
 
-Mesh ReadGmsh(const std::filesystem::path& path) {
+Mesh ReadGmsh(const std::filesystem::path& path) { return ReadGmsh(path, nullptr); }
+
+Mesh ReadGmsh(const std::filesystem::path& path, std::vector<std::int64_t>* tet_tags) {
   TextReader reader = TextReader::FromFile(path);
-  return GmshParser(reader).Parse();
+  GmshParser parser(reader);
+  Mesh mesh = parser.Parse();
+  if (tet_tags) *tet_tags = parser.tet_tags();
+  return mesh;
 }
 
 }  // namespace gipsi

@@ -3,7 +3,9 @@
 /// Reader for Gmsh `.msh` files: format 1.0 (`$NOD`/`$ELM`), 2.x ASCII and binary, and 4.1
 /// ASCII and binary.
 
+#include <cstdint>
 #include <filesystem>
+#include <vector>
 
 #include "gipsi/geometry/mesh.h"
 
@@ -30,5 +32,10 @@ namespace gipsi {
 /// elements with the wrong number of nodes, references to undefined nodes, and duplicate node
 /// tags. The result has passed `Mesh::Validate`.
 Mesh ReadGmsh(const std::filesystem::path& path);
+
+/// The same, also giving the file's element tag of every tet, in the order of the mesh's tets
+/// (`(*tet_tags)[e]` is tet e's tag): messages can then name a tet as Gmsh does (tags are the
+/// file's own, usually counting from 1), not by its 0-based index in the mesh.
+Mesh ReadGmsh(const std::filesystem::path& path, std::vector<std::int64_t>* tet_tags);
 
 }  // namespace gipsi

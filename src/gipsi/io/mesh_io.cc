@@ -25,11 +25,15 @@ std::string LowerExtension(const std::filesystem::path& path) {
   return ext;
 }
 
-}  // namespace
-
-Mesh ReadMesh(const std::filesystem::path& path) {
+/// The reader for `path`'s extension; Gmsh files also give their tet tags.
+Mesh ReadByExtension(const std::filesystem::path& path, MeshFileIds* ids) {
   const std::string ext = LowerExtension(path);
-  if (ext == ".msh") return ReadGmsh(path);
+  if (ext == ".msh") {
+    if (!ids) return ReadGmsh(path);
+    Mesh mesh = ReadGmsh(path, &ids->tets);
+    ids->kind = "Gmsh element tags";
+    return mesh;
+  }
   if (ext == ".node" || ext == ".ele" || ext == ".face") return ReadTetGen(path);
   if (ext == ".vtk") return ReadVtkLegacy(path);
   if (ext == ".vtu") return ReadVtu(path);
@@ -39,6 +43,22 @@ Mesh ReadMesh(const std::filesystem::path& path) {
                   fmt::format("unknown mesh file extension '{}' (supported: .msh, .node/.ele "
                               "(TetGen), .vtk, .vtu, .obj, .stl)",
                               path.extension().string()));
+}
+
+}  // namespace
+
+Mesh ReadMesh(const std::filesystem::path& path) { return ReadMesh(path, nullptr); }
+
+Mesh ReadMesh(const std::filesystem::path& path, MeshFileIds* ids) {
+  if (ids) *ids = MeshFileIds{{}, "0-based indices in file order"};
+  Mesh mesh = ReadByExtension(path, ids);
+  // Some formats (OBJ) skip lines they do not know, so a file of another format, or an empty
+  // one, reads as a mesh without nodes: never what was meant.
+  if (mesh.num_nodes() == 0)
+    ThrowInputError(path.string(), "",
+                    fmt::format("the file holds no nodes: an empty mesh, or not a {} file",
+                                path.extension().string()));
+  return mesh;
 }
 
 void WriteMesh(const std::filesystem::path& path, const Mesh& mesh) {

@@ -5,12 +5,15 @@
 #include <string>
 
 #include "gipsi/geometry/mesh.h"
+#include "gipsi/io/mesh_io.h"
 
 namespace gipsi {
 
 /// Counts (nodes, tets, triangles, boundary faces), named groups, bounding box, element quality
 /// (inverted and degenerate tets with their ids, aspect ratios, volume) and, for surfaces,
 /// whether they are closed and manifold.
-std::string DescribeMesh(const Mesh& mesh);
+/// Tets are named by `ids` (the file's own ids, e.g. Gmsh element tags) when given, else by their
+/// 0-based index; the kind of id is stated.
+std::string DescribeMesh(const Mesh& mesh, const MeshFileIds* ids = nullptr);
 
 }  // namespace gipsi

@@ -8,6 +8,7 @@
 #include "gipsi/base/error.h"
 
 #include "gipsi/base/state.h"
+#include "gipsi/io/sample_times.h"
 
 namespace gipsi {
 
@@ -78,9 +79,7 @@ void VtuSeriesWriter::Observe(const Kernel& kernel, double t) {
   }
   ++frame_;
   frame_times_.push_back(t);
-  if (every_ > 0) {
-    while (next_ <= t + tolerance) next_ += every_;
-  }
+  if (every_ > 0) next_ = NextSampleTime(next_, every_, t + tolerance);
 }
 
 namespace {

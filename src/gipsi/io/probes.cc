@@ -1,13 +1,18 @@
 #include "gipsi/io/probes.h"
 
+#include <cerrno>
+#include <cstring>
+
 #include <algorithm>
 #include <limits>
 
 #include <fmt/format.h>
 
 #include "gipsi/base/error.h"
+#include "gipsi/base/file_io.h"
 #include "gipsi/base/units.h"
 #include "gipsi/geometry/region_json.h"
+#include "gipsi/io/sample_times.h"
 
 namespace gipsi {
 namespace {
@@ -251,7 +256,8 @@ ProbeRecorder::ProbeRecorder(std::vector<Probe> probes, const std::filesystem::p
     if (!resume) {  // a resumed run opens its files once the checkpoint is restored
       stream.file.open(path, std::ios::out | std::ios::trunc);
       if (!stream.file)
-        throw std::runtime_error(fmt::format("{}: cannot create file", path.string()));
+        throw OutputError(
+            fmt::format("{}: cannot create the file: {}", path.string(), std::strerror(errno)));
       stream.file << stream.probe.Header() << '\n';
       stream.file.precision(17);
     }
@@ -267,8 +273,11 @@ void ProbeRecorder::Write(Stream& s, double t) {
     for (std::size_t k = start; k < start + width; ++k) s.file << ',' << row_[k];
     s.file << '\n';
   }
+  errno = 0;
   s.file.flush();
-  if (!s.file) throw std::runtime_error(fmt::format("probe '{}': write failed", s.probe.name));
+  if (!s.file)
+    throw OutputError(fmt::format("{}: cannot write: {}", s.path.string(),
+                                  errno != 0 ? std::strerror(errno) : "the stream failed"));
 }
 
 void ProbeRecorder::Observe(const Kernel& kernel, double t) {
@@ -283,8 +292,7 @@ void ProbeRecorder::Observe(const Kernel& kernel, double t) {
     }
     if (t + tolerance < s.next) continue;
     Write(s, t);
-    if (s.probe.every > 0)
-      while (s.next <= t + tolerance) s.next += s.probe.every;
+    if (s.probe.every > 0) s.next = NextSampleTime(s.next, s.probe.every, t + tolerance);
   }
 }
 

@@ -8,6 +8,7 @@
 #include <fmt/format.h>
 
 #include "gipsi/base/error.h"
+#include "gipsi/base/file_io.h"
 #include "gipsi/base/log.h"
 #include "gipsi/base/units.h"
 #include "gipsi/geometry/generators.h"
@@ -120,6 +121,21 @@ class ObjectBuilder {
   BuildObjectFn fn_;
 };
 
+/// An output's sampling interval `every` [s] read from `node` (0: every macro step). Outputs are
+/// sampled between macro steps, so an interval shorter than the macro step samples every macro
+/// step: it is clamped to 0 with a warning naming the macro step (an interval of 1e-15 s once
+/// meant 1e15 loop turns per simulated second: a hang).
+double ClampSamplingInterval(const JsonNode& node, double every, const Kernel& kernel) {
+  if (every > 0 && every < kernel.macro_dt() * (1 - 1e-9)) {
+    Log().warn(
+        "{}: {}: a sampling interval of {:.6g} s is shorter than the macro step of {:.6g} s "
+        "(schedule.dt, or the largest object dt): sampling every macro step instead",
+        node.file(), node.path(), every, kernel.macro_dt());
+    return 0;
+  }
+  return every;
+}
+
 /// "on_failure": "stop" or {"retry": {"max_halvings": N}} (1 <= N <= 20).
 FailurePolicy ParseFailurePolicy(const JsonNode& node) {
   FailurePolicy policy;
@@ -140,6 +156,12 @@ FailurePolicy ParseFailurePolicy(const JsonNode& node) {
 void ParseEvent(const JsonNode& node, Scene& scene) {
   node.CheckKeys({"at", "object", "apply", "remove", "set_field", "description"});
   const double at = ReadPositiveQuantity(node.At("at"), "s", /*allow_zero=*/true);
+  // The kernel fires an event at the first macro step starting at or after it: one at or after
+  // the end would never fire.
+  if (at >= scene.end_time - 1e-9 * scene.kernel->macro_dt())
+    node.At("at").Fail(fmt::format(
+        "the event at {:.6g} s would never fire: the run ends at schedule.end = {:.6g} s", at,
+        scene.end_time));
   JsonNode object_node = node.At("object");
   std::string object_name = object_node.AsString();
   SimObject* object = nullptr;
@@ -305,20 +327,27 @@ Mesh BuildMesh(const JsonNode& node, const std::filesystem::path& base_dir) {
 }
 
 Scene LoadScene(const std::filesystem::path& file, TypeRegistry& registry,
-                const SceneLimits& limits) {
-  std::ifstream in(file, std::ios::binary);
-  if (!in) ThrowInputError(file.string(), "", "cannot open scene file for reading");
-  std::stringstream text;
-  text << in.rdbuf();
-  return LoadSceneFromString(text.str(), file.string(), file.parent_path(), registry, limits);
+                const SceneLimits& limits, const BuildProgressFn& progress) {
+  const std::string text = ReadRegularFile(file, kMaxSceneFileBytes, "scene file");
+  return LoadSceneFromString(text, file.string(), file.parent_path(), registry, limits, progress);
 }
 
 Scene LoadSceneFromString(std::string_view text, const std::string& name,
                           const std::filesystem::path& base_dir, TypeRegistry& registry,
-                          const SceneLimits& limits) {
+                          const SceneLimits& limits, const BuildProgressFn& progress) {
   JsonDocument doc = JsonDocument::Parse(text, name);
   JsonNode root = doc.root();
   if (!root.is_object()) root.Expected("a JSON object");
+  // Build stages for `progress`: each mesh and object, then connectors, events and probes.
+  int stages_done = 0;
+  int stages = 3;
+  for (const char* key : {"meshes", "objects"})
+    if (auto members = root.Find(key); members && members->is_object())
+      stages += static_cast<int>(members->size());
+  auto stage = [&](const std::string& what) {
+    if (progress) progress(what, stages_done, stages);
+    ++stages_done;
+  };
   root.CheckKeys({"gipsi", "description", "units", "plugins", "meshes", "objects", "connectors",
                   "schedule", "probes", "outputs"});
   if (auto version = root.Find("gipsi"); version && version->AsInt() != 1)
@@ -343,6 +372,10 @@ Scene LoadSceneFromString(std::string_view text, const std::string& name,
 
   if (auto meshes = root.Find("meshes")) {
     for (const auto& [mesh_name, node] : meshes->Members()) {
+      stage(fmt::format("mesh '{}'{}", mesh_name,
+                        node.is_object() && node.Has("generate") && node.At("generate").is_string()
+                            ? " (generate " + node.At("generate").AsString() + ")"
+                            : ""));
       auto mesh = std::make_shared<const Mesh>(BuildMesh(node, base_dir));
       const std::int64_t cells = mesh->num_tets() + mesh->num_triangles();
       const std::int64_t most = std::max<std::int64_t>(mesh->num_nodes(), cells);
@@ -365,6 +398,10 @@ Scene LoadSceneFromString(std::string_view text, const std::string& name,
   JsonNode objects = root.At("objects");
   if (objects.size() == 0) objects.Expected("at least one object");
   for (const auto& [object_name, node] : objects.Members()) {
+    stage(fmt::format("object '{}'{}", object_name,
+                      node.is_object() && node.Has("type") && node.At("type").is_string()
+                          ? " (" + node.At("type").AsString() + ")"
+                          : ""));
     BuiltObject built = builder.Build(object_name, node);
     try {
       scene.kernel->coordinator().AddObject(std::move(built.object), built.dt);
@@ -372,6 +409,7 @@ Scene LoadSceneFromString(std::string_view text, const std::string& name,
       node.Fail(e.what());
     }
   }
+  stage("connectors");
   if (auto connectors = root.Find("connectors")) {
     for (const auto& [connector_name, node] : connectors->Members()) {
       auto connector = registry.CreateConnector(connector_name, node, scene.kernel->coordinator());
@@ -396,14 +434,20 @@ Scene LoadSceneFromString(std::string_view text, const std::string& name,
   } catch (const InputError& e) {
     ThrowInputError(name, "objects", e.what());
   }
+  stage("events");
   if (auto events = schedule.Find("events"))
     for (const auto& event : events->Items()) ParseEvent(event, scene);
   if (auto on_failure = schedule.Find("on_failure"))
     scene.kernel->SetFailurePolicy(ParseFailurePolicy(*on_failure));
 
+  stage("probes and outputs");
   if (auto probes = root.Find("probes"))
-    for (const auto& [probe_name, node] : probes->Members())
+    for (const auto& [probe_name, node] : probes->Members()) {
       scene.probes.push_back(ParseProbe(probe_name, node, *scene.kernel));
+      if (auto every = node.Find("every"))
+        scene.probes.back().every =
+            ClampSamplingInterval(*every, scene.probes.back().every, *scene.kernel);
+    }
 
   scene.output_directory = std::filesystem::path("out") / std::filesystem::path(name).stem();
   if (auto outputs = root.Find("outputs")) {
@@ -430,6 +474,8 @@ Scene LoadSceneFromString(std::string_view text, const std::string& name,
         vtu->CheckKeys({"every", "objects", "display"});
         scene.vtu.every =
             vtu->Has("every") ? ReadPositiveQuantity(vtu->At("every"), "s", true) : 0.0;
+        if (auto every = vtu->Find("every"))
+          scene.vtu.every = ClampSamplingInterval(*every, scene.vtu.every, *scene.kernel);
         scene.vtu.display = vtu->Bool("display", true);
         if (auto names = vtu->Find("objects")) {
           scene.vtu.objects = names->AsStrings();

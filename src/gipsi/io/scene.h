@@ -7,6 +7,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <map>
 #include <memory>
 #include <string>
@@ -62,15 +63,24 @@ struct Scene {
   SceneLimits limits;
 };
 
+/// Largest scene file LoadScene reads [bytes]: 16 MiB (the shipped scenes take a few kB; meshes
+/// live in their own files).
+inline constexpr std::uintmax_t kMaxSceneFileBytes = 16u << 20;
+
+/// Told as each stage of building a scene starts: what (e.g. "mesh 'box' (generate box)",
+/// "object 'cube' (MassSpring)"), how many stages are done and how many there are.
+using BuildProgressFn = std::function<void(std::string_view stage, int done, int total)>;
+
 /// Loads `file` with the types in `registry` (loading the scene's plugins into it first) and
 /// builds the kernel (Initialize is called). Throws InputError on any problem, including a mesh
-/// over `limits.max_mesh_cells`.
+/// over `limits.max_mesh_cells` and a file that is not a regular file of at most
+/// kMaxSceneFileBytes. `progress`, if set, is told each build stage.
 Scene LoadScene(const std::filesystem::path& file, TypeRegistry& registry,
-                const SceneLimits& limits = {});
+                const SceneLimits& limits = {}, const BuildProgressFn& progress = {});
 /// The same from text; `name` is used in messages and `base_dir` resolves relative paths.
 Scene LoadSceneFromString(std::string_view text, const std::string& name,
                           const std::filesystem::path& base_dir, TypeRegistry& registry,
-                          const SceneLimits& limits = {});
+                          const SceneLimits& limits = {}, const BuildProgressFn& progress = {});
 
 /// Where a scene's "plugins" entry points: a path with a '/' is taken relative to `base_dir`; a
 /// bare name ("gipsi_example_plugin", ".so" optional) is searched in $GIPSI_PLUGIN_PATH

@@ -5,10 +5,12 @@
 #include <cmath>
 #include <fstream>
 #include <iterator>
+#include <limits>
 
 #include <fmt/format.h>
 
 #include "gipsi/base/error.h"
+#include "gipsi/base/file_io.h"
 
 namespace gipsi::internal {
 namespace {
@@ -20,28 +22,17 @@ bool IsBlank(char c) {
 }  // namespace
 
 std::string ReadFileBytes(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) ThrowInputError(path.string(), "", "cannot open file");
-  std::string data((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  if (in.bad()) ThrowInputError(path.string(), "", "cannot read file");
-  return data;
+  // A mesh may be large, but it must be a regular file: a device (/dev/zero) or a directory is
+  // refused by name instead of read without end or failing inside the stream library.
+  return ReadRegularFile(path, std::numeric_limits<std::uintmax_t>::max(), "mesh file");
 }
 
 void WriteFileBytes(const std::filesystem::path& path, std::string_view bytes) {
-  std::ofstream out(path, std::ios::binary | std::ios::trunc);
-  if (!out) ThrowInputError(path.string(), "", "cannot open file for writing");
-  out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
-  out.close();
-  if (!out) ThrowInputError(path.string(), "", "cannot write file");
+  gipsi::WriteFileAtomically(path, bytes);
 }
 
 void WriteFileAtomically(const std::filesystem::path& path, std::string_view bytes) {
-  std::filesystem::path tmp = path;
-  tmp += ".tmp";
-  WriteFileBytes(tmp, bytes);
-  std::error_code ec;
-  std::filesystem::rename(tmp, path, ec);
-  if (ec) ThrowInputError(path.string(), "", fmt::format("cannot replace file: {}", ec.message()));
+  gipsi::WriteFileAtomically(path, bytes);
 }
 
 std::string Quote(std::string_view token) {

@@ -20,11 +20,11 @@ namespace gipsi::internal {
 /// cannot be opened or read.
 std::string ReadFileBytes(const std::filesystem::path& path);
 
-/// Writes `bytes` to `path` (truncating). Throws InputError `PATH: cannot write file` on failure.
+/// Writes `bytes` to `path` atomically (gipsi::WriteFileAtomically); throws OutputError.
 void WriteFileBytes(const std::filesystem::path& path, std::string_view bytes);
 
 /// Writes `bytes` to `PATH.tmp` and renames it to `path`, so that readers of `path` only ever
-/// see a complete file (the old or the new one). Throws InputError on failure.
+/// see a complete file (the old or the new one). Throws OutputError (with errno text).
 void WriteFileAtomically(const std::filesystem::path& path, std::string_view bytes);
 
 /// A printable, length-limited rendering of a token for error messages (non-printable bytes

@@ -8,12 +8,34 @@
 #include "gipsi/base/error.h"
 #include "gipsi/base/log.h"
 #include "gipsi/base/units.h"
+#include "gipsi/geometry/quality.h"
 #include "gipsi/geometry/region_json.h"
 #include "gipsi/models/fibres/rule_based_fibres.h"
 #include "gipsi/models/mass_spring/mass_spring.h"
 #include "gipsi/models/mass_spring/mass_spring_local_model.h"
 
 namespace gipsi {
+namespace {
+
+/// A MassSpring accepts a mesh with inverted tets (negative volume in node order 0-1-2-3), but
+/// its volume preservation then pushes them further inside out: say so.
+void WarnInvertedTets(const Mesh& mesh, const std::string& where) {
+  Index inverted = 0, first = -1;
+  for (Index e = 0; e < mesh.num_tets(); ++e) {
+    const auto node = [&](int a) { return Vec3(mesh.nodes.col(mesh.tets(a, e))); };
+    if (TetSignedVolume(node(0), node(1), node(2), node(3)) < 0) {
+      if (inverted++ == 0) first = e;
+    }
+  }
+  if (inverted > 0)
+    Log().warn(
+        "{}: {} of {} tets of the domain are inverted (negative volume in node order 0-1-2-3; "
+        "the first is tet {}, counting from 0): volume preservation would push them further "
+        "inside out; fix the mesh's node order (`gipsi info` lists them)",
+        where, inverted, mesh.num_tets(), first);
+}
+
+}  // namespace
 
 void RegisterMassSpring(TypeRegistry& registry) {
   registry.local_models.Register(
@@ -55,6 +77,7 @@ void RegisterMassSpring(TypeRegistry& registry) {
         std::unique_ptr<MassSpring> object;
         try {
           auto mesh = ctx.DomainMesh();
+          WarnInvertedTets(*mesh, p.file() + ": " + p.path());
           object = std::make_unique<MassSpring>(ctx.name, mesh, params, std::move(integrator));
           if (fibre_rule)
             object->WriteField(object->FindField("fibre"),

@@ -4,18 +4,28 @@
 #include <stb_image_write.h>
 
 #include <stdexcept>
+#include <string>
 
 #include <fmt/format.h>
 
 #include "gipsi/base/error.h"
+#include "gipsi/base/file_io.h"
 
 namespace gipsi::viz {
 
 void WritePng(const Image& image, const std::filesystem::path& file) {
   GIPSI_CHECK(image.rgb.size() == 3 * std::size_t(image.width) * std::size_t(image.height));
-  if (!stbi_write_png(file.c_str(), image.width, image.height, 3, image.rgb.data(),
-                      3 * image.width))
-    throw std::runtime_error(fmt::format("cannot write the PNG image {}", file.string()));
+  // Encoded in memory, then written atomically with every write checked: stb's own file writer
+  // ignores a failing fwrite/fclose and left 0-byte images on a full disk.
+  std::string png;
+  auto append = [](void* context, void* data, int size) {
+    static_cast<std::string*>(context)->append(static_cast<const char*>(data),
+                                               static_cast<std::size_t>(size));
+  };
+  if (!stbi_write_png_to_func(append, &png, image.width, image.height, 3, image.rgb.data(),
+                              3 * image.width))
+    throw OutputError(fmt::format("{}: cannot encode the PNG image", file.string()));
+  WriteFileAtomically(file, png);
 }
 
 Image ReadPng(const std::filesystem::path& file) {

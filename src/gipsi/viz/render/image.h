@@ -23,7 +23,7 @@ struct Image {
   }
 };
 
-/// Writes `image` as a PNG; throws std::runtime_error naming the file if it cannot.
+/// Writes `image` as a PNG, atomically; throws OutputError naming the file and the reason.
 void WritePng(const Image& image, const std::filesystem::path& file);
 /// Reads a PNG (any channel count; converted to RGB); throws std::runtime_error naming the file.
 Image ReadPng(const std::filesystem::path& file);

@@ -1,6 +1,10 @@
 #include "gipsi/viz/render/plot.h"
 
 #include <plplot.h>
+#include <sys/statvfs.h>
+
+#include <cerrno>
+#include <cstring>
 
 #include <algorithm>
 #include <cmath>
@@ -13,6 +17,8 @@
 #include <fmt/format.h>
 
 #include "gipsi/base/error.h"
+#include "gipsi/base/file_io.h"
+#include "gipsi/io/text_reader.h"
 
 namespace gipsi::viz {
 namespace {
@@ -56,16 +62,23 @@ void WritePlot(const PlotData& data, const std::filesystem::path& file) {
   const auto [y0, y1] = Range(data.series, false);
   if (!(x1 > x0) || !(y1 > y0))
     ThrowInputError(file.string(), "", "nothing to plot: the columns hold no finite points");
-  {  // PLplot exits the program on a file it cannot open: find out first.
-    std::ofstream probe(file);
-    if (!probe) throw std::runtime_error(fmt::format("cannot write the plot {}", file.string()));
+  // PLplot draws into a temporary file (it exits the program on a file it cannot open: find
+  // out first) and does not report failed writes; the image is checked to be complete, then
+  // written atomically to `file` with every write checked.
+  std::filesystem::path tmp = file;
+  tmp += ".plot.tmp";
+  {
+    std::ofstream probe(tmp);
+    if (!probe)
+      throw OutputError(
+          fmt::format("{}: cannot create the file: {}", file.string(), std::strerror(errno)));
   }
   if (!HasDevice(device))
     throw std::runtime_error(fmt::format(
         "PLplot has no '{}' driver (install plplot-driver-cairo) for {}", device, file.string()));
 
   plsdev(device.c_str());
-  plsfnam(file.c_str());
+  plsfnam(tmp.c_str());
   plspage(0, 0, data.width, data.height, 0, 0);
   constexpr int kFirstSeries = 3;
   plscmap0n(kFirstSeries + static_cast<int>(std::size(kPlotColors)));
@@ -122,6 +135,26 @@ void WritePlot(const PlotData& data, const std::filesystem::path& file) {
              widths.data(), nullptr, nullptr, nullptr, nullptr);
   }
   plend();
+  std::string bytes;
+  try {
+    bytes = internal::ReadFileBytes(tmp);
+  } catch (const InputError& e) {
+    std::filesystem::remove(tmp);
+    throw OutputError(e.what());
+  }
+  std::filesystem::remove(tmp);
+  const bool complete = ext == ".png" ? bytes.ends_with(std::string_view("IEND\xae\x42\x60\x82", 8))
+                                      : bytes.find("</svg>") != std::string::npos;
+  if (!complete) {
+    struct statvfs disk {};
+    const bool full =
+        ::statvfs(file.parent_path().empty() ? "." : file.parent_path().c_str(), &disk) == 0 &&
+        disk.f_bavail == 0;
+    throw OutputError(fmt::format(
+        "{}: cannot write: {}", file.string(),
+        full ? std::strerror(ENOSPC) : "the plotting library wrote an incomplete image"));
+  }
+  WriteFileAtomically(file, bytes);
 }
 
 std::vector<std::filesystem::path> WritePlots(const std::vector<PlotSpec>& specs,
