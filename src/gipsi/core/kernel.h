@@ -126,6 +126,9 @@ class Kernel {
   /// numerical failure: the outcome and diagnostic say what happened.
   RunResult Run(double end_time, const ProgressFn& progress = {});
   /// Asks a running `Run` to stop after the current macro step (thread- and signal-safe).
+  /// Objects that poll their stop token (SimObject::stop_token; FemSolid between load steps
+  /// and Newton iterations) abandon their step instead: the run then ends inside the macro
+  /// step, "stopped on request", without a checkpoint at the stop.
   void RequestStop() { stop_requested_.store(true); }
 
   [[nodiscard]] double time() const { return start_time_ + macro_index_ * macro_dt_; }
