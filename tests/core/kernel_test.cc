@@ -161,5 +161,57 @@ TEST(Kernel, DivergenceInsideAnAggregateNamesThePart) {
   EXPECT_EQ(&kernel.FindObject("heart.blood"), kernel.coordinator().object(0).FindPart("blood"));
 }
 
+/// An object whose `request_at`-th step asks the kernel to stop in its middle and then polls its
+/// stop token, as a long step (Newton iterations, load increments) does.
+class LongStepObject final : public SimObject {
+ public:
+  LongStepObject(std::string name, Kernel& kernel, std::int64_t request_at)
+      : SimObject(std::move(name)), kernel_(kernel), request_at_(request_at) {}
+  std::string_view type_name() const override { return "LongStep"; }
+  const Points& domain_positions() const override { return positions_; }
+  int polls_after_request = 0;
+
+ protected:
+  StepStatus DoStep(double, double) override {
+    for (int iteration = 0; iteration < 100; ++iteration) {
+      if (step_count() + 1 == request_at_ && iteration == 5) kernel_.RequestStop();
+      if (stop_token().stop_requested()) {
+        ++polls_after_request;
+        return StepStatus::Stopped();
+      }
+    }
+    return StepStatus::Ok();
+  }
+  void DoReadField(FieldId, Eigen::Ref<Eigen::MatrixXd>) const override {}
+  void DoWriteField(FieldId, const Eigen::Ref<const Eigen::MatrixXd>&) override {}
+
+ private:
+  Kernel& kernel_;
+  std::int64_t request_at_;
+  Points positions_ = Points(3, 0);
+};
+
+TEST(Kernel, AStopRequestReachesInsideAStepAlsoInAnAggregate) {
+  // The request is made inside the 3rd step of a part of an aggregate: the kernel hands its
+  // stop token down through the aggregate, the part abandons its step at its next poll, and
+  // the run ends "stopped on request" after 2 completed macro steps.
+  Kernel kernel;
+  Coordinator parts;
+  parts.AddObject(std::make_unique<CountingObject>("ep"), 1e-3);
+  auto& muscle = static_cast<LongStepObject&>(
+      parts.AddObject(std::make_unique<LongStepObject>("muscle", kernel, 3), 1e-3));
+  parts.Prepare(1e-3);
+  kernel.coordinator().AddObject(std::make_unique<AggregateObject>("heart", std::move(parts)),
+                                 1e-3);
+  kernel.Initialize();
+  const RunResult result = kernel.Run(1.0);
+  EXPECT_EQ(result.outcome, RunResult::Outcome::kStopped);
+  EXPECT_EQ(result.macro_steps, 2);
+  EXPECT_EQ(muscle.polls_after_request, 1);
+  EXPECT_EQ(result.diagnostic,
+            "stopped on request at t = 0.002 s, inside the step of object 'heart' (abandoned); "
+            "outputs written up to t = 0.002 s are kept");
+}
+
 }  // namespace
 }  // namespace gipsi

@@ -37,6 +37,7 @@ class AggregateObject : public SimObject {
   /// Number of fields that forward to parts (ids 0 … n−1); a subclass declares its own after.
   [[nodiscard]] std::size_t num_part_fields() const { return proxies_.size(); }
   StepStatus DoStep(double t, double dt) override;
+  void DoSetStopToken(StopToken token) override { parts_.SetStopToken(token); }
   void DoReadField(FieldId id, Eigen::Ref<Eigen::MatrixXd> out) const override;
   void DoWriteField(FieldId id, const Eigen::Ref<const Eigen::MatrixXd>& in) override;
 

@@ -104,6 +104,10 @@ void Coordinator::BeginMacroStep() {
   for (auto& slot : objects_) slot.object->BeginMacroStep();
 }
 
+void Coordinator::SetStopToken(StopToken token) {
+  for (auto& slot : objects_) slot.object->SetStopToken(token);
+}
+
 std::optional<ScheduleFailure> Coordinator::MacroStep(double t, std::int64_t macro_index,
                                                       int split) {
   GIPSI_CHECK(macro_dt_ > 0, "Coordinator::Prepare was not called");

@@ -59,6 +59,8 @@ class Coordinator {
   std::optional<ScheduleFailure> MacroStep(double t, std::int64_t macro_index, int split = 1);
   /// Forwards `BeginMacroStep` to every object.
   void BeginMacroStep();
+  /// Hands `token` to every object (SimObject::SetStopToken).
+  void SetStopToken(StopToken token);
 
   [[nodiscard]] std::size_t num_objects() const { return objects_.size(); }
   [[nodiscard]] std::size_t num_connectors() const { return connectors_.size(); }

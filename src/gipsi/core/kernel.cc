@@ -30,6 +30,8 @@ void Kernel::Initialize(double macro_dt) {
   if (coordinator_.num_objects() == 0) throw InputError("the scene has no objects to simulate");
   macro_dt_ = macro_dt > 0 ? macro_dt : coordinator_.max_object_dt();
   coordinator_.Prepare(macro_dt_);
+  // Long steps (Newton iterations, load steps) poll the stop request inside the step.
+  coordinator_.SetStopToken(StopToken(&stop_requested_));
 }
 
 SimObject& Kernel::FindObject(std::string_view name) const {
@@ -113,6 +115,17 @@ RunResult Kernel::Run(double end_time, const ProgressFn& progress) {
     } catch (const std::exception& e) {  // a state that cannot be saved for roll-back
       return finish(RunResult::Outcome::kStopped,
                     fmt::format("the failure policy needs checkpoints: {}", e.what()));
+    }
+    if (failure && failure->status.code == StepStatus::Code::kStopped) {
+      // A stop request reached inside a step (StopToken): the object abandoned it. Objects
+      // before it in the order may have advanced, so no checkpoint is written at this stop
+      // (the failure policy's roll-back, when active, has restored every object to t).
+      return finish(
+          RunResult::Outcome::kStopped,
+          fmt::format("stopped on request at t = {:.6g} s, inside the step of {} '{}' "
+                      "(abandoned); outputs written up to t = {:.6g} s are kept{}",
+                      failure->time, failure->is_connector ? "connector" : "object", failure->who,
+                      t, checkpoint_every_ > 0 ? "; no checkpoint was written at the stop" : ""));
     }
     if (failure) {
       std::string detail;

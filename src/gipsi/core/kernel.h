@@ -125,7 +125,10 @@ class Kernel {
   /// Runs until `end_time` (rounded to a whole number of macro steps). Never throws for a
   /// numerical failure: the outcome and diagnostic say what happened.
   RunResult Run(double end_time, const ProgressFn& progress = {});
-  /// Asks `Run` to stop after its current macro step, also when asked before it (signal-safe).
+  /// Asks `Run` to stop after its current macro step, also when asked before it (thread- and
+  /// signal-safe). Objects that poll their stop token (SimObject::stop_token; FemSolid between
+  /// load steps and Newton iterations) abandon their step instead: the run then ends inside the
+  /// macro step, "stopped on request", without a checkpoint at the stop.
   void RequestStop() { stop_requested_.store(true); }
 
   [[nodiscard]] double time() const { return start_time_ + macro_index_ * macro_dt_; }

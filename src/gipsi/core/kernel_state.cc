@@ -150,7 +150,8 @@ std::optional<ScheduleFailure> Kernel::StepWithPolicy(double t, std::string& ret
     RestoreSimulation(coordinator_, in);
   };
   std::optional<ScheduleFailure> failure = coordinator_.MacroStep(t, macro_index_);
-  for (int h = 1; failure && h <= policy_.max_halvings; ++h) {
+  auto stopped = [&] { return failure && failure->status.code == StepStatus::Code::kStopped; };
+  for (int h = 1; failure && !stopped() && h <= policy_.max_halvings; ++h) {
     const int split = 1 << h;
     Log().warn("t = {:.6g} s: {} '{}' failed ({}); retrying the macro step as {} steps of {:.6g} s",
                failure->time, failure->is_connector ? "connector" : "object", failure->who,
@@ -162,6 +163,11 @@ std::optional<ScheduleFailure> Kernel::StepWithPolicy(double t, std::string& ret
       failure = coordinator_.MacroStep(t + j * (macro_dt_ / split), macro_index_, split);
     }
     if (!failure) ++retried_;
+  }
+  if (stopped()) {
+    const ScheduleFailure last = *failure;
+    restore();  // every object back at t: a consistent state
+    return last;
   }
   if (failure) {
     retry_note = fmt::format(" (also with the macro step halved {} times)", policy_.max_halvings);

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "gipsi/base/math.h"
+#include "gipsi/base/stop_token.h"
 #include "gipsi/core/boundary_conditions.h"
 #include "gipsi/core/cavity_law.h"
 #include "gipsi/core/field.h"
@@ -147,6 +148,15 @@ class SimObject {
   virtual void RestoreObjectState(StateReader& in);
   /// Called by the kernel at the start of every macro step (aggregates forward it).
   virtual void BeginMacroStep() { bcs_.ClearCouplingLoads(); }
+  /// The run's stop request (the kernel hands it down when it is initialised; aggregates pass
+  /// it to their parts). An object whose step can run long (Newton iterations, load steps)
+  /// polls `stop_token()` inside it and, when a stop is requested, restores the state of the
+  /// start of the step and returns StepStatus::Stopped. Default: a token that never stops.
+  void SetStopToken(StopToken token) {
+    stop_token_ = token;
+    DoSetStopToken(token);
+  }
+  [[nodiscard]] const StopToken& stop_token() const { return stop_token_; }
 
  protected:
   explicit SimObject(std::string name);
@@ -164,6 +174,8 @@ class SimObject {
                               const double* velocities, Eigen::Ref<Eigen::MatrixXd> out) const;
 
   virtual StepStatus DoStep(double t, double dt) = 0;
+  /// Hook of SetStopToken (an aggregate forwards the token to its parts). Default: nothing.
+  virtual void DoSetStopToken(StopToken /*token*/) {}
   virtual void DoReadField(FieldId id, Eigen::Ref<Eigen::MatrixXd> out) const = 0;
   virtual void DoWriteField(FieldId id, const Eigen::Ref<const Eigen::MatrixXd>& in) = 0;
 
@@ -176,6 +188,7 @@ class SimObject {
   std::vector<FieldInfo> fields_;
   double time_ = 0;
   std::int64_t step_count_ = 0;
+  StopToken stop_token_;
 };
 
 /// Number of domain elements: tets if the domain has any, else triangles.

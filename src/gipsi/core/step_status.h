@@ -15,6 +15,10 @@ struct StepStatus {
     kOk,        ///< advanced normally
     kDiverged,  ///< the state became non-finite or exceeded a model bound
     kFailed,    ///< a solver or model could not complete the step
+    /// A stop was requested (SimObject::stop_token) while the step ran: the object abandoned
+    /// it and is back at the state it had at the start of the step. Not a failure: the kernel
+    /// ends the run as "stopped on request".
+    kStopped,
   };
   Code code = Code::kOk;
   const char* what = "";
@@ -28,6 +32,9 @@ struct StepStatus {
   }
   static constexpr StepStatus Failed(const char* what, std::int64_t item = -1, double value = 0) {
     return {Code::kFailed, what, item, value};
+  }
+  static constexpr StepStatus Stopped(const char* what = "stopped on request") {
+    return {Code::kStopped, what, -1, 0};
   }
 };
 

@@ -1,5 +1,6 @@
 #include "gipsi/numerics/newton.h"
 
+#include <algorithm>
 #include <cmath>
 #include <utility>
 
@@ -24,10 +25,42 @@ void NewtonSolver::Prepare(const SparseMatrix& pattern) {
   factor_valid_ = false;
   d_trial_.setZero(n);
   rhs_.setZero(n);
+  simplified_.setZero(n);
   linear_->AnalyzePattern(pattern);
 }
 
-NewtonStats NewtonSolver::Solve(NonlinearSystem& system, VecX& d, SparseMatrix& J) {
+bool NewtonSolver::FactorizeTangent(const SparseMatrix& J, NewtonStats& stats) {
+  if (linear_->Factorize(J)) return true;
+  // An SPD-only direct factorisation refused J. Away from the solution (a large load increment,
+  // a follower pressure, a stiff volumetric penalty) the tangent can be indefinite although the
+  // problem is well posed: LDLᵀ still gives a Newton direction, and the globalisation judges
+  // its step. The switch is permanent and deterministic (a resumed run fails the same
+  // factorisation and switches at the same point), so checkpoints need not record it.
+  stats.linear_failure_kind = LinearFailure::kNotPositiveDefinite;
+  if (!indefinite_ && linear_->AcceptIndefinite()) {
+    indefinite_ = true;
+    if (linear_->Factorize(J)) {
+      stats.linear_failure_kind = LinearFailure::kNone;
+      return true;
+    }
+  }
+  if (indefinite_) stats.linear_failure_kind = LinearFailure::kSingular;
+  return false;
+}
+
+bool NewtonSolver::Monotone(NonlinearSystem& system, NewtonStats& stats, double alpha) {
+  // Simplified Newton correction Δ̄ = −J⁻¹ r(d + αΔ) with the current factorisation, started
+  // from its prediction (1 − α) Δ (what it is for a linear problem).
+  rhs_ = -r_trial_;
+  simplified_ = (1 - alpha) * delta_;
+  const LinearSolveStats ls = linear_->Solve(rhs_, simplified_);
+  stats.linear_iterations += ls.iterations;
+  if (!ls.converged || !simplified_.allFinite()) return false;
+  if (!ApplyLowRank(system, stats, simplified_)) return false;
+  return simplified_.norm() <= (1 - 0.25 * alpha) * delta_.norm();
+}
+
+NewtonStats NewtonSolver::Solve(NonlinearSystem& system, VecX& d, SparseMatrix& J, StopToken stop) {
   NewtonStats stats;
   const bool reuse = options_.reuse_factorization && !options_.fixed_iterations;
   // With reuse, the previous Solve's factorisation is tried first (only the residual is new).
@@ -45,7 +78,8 @@ NewtonStats NewtonSolver::Solve(NonlinearSystem& system, VecX& d, SparseMatrix& 
   const double reference = std::max(norm, system.force_scale());
   auto done = [&](double residual) {
     return !options_.fixed_iterations &&
-           residual <= std::max(options_.tolerance * reference, system.residual_floor());
+           residual <= std::max({options_.tolerance * reference, options_.absolute_tolerance,
+                                 system.residual_floor()});
   };
   if (!std::isfinite(norm)) return stats;
   if (done(norm) || reference == 0) {
@@ -60,12 +94,25 @@ NewtonStats NewtonSolver::Solve(NonlinearSystem& system, VecX& d, SparseMatrix& 
     factor_valid_ = false;  // J now differs from the factorised matrix
     return true;
   };
-  for (int it = 1; it <= options_.max_iterations; ++it) {
+  // Contraction of the last two accepted iterations (the residual ratio, or the increment
+  // ratio ‖Δ̄‖/‖Δ‖ for a step accepted by the monotonicity test): a budget that runs out while
+  // both are ≤ ½ is extended, up to twice max_iterations.
+  double contraction[2] = {1, 1};
+  const bool can_extend = !options_.fixed_iterations;
+  for (int it = 1;; ++it) {
+    const bool converging = contraction[0] <= 0.5 && contraction[1] <= 0.5;
+    if (it > options_.max_iterations &&
+        !(can_extend && converging && it <= 2 * options_.max_iterations))
+      break;
+    if (stop.stop_requested()) {
+      stats.interrupted = true;
+      return stats;
+    }
     stats.iterations = it;
     bool fresh = need_factor;
     if (need_factor) {
       factor_valid_ = false;
-      if (!linear_->Factorize(J)) {
+      if (!FactorizeTangent(J, stats)) {
         stats.linear_failure = true;
         return stats;
       }
@@ -84,7 +131,7 @@ NewtonStats NewtonSolver::Solve(NonlinearSystem& system, VecX& d, SparseMatrix& 
     // `refactorized` describes the last Factorize, so count it only in the iteration that called
     // it.
     stats.refactorizations += fresh && ls.refactorized ? 1 : 0;
-    const bool solved = ls.converged && delta_.allFinite() && ApplyLowRank(system, stats);
+    const bool solved = ls.converged && delta_.allFinite() && ApplyLowRank(system, stats, delta_);
     if (!solved && !fresh) {
       if (!refresh()) {
         stats.inadmissible = true;
@@ -95,6 +142,7 @@ NewtonStats NewtonSolver::Solve(NonlinearSystem& system, VecX& d, SparseMatrix& 
     }
     if (!solved) {
       stats.linear_failure = true;
+      stats.linear_failure_kind = LinearFailure::kNotConverged;
       return stats;
     }
     if (it == 1) {
@@ -107,18 +155,31 @@ NewtonStats NewtonSolver::Solve(NonlinearSystem& system, VecX& d, SparseMatrix& 
       stats.converged = true;  // accepted by definition in interactive mode
       return stats;
     }
-    // Backtracking line search on ‖r‖.
+    // Backtracking: residual (Armijo) or natural monotonicity (see the file comment).
     double alpha = 1;
     bool accepted = false;
+    bool by_monotonicity = false;
     double trial_norm = 0;
     const int tries = options_.line_search ? options_.max_line_search_steps : 1;
     for (int ls_step = 0; ls_step < tries; ++ls_step, alpha *= 0.5) {
+      if (ls_step > 0) {
+        ++stats.backtracks;
+        if (stop.stop_requested()) {
+          stats.interrupted = true;
+          return stats;
+        }
+      }
       d_trial_ = d + alpha * delta_;
       if (!system.CalcResidual(d_trial_, r_trial_)) continue;
       trial_norm = r_trial_.norm();
       if (!std::isfinite(trial_norm)) continue;
       if (!options_.line_search || trial_norm <= (1 - 1e-4 * alpha) * norm) {
         accepted = true;
+        break;
+      }
+      // Only with a fresh Jacobian: a stale one that fails the residual test is refreshed first.
+      if (options_.monotonicity_test && fresh && Monotone(system, stats, alpha)) {
+        accepted = by_monotonicity = true;
         break;
       }
     }
@@ -134,6 +195,7 @@ NewtonStats NewtonSolver::Solve(NonlinearSystem& system, VecX& d, SparseMatrix& 
     if (!accepted) {
       // No decrease: take the full step anyway if it is admissible (Newton may need to climb
       // out of a poor start); otherwise report the failure.
+      alpha = 1;
       d_trial_ = d + delta_;
       if (!system.CalcResidual(d_trial_, r_trial_) || !r_trial_.allFinite()) {
         stats.inadmissible = true;
@@ -143,6 +205,11 @@ NewtonStats NewtonSolver::Solve(NonlinearSystem& system, VecX& d, SparseMatrix& 
     }
     d.swap(d_trial_);
     const double ratio = norm > 0 ? trial_norm / norm : 0;
+    if (by_monotonicity) ++stats.monotonicity_accepts;
+    contraction[0] = contraction[1];
+    contraction[1] = alpha < 1 || !accepted ? 1.0
+                     : by_monotonicity      ? simplified_.norm() / delta_.norm()
+                                            : ratio;
     norm = trial_norm;
     stats.final_residual = norm;
     if (it < NewtonStats::kHistory) stats.residual_history[static_cast<std::size_t>(it)] = norm;
@@ -177,11 +244,11 @@ NewtonStats NewtonSolver::Solve(NonlinearSystem& system, VecX& d, SparseMatrix& 
   return stats;
 }
 
-bool NewtonSolver::ApplyLowRank(NonlinearSystem& system, NewtonStats& stats) {
+bool NewtonSolver::ApplyLowRank(NonlinearSystem& system, NewtonStats& stats, VecX& x) {
   const int k = system.num_low_rank_terms();
   if (k == 0) return true;
   GIPSI_CHECK(k <= kMaxLowRankTerms);
-  // (J + B W Bᵀ)⁻¹ r = y − Z (W⁻¹ + Bᵀ Z)⁻¹ Bᵀ y with y = J⁻¹ r (in delta_) and Z = J⁻¹ B.
+  // (J + B W Bᵀ)⁻¹ r = y − Z (W⁻¹ + Bᵀ Z)⁻¹ Bᵀ y with y = J⁻¹ r (in x) and Z = J⁻¹ B.
   // Terms with w = 0 drop out and are skipped.
   if (static_cast<int>(low_rank_z_.size()) < k) low_rank_z_.resize(static_cast<std::size_t>(k));
   std::array<const VecX*, kMaxLowRankTerms> b{};
@@ -207,7 +274,7 @@ bool NewtonSolver::ApplyLowRank(NonlinearSystem& system, NewtonStats& stats) {
   SmallVec c(m);
   for (int i = 0; i < m; ++i) {
     const auto ai = static_cast<std::size_t>(active[static_cast<std::size_t>(i)]);
-    c[i] = b[ai]->dot(delta_);
+    c[i] = b[ai]->dot(x);
     for (int j = 0; j < m; ++j)
       s(i, j) =
           b[ai]->dot(low_rank_z_[static_cast<std::size_t>(active[static_cast<std::size_t>(j)])]);
@@ -215,19 +282,52 @@ bool NewtonSolver::ApplyLowRank(NonlinearSystem& system, NewtonStats& stats) {
   }
   const SmallVec coef = s.ldlt().solve(c);
   for (int j = 0; j < m; ++j)
-    delta_ -= coef[j] * low_rank_z_[static_cast<std::size_t>(active[static_cast<std::size_t>(j)])];
-  return delta_.allFinite();
+    x -= coef[j] * low_rank_z_[static_cast<std::size_t>(active[static_cast<std::size_t>(j)])];
+  return x.allFinite();
 }
 
-std::string Describe(const NewtonStats& stats, const NewtonOptions& options) {
+std::string Describe(const NewtonStats& stats, const NewtonOptions& options,
+                     std::string_view solver) {
+  // The residuals of the accepted iterates: a solve that stopped inside iteration k has k.
+  const int accepted =
+      stats.linear_failure || stats.interrupted ? stats.iterations - 1 : stats.iterations;
   std::string history;
-  for (int i = 0; i <= std::min(stats.iterations, NewtonStats::kHistory - 1); ++i)
+  for (int i = 0; i <= std::min(std::max(accepted, 0), NewtonStats::kHistory - 1); ++i)
     history +=
         fmt::format("{}{:.2e}", i ? " " : "", stats.residual_history[static_cast<std::size_t>(i)]);
-  const char* why = stats.inadmissible ? "no admissible state (inverted elements?)"
-                    : stats.linear_failure
-                        ? "the linear solve failed (matrix not positive definite?)"
-                        : "did not converge";
+  const std::string name = solver.empty() ? std::string("the linear solver")
+                                          : fmt::format("the '{}' linear solver", solver);
+  if (stats.linear_failure) {
+    switch (stats.linear_failure_kind) {
+      case LinearFailure::kNotPositiveDefinite:
+        return fmt::format(
+            "Newton: the tangent matrix is not positive definite at iteration {}: {} needs a "
+            "positive definite matrix and could not factorise it. A tangent turns indefinite "
+            "when a load increment is too large for the volumetric penalty (bulk_modulus) or a "
+            "follower pressure, or past a buckling or limit point: try more \"load_steps\", or "
+            "a solver that accepts indefinite matrices, \"linear_solver\": {{\"type\": "
+            "\"ldlt\"}} or {{\"type\": \"cholmod\"}}; |r|: {}",
+            stats.iterations, name, history);
+      case LinearFailure::kSingular:
+        return fmt::format(
+            "Newton: the tangent matrix is singular at iteration {}: {} met a zero pivot even "
+            "in its indefinite (LDLT) factorisation. Either the body is not held against "
+            "rigid motion (check the boundary conditions) or the load increment reached a "
+            "limit point: try more \"load_steps\"; |r|: {}",
+            stats.iterations, name, history);
+      default:
+        return fmt::format(
+            "Newton: the linear solve failed at iteration {}: {} did not reach its tolerance "
+            "(an ill-conditioned or indefinite tangent): try \"linear_solver\": {{\"type\": "
+            "\"cholmod\"}} or more \"load_steps\"; |r|: {}",
+            stats.iterations, name, history);
+    }
+  }
+  if (stats.interrupted)
+    return fmt::format("Newton: stopped on request after {} iteration(s); |r|: {}",
+                       stats.iterations, history);
+  const char* why =
+      stats.inadmissible ? "no admissible state (inverted elements?)" : "did not converge";
   return fmt::format("Newton: {} after {} iteration(s) (tolerance {:.1e}); |r|: {}", why,
                      stats.iterations, options.tolerance, history);
 }

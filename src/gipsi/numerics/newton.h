@@ -1,22 +1,41 @@
 #pragma once
 /// @file
-/// Newton's method with a backtracking line search for sparse nonlinear systems r(d) = 0 whose
-/// Jacobian is symmetric positive definite near the solution (implicit mechanics). The system
+/// Newton's method with a globalised step for sparse nonlinear systems r(d) = 0 whose Jacobian
+/// is symmetric and, near the solution, positive definite (implicit mechanics). The system
 /// evaluates residuals and assembles Jacobians in place; the solver owns nothing but work
 /// vectors and a LinearSolver, so a step allocates nothing after `Prepare`.
 ///
 /// Iteration k: solve J(d_k) Δ = −r(d_k); take d_{k+1} = d_k + α Δ with α = 1, ½, ¼, … until
-/// ‖r(d_{k+1})‖ ≤ (1 − c α) ‖r(d_k)‖ (Armijo on the residual norm; c = 1e-4) and the trial state
-/// is admissible (e.g. no inverted element for laws defined only for det F > 0). Converged when
-/// ‖r‖ ≤ max(tolerance · max(‖r(d_0)‖, force_scale), residual_floor) or
-/// ‖Δ‖∞ ≤ max(increment_tolerance, relative_increment_tolerance · ‖d‖∞).
+/// the trial state is admissible (e.g. no inverted element) and makes progress by one of two
+/// merits:
+///   1. the residual norm (Armijo, c = 1e-4): ‖r(d_k + αΔ)‖ ≤ (1 − c α) ‖r(d_k)‖; or
+///   2. the natural monotonicity test on the increment (Deuflhard, "Newton Methods for
+///      Nonlinear Problems", Springer 2004, §3.3, the test of NLEQ-ERR): the simplified Newton
+///      correction with the same factorisation, Δ̄ = −J(d_k)⁻¹ r(d_k + αΔ), satisfies
+///      ‖Δ̄‖ ≤ (1 − α/4) ‖Δ‖.
+/// The second is affine covariant: it measures progress in the unknowns, not in the residual,
+/// so it accepts the full step of a nearly incompressible solid whose residual jumps by
+/// orders of magnitude in the stiff volumetric modes while the iterate is already in the
+/// region of quadratic convergence (a residual-only line search cuts such a step to 1/4096
+/// and stalls). It costs one more solve with the factorised J, taken only when the residual
+/// test fails.
+///
+/// Converged when ‖r‖ ≤ max(tolerance · max(‖r(d_0)‖, force_scale), absolute_tolerance,
+/// residual_floor) or the full correction is small: ‖Δ‖∞ ≤ max(increment_tolerance,
+/// relative_increment_tolerance · ‖d‖∞). An iteration budget that runs out while the solve is
+/// converging (each of the last two iterations contracted by at least half) is extended, up to
+/// twice `max_iterations`: a converging solve is not abandoned (and then bisected by its
+/// caller) one iteration before it would converge.
 
 #include <array>
+#include <cstdint>
 #include <memory>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "gipsi/base/math.h"
+#include "gipsi/base/stop_token.h"
 #include "gipsi/numerics/sparse/linear_solver.h"
 
 namespace gipsi {
@@ -48,16 +67,27 @@ class NonlinearSystem {
   virtual void LowRankTerm(int /*k*/, const VecX*& /*b*/, double& /*w*/) const {}
 };
 
-/// Options. Plain struct.
+/// Options. Plain struct. The defaults are the stated defaults of the scene key "newton".
 struct NewtonOptions {
+  /// Iteration budget; extended up to twice this while the solve is converging.
   int max_iterations = 25;
-  double tolerance = 1e-8;         ///< relative residual
+  /// Relative residual tolerance: converged when ‖r‖ ≤ tolerance · max(‖r(d_0)‖,
+  /// force_scale) (the system's applied-load scale).
+  double tolerance = 1e-8;
+  /// Absolute residual tolerance [the residual's unit, N for mechanics]: also converged when
+  /// ‖r‖ ≤ absolute_tolerance. 0 disables (the system's round-off floor still applies).
+  double absolute_tolerance = 0;
   double increment_tolerance = 0;  ///< absolute ‖Δ‖∞ [m]; 0 disables
   /// Also converged when the full Newton correction is this small relative to the iterate,
   /// ‖Δ‖∞ ≤ relative_increment_tolerance · ‖d‖∞ (the residual has reached its round-off floor
   /// and further iterations cannot move the solution); 0 disables.
   double relative_increment_tolerance = 1e-11;
+  /// Globalise the step (the residual and natural-monotonicity tests above); false takes full
+  /// Newton steps whatever they do (as long as the state stays admissible).
   bool line_search = true;
+  /// Accept a trial step by the natural monotonicity test when the residual test fails (one
+  /// extra solve with the factorised Jacobian per such trial). false: residual test only.
+  bool monotonicity_test = true;
   int max_line_search_steps = 12;
   /// Interactive mode: take exactly max_iterations iterations and accept the result (the usual
   /// one-Newton-step-per-frame practice); the residual is then not recomputed.
@@ -75,14 +105,28 @@ struct NewtonOptions {
   bool reuse_factorization = false;
 };
 
-/// Outcome of one solve. Plain struct.
+/// Why a linear solve failed. Plain enum.
+enum class LinearFailure : std::uint8_t {
+  kNone,
+  kNotPositiveDefinite,  ///< an SPD-only factorisation refused the tangent (indefinite?)
+  kSingular,             ///< refused even by the indefinite (LDLᵀ) factorisation
+  kNotConverged,         ///< an iterative solve missed its tolerance or gave non-finite values
+};
+
+/// Outcome of one solve. Plain struct, trivially copyable (checkpoints store it as bytes).
 struct NewtonStats {
   bool converged = false;
   bool inadmissible = false;  ///< stopped because no admissible state was found
   bool linear_failure = false;
+  bool interrupted = false;  ///< a stop was requested (StopToken) before convergence
+  LinearFailure linear_failure_kind = LinearFailure::kNone;
   int iterations = 0;
   int linear_iterations = 0;
   int refactorizations = 0;
+  /// Iterations whose full step was accepted by the natural monotonicity test although the
+  /// residual grew (the case a residual-only line search would have cut).
+  int monotonicity_accepts = 0;
+  int backtracks = 0;  ///< step halvings in the line search, over all iterations
   double initial_residual = 0;
   double final_residual = 0;
   static constexpr int kHistory = 8;
@@ -100,7 +144,10 @@ class NewtonSolver {
   void Prepare(const SparseMatrix& pattern);
   /// Solves r(d) = 0 starting from d (in: initial guess; out: the last accepted iterate).
   /// `J` is the matrix the system assembles into (the pattern given to Prepare).
-  NewtonStats Solve(NonlinearSystem& system, VecX& d, SparseMatrix& J);
+  /// Polls `stop` at the start of every iteration and before every line-search trial: when a
+  /// stop is requested it returns at once with `interrupted` set and d at the last accepted
+  /// iterate (not converged).
+  NewtonStats Solve(NonlinearSystem& system, VecX& d, SparseMatrix& J, StopToken stop = {});
 
   [[nodiscard]] const NewtonOptions& options() const { return options_; }
   [[nodiscard]] LinearSolver& linear_solver() { return *linear_; }
@@ -117,19 +164,27 @@ class NewtonSolver {
  private:
   NewtonOptions options_;
   std::unique_ptr<LinearSolver> linear_;
-  VecX r_, r_trial_, delta_, d_trial_, rhs_;
+  VecX r_, r_trial_, delta_, d_trial_, rhs_, simplified_;
   VecX warm_;  // first correction of the last solve
   bool warm_valid_ = false;
   bool factor_valid_ = false;  // the linear solver holds a factorisation of the current J
+  bool indefinite_ = false;    // the linear solver was switched to its indefinite mode
   static constexpr int kMaxLowRankTerms = 8;
   std::vector<VecX> low_rank_z_;  // J⁻¹ b_k of the low-rank terms (sized on first use)
 
-  /// Applies the low-rank correction to delta_ = J⁻¹ rhs (Woodbury); false if a solve fails.
-  bool ApplyLowRank(NonlinearSystem& system, NewtonStats& stats);
+  /// Applies the low-rank terms to x = J⁻¹ rhs (Woodbury); false if a solve fails.
+  bool ApplyLowRank(NonlinearSystem& system, NewtonStats& stats, VecX& x);
+  /// The natural monotonicity test of trial step α: true if ‖J⁻¹ r_trial_‖ ≤ (1 − α/4) ‖Δ‖.
+  bool Monotone(NonlinearSystem& system, NewtonStats& stats, double alpha);
+  /// Factorises J; on failure of an SPD-only direct solver, switches it to its indefinite
+  /// (LDLᵀ) mode once and retries. Sets the failure kind.
+  bool FactorizeTangent(const SparseMatrix& J, NewtonStats& stats);
 };
 
-/// One-line summary of a failed solve for diagnostics ("Newton did not converge in 25
-/// iterations: |r| 3.1e+02 -> 4.5e-03 (tolerance 1e-08) ...").
-std::string Describe(const NewtonStats& stats, const NewtonOptions& options);
+/// Summary of a failed solve for diagnostics: what failed, the residual history, and for a
+/// tangent that could not be factorised, with which solver (`solver`, e.g. "cholmod") and
+/// what to try.
+std::string Describe(const NewtonStats& stats, const NewtonOptions& options,
+                     std::string_view solver = {});
 
 }  // namespace gipsi

@@ -7,7 +7,9 @@
 /// The factorised values are those of J: while a factorisation is kept (factor_valid_), Solve
 /// writes J only in CalcResidualAndJacobian, and it marks the factors stale whenever it does so
 /// without factorising (when the iterations run out), so the saved J is always the factorised
-/// matrix.
+/// matrix. Whether the linear solver was switched to its indefinite mode is not saved: the
+/// switch happens at the first factorisation that needs it, in the resumed run as in the
+/// original, and gives the same factors.
 
 #include <algorithm>
 #include <span>
@@ -40,7 +42,9 @@ void NewtonSolver::RestoreState(StateReader& in, SparseMatrix& J) {
     std::vector<double> values(static_cast<std::size_t>(J.nonZeros()));
     in.ReadArrayExact(values, "the factorised Newton matrix");
     std::copy(values.begin(), values.end(), J.valuePtr());
-    if (!linear_->Factorize(J)) in.Fail("the saved Newton matrix cannot be factorised again");
+    // The run that saved it may have switched its solver to the indefinite mode (newton.cc).
+    NewtonStats stats;
+    if (!FactorizeTangent(J, stats)) in.Fail("the saved Newton matrix cannot be factorised again");
     factor_valid_ = true;
   }
   in.EndSection();

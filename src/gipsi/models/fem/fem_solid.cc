@@ -69,7 +69,7 @@ FemSolid::FemSolid(std::string name, std::shared_ptr<const Mesh> domain, FemPara
   x_ = rest_;
   scheme_ = ImplicitScheme(params_.scheme, params_.newmark_beta, params_.newmark_gamma);
   scheme_.Reset(VecX::Zero(3 * n), VecX::Zero(3 * n), VecX::Zero(3 * n));
-  saved_scheme_ = scheme_;
+  saved_scheme_ = begin_scheme_ = scheme_;
   newton_ = std::make_unique<NewtonSolver>(params_.newton, MakeLinearSolver(params_.linear_solver));
   // Rigid-body modes of the rest shape: what an AMG preconditioner coarsens (others ignore it).
   newton_->linear_solver().SetNearNullSpace(RigidBodyModes(rest_));
@@ -477,6 +477,8 @@ void FemSolid::InitialAcceleration() {
 }
 
 StepStatus FemSolid::Advance(double s0, double s1, double dt, int depth) {
+  // A stop request is honoured before every load increment and bisection, and inside Newton.
+  if (stop_token().stop_requested()) return StepStatus::Stopped();
   saved_scheme_ = scheme_;
   scheme_.Begin((s1 - s0) * dt);
   s_ = s1;
@@ -498,7 +500,7 @@ StepStatus FemSolid::Advance(double s0, double s1, double dt, int depth) {
     // loads at the first iterate (TakeLoadScale) once Newton evaluates it.
     force_scale_ = (f_nodal_prev_ + s1 * (f_nodal_new_ - f_nodal_prev_)).norm();
     load_scale_pending_ = true;
-    last_newton_ = newton_->Solve(*this, d_, jac_);
+    last_newton_ = newton_->Solve(*this, d_, jac_, stop_token());
   };
   solve(predict);
   if (predict && last_newton_.inadmissible && last_newton_.iterations == 0) {
@@ -514,13 +516,16 @@ StepStatus FemSolid::Advance(double s0, double s1, double dt, int depth) {
   }
   scheme_ = saved_scheme_;
   RestoreCavityPressures();
+  if (last_newton_.interrupted) return StepStatus::Stopped();
+  // Newton extends its budget while it converges (newton.h), so what arrives here is not
+  // converging: a smaller increment is the remedy.
   if (depth < params_.max_bisections) {
     const double mid = 0.5 * (s0 + s1);
     StepStatus status = Advance(s0, mid, dt, depth + 1);
     if (!status.ok()) return status;
     return Advance(mid, s1, dt, depth + 1);
   }
-  failure_detail_ = Describe(last_newton_, params_.newton);
+  failure_detail_ = Describe(last_newton_, params_.newton, newton_->linear_solver().name());
   if (failed_cavity_ >= 0)
     failure_detail_ += fmt::format(
         "; the blood coupled to cavity '{}' found no pressure for the wall's volume (is the blood "
@@ -535,7 +540,10 @@ StepStatus FemSolid::Advance(double s0, double s1, double dt, int depth) {
   if (last_newton_.inadmissible)
     return StepStatus::Failed("no admissible state: an element inverted; element", first_invalid_);
   if (last_newton_.linear_failure)
-    return StepStatus::Failed("linear solver failed (tangent not positive definite?)");
+    return StepStatus::Failed(
+        last_newton_.linear_failure_kind == LinearFailure::kNotConverged
+            ? "the linear solve of the Newton step failed"
+            : "the tangent matrix could not be factorised (indefinite or singular)");
   return StepStatus::Failed("Newton did not converge; final residual", -1,
                             last_newton_.final_residual);
 }
@@ -548,6 +556,7 @@ StepStatus FemSolid::DoStep(double t, double dt) {
   GatherTargets();
   if (params_.scheme == ImplicitSchemeKind::kNewmark && step_count() == 0) InitialAcceleration();
   x_begin_ = scheme_.x();
+  begin_scheme_ = scheme_;  // for a stop inside the step (allocation-free: same sizes)
   failure_detail_.clear();
   const auto start = Clock::now();
   const double solve_before = profile_.assembly_seconds;
@@ -557,6 +566,12 @@ StepStatus FemSolid::DoStep(double t, double dt) {
     status = Advance(double(k) / pieces, double(k + 1) / pieces, dt, 0);
   profile_.solve_seconds += Seconds(start) - (profile_.assembly_seconds - solve_before);
   ++profile_.steps;
+  if (status.code == StepStatus::Code::kStopped) {
+    // Abandon the whole step, committed load increments and bisections included: the object
+    // is back at the start of the step, consistent with its clock.
+    scheme_ = begin_scheme_;
+    RestoreCavityPressures();
+  }
   UpdatePositions();
   if (!status.ok()) return status;
   f_nodal_prev_ = f_nodal_new_;

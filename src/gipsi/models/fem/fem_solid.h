@@ -13,7 +13,10 @@
 /// Time stepping by any ImplicitScheme (Static, BackwardEuler, BDF2, Newmark) and Newton with
 /// line search; the tangent is consistent (law tangents, symmetric part of the load tangent).
 /// A step whose Newton solve fails is bisected (loads interpolated linearly over the step) up
-/// to `max_bisections` times before the step is reported failed with a diagnostic.
+/// to `max_bisections` times before the step is reported failed with a diagnostic; a solve
+/// that is still converging when its iterations run out is given more (newton.h) instead.
+/// A stop request (stop_token) is polled before every load increment and Newton iteration;
+/// the step is then abandoned (the state of its start restored) and reported as stopped.
 /// Kinematic boundary conditions (displacement, velocity per axis on boundary vertices) are
 /// imposed exactly; reaction forces are readable as the boundary field "reaction_force".
 /// Units: SI (m, kg, s, N, Pa).
@@ -192,6 +195,7 @@ class FemSolid final : public SimObject, private NonlinearSystem {
   SparseMatrix jac_;        // Newton matrix
   SparseMatrix damping_k_;  // K_n for Rayleigh β
   ImplicitScheme scheme_, saved_scheme_;
+  ImplicitScheme begin_scheme_;  // at the start of the step (a stop abandons the step)
   std::unique_ptr<NewtonSolver> newton_;
   NewtonStats last_newton_;
   FemProfile profile_;

@@ -13,7 +13,8 @@ namespace gipsi {
 namespace {
 
 NewtonOptions ParseNewton(const JsonNode& node, NewtonOptions options) {
-  node.CheckKeys({"max_iterations", "tolerance", "increment_tolerance", "line_search",
+  node.CheckKeys({"max_iterations", "tolerance", "absolute_tolerance", "increment_tolerance",
+                  "relative_increment_tolerance", "line_search", "monotonicity_test",
                   "fixed_iterations", "reuse_factorization"});
   if (auto it = node.Find("max_iterations")) {
     const std::int64_t n = it->AsInt();
@@ -21,9 +22,13 @@ NewtonOptions ParseNewton(const JsonNode& node, NewtonOptions options) {
     options.max_iterations = static_cast<int>(n);
   }
   options.tolerance = node.Positive("tolerance", options.tolerance);
+  options.absolute_tolerance = node.NonNegative("absolute_tolerance", options.absolute_tolerance);
   options.increment_tolerance =
       node.NonNegative("increment_tolerance", options.increment_tolerance);
+  options.relative_increment_tolerance =
+      node.NonNegative("relative_increment_tolerance", options.relative_increment_tolerance);
   options.line_search = node.Bool("line_search", options.line_search);
+  options.monotonicity_test = node.Bool("monotonicity_test", options.monotonicity_test);
   options.fixed_iterations = node.Bool("fixed_iterations", options.fixed_iterations);
   options.reuse_factorization = node.Bool("reuse_factorization", options.reuse_factorization);
   return options;

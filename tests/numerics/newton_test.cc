@@ -1,0 +1,260 @@
+// NewtonSolver on small algebraic systems: the globalisation (residual and natural
+// monotonicity tests), the tolerance semantics, the budget extension of a converging solve and
+// the stop request.
+
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <cmath>
+#include <functional>
+#include <vector>
+
+#include "gipsi/numerics/newton.h"
+
+namespace gipsi {
+namespace {
+
+/// A system with a diagonal Jacobian: r_i = f_i(x_i), J_ii = f_i'(x_i). Counts evaluations.
+class DiagonalSystem final : public NonlinearSystem {
+ public:
+  using Fn = std::function<double(int, double)>;
+  DiagonalSystem(Fn f, Fn df) : f_(std::move(f)), df_(std::move(df)) {}
+  bool CalcResidual(const VecX& d, VecX& r) override {
+    ++residuals;
+    if (on_evaluation) on_evaluation();
+    for (Index i = 0; i < d.size(); ++i) r[i] = f_(static_cast<int>(i), d[i]);
+    return r.allFinite();
+  }
+  bool CalcResidualAndJacobian(const VecX& d, VecX& r, SparseMatrix& J) override {
+    ++jacobians;
+    if (!CalcResidual(d, r)) return false;
+    for (Index i = 0; i < d.size(); ++i) J.coeffRef(i, i) = df_(static_cast<int>(i), d[i]);
+    return true;
+  }
+  int residuals = 0, jacobians = 0;
+  std::function<void()> on_evaluation;
+
+ private:
+  Fn f_, df_;
+};
+
+SparseMatrix DiagonalPattern(Index n) {
+  SparseMatrix J(n, n);
+  for (Index i = 0; i < n; ++i) J.insert(i, i) = 1;
+  J.makeCompressed();
+  return J;
+}
+
+NewtonStats Solve(DiagonalSystem& system, VecX& x, NewtonOptions options, StopToken stop = {}) {
+  NewtonSolver newton(options, MakeLinearSolver(LinearSolverOptions{.type = "ldlt"}));
+  SparseMatrix J = DiagonalPattern(x.size());
+  newton.Prepare(J);
+  return newton.Solve(system, x, J, stop);
+}
+
+// A soft unknown u with a mildly nonlinear residual and a stiff unknown v (stiffness K = 1e3
+// on a length scale ε = 1e-3) whose first Newton step overshoots: the full step raises ‖r‖
+// 1.55× (the stiff residual grows sixfold) while the correction it leaves, Δ̄ = −J₀⁻¹ r(x₁),
+// is 7× smaller than Δ — the situation of a nearly incompressible solid, where the residual of
+// the stiff volumetric modes jumps while the displacements are already converging.
+constexpr double kK = 1e3, kEps = 1e-3;
+DiagonalSystem SoftAndStiff() {
+  return DiagonalSystem(
+      [](int i, double x) {
+        return i == 0 ? (x - 1) + 0.1 * (x - 1) * (x - 1) : kK * (x + x * x / kEps);
+      },
+      [](int i, double x) { return i == 0 ? 1 + 0.2 * (x - 1) : kK * (1 + 2 * x / kEps); });
+}
+
+TEST(Newton, AcceptsAFullStepThatRaisesTheResidualButContractsTheIncrement) {
+  DiagonalSystem system = SoftAndStiff();
+  VecX x(2);
+  x << 0, -0.4 * kEps;
+  NewtonOptions options;
+  options.tolerance = 1e-12;
+  const NewtonStats stats = Solve(system, x, options);
+  ASSERT_TRUE(stats.converged) << Describe(stats, options);
+  EXPECT_GT(stats.residual_history[1], 1.5 * stats.residual_history[0]);  // the residual rose
+  EXPECT_EQ(stats.monotonicity_accepts, 1);
+  EXPECT_EQ(stats.backtracks, 0);  // every step was a full Newton step
+  EXPECT_NEAR(x[0], 1, 1e-12);
+  EXPECT_NEAR(x[1], 0, 1e-12 * kEps);
+
+  // A residual-only line search cuts that first step instead.
+  DiagonalSystem residual_only = SoftAndStiff();
+  VecX y(2);
+  y << 0, -0.4 * kEps;
+  options.monotonicity_test = false;
+  const NewtonStats cut = Solve(residual_only, y, options);
+  ASSERT_TRUE(cut.converged);
+  EXPECT_GT(cut.backtracks, 0);
+  EXPECT_EQ(cut.monotonicity_accepts, 0);
+}
+
+TEST(Newton, BacktrackingStillRescuesAnOvershootingStep) {
+  // r = arctan(x) from x₀ = 3: the full Newton step lands at −9.5, where both |r| and the
+  // simplified correction grow, and plain Newton diverges; the line search halves twice.
+  auto atan_system = [] {
+    return DiagonalSystem([](int, double x) { return std::atan(x); },
+                          [](int, double x) { return 1 / (1 + x * x); });
+  };
+  DiagonalSystem system = atan_system();
+  VecX x = VecX::Constant(1, 3.0);
+  NewtonOptions options;
+  options.tolerance = 1e-12;
+  const NewtonStats stats = Solve(system, x, options);
+  ASSERT_TRUE(stats.converged) << Describe(stats, options);
+  EXPECT_GE(stats.backtracks, 2);
+  EXPECT_EQ(stats.monotonicity_accepts, 0);
+  EXPECT_NEAR(x[0], 0, 1e-12);
+
+  DiagonalSystem plain = atan_system();
+  VecX y = VecX::Constant(1, 3.0);
+  options.line_search = false;
+  EXPECT_FALSE(Solve(plain, y, options).converged);
+}
+
+// r = x³ from x₀: Newton contracts x by 2/3 and the residual by (2/3)³ ≈ 0.296 per iteration
+// (a triple root), so the iteration counts of the tolerances are known in closed form.
+DiagonalSystem Cubic() {
+  return DiagonalSystem([](int, double x) { return x * x * x; },
+                        [](int, double x) { return 3 * x * x; });
+}
+
+TEST(Newton, RelativeResidualToleranceIsRelativeToTheInitialResidual) {
+  // ‖r_k‖ = (8/27)^k ‖r_0‖ ≤ 1e-3 ‖r_0‖ first at k = ⌈ln 1e-3 / ln(8/27)⌉ = 6, whatever x₀.
+  for (double x0 : {1.0, 100.0}) {
+    DiagonalSystem system = Cubic();
+    VecX x = VecX::Constant(1, x0);
+    NewtonOptions options;
+    options.tolerance = 1e-3;
+    const NewtonStats stats = Solve(system, x, options);
+    ASSERT_TRUE(stats.converged);
+    EXPECT_EQ(stats.iterations, 6) << "x0 = " << x0;
+  }
+}
+
+TEST(Newton, AbsoluteResidualToleranceIsInTheResidualsUnits) {
+  // From x₀ = 10 (r₀ = 1000) with a relative tolerance too tight to matter: ‖r_k‖ ≤ 1e-3
+  // first at k = ⌈ln 1e-6 / ln(8/27)⌉ = 12; from x₀ = 1 (r₀ = 1): k = ⌈ln 1e-3 / ln(8/27)⌉ = 6.
+  for (auto [x0, expected] : {std::pair{10.0, 12}, std::pair{1.0, 6}}) {
+    DiagonalSystem system = Cubic();
+    VecX x = VecX::Constant(1, x0);
+    NewtonOptions options;
+    options.tolerance = 1e-30;
+    options.absolute_tolerance = 1e-3;
+    options.max_iterations = 50;
+    const NewtonStats stats = Solve(system, x, options);
+    ASSERT_TRUE(stats.converged);
+    EXPECT_EQ(stats.iterations, expected) << "x0 = " << x0;
+  }
+}
+
+TEST(Newton, IncrementTolerancesMeasureTheFullCorrection) {
+  // Iteration k's correction is Δ = −x_{k−1}/3 = −(2/3)^{k−1}/3 from x₀ = 1.
+  // Absolute: ≤ 1e-2 first at k − 1 = ⌈ln 0.03 / ln(2/3)⌉ = 9, k = 10.
+  DiagonalSystem system = Cubic();
+  VecX x = VecX::Constant(1, 1.0);
+  NewtonOptions options;
+  options.tolerance = 1e-300;
+  options.increment_tolerance = 1e-2;
+  options.max_iterations = 50;
+  NewtonStats stats = Solve(system, x, options);
+  ASSERT_TRUE(stats.converged);
+  EXPECT_EQ(stats.iterations, 10);
+  // Relative to the iterate, |Δ| = |x_k|/2 (x_k = (2/3) x_{k−1}): never below 0.4, always
+  // below 0.6.
+  options.increment_tolerance = 0;
+  options.relative_increment_tolerance = 0.4;
+  x.setConstant(1.0);
+  DiagonalSystem again = Cubic();
+  stats = Solve(again, x, options);
+  EXPECT_FALSE(stats.converged);
+  options.relative_increment_tolerance = 0.6;
+  x.setConstant(1.0);
+  DiagonalSystem once = Cubic();
+  stats = Solve(once, x, options);
+  ASSERT_TRUE(stats.converged);
+  EXPECT_EQ(stats.iterations, 1);
+}
+
+TEST(Newton, AConvergingSolveIsNotCutShort) {
+  // The cubic needs ⌈ln 1e-8 / ln(8/27)⌉ = 16 iterations at tolerance 1e-8. With a budget of 10
+  // it is still contracting by 0.3 per iteration when the budget runs out: Newton goes on (up
+  // to 2 × 10) instead of failing, which would make FemSolid bisect a converging increment.
+  DiagonalSystem system = Cubic();
+  VecX x = VecX::Constant(1, 1.0);
+  NewtonOptions options;
+  options.max_iterations = 10;
+  NewtonStats stats = Solve(system, x, options);
+  ASSERT_TRUE(stats.converged) << Describe(stats, options);
+  EXPECT_EQ(stats.iterations, 16);
+  // The extension is bounded: 1e-16 needs 31 iterations, more than 2 × 10.
+  DiagonalSystem tight = Cubic();
+  x.setConstant(1.0);
+  options.tolerance = 1e-16;
+  options.relative_increment_tolerance = 0;
+  stats = Solve(tight, x, options);
+  EXPECT_FALSE(stats.converged);
+  EXPECT_EQ(stats.iterations, 20);
+}
+
+TEST(Newton, AStopRequestEndsTheSolveWithinTheIteration) {
+  // The flag is raised inside the 4th residual evaluation; the solve returns without another
+  // linear solve: at most the Jacobian of the step just accepted is assembled after it.
+  DiagonalSystem system = Cubic();
+  std::atomic<bool> flag{false};
+  int at_request = -1;
+  system.on_evaluation = [&] {
+    if (system.residuals == 4) {
+      flag.store(true);
+      at_request = system.residuals;
+    }
+  };
+  VecX x = VecX::Constant(1, 1.0);
+  NewtonOptions options;
+  options.tolerance = 1e-12;
+  const NewtonStats stats = Solve(system, x, options, StopToken(&flag));
+  EXPECT_TRUE(stats.interrupted);
+  EXPECT_FALSE(stats.converged);
+  // Evaluations: r₀ and J₀; iteration 1: trial, J₁; iteration 2: the trial raising the flag,
+  // then J₂ of the accepted step; no iteration 3.
+  EXPECT_EQ(system.residuals - at_request, 1);
+  EXPECT_EQ(stats.iterations, 2);
+  EXPECT_EQ(Describe(stats, options).rfind("Newton: stopped on request after ", 0), 0u);
+}
+
+TEST(Newton, AnIndefiniteTangentFallsBackToLdltAndOtherwiseSaysWhatToTry) {
+  // r = x − x³/3 − 0.5 from x₀ = 1.5: J = 1 − x² = −1.25 < 0. "ldlt" refuses it as SPD,
+  // switches to its indefinite mode and converges to the root x ≈ 1.384 (J < 0 there too)...
+  auto system_of = [] {
+    return DiagonalSystem([](int, double x) { return x - x * x * x / 3 - 0.5; },
+                          [](int, double x) { return 1 - x * x; });
+  };
+  DiagonalSystem system = system_of();
+  VecX x = VecX::Constant(1, 1.5);
+  NewtonOptions options;
+  options.tolerance = 1e-12;
+  const NewtonStats stats = Solve(system, x, options);
+  ASSERT_TRUE(stats.converged) << Describe(stats, options);
+  EXPECT_NEAR(x[0], 1.3844, 1e-3);
+  // ... while CG, for SPD matrices only, fails and the message says why and what to try.
+  DiagonalSystem cg_system = system_of();
+  NewtonSolver cg(options, MakeLinearSolver(LinearSolverOptions{.type = "cg"}));
+  SparseMatrix J = DiagonalPattern(1);
+  cg.Prepare(J);
+  VecX y = VecX::Constant(1, 1.5);
+  const NewtonStats failed = cg.Solve(cg_system, y, J);
+  ASSERT_TRUE(failed.linear_failure);
+  EXPECT_EQ(failed.linear_failure_kind, LinearFailure::kNotPositiveDefinite);
+  EXPECT_EQ(Describe(failed, options, cg.linear_solver().name()),
+            "Newton: the tangent matrix is not positive definite at iteration 1: the 'cg+jacobi' "
+            "linear solver needs a positive definite matrix and could not factorise it. A tangent "
+            "turns indefinite when a load increment is too large for the volumetric penalty "
+            "(bulk_modulus) or a follower pressure, or past a buckling or limit point: try more "
+            "\"load_steps\", or a solver that accepts indefinite matrices, \"linear_solver\": "
+            "{\"type\": \"ldlt\"} or {\"type\": \"cholmod\"}; |r|: 1.25e-01");
+}
+
+}  // namespace
+}  // namespace gipsi
