@@ -269,6 +269,8 @@ void DisplayManager::ComputeValues() {
   object.ReadField(*field_, raw_);
   if (draw_.color.component >= 0)
     item_ = raw_.row(draw_.color.component);
+  else if (raw_.rows() == 1)  // a scalar is drawn as it is: its "magnitude" is not |value|
+    item_ = raw_.row(0);
   else
     item_ = raw_.colwise().norm();
   const Eigen::RowVectorXd* per_node = &item_;
@@ -460,15 +462,23 @@ SceneDisplay::SceneDisplay(const Kernel& kernel,
       if (&other == &m || !mechanical(other.object()) ||
           other.object().domain_ptr() != m.object().domain_ptr())
         continue;
-      m.DrawOn(other.object());
-      const bool asked = std::any_of(scene_specs.begin(), scene_specs.end(),
-                                     [&](const auto& p) { return p.first == &other.object(); });
-      const bool colored = std::find(named.begin(), named.end(), &other.object()) != named.end();
-      if (!asked && !colored) {
-        DrawSpec hidden = other.draw();
+      // One of the two coincident surfaces is hidden at first: the muscle, unless the scene or
+      // the command line chose to draw it and not the electrophysiology.
+      auto chosen = [&](const SimObject& o) {
+        return std::find(named.begin(), named.end(), &o) != named.end() ||
+               std::any_of(scene_specs.begin(), scene_specs.end(),
+                           [&](const auto& p) { return p.first == &o; });
+      };
+      auto hide = [](DisplayManager& d) {
+        DrawSpec hidden = d.draw();
         hidden.visible = false;
-        other = DisplayManager(other.object(), hidden, other.name());
-      }
+        d = DisplayManager(d.object(), hidden, d.name());
+      };
+      if (chosen(other.object()) && !chosen(m.object()))
+        hide(m);
+      else if (!chosen(other.object()))
+        hide(other);
+      m.DrawOn(other.object());
       break;
     }
   }
