@@ -265,6 +265,7 @@ void SimulationThread::Loop() {
         Load(display_->Colors());  // the scene's start, drawn as it is drawn now
         UpdateStatus([](SimulationStatus& s) {
           s.failed = false;
+          s.at_end = false;
           s.message.clear();
         });
       } catch (const std::exception& e) {
@@ -339,7 +340,6 @@ void SimulationThread::Loop() {
         continue;
       }
     }
-    UpdateStatus([&](SimulationStatus& s) { s.at_end = false; });
     if (playing) {
       if (c.speed > 0) {  // real-time pacing: do not get ahead of the wall clock
         const double wall = std::chrono::duration<double>(Clock::now() - wall_anchor).count();
@@ -362,7 +362,10 @@ void SimulationThread::Loop() {
         break;
       }
     }
-    if (steps > 0) republish = true;
+    if (steps > 0) {
+      republish = true;
+      UpdateStatus([](SimulationStatus& s) { s.at_end = false; });  // on past the end
+    }
     if (c.run_until >= 0 && kernel.time() >= c.run_until - 1e-12) {
       std::lock_guard lock(mutex_);
       commands_.playing = false;

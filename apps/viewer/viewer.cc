@@ -416,8 +416,7 @@ int RunViewer(const ViewerOptions& options) {
       gl.Viewport(0, 0, fb_width, fb_height);
       ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
 
-      if (!options.screenshot.empty() && status.failed) {
-        std::cerr << "gipsi: error: " << status.message << "\n";
+      if (!options.screenshot.empty() && status.failed) {  // (the message is on stderr already)
         exit_code = 3;
         break;
       }

@@ -57,12 +57,17 @@ std::unique_ptr<LocalModelBuilder> Builder(TypeRegistry& registry, SimObject& ob
 Vec3 Node(const SimObject& object, Index node) { return object.domain_positions().col(node); }
 
 TEST(PullForce, IsASpringCappedAtItsMaximum) {
-  const PullSpring spring{100, 2};
+  PullSpring spring;
+  spring.stiffness = 100;
+  spring.max_force = 2;
   const Vec3 x(1, 2, 3);
   EXPECT_LT((PullForce(spring, x + Vec3(0.01, 0, 0), x) - Vec3(1, 0, 0)).norm(), 1e-12);
   const Vec3 far = PullForce(spring, x + Vec3(0, 3, 4), x);  // k d = 500 N: capped, same way
   EXPECT_NEAR(far.norm(), 2, 1e-12);
   EXPECT_LT((far.normalized() - Vec3(0, 0.6, 0.8)).norm(), 1e-12);
+  // The damper acts on the node's velocity.
+  spring.damping = 10;
+  EXPECT_LT((PullForce(spring, x, x, Vec3(0, 0, 0.1)) - Vec3(0, 0, -1)).norm(), 1e-12);
 }
 
 TEST(PullTool, AZeroLengthDragIsANoOp) {
