@@ -95,6 +95,11 @@ VizCommands::VizCommands(CLI::App& app) {
   view_->add_option("--speed", speed_, "Target real-time factor (0: as fast as possible)")
       ->capture_default_str()
       ->check(NonNegativeNumber("a non-negative real-time factor"));
+  view_
+      ->add_option("--at-end", at_end_,
+                   "At the scene's schedule.end while playing: pause, loop (start again) or "
+                   "continue")
+      ->capture_default_str();
   view_->add_flag("--no-ui", no_ui_, "Hide the panel");
   view_->add_option("--screenshot", screenshot_,
                     "Run to --screenshot-time, save the window as this PNG and exit");
@@ -184,6 +189,7 @@ int VizCommands::View() {
   if (!camera_.empty()) viz::ParseCamera(camera_, "--camera", options.camera);
   options.play = play_;
   options.speed = speed_;
+  options.at_end = viz::ParseAtEnd(at_end_, "--at-end");
   options.show_ui = !no_ui_;
   options.screenshot = screenshot_;
   options.screenshot_time = screenshot_time_;

@@ -39,7 +39,7 @@ class VizCommands {
   bool wireframe_ = false, no_color_bar_ = false, unlit_ = false;
 
   CLI::App* view_ = nullptr;
-  std::string view_size_ = "1280x800", screenshot_, drag_;
+  std::string view_size_ = "1280x800", screenshot_, drag_, at_end_ = "pause";
   double screenshot_time_ = 0, speed_ = 1;
   bool play_ = false, no_ui_ = false;
 

@@ -1,9 +1,15 @@
 #include "viewer/simulation_thread.h"
 
 #include <chrono>
+#include <iostream>
+#include <limits>
 
+#include <fmt/format.h>
+
+#include "gipsi/base/json_node.h"
 #include "gipsi/base/log.h"
 #include "gipsi/haptics/haptic_probe.h"
+#include "gipsi/viz/plot_spec.h"
 
 namespace gipsi::viz {
 namespace {
@@ -15,9 +21,17 @@ constexpr std::size_t kMaxTraceSamples = 2000;
 
 SimulationThread::SimulationThread(LoadFn load,
                                    std::vector<std::pair<std::string, ColorSpec>> colors,
-                                   TripleBuffer<FrameBuffers>& frames)
+                                   TripleBuffer<FrameBuffers>& frames,
+                                   const std::vector<std::string>& show,
+                                   const std::vector<std::string>& hide)
     : load_(std::move(load)), initial_colors_(std::move(colors)), frames_(frames) {
-  Load();  // throws on bad input, before any thread exists
+  Load(initial_colors_);  // throws on bad input, before any thread exists
+  std::vector<std::string> names;
+  for (std::size_t i = 0; i < display_->size(); ++i) {
+    names.push_back(display_->manager(i).name());
+    initially_hidden_.push_back(!display_->manager(i).draw().visible);
+  }
+  ApplyVisibility(*scene_->kernel, names, show, hide, initially_hidden_);
   Publish();
   thread_ = std::thread([this] { Loop(); });
 }
@@ -29,16 +43,18 @@ SimulationThread::~SimulationThread() {
   tool_.Release();
 }
 
-void SimulationThread::Load() {
+void SimulationThread::Load(const std::vector<std::pair<std::string, ColorSpec>>& colors) {
   tool_.Release();
-  auto scene = std::make_unique<Scene>(load_());
-  auto display = std::make_unique<SceneDisplay>(*scene->kernel, scene->display, initial_colors_);
+  auto registry = std::make_unique<TypeRegistry>();
+  auto scene = std::make_unique<Scene>(load_(*registry));
+  auto display = std::make_unique<SceneDisplay>(*scene->kernel, scene->display, colors);
   {
     std::lock_guard lock(mutex_);
     mouse_ = nullptr;
   }
   haptics_.reset();  // joins the old scene's real-time haptic loops before the scene goes
   scene_ = std::move(scene);
+  registry_ = std::move(registry);
   display_ = std::move(display);
   // Real-time probes tick from the load on, playing or paused (paused, their models go stale
   // and the watchdog fades the force out).
@@ -63,6 +79,13 @@ void SimulationThread::Load() {
     trace.name = probe.name;
     const auto columns = ProbeColumns(probe);
     trace.columns.assign(columns.begin() + 1, columns.end());  // after "time"
+    for (const std::string& column : trace.columns) {
+      const ColumnDisplay shown = DisplayOfColumn(probe, column, scene_->plots);
+      trace.labels.push_back(shown.label);
+      trace.units.push_back(shown.unit);
+      trace.scales.push_back(shown.scale);
+      trace.no_data.push_back(shown.no_data.value_or(std::numeric_limits<double>::quiet_NaN()));
+    }
     trace.values.resize(trace.columns.size());
     traces_.push_back(std::move(trace));
   }
@@ -78,11 +101,15 @@ void SimulationThread::Load() {
       const SimObject& object = display_->manager(i).object();
       std::vector<std::string> fields;
       for (const FieldInfo& f : object.fields())
-        if (f.readable() &&
-            (f.location == FieldLocation::kNode || f.location == FieldLocation::kElement ||
-             (f.location == FieldLocation::kBoundaryVertex && !object.display().map)))
+        if (f.name == s.draws.back().color.field || OffersField(object, object.FindField(f.name)))
           fields.push_back(f.name);
-      s.objects.emplace_back(object.name(), std::move(fields));
+      // Pulled is the tissue it is drawn on (a heart's bioelectricity: its muscle).
+      const SimObject& tissue = display_->manager(i).geometry_object();
+      const auto external = tissue.TryFindField("external_force");
+      const bool pullable = registry_->local_models.Contains(tissue.type_name()) && external &&
+                            tissue.field_info(*external).writable() &&
+                            tissue.boundary().num_vertices() > 0;
+      s.objects.push_back({display_->manager(i).name(), std::move(fields), pullable});
     }
   });
 }
@@ -108,6 +135,14 @@ void SimulationThread::Publish() {
   frames_.Publish();
 }
 
+void SimulationThread::Report(const std::string& message, bool failed) {
+  std::cerr << "gipsi: error: " << message << std::endl;
+  UpdateStatus([&](SimulationStatus& s) {
+    s.message = message;
+    s.failed = s.failed || failed;
+  });
+}
+
 void SimulationThread::UpdateStatus(const std::function<void(SimulationStatus&)>& change) {
   std::lock_guard lock(mutex_);
   change(status_);
@@ -120,6 +155,7 @@ SimulationStatus SimulationThread::status() const {
 
 void SimulationThread::SetPlaying(bool playing) {
   std::lock_guard lock(mutex_);
+  if (playing && status_.at_end) commands_.reset = true;  // paused at the end: play it again
   commands_.playing = playing;
   commands_.run_until = -1;
   wake_.notify_all();
@@ -140,6 +176,10 @@ void SimulationThread::Reset() {
 void SimulationThread::SetSpeed(double real_time_factor) {
   std::lock_guard lock(mutex_);
   commands_.speed = real_time_factor;
+}
+void SimulationThread::SetAtEnd(AtEnd at_end) {
+  std::lock_guard lock(mutex_);
+  commands_.at_end = at_end;
 }
 void SimulationThread::SetColor(std::size_t surface, ColorSpec spec) {
   std::lock_guard lock(mutex_);
@@ -222,13 +262,14 @@ void SimulationThread::Loop() {
     bool republish = false;
     if (c.reset) {
       try {
-        Load();
+        Load(display_->Colors());  // the scene's start, drawn as it is drawn now
         UpdateStatus([](SimulationStatus& s) {
           s.failed = false;
+          s.at_end = false;
           s.message.clear();
         });
       } catch (const std::exception& e) {
-        UpdateStatus([&](SimulationStatus& s) { s.message = e.what(); });
+        Report(e.what(), false);
       }
       republish = true;
       was_playing = false;
@@ -238,22 +279,36 @@ void SimulationThread::Loop() {
       try {
         DrawSpec draw = display_->manager(surface).draw();
         draw.color = spec;
-        display_->manager(surface) = DisplayManager(display_->manager(surface).object(), draw);
+        DisplayManager& manager = display_->manager(surface);
+        manager = DisplayManager(manager.object(), draw, manager.name());
         UpdateStatus([&](SimulationStatus& s) { s.draws[surface] = draw; });
       } catch (const std::exception& e) {
-        UpdateStatus([&](SimulationStatus& s) { s.message = e.what(); });
+        Report(e.what(), false);
       }
       republish = true;
     }
     if (c.tool == 1 && c.tool_surface < display_->size()) {
       // The viewer owns the scene (non-const); the display manager only holds it for reading.
-      auto& object = const_cast<SimObject&>(display_->manager(c.tool_surface).object());
-      if (!tool_.Grab(object, c.tool_point))
-        UpdateStatus([](SimulationStatus& s) { s.message = "every boundary vertex is held"; });
+      auto& object = const_cast<SimObject&>(display_->manager(c.tool_surface).geometry_object());
+      std::string why;
+      if (!registry_->local_models.Contains(object.type_name())) {
+        why = fmt::format("object '{}' ({}) cannot be pulled: no haptic local model for its type",
+                          object.name(), object.type_name());
+      } else {
+        try {
+          const JsonNode where(nlohmann::ordered_json(), "viewer", "mouse pull");
+          why = tool_.Grab(registry_->local_models.Get(object.type_name(), where)(object, 3),
+                           c.tool_point, scene_->kernel->macro_dt());
+        } catch (const std::exception& e) {
+          why = e.what();
+        }
+      }
+      if (!why.empty()) Report("mouse pull: " + why, false);
     } else if (c.tool == 2) {
       tool_.Release();
     }
     if (c.tool_target_new) tool_.MoveTo(c.tool_target);
+    if (c.tool != 0 || c.tool_target_new) republish = true;  // the pull's status
 
     Kernel& kernel = *scene_->kernel;
     const bool failed = status().failed;
@@ -265,6 +320,26 @@ void SimulationThread::Loop() {
     }
     was_playing = playing;
     last_speed = c.speed;
+    if (playing) {
+      const PlayStep next = NextPlayStep(kernel.time(), scene_->end_time, kernel.macro_dt(),
+                                         c.at_end, c.run_until >= 0);
+      if (next == PlayStep::kPause) {
+        std::lock_guard lock(mutex_);
+        commands_.playing = false;
+        status_.at_end = true;
+        continue;
+      }
+      if (next == PlayStep::kRestart) {
+        try {
+          Load(display_->Colors());
+        } catch (const std::exception& e) {
+          Report(e.what(), true);
+        }
+        Publish();
+        was_playing = false;
+        continue;
+      }
+    }
     if (playing) {
       if (c.speed > 0) {  // real-time pacing: do not get ahead of the wall clock
         const double wall = std::chrono::duration<double>(Clock::now() - wall_anchor).count();
@@ -278,18 +353,19 @@ void SimulationThread::Loop() {
       steps = 1;
     }
     for (int k = 0; k < steps; ++k) {
+      tool_.Apply();  // the pull's spring force for this macro step
       const RunResult result = kernel.Run(kernel.time() + kernel.macro_dt());
       if (!result.ok()) {
-        UpdateStatus([&](SimulationStatus& s) {
-          s.failed = true;
-          s.message = result.diagnostic;
-        });
+        Report(result.diagnostic, true);
         std::lock_guard lock(mutex_);
         commands_.playing = false;
         break;
       }
     }
-    if (steps > 0) republish = true;
+    if (steps > 0) {
+      republish = true;
+      UpdateStatus([](SimulationStatus& s) { s.at_end = false; });  // on past the end
+    }
     if (c.run_until >= 0 && kernel.time() >= c.run_until - 1e-12) {
       std::lock_guard lock(mutex_);
       commands_.playing = false;
@@ -303,7 +379,12 @@ void SimulationThread::Loop() {
       rate_sim = kernel.time();
       UpdateStatus([&](SimulationStatus& s) { s.real_time_factor = rtf; });
     }
-    UpdateStatus([&](SimulationStatus& s) { s.time = kernel.time(); });
+    UpdateStatus([&](SimulationStatus& s) {
+      s.time = kernel.time();
+      s.pull_object = tool_.active() ? kernel.ObjectPath(tool_.object()) : std::string();
+      s.pull_force = tool_.force().norm();
+      s.pull_max_force = tool_.spring().max_force;
+    });
     if (republish) Publish();
   }
 }

@@ -78,8 +78,7 @@ struct SurfaceUi {
 }  // namespace
 
 int RunViewer(const ViewerOptions& options) {
-  auto load = [&options] {
-    TypeRegistry registry;
+  auto load = [&options](TypeRegistry& registry) {
     RegisterBuiltins(registry);
     for (const auto& plugin : options.plugins) registry.LoadPlugin(plugin);
     Scene scene = LoadScene(options.scene, registry);
@@ -87,17 +86,11 @@ int RunViewer(const ViewerOptions& options) {
     return scene;
   };
   TripleBuffer<FrameBuffers> frames;
-  SimulationThread sim(load, options.colors, frames);  // bad input throws here
-  // --show / --hide name drawn objects; checked before any window opens.
-  std::vector<bool> initially_hidden;
-  {
-    const SimulationStatus status = sim.status();
-    std::vector<std::string> names;
-    for (const auto& object : status.objects) names.push_back(object.first);
-    for (const DrawSpec& draw : status.draws) initially_hidden.push_back(!draw.visible);
-    ApplyVisibility(names, options.show, options.hide, initially_hidden);
-  }
+  // Bad input (scene, colours, --show / --hide) throws here, before any window opens.
+  SimulationThread sim(load, options.colors, frames, options.show, options.hide);
+  const std::vector<bool> initially_hidden = sim.initially_hidden();
   sim.SetSpeed(options.speed);
+  sim.SetAtEnd(options.at_end);
 
   glfwSetErrorCallback(OnGlfwError);
   if (!glfwInit()) {
@@ -148,6 +141,7 @@ int RunViewer(const ViewerOptions& options) {
     std::vector<SurfaceUi> ui;
     float speed = static_cast<float>(options.speed > 0 ? options.speed : 1.0);
     bool as_fast_as_possible = options.speed <= 0;
+    int at_end = static_cast<int>(options.at_end);
     bool dragging_tool = false, dragging_haptic = false;
     Vec3 tool_plane_point = Vec3::Zero(), tool_plane_normal = Vec3::UnitZ();
     int frames_at_screenshot_time = 0;
@@ -177,7 +171,7 @@ int RunViewer(const ViewerOptions& options) {
           ui[i].visible =
               i < initially_hidden.size() ? !initially_hidden[i] : status.draws[i].visible;
           ui[i].wireframe = status.draws[i].wireframe;
-          const auto& fields = status.objects[i].second;
+          const auto& fields = status.objects[i].fields;
           const auto f = std::find(fields.begin(), fields.end(), spec.field);
           ui[i].field = f == fields.end() ? 0 : static_cast<int>(f - fields.begin()) + 1;
           ui[i].component = spec.component + 1;
@@ -190,6 +184,13 @@ int RunViewer(const ViewerOptions& options) {
       for (std::size_t i = 0; i < ui.size(); ++i) {
         render.hidden[i] = !ui[i].visible;
         render.edges[i] = ui[i].wireframe;
+      }
+      // The mouse pulls only visible objects that can be pulled (SimulationThread::Grab).
+      std::vector<bool> not_pullable(ui.size(), true);
+      bool any_pullable = false;
+      for (std::size_t i = 0; i < ui.size() && i < status.objects.size(); ++i) {
+        not_pullable[i] = render.hidden[i] || !status.objects[i].pullable;
+        any_pullable = any_pullable || status.objects[i].pullable;
       }
       if (!fitted && frame.frame >= 0) {
         camera.FitTo(frame, double(scene_width) / fb_height);
@@ -211,9 +212,9 @@ int RunViewer(const ViewerOptions& options) {
           sim.HapticBeginDrag(forward);
           sim.HapticDragTo(origin, dir);
           dragging_haptic = true;
-        } else if (ImGui::IsMouseClicked(ImGuiMouseButton_Left) && tool_key) {
+        } else if (ImGui::IsMouseClicked(ImGuiMouseButton_Left) && tool_key && any_pullable) {
           const auto [origin, dir] = MouseRay(camera, mx, my, panel, scene_width, fb_height);
-          if (auto hit = PickSurface(frame, origin, dir, render.hidden)) {
+          if (auto hit = PickSurface(frame, origin, dir, not_pullable)) {
             sim.Grab(hit->surface, hit->point);
             dragging_tool = true;
             tool_plane_point = hit->point;
@@ -252,13 +253,14 @@ int RunViewer(const ViewerOptions& options) {
           sim.HapticBeginDrag((camera.target - camera.Eye()).normalized());
           sim.HapticDragTo(o, r);
           sim.HapticEndDrag();
-        } else if (auto hit = PickSurface(frame, origin, dir, render.hidden)) {
+        } else if (auto hit = PickSurface(frame, origin, dir, not_pullable)) {
           sim.Grab(hit->surface, hit->point);
           const Vec3 normal = (camera.target - camera.Eye()).normalized();
           const auto [o, r] = MouseRay(camera, d[2], d[3], panel, scene_width, fb_height);
           sim.Drag(o + r * ((hit->point - o).dot(normal) / r.dot(normal)));
         } else {
-          std::cerr << "gipsi: --drag: nothing under the mouse at " << d[0] << ", " << d[1] << "\n";
+          std::cerr << "gipsi: --drag: nothing that can be pulled under the mouse at " << d[0]
+                    << ", " << d[1] << "\n";
         }
         sim.RunUntil(options.screenshot_time);
         scripted_drag_done = true;
@@ -278,7 +280,8 @@ int RunViewer(const ViewerOptions& options) {
         ImGui::Begin(
             "GiPSi", nullptr,
             ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoResize | ImGuiWindowFlags_NoCollapse);
-        ImGui::Text("t = %.4f / %.4g s", status.time, status.end_time);
+        ImGui::Text("t = %.4f / %.4g s%s", status.time, status.end_time,
+                    status.at_end ? " (end)" : "");
         ImGui::Text("real-time factor %.3g", status.real_time_factor);
         if (ImGui::Button(status.playing ? "Pause" : "Play")) sim.SetPlaying(!status.playing);
         ImGui::SameLine();
@@ -289,6 +292,8 @@ int RunViewer(const ViewerOptions& options) {
             ImGui::SliderFloat("speed", &speed, 0.01f, 10.0f, "%.3g x real time",
                                ImGuiSliderFlags_Logarithmic))
           sim.SetSpeed(as_fast_as_possible ? 0.0 : double(speed));
+        if (ImGui::Combo("at the end", &at_end, "pause\0loop\0continue\0"))
+          sim.SetAtEnd(static_cast<AtEnd>(at_end));
         if (!status.message.empty())
           ImGui::TextColored(ImVec4(0.8f, 0.1f, 0.1f, 1), "%s", status.message.c_str());
         ImGui::Separator();
@@ -296,7 +301,8 @@ int RunViewer(const ViewerOptions& options) {
         ImGui::SameLine();
         ImGui::Checkbox("lighting", &render.lighting);
         for (std::size_t i = 0; i < ui.size() && i < status.objects.size(); ++i) {
-          const auto& [name, fields] = status.objects[i];
+          const std::string& name = status.objects[i].name;
+          const auto& fields = status.objects[i].fields;
           ImGui::PushID(static_cast<int>(i));
           ImGui::Checkbox(name.c_str(), &ui[i].visible);
           if (i < frame.surfaces.size() && frame.surfaces[i].primitive == Primitive::kTriangles) {
@@ -337,9 +343,14 @@ int RunViewer(const ViewerOptions& options) {
                   ImGui::GetColorU32(ImVec4(a.r, a.g, a.b, 1)));
             }
             ImGui::Dummy(ImVec2(w, h));
-            ImGui::Text("%.4g", s.range_lo);
-            ImGui::SameLine(std::max(1.0f, w - 60));
-            ImGui::Text("%.4g", s.range_hi);
+            if (s.num_no_data == s.num_vertices()) {  // e.g. no activation time anywhere yet
+              ImGui::Text("not yet");
+            } else {
+              ImGui::Text("%.4g", s.range_lo);
+              ImGui::SameLine(std::max(1.0f, w - 60));
+              ImGui::Text("%.4g", s.range_hi);
+              if (s.num_no_data > 0) ImGui::TextDisabled("grey: not yet");
+            }
           }
           ImGui::PopID();
         }
@@ -352,22 +363,38 @@ int RunViewer(const ViewerOptions& options) {
           if (const auto tool = sim.HapticTool())
             ImGui::Text("tool at (%.4g, %.4g, %.4g) m\nforce %.3g N", tool->first.x(),
                         tool->first.y(), tool->first.z(), tool->second.norm());
-        } else {
+        } else if (any_pullable) {
           ImGui::TextWrapped(
               "Mouse: left drag orbits, right drag pans, wheel zooms; Ctrl (or Shift) + left "
-              "drag pulls the surface.");
+              "drag pulls the tissue.");
+        } else {
+          ImGui::TextWrapped("Mouse: left drag orbits, right drag pans, wheel zooms.");
         }
         if (!frame.traces.empty()) {
           ImGui::Separator();
+          std::vector<float> shown;
           for (const ProbeTrace& trace : frame.traces)
             for (std::size_t c = 0; c < trace.columns.size(); ++c) {
               const auto& v = trace.values[c];
               if (v.empty()) continue;
-              const std::string label = trace.name + "." + trace.columns[c];
-              const std::string overlay = fmt::format("{} {:.4g}", label, v.back());
-              ImGui::PlotLines(("##" + label).c_str(), v.data(), static_cast<int>(v.size()), 0,
-                               overlay.c_str(), FLT_MAX, FLT_MAX,
-                               ImVec2(ImGui::GetContentRegionAvail().x, 50));
+              // In the scene's display units, labelled above the curve (not over it); a
+              // no-data marker (e.g. -1 for "not activated yet") is a gap, not a value.
+              const double scale = c < trace.scales.size() ? trace.scales[c] : 1.0;
+              const double marker = c < trace.no_data.size() ? trace.no_data[c] : NAN;
+              shown.resize(v.size());
+              for (std::size_t k = 0; k < v.size(); ++k)
+                shown[k] = v[k] == float(marker) ? NAN : float(scale * v[k]);
+              const std::string label =
+                  c < trace.labels.size() ? trace.labels[c] : trace.columns[c];
+              const std::string unit = c < trace.units.size() ? trace.units[c] : "";
+              const std::string value =
+                  std::isnan(shown.back())
+                      ? std::string(v.back() == float(marker) ? "not yet" : "-")
+                      : fmt::format("{:.4g}{}{}", shown.back(), unit.empty() ? "" : " ", unit);
+              ImGui::Text("%s: %s", label.c_str(), value.c_str());
+              ImGui::PlotLines(("##" + trace.name + "." + trace.columns[c]).c_str(), shown.data(),
+                               static_cast<int>(shown.size()), 0, nullptr, FLT_MAX, FLT_MAX,
+                               ImVec2(ImGui::GetContentRegionAvail().x, 40));
             }
         }
         ImGui::End();
@@ -389,8 +416,7 @@ int RunViewer(const ViewerOptions& options) {
       gl.Viewport(0, 0, fb_width, fb_height);
       ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
 
-      if (!options.screenshot.empty() && status.failed) {
-        std::cerr << "gipsi: error: " << status.message << "\n";
+      if (!options.screenshot.empty() && status.failed) {  // (the message is on stderr already)
         exit_code = 3;
         break;
       }
@@ -403,6 +429,9 @@ int RunViewer(const ViewerOptions& options) {
           std::cout << fmt::format("{}: {} x {} at t = {:.6g} s ({})\n", options.screenshot,
                                    image.width, image.height, frame.time,
                                    reinterpret_cast<const char*>(gl.GetString(GL_RENDERER)));
+          if (!status.pull_object.empty())
+            std::cout << fmt::format("mouse pull on '{}': force {:.6g} N (cap {:.6g} N)\n",
+                                     status.pull_object, status.pull_force, status.pull_max_force);
           if (const auto tool = sim.HapticTool())
             std::cout << fmt::format(
                 "haptic tool at ({:.9g}, {:.9g}, {:.9g}) m, force ({:.9g}, {:.9g}, {:.9g}) N\n",

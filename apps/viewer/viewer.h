@@ -13,6 +13,7 @@
 
 #include "gipsi/viz/camera.h"
 #include "gipsi/viz/display_manager.h"
+#include "gipsi/viz/playback.h"
 
 namespace gipsi::viz {
 
@@ -25,9 +26,10 @@ struct ViewerOptions {
   std::vector<std::string> as;          ///< "OBJECT:lines" etc.: geometry whatever the scene says
   Camera camera;
   int width = 1280, height = 800;
-  bool play = false;    ///< start playing
-  double speed = 1.0;   ///< target real-time factor (0: as fast as possible)
-  bool show_ui = true;  ///< the ImGui panel
+  bool play = false;             ///< start playing
+  double speed = 1.0;            ///< target real-time factor (0: as fast as possible)
+  AtEnd at_end = AtEnd::kPause;  ///< what playing does at the scene's schedule.end
+  bool show_ui = true;           ///< the ImGui panel
   /// Test and batch mode: run to `screenshot_time`, save the window to this PNG, and exit.
   std::string screenshot;
   double screenshot_time = 0;

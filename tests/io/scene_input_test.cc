@@ -17,10 +17,10 @@
 #include <gtest/gtest.h>
 
 #include "gipsi/base/error.h"
+#include "gipsi/io/builtins.h"
 #include "gipsi/io/mesh_io.h"
 #include "gipsi/io/sample_times.h"
 #include "gipsi/io/scene.h"
-#include "gipsi/models/builtins.h"
 #include "io/scene_test_util.h"
 #include "temp_dir.h"
 

@@ -106,10 +106,10 @@ TEST(LineProbe, SamplesAtEachRequestedTimeOrOnceAtTheEnd) {
   EXPECT_TRUE(scene.plots[0].profile);
   const PlotData data = LoadPlotData(scene.plots[0], dir / "probes");
   ASSERT_EQ(data.series.size(), 2u);
-  EXPECT_EQ(data.series[0].label, "two.displacement_z at t = 0.01 s");
-  EXPECT_EQ(data.series[1].label, "two.displacement_z at t = 0.02 s");
+  EXPECT_EQ(data.series[0].label, "displacement z at t = 0.01 s");
+  EXPECT_EQ(data.series[1].label, "displacement z at t = 0.02 s");
   EXPECT_THAT(data.series[1].x, ElementsAre(0.0, 0.5, 1.0));
-  EXPECT_EQ(data.x_label, "two.distance [m]");
+  EXPECT_EQ(data.x_label, "distance [m]");
 }
 
 TEST(LineProbe, BadLinesNameTheirJsonPath) {

@@ -59,8 +59,8 @@ TEST(PlotUnits, ConvertsTheColumnsAndNamesTheUnitsInTheLabels) {
   EXPECT_DOUBLE_EQ(data.series[0].x[1], 4.0);
   EXPECT_DOUBLE_EQ(data.series[0].y[0], 3.0);
   EXPECT_DOUBLE_EQ(data.series[0].y[1], 5.0);
-  EXPECT_EQ(data.x_label, "e.kinetic_energy [mJ]");
-  EXPECT_EQ(data.y_label, "e.strain_energy [uJ]");
+  EXPECT_EQ(data.x_label, "kinetic energy [mJ]");
+  EXPECT_EQ(data.y_label, "strain energy [uJ]");
 }
 
 TEST(PlotUnits, WithoutUnitsTheLabelsShowTheSiUnits) {

@@ -174,7 +174,7 @@ TEST(SnapshotCommand, RejectsBadOptionsNamingThem) {
   EXPECT_THAT(r.output, HasSubstr("--as: no object named 'nobody'"));
   r = run("--hide bean");
   EXPECT_EQ(r.code, 1);
-  EXPECT_THAT(r.output, HasSubstr("--hide: no drawn object named 'bean' (did you mean 'beam'?)"));
+  EXPECT_THAT(r.output, HasSubstr("--hide: no object named 'bean' (did you mean 'beam'?)"));
 }
 
 /// The unit-cube block drawn as the scene's "display" entry asks, head-on (as RenderHeadOn),

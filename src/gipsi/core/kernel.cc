@@ -5,10 +5,12 @@
 #include <cmath>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include "gipsi/base/error.h"
 #include "gipsi/base/json_node.h"
 #include "gipsi/base/log.h"
+#include "gipsi/core/aggregate.h"
 
 namespace gipsi {
 
@@ -34,13 +36,53 @@ void Kernel::Initialize(double macro_dt) {
   coordinator_.SetStopToken(StopToken(&stop_requested_));
 }
 
+namespace {
+
+void CollectPaths(const std::string& prefix, const SimObject& object,
+                  std::vector<std::pair<std::string, SimObject*>>& out) {
+  const std::string path = prefix.empty() ? object.name() : prefix + "." + object.name();
+  // The kernel owns its objects and hands them out mutable (as FindObject always has).
+  out.emplace_back(path, const_cast<SimObject*>(&object));
+  if (const auto* aggregate = dynamic_cast<const AggregateObject*>(&object))
+    for (std::size_t i = 0; i < aggregate->parts().num_objects(); ++i)
+      CollectPaths(path, aggregate->parts().object(i), out);
+}
+
+}  // namespace
+
+std::vector<std::pair<std::string, SimObject*>> Kernel::ObjectPaths() const {
+  std::vector<std::pair<std::string, SimObject*>> paths;
+  for (std::size_t i = 0; i < coordinator_.num_objects(); ++i)
+    CollectPaths("", coordinator_.object(i), paths);
+  return paths;
+}
+
+std::string Kernel::ObjectPath(const SimObject& object) const {
+  for (const auto& [path, o] : ObjectPaths())
+    if (o == &object) return path;
+  return object.name();
+}
+
 SimObject& Kernel::FindObject(std::string_view name) const {
   if (SimObject* object = coordinator_.FindObject(name)) return *object;
-  auto names = coordinator_.ObjectNames();
-  std::string list;
-  for (const auto& n : names) list += (list.empty() ? "" : ", ") + n;
-  throw InputError(
-      fmt::format("no object named '{}'{}; objects: {}", name, SuggestClosest(name, names), list));
+  const auto paths = ObjectPaths();
+  std::vector<std::string> names, candidates, matches;
+  SimObject* match = nullptr;
+  for (const auto& [path, object] : paths) {
+    names.push_back(path);
+    candidates.push_back(path);
+    if (path != object->name()) candidates.push_back(object->name());
+    if (object->name() == name) {  // a part by its own name
+      matches.push_back(path);
+      match = object;
+    }
+  }
+  if (matches.size() == 1) return *match;
+  if (matches.size() > 1)
+    throw InputError(fmt::format("object name '{}' is ambiguous: it could be {}", name,
+                                 fmt::join(matches, " or ")));
+  throw InputError(fmt::format("no object named '{}'{}; objects: {}", name,
+                               SuggestClosest(name, candidates), fmt::join(names, ", ")));
 }
 
 void Kernel::FireDueEvents(double t) {

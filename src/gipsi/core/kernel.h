@@ -139,9 +139,19 @@ class Kernel {
   [[nodiscard]] const std::vector<std::pair<double, std::string>>& fired_events() const {
     return fired_;
   }
-  /// The object called `name` (dotted for parts of aggregates); throws InputError listing the
-  /// objects when there is none.
+  /// The object called `name`: the one naming scheme of scenes, probes, the command line and
+  /// the viewer. An object's name is its full dotted path ("heart.bioelectricity" for the part
+  /// `bioelectricity` of the aggregate `heart`); a part's own name ("bioelectricity") is accepted
+  /// too when exactly one object or part has it. Throws InputError listing every object and part
+  /// by its full name when there is none, or naming the candidates when a short name is
+  /// ambiguous.
   [[nodiscard]] SimObject& FindObject(std::string_view name) const;
+  /// The full dotted name of every object and part, depth first (an aggregate before its
+  /// parts), with the object.
+  [[nodiscard]] std::vector<std::pair<std::string, SimObject*>> ObjectPaths() const;
+  /// The full dotted name of `object` (FindObject finds it by it); its own name if it is not in
+  /// this kernel.
+  [[nodiscard]] std::string ObjectPath(const SimObject& object) const;
 
  private:
   void FireDueEvents(double t);

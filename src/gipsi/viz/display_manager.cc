@@ -165,15 +165,19 @@ bool DisplayManager::HasDefaultGeometry(const SimObject& object) {
 DisplayManager::DisplayManager(const SimObject& object, ColorSpec spec)
     : DisplayManager(object, DrawSpec{std::move(spec), std::nullopt, false, true, 0, false}) {}
 
-DisplayManager::DisplayManager(const SimObject& object, DrawSpec spec)
-    : object_(&object), draw_(std::move(spec)), map_(ColorMap::Named("viridis")) {
+DisplayManager::DisplayManager(const SimObject& object, DrawSpec spec, std::string name)
+    : object_(&object),
+      geometry_(&object),
+      draw_(std::move(spec)),
+      name_(name.empty() ? object.name() : std::move(name)),
+      map_(ColorMap::Named("viridis")) {
   if (draw_.as) {
     primitive_ = *draw_.as;
   } else if (object.display().triangles.cols() == 0 && HasOwnSegments(object)) {
     primitive_ = Primitive::kLines;
   }
   auto fail_geometry = [&](const std::string& what) {
-    throw InputError(fmt::format("object '{}': display: {}", object.name(), what));
+    throw InputError(fmt::format("object '{}': display: {}", name_, what));
   };
   switch (primitive_) {
     case Primitive::kTriangles:
@@ -190,7 +194,7 @@ DisplayManager::DisplayManager(const SimObject& object, DrawSpec spec)
   }
   const bool surface = primitive_ == Primitive::kTriangles;
   auto fail = [&](const std::string& what) {
-    throw InputError(fmt::format("object '{}': display colour: {}", object.name(), what));
+    throw InputError(fmt::format("object '{}': display colour: {}", name_, what));
   };
   try {
     map_ = ColorMap::Named(draw_.color.color_map);
@@ -201,7 +205,13 @@ DisplayManager::DisplayManager(const SimObject& object, DrawSpec spec)
     fail(fmt::format("range [{}, {}] is empty", draw_.color.range->first,
                      draw_.color.range->second));
   if (draw_.color.field.empty()) return;
-  field_ = object.FindField(draw_.color.field);  // throws naming the object and its fields
+  field_ = object.TryFindField(draw_.color.field);
+  if (!field_) {
+    std::vector<std::string> names;
+    for (const FieldInfo& f : object.fields()) names.push_back(f.name);
+    fail(fmt::format("no field '{}'{}; its fields are: {}", draw_.color.field,
+                     SuggestClosest(draw_.color.field, names), fmt::join(names, ", ")));
+  }
   const FieldInfo& info = object.field_info(*field_);
   if (!info.readable()) fail(fmt::format("field '{}' cannot be read", info.name));
   if (draw_.color.component >= info.components)
@@ -259,6 +269,8 @@ void DisplayManager::ComputeValues() {
   object.ReadField(*field_, raw_);
   if (draw_.color.component >= 0)
     item_ = raw_.row(draw_.color.component);
+  else if (raw_.rows() == 1)  // a scalar is drawn as it is: its "magnitude" is not |value|
+    item_ = raw_.row(0);
   else
     item_ = raw_.colwise().norm();
   const Eigen::RowVectorXd* per_node = &item_;
@@ -281,16 +293,27 @@ void DisplayManager::ComputeValues() {
   if (location_ == FieldLocation::kBoundaryVertex) {
     values_ = item_;
   } else if (display.map) {
-    display.map->Apply(*per_node, values_);
+    // A display vertex touching an item without data has none (not a blend with the marker).
+    const FieldInfo& info = object.field_info(*field_);
+    if (info.no_data && location_ == FieldLocation::kNode)
+      display.map->ApplyMarked(*per_node, values_, *info.no_data);
+    else
+      display.map->Apply(*per_node, values_);
   } else {
     const auto& to_node = object.boundary().vertex_to_node;
     for (Index v = 0; v < num_vertices; ++v) values_(v) = (*per_node)(to_node[std::size_t(v)]);
   }
 }
 
+void DisplayManager::DrawOn(const SimObject& other) {
+  GIPSI_CHECK(other.domain_ptr() == object_->domain_ptr(),
+              "object '{}' cannot be drawn on '{}': another domain mesh", name_, other.name());
+  geometry_ = &other;
+}
+
 void DisplayManager::Fill(SurfaceBuffers& out) {
   const SimObject& object = *object_;
-  if (out.object != object.name()) out.object = object.name();
+  if (out.object != name_) out.object = name_;
   out.primitive = primitive_;
   out.wireframe = draw_.wireframe && primitive_ == Primitive::kTriangles;
   out.size = draw_.size > 0                     ? draw_.size
@@ -298,9 +321,21 @@ void DisplayManager::Fill(SurfaceBuffers& out) {
                                                 : kDefaultLineWidth;
   std::size_t num_vertices = 0;
   if (primitive_ == Primitive::kTriangles) {
-    object.UpdateDisplay();
     const DisplayGeometry& display = object.display();
-    const Points& x = display.positions;
+    if (geometry_ == object_) {
+      object.UpdateDisplay();
+    } else {  // the display surface on the other object's current node positions
+      const Points& nodes = geometry_->domain_positions();
+      positions_.resize(3, display.positions.cols());
+      if (display.map) {
+        display.map->Apply(nodes, positions_);
+      } else {
+        const auto& to_node = object.boundary().vertex_to_node;
+        for (Index v = 0; v < positions_.cols(); ++v)
+          positions_.col(v) = nodes.col(to_node[std::size_t(v)]);
+      }
+    }
+    const Points& x = geometry_ == object_ ? display.positions : positions_;
     const Triangles& tris = display.triangles;
     VertexNormals(x, tris, normals_);
     num_vertices = static_cast<std::size_t>(x.cols());
@@ -315,7 +350,7 @@ void DisplayManager::Fill(SurfaceBuffers& out) {
       out.indices[i] = static_cast<std::uint32_t>(tris.data()[i]);
   } else {
     // Lines and points live on the current domain nodes and are drawn unshaded (zero normals).
-    const Points& x = object.domain_positions();
+    const Points& x = geometry_->domain_positions();
     num_vertices = static_cast<std::size_t>(x.cols());
     out.positions.resize(3 * num_vertices);
     out.normals.assign(3 * num_vertices, 0.0f);
@@ -341,30 +376,42 @@ void DisplayManager::Fill(SurfaceBuffers& out) {
     out.units.clear();
     out.color_map.clear();
     out.range_lo = out.range_hi = 0;
+    out.num_no_data = 0;
     return;
   }
   ComputeValues();
+  const FieldInfo& info = object.field_info(*field_);
+  // The no-data marker is not a value: such vertices are drawn in kNoDataColor, out of the
+  // range (scalar fields; a component or magnitude of a vector is a value).
+  const bool marked = info.no_data && info.components == 1;
+  auto no_data = [&](Index v) { return marked && values_(v) == *info.no_data; };
   double lo = std::numeric_limits<double>::infinity(), hi = -lo;
   if (draw_.color.range) {
     std::tie(lo, hi) = *draw_.color.range;
   } else {
     for (Index v = 0; v < values_.size(); ++v) {
-      if (std::isnan(values_(v))) continue;
+      if (std::isnan(values_(v)) || no_data(v)) continue;
       lo = std::min(lo, values_(v));
       hi = std::max(hi, values_(v));
     }
     if (!(lo <= hi)) lo = hi = 0;  // no values, or all NaN
   }
   out.values.resize(num_vertices);
+  out.num_no_data = 0;
   for (std::size_t v = 0; v < num_vertices; ++v) {
     const double value = values_(Index(v));
+    if (no_data(Index(v))) {
+      ++out.num_no_data;
+      out.values[v] = std::numeric_limits<float>::quiet_NaN();
+      std::copy_n(kNoDataColor, 3, out.colors.data() + 3 * v);
+      continue;
+    }
     out.values[v] = static_cast<float>(value);
     const Rgb c = map_.Map(value, lo, hi);
     out.colors[3 * v] = c.r;
     out.colors[3 * v + 1] = c.g;
     out.colors[3 * v + 2] = c.b;
   }
-  const FieldInfo& info = object.field_info(*field_);
   if (out.field != label_) out.field = label_;
   if (out.units != info.units) out.units = info.units;
   if (out.color_map != map_.name()) out.color_map = map_.name();
@@ -396,9 +443,44 @@ SceneDisplay::SceneDisplay(const Kernel& kernel,
     if (it != named.end()) {
       draw.color = colors[std::size_t(it - named.begin())].second;
     } else if (draw.color.field.empty() && !draw.solid_given) {
-      draw.color.solid = kPalette[solid++ % std::size(kPalette)];
+      if (auto color = DefaultColor(*leaf))
+        draw.color = *color;
+      else
+        draw.color.solid = kPalette[solid++ % std::size(kPalette)];
     }
-    managers_.emplace_back(*leaf, std::move(draw));
+    managers_.emplace_back(*leaf, std::move(draw), kernel.ObjectPath(*leaf));
+  }
+  // Objects without mechanics drawn on a mechanical object of the same mesh (the same tissue).
+  auto mechanical = [](const SimObject& o) {
+    const auto position = o.TryFindField("position");
+    return position && o.field_info(*position).location == FieldLocation::kNode &&
+           o.domain_positions().cols() == o.domain().num_nodes();
+  };
+  for (DisplayManager& m : managers_) {
+    if (mechanical(m.object()) || m.object().domain().num_nodes() == 0) continue;
+    for (DisplayManager& other : managers_) {
+      if (&other == &m || !mechanical(other.object()) ||
+          other.object().domain_ptr() != m.object().domain_ptr())
+        continue;
+      // One of the two coincident surfaces is hidden at first: the muscle, unless the scene or
+      // the command line chose to draw it and not the electrophysiology.
+      auto chosen = [&](const SimObject& o) {
+        return std::find(named.begin(), named.end(), &o) != named.end() ||
+               std::any_of(scene_specs.begin(), scene_specs.end(),
+                           [&](const auto& p) { return p.first == &o; });
+      };
+      auto hide = [](DisplayManager& d) {
+        DrawSpec hidden = d.draw();
+        hidden.visible = false;
+        d = DisplayManager(d.object(), hidden, d.name());
+      };
+      if (chosen(other.object()) && !chosen(m.object()))
+        hide(m);
+      else if (!chosen(other.object()))
+        hide(other);
+      m.DrawOn(other.object());
+      break;
+    }
   }
   for (std::size_t i = 0; i < named.size(); ++i)
     if (std::none_of(managers_.begin(), managers_.end(),
@@ -407,6 +489,12 @@ SceneDisplay::SceneDisplay(const Kernel& kernel,
           fmt::format("object '{}' has nothing to draw and colour (no display surface or springs; "
                       "its scene \"display\" may ask for \"as\": \"points\")",
                       colors[i].first));
+}
+
+std::vector<std::pair<std::string, ColorSpec>> SceneDisplay::Colors() const {
+  std::vector<std::pair<std::string, ColorSpec>> colors;
+  for (const DisplayManager& m : managers_) colors.emplace_back(m.name(), m.spec());
+  return colors;
 }
 
 std::vector<bool> SceneDisplay::Hidden() const {
@@ -420,6 +508,32 @@ void SceneDisplay::Fill(double t, FrameBuffers& out) {
   out.frame = frames_++;
   out.surfaces.resize(managers_.size());
   for (std::size_t i = 0; i < managers_.size(); ++i) managers_[i].Fill(out.surfaces[i]);
+}
+
+bool OffersField(const SimObject& object, FieldId id) {
+  const FieldInfo& info = object.field_info(id);
+  if (!info.readable()) return false;
+  const bool located = info.location == FieldLocation::kNode ||
+                       info.location == FieldLocation::kElement ||
+                       (info.location == FieldLocation::kBoundaryVertex && !object.display().map);
+  if (!located) return false;
+  if (!info.writable() || info.name == "position" || info.name == "velocity") return true;
+  Eigen::MatrixXd values(info.components, object.FieldCount(id));
+  if (values.cols() < 2) return false;
+  object.ReadField(id, values);
+  return !(values.colwise() - values.col(0)).isZero(0.0);
+}
+
+std::optional<ColorSpec> DefaultColor(const SimObject& object) {
+  const auto v = object.TryFindField("V");
+  if (!v) return std::nullopt;
+  const FieldInfo& info = object.field_info(*v);
+  if (!info.readable() || info.location != FieldLocation::kNode || info.components != 1)
+    return std::nullopt;
+  ColorSpec spec;
+  spec.field = std::string("V");  // (moved in: GCC 12 warns falsely on assigning a literal here)
+  spec.color_map = std::string("cool-warm");
+  return spec;
 }
 
 void ApplyGeometryOptions(const Kernel& kernel, const std::vector<std::string>& options,
@@ -454,16 +568,24 @@ void ApplyGeometryOptions(const Kernel& kernel, const std::vector<std::string>& 
   }
 }
 
-void ApplyVisibility(const std::vector<std::string>& names, const std::vector<std::string>& show,
-                     const std::vector<std::string>& hide, std::vector<bool>& hidden) {
+void ApplyVisibility(const Kernel& kernel, const std::vector<std::string>& names,
+                     const std::vector<std::string>& show, const std::vector<std::string>& hide,
+                     std::vector<bool>& hidden) {
   hidden.resize(names.size(), false);
   for (const auto* list : {&show, &hide})
     for (const std::string& name : *list) {
-      const auto it = std::find(names.begin(), names.end(), name);
+      const char* option = list == &show ? "--show" : "--hide";
+      std::string path;
+      try {
+        path = kernel.ObjectPath(kernel.FindObject(name));
+      } catch (const InputError& e) {
+        ThrowInputError("command line", option, e.what());
+      }
+      const auto it = std::find(names.begin(), names.end(), path);
       if (it == names.end())
-        ThrowInputError("command line", list == &show ? "--show" : "--hide",
-                        fmt::format("no drawn object named '{}'{}; drawn: {}", name,
-                                    SuggestClosest(name, names), fmt::join(names, ", ")));
+        ThrowInputError(
+            "command line", option,
+            fmt::format("object '{}' is not drawn; drawn: {}", path, fmt::join(names, ", ")));
       hidden[std::size_t(it - names.begin())] = list == &hide;
     }
 }

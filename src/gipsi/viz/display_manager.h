@@ -73,14 +73,25 @@ class DisplayManager {
   /// Throws InputError (naming the object) for an unknown or unreadable field, a component out
   /// of range, an unsupported field location, an unknown colour map, an empty range, or a
   /// geometry the object does not have (no display surface, no springs or edges, no nodes).
-  DisplayManager(const SimObject& object, DrawSpec spec);
+  /// `name` is the object's full dotted name (Kernel::ObjectPath), used in the buffers and in
+  /// messages; empty: the object's own name.
+  DisplayManager(const SimObject& object, DrawSpec spec, std::string name = {});
   /// The object drawn in its default way, coloured by `spec`.
   DisplayManager(const SimObject& object, ColorSpec spec);
+
+  /// Draws the object on the current geometry of `other`, an object on the very same domain
+  /// mesh (e.g. a heart's bioelectricity on its moving muscle: the same tissue), instead of on
+  /// its own (rest) node positions. Precondition (checked): the same domain mesh.
+  void DrawOn(const SimObject& other);
+  /// The object whose geometry it is drawn on: `other` of DrawOn, else the object itself.
+  [[nodiscard]] const SimObject& geometry_object() const { return *geometry_; }
 
   /// Whether the object has something to draw by default (see DrawSpec::as).
   static bool HasDefaultGeometry(const SimObject& object);
 
   [[nodiscard]] const SimObject& object() const { return *object_; }
+  /// The object's full dotted name (SurfaceBuffers::object).
+  [[nodiscard]] const std::string& name() const { return name_; }
   [[nodiscard]] const ColorSpec& spec() const { return draw_.color; }
   [[nodiscard]] const DrawSpec& draw() const { return draw_; }
   [[nodiscard]] Primitive primitive() const { return primitive_; }
@@ -92,7 +103,9 @@ class DisplayManager {
   void ComputeValues();  // values_ at display vertices
 
   const SimObject* object_;
+  const SimObject* geometry_;  // whose node positions it is drawn on
   DrawSpec draw_;
+  std::string name_;
   Primitive primitive_ = Primitive::kTriangles;
   std::vector<std::uint32_t> segments_;  // lines: node pairs
   ColorMap map_;
@@ -106,10 +119,15 @@ class DisplayManager {
   Eigen::RowVectorXd node_;  // scalar per node (element fields)
   Eigen::RowVectorXd values_;
   Points normals_ = Points(3, 0);
+  Points positions_ = Points(3, 0);  // display positions on another object's geometry
 };
 
 /// Display managers for every leaf object of a kernel that has something to draw (see
 /// DrawSpec::as) or that the scene asks to draw, and `Fill` for all of them into one frame.
+/// An object without mechanics (no "position" field) on the same domain mesh as one with
+/// mechanics is drawn on that one's moving geometry (DisplayManager::DrawOn: a heart's
+/// bioelectricity on its muscle), and the mechanical one starts hidden unless the scene draws
+/// it or the command line colours it (both on one surface would fight for its pixels).
 /// Each is drawn as the scene's spec says (`scene_specs`, from the objects' "display" keys),
 /// with its colour replaced by `colors[name]` when given (the command line's choice); objects
 /// without a colour get solid colours from a fixed palette. Not copyable; movable.
@@ -120,6 +138,9 @@ class SceneDisplay {
   SceneDisplay(const Kernel& kernel,
                const std::vector<std::pair<const SimObject*, DrawSpec>>& scene_specs,
                const std::vector<std::pair<std::string, ColorSpec>>& colors);
+  /// Each manager's full object name and colour, e.g. to draw a reloaded scene (the viewer's
+  /// reset) as this one is drawn.
+  [[nodiscard]] std::vector<std::pair<std::string, ColorSpec>> Colors() const;
   /// Hidden flags for RenderOptions::hidden: !visible of each manager's spec.
   [[nodiscard]] std::vector<bool> Hidden() const;
   [[nodiscard]] std::size_t size() const { return managers_.size(); }
@@ -132,6 +153,18 @@ class SceneDisplay {
   std::int64_t frames_ = 0;
 };
 
+/// Whether the viewer offers field `id` of `object` to colour by: a readable node or element
+/// field, or a boundary-vertex field of an object drawn with its own boundary; a writable one
+/// (an input such as a MassSpring's `fibre` or `nodal_active_tension`, or `external_force`) only
+/// if its items hold more than one value, so inputs that nothing in the scene drives are not
+/// offered; the mechanical state (`position`, `velocity`) always. Reads the field (allocates).
+bool OffersField(const SimObject& object, FieldId id);
+
+/// The default colour of an object the scene and command line leave uncoloured: an
+/// electrophysiology object (a readable node field "V", the transmembrane potential) is coloured
+/// by V through the cool-warm map; std::nullopt for others (solid colours).
+std::optional<ColorSpec> DefaultColor(const SimObject& object);
+
 /// Applies the command line's `--as OBJECT:surface|lines|points` choices (`options`) to a
 /// scene's draw specs (adding one for an object that has none). Throws InputError naming
 /// `option` for bad syntax or an unknown object.
@@ -139,10 +172,12 @@ void ApplyGeometryOptions(const Kernel& kernel, const std::vector<std::string>& 
                           std::string_view option,
                           std::vector<std::pair<const SimObject*, DrawSpec>>& specs);
 
-/// Applies the command line's `--show` and `--hide` (object names) to `hidden` (one flag per
-/// drawn object, named `names`). Throws InputError naming the option for a name that is not
-/// drawn.
-void ApplyVisibility(const std::vector<std::string>& names, const std::vector<std::string>& show,
-                     const std::vector<std::string>& hide, std::vector<bool>& hidden);
+/// Applies the command line's `--show` and `--hide` (object names, resolved by
+/// Kernel::FindObject: full dotted names, or a part's own name when unambiguous) to `hidden`
+/// (one flag per drawn object, whose full names are `names`). Throws InputError naming the
+/// option for an unknown name or an object that is not drawn.
+void ApplyVisibility(const Kernel& kernel, const std::vector<std::string>& names,
+                     const std::vector<std::string>& show, const std::vector<std::string>& hide,
+                     std::vector<bool>& hidden);
 
 }  // namespace gipsi::viz

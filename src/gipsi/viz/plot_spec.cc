@@ -62,6 +62,12 @@ std::vector<PlotData::Series> SplitSeries(const std::string& label, const std::v
   return out;
 }
 
+std::string ReadableColumn(const std::string& column) {
+  std::string label = column.substr(column.rfind('.') + 1);
+  std::replace(label.begin(), label.end(), '_', ' ');
+  return label;
+}
+
 std::vector<std::string> ProbeColumns(const Probe& probe) {
   std::vector<std::string> columns;
   const std::string header = probe.Header();
@@ -190,7 +196,7 @@ PlotData LoadPlotData(const PlotSpec& spec, const std::filesystem::path& probe_d
   data.title = spec.title;
   data.width = spec.width;
   data.height = spec.height;
-  auto label = [](const ColumnRef& c) { return c.probe + "." + c.column; };
+  auto label = [](const ColumnRef& c) { return ReadableColumn(c.column); };
   auto with_unit = [](std::string text, const std::string& unit) {
     return unit.empty() ? text : text + " [" + unit + "]";
   };
@@ -221,6 +227,33 @@ PlotData LoadPlotData(const PlotSpec& spec, const std::filesystem::path& probe_d
   data.y_label = spec.y.size() == 1 ? with_unit(label(spec.y[0]), spec.y_unit)
                                     : (spec.y_unit.empty() ? "" : "[" + spec.y_unit + "]");
   return data;
+}
+
+ColumnDisplay DisplayOfColumn(const Probe& probe, const std::string& column,
+                              const std::vector<PlotSpec>& plots) {
+  ColumnDisplay out;
+  out.label = ReadableColumn(column);
+  out.unit = ProbeColumnUnits(probe, column);
+  for (const PlotSpec& plot : plots) {
+    const auto same = [&](const ColumnRef& ref) {
+      return ref.probe == probe.name && ref.column == column;
+    };
+    if (plot.x && same(*plot.x)) {
+      out.unit = plot.x_unit;
+      out.scale = plot.x_scale;
+      break;
+    }
+    if (std::any_of(plot.y.begin(), plot.y.end(), same)) {
+      out.unit = plot.y_unit;
+      out.scale = plot.y_scale;
+      break;
+    }
+  }
+  for (FieldId id : probe.fields) {
+    const FieldInfo& info = probe.object->field_info(id);
+    if (info.components == 1 && column == info.name) out.no_data = info.no_data;
+  }
+  return out;
 }
 
 }  // namespace gipsi::viz

@@ -80,11 +80,31 @@ std::vector<PlotData::Series> SplitSeries(const std::string& label, const std::v
                                           const std::vector<double>& key,
                                           const std::string& key_name = "time");
 
+/// A probe column as plots label it: its last dotted part with spaces for underscores
+/// ("blood.lv_pressure" → "lv pressure", "displacement_z" → "displacement z"), not the probe's
+/// internal path.
+std::string ReadableColumn(const std::string& column);
+
 /// The CSV columns a probe writes (its header split at commas).
 std::vector<std::string> ProbeColumns(const Probe& probe);
 
 /// The SI unit of one of a probe's CSV columns ("s" for time, "m" for a line probe's distance
 /// and coordinates, else its field's unit); empty if the probe has no such column.
 std::string ProbeColumnUnits(const Probe& probe, const std::string& column);
+
+/// How a live plot shows one probe column (the viewer's traces). Plain struct.
+struct ColumnDisplay {
+  std::string label;  ///< readable: "lv pressure" for the column "blood.lv_pressure"
+  std::string unit;   ///< the unit it is shown in ("" for none)
+  double scale = 1;   ///< from the column's SI values to `unit`
+  /// The field's no-data marker (FieldInfo::no_data) in SI, if it has one: shown as "not yet".
+  std::optional<double> no_data;
+};
+
+/// How to show column `column` of `probe`: in the unit a plot of the scene (`plots`) draws it in
+/// (e.g. mmHg for a pressure the scene plots in mmHg), else its field's SI unit; labelled by the
+/// column's last dotted part with spaces for underscores.
+ColumnDisplay DisplayOfColumn(const Probe& probe, const std::string& column,
+                              const std::vector<PlotSpec>& plots);
 
 }  // namespace gipsi::viz

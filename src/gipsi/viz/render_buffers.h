@@ -36,6 +36,9 @@ struct SurfaceBuffers {
   std::string units;                  ///< its units
   std::string color_map;              ///< colour map name ("" if solid)
   double range_lo = 0, range_hi = 0;  ///< the value range the colours span
+  /// Vertices whose field holds its no-data marker (FieldInfo::no_data, e.g. -1 for "not
+  /// activated yet"): drawn in kNoDataColor, left out of the range; the values hold NaN there.
+  std::size_t num_no_data = 0;
 
   [[nodiscard]] std::size_t num_vertices() const { return positions.size() / 3; }
   /// Number of triangles (0 for lines and points).
@@ -44,10 +47,17 @@ struct SurfaceBuffers {
   }
 };
 
+/// The colour of vertices without data (a light grey).
+inline constexpr float kNoDataColor[3] = {0.75f, 0.75f, 0.75f};
+
 /// Recent samples of one probe, for live plots. Copyable and movable.
 struct ProbeTrace {
-  std::string name;                        ///< probe name
-  std::vector<std::string> columns;        ///< CSV columns after time
+  std::string name;                  ///< probe name
+  std::vector<std::string> columns;  ///< CSV columns after time
+  /// Per column: readable label, display unit ("" for none), the factor from the column's SI
+  /// values to that unit, and its no-data marker (NaN: none) in SI.
+  std::vector<std::string> labels, units;
+  std::vector<double> scales, no_data;
   std::vector<float> time;                 ///< sample times [s], oldest first
   std::vector<std::vector<float>> values;  ///< values[c][k]: column c at time[k]
 };

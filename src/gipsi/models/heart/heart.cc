@@ -168,10 +168,12 @@ void Heart::FinishBeat(double t) {
   constexpr double kMl = 1e6, kMmHg = 1.0 / 133.322387415;
   Log().info(
       "{}: beat {} ({:.3f} s): EDV {:.1f} mL, ESV {:.1f} mL, SV {:.1f} mL, EF {:.1f} %, peak {} "
-      "pressure {:.1f} mmHg, {} {:.1f}/{:.1f} mmHg, change from the previous beat {:.2f} %",
+      "pressure {:.1f} mmHg, {} {:.1f}/{:.1f} mmHg, change from the previous beat {}",
       name(), beat.beat, t, kMl * beat.edv, kMl * beat.esv, kMl * beat.stroke_volume(),
       100 * beat.ejection_fraction(), monitor_.chamber, kMmHg * beat.peak_pressure, monitor_.artery,
-      kMmHg * beat.arterial_systolic, kMmHg * beat.arterial_diastolic, 100 * beat.change);
+      kMmHg * beat.arterial_systolic, kMmHg * beat.arterial_diastolic,
+      beats_.size() == 1 ? std::string("—")  // no previous beat to compare with
+                         : fmt::format("{:.2f} %", 100 * beat.change));
 }
 
 void Heart::DoReadField(FieldId id, Eigen::Ref<Eigen::MatrixXd> out) const {

@@ -79,9 +79,8 @@ Image RenderSnapshot(Scene& scene, SnapshotOptions options, SnapshotResult* resu
   if (options.render.hidden.empty()) {
     options.render.hidden = display.Hidden();
     std::vector<std::string> names;
-    for (std::size_t i = 0; i < display.size(); ++i)
-      names.push_back(display.manager(i).object().name());
-    ApplyVisibility(names, options.show, options.hide, options.render.hidden);
+    for (std::size_t i = 0; i < display.size(); ++i) names.push_back(display.manager(i).name());
+    ApplyVisibility(*scene.kernel, names, options.show, options.hide, options.render.hidden);
   }
   SnapshotResult local;
   SnapshotResult& r = result ? *result : local;

@@ -89,7 +89,19 @@ void WritePlot(const PlotData& data, const std::filesystem::path& file) {
     plscol0(static_cast<int>(kFirstSeries + i), (kPlotColors[i] >> 16) & 0xff,
             (kPlotColors[i] >> 8) & 0xff, kPlotColors[i] & 0xff);
   plinit();
-  plenv(x0, x1, y0, y1, 0, -2);  // viewport and window only; the box is drawn below
+  // Several series: the legend goes right of the axes, outside the data, in a strip as wide as
+  // its longest label (about 0.6 em per character at PLplot's default size, plus the sample
+  // line), so it never covers a curve.
+  const bool legend = data.series.size() > 1;
+  double legend_fraction = 0;
+  if (legend) {
+    std::size_t longest = 0;
+    for (const auto& series : data.series) longest = std::max(longest, series.label.size());
+    legend_fraction = std::min(0.45, (7.0 * double(longest) + 60.0) / data.width);
+  }
+  pladv(0);
+  plvpor(0.1, 0.95 - legend_fraction, 0.12, 0.9);
+  plwind(x0, x1, y0, y1);
   plcol0(2);
   plwidth(1.0);
   plbox("g", 0, 0, "g", 0, 0);
@@ -116,7 +128,7 @@ void WritePlot(const PlotData& data, const std::filesystem::path& file) {
     }
     flush();
   }
-  if (data.series.size() > 1) {
+  if (legend) {
     const std::size_t count = data.series.size();
     const auto n = static_cast<PLINT>(count);
     std::vector<PLINT> options(count, PL_LEGEND_LINE), colors(count), text_colors(count, 1),
@@ -129,10 +141,11 @@ void WritePlot(const PlotData& data, const std::filesystem::path& file) {
     }
     PLFLT legend_width = 0, legend_height = 0;
     plwidth(1.0);
-    pllegend(&legend_width, &legend_height, PL_LEGEND_BACKGROUND | PL_LEGEND_BOUNDING_BOX, 0, 0.0,
-             0.0, 0.08, 0, 1, 1, 0, 0, n, options.data(), 1.0, 0.8, 2.0, 0.0, text_colors.data(),
-             text.data(), nullptr, nullptr, nullptr, nullptr, colors.data(), styles.data(),
-             widths.data(), nullptr, nullptr, nullptr, nullptr);
+    pllegend(&legend_width, &legend_height, PL_LEGEND_BACKGROUND | PL_LEGEND_BOUNDING_BOX,
+             PL_POSITION_RIGHT | PL_POSITION_TOP | PL_POSITION_OUTSIDE, 0.02, 0.0, 0.08, 0, 1, 1, 0,
+             0, n, options.data(), 1.0, 0.8, 2.0, 0.0, text_colors.data(), text.data(), nullptr,
+             nullptr, nullptr, nullptr, colors.data(), styles.data(), widths.data(), nullptr,
+             nullptr, nullptr, nullptr);
   }
   plend();
   std::string bytes;
