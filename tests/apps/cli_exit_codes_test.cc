@@ -206,7 +206,10 @@ TEST(GipsiSignals, SigtermStopsARunningRunWithinAMacroStep) {
   const pid_t pid = Spawn({"run", Scene("hanging_sheet.json"), "--until", "10000", "--no-vtu", "-q",
                            "--out", (dir / "out").string()},
                           dir / "log");
-  std::this_thread::sleep_for(std::chrono::seconds(2));  // built and running
+  // Wait until it runs: its probe CSV has rows (however loaded the machine is).
+  const fs::path csv = dir / "out" / "probes" / "centre.csv";
+  for (int i = 0; i < 600 && ReadAll(csv).size() < 1000; ++i)
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
   kill(pid, SIGTERM);
   const auto [code, seconds] = WaitFor(pid, std::chrono::seconds(20));
   EXPECT_EQ(code, 130) << ReadAll(dir / "log");
@@ -222,14 +225,17 @@ TEST(GipsiSignals, SigintStopsALongBuildThatReportsItsStages) {
     "objects": {"cube": {"type": "MassSpring", "domain": "box", "dt": 0.001}},
     "schedule": {"end": 1}})";
   const pid_t pid = Spawn({"validate", (dir / "big.json").string()}, dir / "log");
-  // Started and building (it takes tens of seconds), even on a loaded machine.
-  std::this_thread::sleep_for(std::chrono::seconds(3));
+  // Not a terminal: once the mesh stage has taken 2 s, a plain line says so. Wait for it (the
+  // build takes tens of seconds), so the signal surely comes while building, however loaded the
+  // machine is.
+  const std::string stage = "building: [1/5] mesh 'box' (generate box) ...\n";
+  for (int i = 0; i < 600 && ReadAll(dir / "log").find(stage) == std::string::npos; ++i)
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  EXPECT_THAT(ReadAll(dir / "log"), HasSubstr(stage));
   kill(pid, SIGINT);
   const auto [code, seconds] = WaitFor(pid, std::chrono::seconds(60));
   EXPECT_EQ(code, 130) << ReadAll(dir / "log");
   EXPECT_LT(seconds, 2.0);  // measured 0.2 s: at once, not at the end of the build
-  // Not a terminal: a plain line for the stage that has taken over 2 s.
-  EXPECT_THAT(ReadAll(dir / "log"), HasSubstr("building: [1/5] mesh 'box' (generate box) ...\n"));
   EXPECT_THAT(ReadAll(dir / "log"),
               HasSubstr("gipsi: stopped on request while building the scene"));
 }
