@@ -91,13 +91,13 @@ void WritePlot(const PlotData& data, const std::filesystem::path& file) {
   plinit();
   // Several series: the legend goes right of the axes, outside the data, in a strip as wide as
   // its longest label (about 0.6 em per character at PLplot's default size, plus the sample
-  // line), so it never covers a curve.
+  // line), so it never covers a curve; it is centred on the axes' height.
   const bool legend = data.series.size() > 1;
   double legend_fraction = 0;
   if (legend) {
     std::size_t longest = 0;
     for (const auto& series : data.series) longest = std::max(longest, series.label.size());
-    legend_fraction = std::min(0.45, (7.0 * double(longest) + 60.0) / data.width);
+    legend_fraction = std::min(0.45, (6.5 * double(longest) + 90.0) / data.width);
   }
   pladv(0);
   plvpor(0.1, 0.95 - legend_fraction, 0.12, 0.9);
@@ -142,10 +142,10 @@ void WritePlot(const PlotData& data, const std::filesystem::path& file) {
     PLFLT legend_width = 0, legend_height = 0;
     plwidth(1.0);
     pllegend(&legend_width, &legend_height, PL_LEGEND_BACKGROUND | PL_LEGEND_BOUNDING_BOX,
-             PL_POSITION_RIGHT | PL_POSITION_TOP | PL_POSITION_OUTSIDE, 0.02, 0.0, 0.08, 0, 1, 1, 0,
-             0, n, options.data(), 1.0, 0.8, 2.0, 0.0, text_colors.data(), text.data(), nullptr,
-             nullptr, nullptr, nullptr, colors.data(), styles.data(), widths.data(), nullptr,
-             nullptr, nullptr, nullptr);
+             PL_POSITION_RIGHT | PL_POSITION_OUTSIDE, 0.02, 0.0, 0.08, 0, 1, 1, 0, 0, n,
+             options.data(), 1.0, 0.8, 2.0, 0.0, text_colors.data(), text.data(), nullptr, nullptr,
+             nullptr, nullptr, colors.data(), styles.data(), widths.data(), nullptr, nullptr,
+             nullptr, nullptr);
   }
   plend();
   std::string bytes;
