@@ -177,8 +177,10 @@ NewtonStats NewtonSolver::Solve(NonlinearSystem& system, VecX& d, SparseMatrix& 
         accepted = true;
         break;
       }
-      // Only with a fresh Jacobian: a stale one that fails the residual test is refreshed first.
-      if (options_.monotonicity_test && fresh && Monotone(system, stats, alpha)) {
+      // Only with a fresh Jacobian (a stale one that fails the residual test is refreshed
+      // first) and without low-rank terms (see NewtonOptions::monotonicity_test).
+      if (options_.monotonicity_test && fresh && system.num_low_rank_terms() == 0 &&
+          Monotone(system, stats, alpha)) {
         accepted = by_monotonicity = true;
         break;
       }
