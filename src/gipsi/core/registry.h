@@ -18,7 +18,9 @@
 #include "gipsi/numerics/ode.h"
 
 /// Version of the plugin interface; a plugin built against another version is refused.
-#define GIPSI_PLUGIN_ABI_VERSION 3  // 2: checkpoint hooks; 3: haptic local models by type
+/// 2: checkpoint hooks; 3: haptic local models by type; 4: SimObject's stop token, local models
+/// in core.
+#define GIPSI_PLUGIN_ABI_VERSION 4
 
 namespace gipsi {
 
