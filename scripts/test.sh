@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Installs the dependencies, then checks formatting and the layer graph, builds the release
-# configuration and runs every test in it: the newcomer's command, about 25 minutes on a fresh
+# configuration and runs every test in it: the newcomer's command, about 23 minutes on a fresh
 # 2-core machine (docs/robustness.md, "Test stages and their cost").
 #   bash scripts/test.sh --full   adds the same suite under AddressSanitizer + UBSan (minus the
 #                                 slowest pure-physics tests, which the release stage runs), the
