@@ -69,7 +69,12 @@ if [ "${1:-}" = "--full" ]; then
   asan_skip+='|Resume\.HeartIsBitwiseIdentical'
   # The viewer's 10-simulated-second pulls on the liver and the heart (32-90 s each in release
   # under Xvfb): the pull's code runs under the sanitizers in the short pull tests beside them.
-  asan_skip+='|Viewer\.APullKeepsThe(HangingLiverRunning|HeartBeating)For10SimulatedSeconds)$'
+  asan_skip+='|Viewer\.APullKeepsThe(HangingLiverRunning|HeartBeating)For10SimulatedSeconds'
+  # A full disk simulated by the file-size limit: when its write fails, PLplot (5.15, Debian)
+  # frees a pointer it never set (ASan's 0xbe fill pattern, SIGBUS in plend); the release stage
+  # runs this test, where that pointer happens to be null. Not GiPSi's memory; to be worked
+  # around by rendering plots into memory (noted for an issue).
+  asan_skip+='|GipsiExitCodes\.AFullDiskExits4WithTheReasonAndLeavesNoPartialFile)$'
   echo "== asan (address + undefined behavior sanitizers)"
   cmake --preset asan
   cmake --build --preset asan
