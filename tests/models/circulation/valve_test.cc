@@ -7,6 +7,8 @@
 
 #include <gtest/gtest.h>
 
+#include "gipsi/base/error.h"
+#include "gipsi/base/state.h"
 #include "gipsi/models/circulation/circuit.h"
 #include "models/circulation/circulation_test_util.h"
 
@@ -39,6 +41,71 @@ TEST(ValveEventLog, KeepsTheMostRecentEventsAndCountsAll) {
   ASSERT_EQ(since.size(), 1u);
   EXPECT_DOUBLE_EQ(since[0].time, 0.4);
   EXPECT_TRUE(log.EventsSince(5).empty());
+}
+
+/// `log` saved and restored into a fresh log of the same capacity.
+ValveEventLog RoundTrip(const ValveEventLog& log, std::size_t capacity, std::size_t* bytes) {
+  StateWriter out;
+  log.SaveState(out);
+  *bytes = out.bytes().size();
+  ValveEventLog restored(capacity);
+  StateReader in(out.TakeBytes(), "the test log");
+  restored.RestoreState(in);
+  EXPECT_TRUE(in.at_end());
+  return restored;
+}
+
+TEST(ValveEventLog, SavesOnlyTheEventsItHoldsAndRestoresThemInOrder) {
+  // Partly filled: 4 events in room for 100,000. The state holds the 4 events (13 bytes each
+  // plus headers), not the ring (1.6 MB).
+  ValveEventLog partial;
+  for (int k = 0; k < 4; ++k)
+    partial.Record({0.1 * k, k, k % 2 ? ValveState::kOpen : ValveState::kClosed});
+  std::size_t bytes = 0;
+  ValveEventLog restored = RoundTrip(partial, 100000, &bytes);
+  EXPECT_LT(bytes, 300u);
+  EXPECT_EQ(restored.total(), 4);
+  const auto a = partial.Events(), b = restored.Events();
+  ASSERT_EQ(b.size(), 4u);
+  for (std::size_t k = 0; k < a.size(); ++k) {
+    EXPECT_EQ(b[k].time, a[k].time);
+    EXPECT_EQ(b[k].valve, a[k].valve);
+    EXPECT_EQ(b[k].state, a[k].state);
+  }
+  // Wrapped: 7 events in room for 3, so the ring's slots are out of time order; the restored
+  // log returns the last 3 oldest first and goes on wrapping where the original would.
+  ValveEventLog wrapped(3);
+  for (int k = 0; k < 7; ++k) wrapped.Record({0.1 * k, k, ValveState::kOpen});
+  restored = RoundTrip(wrapped, 3, &bytes);
+  wrapped.Record({0.7, 7, ValveState::kClosed});
+  restored.Record({0.7, 7, ValveState::kClosed});
+  EXPECT_EQ(restored.total(), 8);
+  const auto c = wrapped.Events(), d = restored.Events();
+  ASSERT_EQ(d.size(), 3u);
+  for (std::size_t k = 0; k < c.size(); ++k) {
+    EXPECT_EQ(d[k].time, c[k].time);
+    EXPECT_EQ(d[k].valve, c[k].valve);
+    EXPECT_EQ(d[k].state, c[k].state);
+  }
+  EXPECT_EQ(d[0].valve, 5);
+}
+
+TEST(ValveEventLog, AStateOfMoreEventsThanItsRoomIsAClearError) {
+  ValveEventLog log(3);
+  log.Record({0.1, 0, ValveState::kOpen});
+  // A state restored into a log with room for fewer events than were kept (another
+  // scene's checkpoint) is refused naming the array.
+  ValveEventLog other(8);
+  for (int k = 0; k < 5; ++k) other.Record({0.1 * k, 0, ValveState::kOpen});
+  StateWriter more;
+  other.SaveState(more);
+  StateReader in(more.TakeBytes(), "other.gck");
+  try {
+    log.RestoreState(in);
+    FAIL() << "a log of 5 events restored into room for 3";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("the valve event times"), std::string::npos) << e.what();
+  }
 }
 
 // A chamber (cosine elastance) ejects through a valve into a reservoir at 80 mmHg. Integrated

@@ -5,6 +5,13 @@
 /// event log and the counters. Pressures and flows are outputs recomputed from the state but
 /// are saved too, so probes read the same values before the first step after a restore.
 
+#include <algorithm>
+#include <cstdint>
+#include <vector>
+
+#include <fmt/format.h>
+
+#include "gipsi/base/error.h"
 #include "gipsi/base/state.h"
 #include "gipsi/models/circulation/circuit.h"
 #include "gipsi/models/circulation/circulation.h"
@@ -13,14 +20,48 @@
 
 namespace gipsi {
 
+// Only the slots in use are saved, field by field (no padding bytes): a log with room for
+// 100,000 events holds a few hundred in a typical run, and saving the whole ring made it 70 % of
+// the heart's state (1.6 MB of 2.3 MB per roll-back snapshot). Slots not saved are never read
+// before they are written again (EventsSince reads the last min(total, capacity) events).
 void ValveEventLog::SaveState(StateWriter& out) const {
-  out.WriteArray(ring_);
+  out.BeginSection("ValveEventLog", 2);
+  const std::size_t used = static_cast<std::size_t>(
+      std::min<std::int64_t>(total_, static_cast<std::int64_t>(ring_.size())));
+  std::vector<double> times(used);
+  std::vector<std::int32_t> valves(used);
+  std::vector<std::uint8_t> states(used);
+  for (std::size_t k = 0; k < used; ++k) {
+    times[k] = ring_[k].time;
+    valves[k] = ring_[k].valve;
+    states[k] = static_cast<std::uint8_t>(ring_[k].state);
+  }
   out.WriteInt(total_);
+  out.WriteArray(times);
+  out.WriteArray(valves);
+  out.WriteArray(states);
+  out.EndSection();
 }
 
 void ValveEventLog::RestoreState(StateReader& in) {
-  in.ReadArrayExact(ring_, "the valve event log");
-  total_ = in.ReadInt();
+  in.BeginSection("ValveEventLog", 2);
+  const std::int64_t total = in.ReadInt();
+  if (total < 0) throw InputError(fmt::format("the valve event log: a negative count {}", total));
+  std::vector<double> times(static_cast<std::size_t>(
+      std::min<std::int64_t>(total, static_cast<std::int64_t>(ring_.size()))));
+  std::vector<std::int32_t> valves(times.size());
+  std::vector<std::uint8_t> states(times.size());
+  in.ReadArrayExact(times, "the valve event times");
+  in.ReadArrayExact(valves, "the valve event valves");
+  in.ReadArrayExact(states, "the valve event states");
+  in.EndSection();
+  for (std::size_t k = 0; k < times.size(); ++k) {
+    if (states[k] > static_cast<std::uint8_t>(ValveState::kOpen))
+      throw InputError(
+          fmt::format("the valve event log: event {} has no valve state {}", k, int(states[k])));
+    ring_[k] = {times[k], valves[k], static_cast<ValveState>(states[k])};
+  }
+  total_ = total;
 }
 
 void Circuit::SaveState(StateWriter& out) const {
