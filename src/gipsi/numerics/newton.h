@@ -116,7 +116,8 @@ enum class LinearFailure : std::uint8_t {
   kNotConverged,         ///< an iterative solve missed its tolerance or gave non-finite values
 };
 
-/// Outcome of one solve. Plain struct, trivially copyable (checkpoints store it as bytes).
+/// Outcome of one solve. Plain struct, trivially copyable (FemSolid checkpoints save it field by
+/// field: models/fem/fem_solid_state.cc).
 struct NewtonStats {
   bool converged = false;
   bool inadmissible = false;  ///< stopped because no admissible state was found

@@ -7,10 +7,55 @@
 /// last Jacobian norm (it sets the round-off floor of the next step's first residual).
 /// Constraint targets and the current loads are gathered afresh at the start of every step.
 
+#include <algorithm>
+#include <vector>
+
+#include <fmt/format.h>
+
+#include "gipsi/base/error.h"
 #include "gipsi/base/state.h"
 #include "gipsi/models/fem/fem_solid.h"
 
 namespace gipsi {
+namespace {
+
+// The last Newton statistics (the failure message and the profile read them), field by field:
+// a raw copy of the struct would also store its padding bytes, which are indeterminate.
+void SaveStats(StateWriter& out, const NewtonStats& s) {
+  out.BeginSection("NewtonStats", 1);
+  for (bool b : {s.converged, s.inadmissible, s.linear_failure, s.interrupted}) out.WriteBool(b);
+  out.WriteInt(static_cast<std::int64_t>(s.linear_failure_kind));
+  for (int n : {s.iterations, s.linear_iterations, s.refactorizations, s.monotonicity_accepts,
+                s.backtracks})
+    out.WriteInt(n);
+  out.WriteDouble(s.initial_residual);
+  out.WriteDouble(s.final_residual);
+  out.WriteArray(std::span<const double>(s.residual_history));
+  out.EndSection();
+}
+
+NewtonStats RestoreStats(StateReader& in) {
+  NewtonStats s;
+  in.BeginSection("NewtonStats", 1);
+  for (bool* b : {&s.converged, &s.inadmissible, &s.linear_failure, &s.interrupted})
+    *b = in.ReadBool();
+  const std::int64_t kind = in.ReadInt();
+  if (kind < 0 || kind > static_cast<std::int64_t>(LinearFailure::kNotConverged))
+    throw InputError(fmt::format("the Newton statistics: no linear failure kind {}", kind));
+  s.linear_failure_kind = static_cast<LinearFailure>(kind);
+  for (int* n : {&s.iterations, &s.linear_iterations, &s.refactorizations, &s.monotonicity_accepts,
+                 &s.backtracks})
+    *n = static_cast<int>(in.ReadInt());
+  s.initial_residual = in.ReadDouble();
+  s.final_residual = in.ReadDouble();
+  std::vector<double> history(s.residual_history.size());
+  in.ReadArrayExact(history, "the Newton residual history");
+  std::copy(history.begin(), history.end(), s.residual_history.begin());
+  in.EndSection();
+  return s;
+}
+
+}  // namespace
 
 void FemSolid::SaveObjectState(StateWriter& out) const {
   scheme_.SaveState(out);
@@ -33,7 +78,7 @@ void FemSolid::SaveObjectState(StateWriter& out) const {
   out.WriteArray(cavity_pressures);
   out.WriteArray(cavity_stiffnesses);
   out.WriteDouble(jacobian_norm_);
-  out.WriteArray(std::span<const NewtonStats>(&last_newton_, 1));
+  SaveStats(out, last_newton_);
 }
 
 void FemSolid::RestoreObjectState(StateReader& in) {
@@ -59,9 +104,7 @@ void FemSolid::RestoreObjectState(StateReader& in) {
     cavities_[c].stiffness = cavity_stiffnesses[c];
   }
   jacobian_norm_ = in.ReadDouble();
-  std::vector<NewtonStats> stats(1);
-  in.ReadArrayExact(stats, "the Newton statistics");
-  last_newton_ = stats.front();
+  last_newton_ = RestoreStats(in);
   UpdatePositions();
 }
 
