@@ -41,6 +41,7 @@
 #include "gipsi/models/ep/cell_models.h"
 #include "gipsi/models/ep/single_cell.h"
 #include "gipsi/viz/render/plot.h"
+#include "run_progress.h"
 #include "viz_commands.h"
 
 /// LeakSanitizer (sanitizer builds only; never called otherwise): libgmsh 4.8 leaks small
@@ -98,63 +99,6 @@ class SignalTarget {
   SignalTarget(const SignalTarget&) = delete;
   SignalTarget& operator=(const SignalTarget&) = delete;
   ~SignalTarget() { g_running_kernel.store(nullptr); }
-};
-
-/// "1m05s" / "12s" / "3h02m" for a number of wall seconds.
-std::string Duration(double seconds) {
-  const auto s = static_cast<std::int64_t>(std::llround(std::max(0.0, seconds)));
-  if (s >= 3600) return fmt::format("{}h{:02d}m", s / 3600, (s % 3600) / 60);
-  if (s >= 60) return fmt::format("{}m{:02d}s", s / 60, s % 60);
-  return fmt::format("{}s", s);
-}
-
-/// Progress of a run. On a terminal: a bar rewritten in place at most 10 times a second, with
-/// the estimated wall time left (ETA, from the pace since the first step); otherwise a plain line
-/// at every 10 % of the run.
-class Progress {
- public:
-  explicit Progress(bool quiet) : quiet_(quiet), tty_(isatty(STDERR_FILENO) != 0) {}
-  void Update(double t, double end) {
-    if (quiet_ || end <= 0) return;
-    const double fraction = std::min(1.0, t / end);
-    auto now = std::chrono::steady_clock::now();
-    if (!started_) {  // the first step's time and wall clock: the pace is measured from here
-      started_ = true;
-      t0_ = t;
-      wall0_ = now;
-    }
-    const double elapsed = std::chrono::duration<double>(now - wall0_).count();
-    const std::string eta = t > t0_ && elapsed > 0.5
-                                ? fmt::format(", ETA {}", Duration(elapsed * (end - t) / (t - t0_)))
-                                : std::string();
-    if (tty_) {
-      if (now - last_ < std::chrono::milliseconds(100) && fraction < 1.0) return;
-      last_ = now;
-      const int width = 30, filled = static_cast<int>(fraction * width);
-      std::fprintf(stderr, "\r[%s%s] %5.1f%%  t = %.4g / %.4g s%s\033[K",
-                   std::string(filled, '#').c_str(), std::string(width - filled, ' ').c_str(),
-                   100 * fraction, t, end, eta.c_str());
-      std::fflush(stderr);
-      dirty_ = true;
-    } else {
-      const int decile = static_cast<int>(fraction * 10 + 1e-9);
-      if (decile <= last_decile_) return;
-      last_decile_ = decile;
-      std::fprintf(stderr, "progress: %3d%%  t = %.6g s%s\n", decile * 10, t,
-                   decile < 10 ? eta.c_str() : "");
-    }
-  }
-  void Done() {
-    if (dirty_) std::fprintf(stderr, "\n");
-    dirty_ = false;
-  }
-
- private:
-  bool quiet_, tty_;
-  bool dirty_ = false, started_ = false;
-  int last_decile_ = 0;
-  double t0_ = 0;
-  std::chrono::steady_clock::time_point last_{}, wall0_{};
 };
 
 /// Progress of building a scene (gipsi::BuildProgressFn): which stage (mesh, object, ...) is
@@ -426,7 +370,7 @@ int Run(const std::string& file, const std::string& out_dir, double until, bool 
   for (std::size_t i = 0; i < coordinator.num_connectors(); ++i)
     fired_before[i] = coordinator.connector(i).fire_count();
 
-  Progress progress(quiet);
+  gipsi::cli::RunProgress progress(quiet, isatty(STDERR_FILENO) != 0, stderr);
   gipsi::RealtimeHaptics haptics(kernel);  // joins the loops however the run ends
   haptics.Start();
   gipsi::RunResult result =
