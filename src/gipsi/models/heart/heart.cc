@@ -110,9 +110,14 @@ Heart::Heart(std::string name, Coordinator parts, HeartMonitorSpec monitor)
       {"arterial_systolic_pressure", L::kGlobal, 1, "Pa", A::kRead, "of the last completed beat"},
       {"arterial_diastolic_pressure", L::kGlobal, 1, "Pa", A::kRead, "of the last completed beat"},
       {"cycle_change", L::kGlobal, 1, "1", A::kRead,
-       "largest relative change of the beat's figures from the previous beat (1: first beat)"},
+       "largest relative change of the last beat's figures from the beat before it"},
   };
-  for (const FieldInfo& info : own) DeclareField(info);
+  // The beat figures have no value before the first beat is complete, nor the change before
+  // the second: they read -1, which probes, plots and the viewer show as "no data".
+  for (FieldInfo info : own) {
+    if (info.name != "beats") info.no_data = kNoBeat;
+    DeclareField(info);
+  }
 }
 
 StepStatus Heart::DoStep(double t, double dt) {
@@ -180,6 +185,10 @@ void Heart::DoReadField(FieldId id, Eigen::Ref<Eigen::MatrixXd> out) const {
   const auto index = static_cast<std::size_t>(id.value());
   if (index < first_own_field_) {
     AggregateObject::DoReadField(id, out);
+    return;
+  }
+  if (index > first_own_field_ && beats_.empty()) {  // no completed beat: no figures yet
+    out(0, 0) = kNoBeat;
     return;
   }
   const BeatSummary last = beats_.empty() ? BeatSummary{} : beats_.back();

@@ -31,6 +31,10 @@ struct HeartMonitorSpec {
   double period = 0.8;           ///< beat length [s]; beats start at t = 0
 };
 
+/// What the beat monitor's fields read when there is no value yet (before the first completed
+/// beat; for `cycle_change`, before the second): their FieldInfo::no_data marker.
+inline constexpr double kNoBeat = -1;
+
 /// One completed beat. Plain struct (SI units).
 struct BeatSummary {
   int beat = 0;                   ///< 1, 2, …
@@ -40,7 +44,8 @@ struct BeatSummary {
   double peak_pressure = 0;       ///< chamber [Pa]
   double arterial_systolic = 0;   ///< [Pa]
   double arterial_diastolic = 0;  ///< [Pa]
-  double change = 1;  ///< largest relative change of the above from the previous beat (1: first)
+  /// Largest relative change of the above from the previous beat; kNoBeat for the first beat.
+  double change = kNoBeat;
   [[nodiscard]] double stroke_volume() const { return edv - esv; }
   [[nodiscard]] double ejection_fraction() const { return edv > 0 ? (edv - esv) / edv : 0; }
 };
