@@ -1,8 +1,11 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include "gipsi/base/error.h"
 #include "gipsi/core/kernel.h"
+#include "gipsi/geometry/boundary.h"
 #include "gipsi/geometry/generators.h"
 #include "gipsi/models/connectors/boundary_coupling.h"
 #include "gipsi/models/connectors/field_copy.h"
@@ -52,6 +55,66 @@ TEST(FieldCopy, BarycentricMappingReproducesLinearFieldsAcrossMeshes) {
   fine->ReadField(fine->FindField("external_force"), got);
   Eigen::MatrixXd expected = (A * fine->domain().nodes).colwise() + b;
   EXPECT_LT((got - expected).cwiseAbs().maxCoeff(), 1e-12);
+}
+
+/// A tet box with two node scalars: "marked" (no-data marker -1) and "plain" (no marker).
+class MarkedFields final : public SimObject {
+ public:
+  MarkedFields(std::string name, int cells, double plain_marker_or_nan)
+      : SimObject(std::move(name)) {
+    auto mesh =
+        std::make_shared<const Mesh>(MakeTetBox(Vec3::Zero(), Vec3::Ones(), {cells, cells, cells}));
+    SetGeometry(mesh, MakeBoundary(*mesh));
+    FieldInfo marked{"marked", FieldLocation::kNode, 1, "s", FieldAccess::kReadWrite, "marked"};
+    marked.no_data = -1;
+    marked_id_ = DeclareField(marked);
+    FieldInfo plain{"plain", FieldLocation::kNode, 1, "s", FieldAccess::kReadWrite, "plain"};
+    if (!std::isnan(plain_marker_or_nan)) plain.no_data = plain_marker_or_nan;
+    plain_id_ = DeclareField(plain);
+    marked_ = plain_ = Eigen::RowVectorXd::Zero(mesh->num_nodes());
+  }
+  std::string_view type_name() const override { return "MarkedFields"; }
+  const Points& domain_positions() const override { return domain().nodes; }
+  Eigen::RowVectorXd marked_, plain_;
+
+ protected:
+  StepStatus DoStep(double, double) override { return StepStatus::Ok(); }
+  void DoReadField(FieldId id, Eigen::Ref<Eigen::MatrixXd> out) const override {
+    out.row(0) = id == marked_id_ ? marked_ : plain_;
+  }
+  void DoWriteField(FieldId id, const Eigen::Ref<const Eigen::MatrixXd>& in) override {
+    (id == marked_id_ ? marked_ : plain_) = in.row(0);
+  }
+
+ private:
+  FieldId marked_id_, plain_id_;
+};
+
+TEST(FieldCopy, TheNoDataMarkerIsNeitherBlendedNorScaled) {
+  // Activation times on a coarse box (-1: not activated, at x = 1), copied in ms (scale 1000)
+  // onto a finer box: targets whose interpolation touches a marked node read a marker, never a
+  // blend such as 0.5 * 0.04 + 0.5 * (-1) = -0.48 "ms"; the others read the interpolated value.
+  for (const double target_marker : {std::nan(""), -7.0}) {
+    MarkedFields coarse("coarse", 2, std::nan("")), fine("fine", 4, target_marker);
+    const Points& x = coarse.domain().nodes;
+    for (Index n = 0; n < x.cols(); ++n) coarse.marked_(n) = x(0, n) == 1.0 ? -1 : 0.08 * x(0, n);
+    FieldCopy copy("copy", coarse, coarse.FindField("marked"), fine, fine.FindField("plain"),
+                   FieldCopy::Mapping::kAuto, 1000.0);
+    ASSERT_EQ(copy.mapping(), FieldCopy::Mapping::kBarycentric);
+    ASSERT_TRUE(copy.Fire(0).ok());
+    const double marker = std::isnan(target_marker) ? -1 : target_marker;
+    const Points& y = fine.domain().nodes;
+    int marked = 0;
+    for (Index n = 0; n < y.cols(); ++n) {
+      if (y(0, n) > 0.5 + 1e-12) {  // in the cells next to x = 1: touches a marked node
+        EXPECT_EQ(fine.plain_(n), marker) << "node at x = " << y(0, n);
+        ++marked;
+      } else {
+        EXPECT_NEAR(fine.plain_(n), 1000 * 0.08 * y(0, n), 1e-9) << "node at x = " << y(0, n);
+      }
+    }
+    EXPECT_EQ(marked, 25 * 2);  // the fine box's planes x = 0.75 and x = 1
+  }
 }
 
 TEST(FieldCopy, RejectsMismatchedComponents) {

@@ -1,6 +1,7 @@
 #include "gipsi/models/connectors/field_copy.h"
 
 #include <cmath>
+#include <optional>
 
 #include <fmt/format.h>
 
@@ -56,12 +57,26 @@ FieldCopy::FieldCopy(std::string name, SimObject& from, FieldId from_field, SimO
 
 StepStatus FieldCopy::DoFire(double /*t*/) {
   from_.ReadField(from_field_, source_);
-  if (map_) {
+  // A source field's no-data marker (e.g. -1 for "never activated") is neither blended nor
+  // scaled: an item that reads it, or whose interpolation touches it, gets the target field's
+  // own marker if it declares one, else the source's marker unchanged.
+  const std::optional<double> marker = from_.field_info(from_field_).no_data;
+  if (map_ && marker) {
+    map_->ApplyMarked(source_, target_, *marker);
+  } else if (map_) {
     map_->Apply(source_, target_);
   } else {
     target_ = source_;
   }
-  if (scale_ != 1.0) target_ *= scale_;
+  if (marker) {
+    const double written = to_.field_info(to_field_).no_data.value_or(*marker);
+    for (Index i = 0; i < target_.size(); ++i) {
+      double& v = target_.data()[i];
+      v = v == *marker ? written : v * scale_;
+    }
+  } else if (scale_ != 1.0) {
+    target_ *= scale_;
+  }
   for (Index i = 0; i < target_.size(); ++i)
     if (!std::isfinite(target_.data()[i]))
       return StepStatus::Diverged("non-finite value transferred at item", i / target_.rows(),

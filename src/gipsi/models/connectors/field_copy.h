@@ -8,6 +8,9 @@
 /// "direct" needs equal item counts; "barycentric" interpolates node fields inside the source's
 /// tets (or on its triangles); "nearest" takes the closest source item; "auto" picks direct when
 /// the item positions coincide, barycentric for node fields, nearest otherwise.
+/// A source field with a no-data marker (FieldInfo::no_data, e.g. `activation_time`'s -1) keeps
+/// it apart: a target item whose value would read or blend the marker gets the target field's
+/// marker (the source's if the target declares none), never a blend and never scaled.
 
 #include <optional>
 
