@@ -106,6 +106,13 @@ TEST(Restep, AggregateWithBoundaryCouplingIsBitwise) {
 
 TEST(Restep, FemSolidDynamicIsBitwise) { ExpectRestepIsBitwise("cantilever.json", 0.05, 0.08); }
 
+TEST(Restep, FemSolidQuasiStaticNewtonIsBitwise) {
+  // The Land et al. Guccione beam (Static, 10 load steps, Newton with the natural monotonicity
+  // test): one macro step, run again from the start after the first run left its warm start,
+  // kept factorisation and statistics at the loaded state.
+  ExpectRestepIsBitwise("land_beam.json", 0, 1);
+}
+
 TEST(Restep, FemSolidUnderARigidToolIsBitwise) {
   // FemSolid, a RigidTool on its scripted path and the contact between them.
   ExpectRestepIsBitwise("probe_indentation.json", 0.5, 0.6);
