@@ -238,6 +238,7 @@ TEST(Newton, AnIndefiniteTangentFallsBackToLdltAndOtherwiseSaysWhatToTry) {
   const NewtonStats stats = Solve(system, x, options);
   ASSERT_TRUE(stats.converged) << Describe(stats, options);
   EXPECT_NEAR(x[0], 1.3844, 1e-3);
+  EXPECT_TRUE(stats.switched_to_indefinite);  // the object logs it once
   // ... while CG, for SPD matrices only, fails and the message says why and what to try.
   DiagonalSystem cg_system = system_of();
   NewtonSolver cg(options, MakeLinearSolver(LinearSolverOptions{.type = "cg"}));

@@ -39,6 +39,7 @@ bool NewtonSolver::FactorizeTangent(const SparseMatrix& J, NewtonStats& stats) {
   stats.linear_failure_kind = LinearFailure::kNotPositiveDefinite;
   if (!indefinite_ && linear_->AcceptIndefinite()) {
     indefinite_ = true;
+    stats.switched_to_indefinite = true;
     if (linear_->Factorize(J)) {
       stats.linear_failure_kind = LinearFailure::kNone;
       return true;

@@ -123,6 +123,9 @@ struct NewtonStats {
   bool inadmissible = false;  ///< stopped because no admissible state was found
   bool linear_failure = false;
   bool interrupted = false;  ///< a stop was requested (StopToken) before convergence
+  /// This solve switched the direct solver to its indefinite (LDLᵀ) mode, for good: the tangent
+  /// was not positive definite (the object says so once, with its name and time).
+  bool switched_to_indefinite = false;
   LinearFailure linear_failure_kind = LinearFailure::kNone;
   int iterations = 0;
   int linear_iterations = 0;

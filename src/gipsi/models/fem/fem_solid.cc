@@ -501,6 +501,12 @@ StepStatus FemSolid::Advance(double s0, double s1, double dt, int depth) {
     force_scale_ = (f_nodal_prev_ + s1 * (f_nodal_new_ - f_nodal_prev_)).norm();
     load_scale_pending_ = true;
     last_newton_ = newton_->Solve(*this, d_, jac_, stop_token());
+    if (last_newton_.switched_to_indefinite)  // once per run: the switch is for good
+      Log().warn(
+          "{}: t = {:.6g} s, load increment to {:.4g} % of the step: the tangent is not "
+          "positive definite (a large load increment, a follower pressure or a stiff "
+          "bulk_modulus); the '{}' solver factorises it as LDLT from now on (docs/newton.md)",
+          name(), time(), 100 * s1, newton_->linear_solver().name());
   };
   solve(predict);
   if (predict && last_newton_.inadmissible && last_newton_.iterations == 0) {

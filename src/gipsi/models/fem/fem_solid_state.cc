@@ -23,7 +23,9 @@ namespace {
 // a raw copy of the struct would also store its padding bytes, which are indeterminate.
 void SaveStats(StateWriter& out, const NewtonStats& s) {
   out.BeginSection("NewtonStats", 1);
-  for (bool b : {s.converged, s.inadmissible, s.linear_failure, s.interrupted}) out.WriteBool(b);
+  for (bool b :
+       {s.converged, s.inadmissible, s.linear_failure, s.interrupted, s.switched_to_indefinite})
+    out.WriteBool(b);
   out.WriteInt(static_cast<std::int64_t>(s.linear_failure_kind));
   for (int n : {s.iterations, s.linear_iterations, s.refactorizations, s.monotonicity_accepts,
                 s.backtracks})
@@ -37,7 +39,8 @@ void SaveStats(StateWriter& out, const NewtonStats& s) {
 NewtonStats RestoreStats(StateReader& in) {
   NewtonStats s;
   in.BeginSection("NewtonStats", 1);
-  for (bool* b : {&s.converged, &s.inadmissible, &s.linear_failure, &s.interrupted})
+  for (bool* b : {&s.converged, &s.inadmissible, &s.linear_failure, &s.interrupted,
+                  &s.switched_to_indefinite})
     *b = in.ReadBool();
   const std::int64_t kind = in.ReadInt();
   if (kind < 0 || kind > static_cast<std::int64_t>(LinearFailure::kNotConverged))
