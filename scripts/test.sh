@@ -68,9 +68,9 @@ if [ "${1:-}" = "--full" ]; then
   # The heart's resume (three runs of the coupled heart, 10-30 s in release; minutes under ASan):
   # its kept-factorisation restore (numerics/newton_state.cc) is checked in the release stage.
   asan_skip+='|Resume\.HeartIsBitwiseIdentical'
-  # The viewer's 10-simulated-second pulls on the liver and the heart (32-90 s each in release
+  # The viewer's 10-simulated-second pulls on the liver and both hearts (32-90 s each in release
   # under Xvfb): the pull's code runs under the sanitizers in the short pull tests beside them.
-  asan_skip+='|Viewer\.APullKeepsThe(HangingLiverRunning|HeartBeating)For10SimulatedSeconds'
+  asan_skip+='|Viewer\.APullKeepsThe(HangingLiverRunning|HeartBeating|MassSpringHeartBeating)For10SimulatedSeconds'
   # A full disk simulated by the file-size limit: when its write fails, PLplot (5.15, Debian)
   # frees a pointer it never set (ASan's 0xbe fill pattern, SIGBUS in plend); the release stage
   # runs this test, where that pointer happens to be null. Not GiPSi's memory; to be worked
@@ -89,7 +89,7 @@ if [ "${1:-}" = "--full" ]; then
   echo "== tsan (thread sanitizer: haptic loop, display publishing, viewer simulation thread)"
   cmake --preset tsan
   cmake --build --preset tsan
-  ctest --preset tsan -E '^Viewer\.APullKeepsThe(HangingLiverRunning|HeartBeating)For10SimulatedSeconds$'
+  ctest --preset tsan -E '^Viewer\.APullKeepsThe(HangingLiverRunning|HeartBeating|MassSpringHeartBeating)For10SimulatedSeconds$'
   stage_done tsan
 
   echo "== fuzz (libFuzzer, clang, ASan + UBSan; 15 s per target)"
