@@ -11,7 +11,6 @@
 
 #include <fmt/format.h>
 
-#include "gipsi/base/error.h"
 #include "gipsi/base/state.h"
 #include "gipsi/models/circulation/circuit.h"
 #include "gipsi/models/circulation/circulation.h"
@@ -46,7 +45,7 @@ void ValveEventLog::SaveState(StateWriter& out) const {
 void ValveEventLog::RestoreState(StateReader& in) {
   in.BeginSection("ValveEventLog", 2);
   const std::int64_t total = in.ReadInt();
-  if (total < 0) throw InputError(fmt::format("the valve event log: a negative count {}", total));
+  if (total < 0) in.Fail(fmt::format("the valve event log: a negative count {}", total));
   std::vector<double> times(static_cast<std::size_t>(
       std::min<std::int64_t>(total, static_cast<std::int64_t>(ring_.size()))));
   std::vector<std::int32_t> valves(times.size());
@@ -57,7 +56,7 @@ void ValveEventLog::RestoreState(StateReader& in) {
   in.EndSection();
   for (std::size_t k = 0; k < times.size(); ++k) {
     if (states[k] > static_cast<std::uint8_t>(ValveState::kOpen))
-      throw InputError(
+      in.Fail(
           fmt::format("the valve event log: event {} has no valve state {}", k, int(states[k])));
     ring_[k] = {times[k], valves[k], static_cast<ValveState>(states[k])};
   }

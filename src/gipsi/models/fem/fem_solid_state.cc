@@ -12,7 +12,6 @@
 
 #include <fmt/format.h>
 
-#include "gipsi/base/error.h"
 #include "gipsi/base/state.h"
 #include "gipsi/models/fem/fem_solid.h"
 
@@ -44,7 +43,7 @@ NewtonStats RestoreStats(StateReader& in) {
     *b = in.ReadBool();
   const std::int64_t kind = in.ReadInt();
   if (kind < 0 || kind > static_cast<std::int64_t>(LinearFailure::kNotConverged))
-    throw InputError(fmt::format("the Newton statistics: no linear failure kind {}", kind));
+    in.Fail(fmt::format("the Newton statistics: no linear failure kind {}", kind));
   s.linear_failure_kind = static_cast<LinearFailure>(kind);
   for (int* n : {&s.iterations, &s.linear_iterations, &s.refactorizations, &s.monotonicity_accepts,
                  &s.backtracks})
