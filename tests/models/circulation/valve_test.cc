@@ -43,6 +43,17 @@ TEST(ValveEventLog, KeepsTheMostRecentEventsAndCountsAll) {
   EXPECT_TRUE(log.EventsSince(5).empty());
 }
 
+/// The kept events of `a` and `b` are the same, in the same order.
+void ExpectSameEvents(const ValveEventLog& a, const ValveEventLog& b) {
+  const auto x = a.Events(), y = b.Events();
+  ASSERT_EQ(x.size(), y.size());
+  for (std::size_t k = 0; k < x.size(); ++k) {
+    EXPECT_EQ(y[k].time, x[k].time) << k;
+    EXPECT_EQ(y[k].valve, x[k].valve) << k;
+    EXPECT_EQ(y[k].state, x[k].state) << k;
+  }
+}
+
 /// `log` saved and restored into a fresh log of the same capacity.
 ValveEventLog RoundTrip(const ValveEventLog& log, std::size_t capacity, std::size_t* bytes) {
   StateWriter out;
@@ -65,13 +76,8 @@ TEST(ValveEventLog, SavesOnlyTheEventsItHoldsAndRestoresThemInOrder) {
   ValveEventLog restored = RoundTrip(partial, 100000, &bytes);
   EXPECT_LT(bytes, 300u);
   EXPECT_EQ(restored.total(), 4);
-  const auto a = partial.Events(), b = restored.Events();
-  ASSERT_EQ(b.size(), 4u);
-  for (std::size_t k = 0; k < a.size(); ++k) {
-    EXPECT_EQ(b[k].time, a[k].time);
-    EXPECT_EQ(b[k].valve, a[k].valve);
-    EXPECT_EQ(b[k].state, a[k].state);
-  }
+  ASSERT_EQ(restored.Events().size(), 4u);
+  ExpectSameEvents(partial, restored);
   // Wrapped: 7 events in room for 3, so the ring's slots are out of time order; the restored
   // log returns the last 3 oldest first and goes on wrapping where the original would.
   ValveEventLog wrapped(3);
@@ -80,14 +86,9 @@ TEST(ValveEventLog, SavesOnlyTheEventsItHoldsAndRestoresThemInOrder) {
   wrapped.Record({0.7, 7, ValveState::kClosed});
   restored.Record({0.7, 7, ValveState::kClosed});
   EXPECT_EQ(restored.total(), 8);
-  const auto c = wrapped.Events(), d = restored.Events();
-  ASSERT_EQ(d.size(), 3u);
-  for (std::size_t k = 0; k < c.size(); ++k) {
-    EXPECT_EQ(d[k].time, c[k].time);
-    EXPECT_EQ(d[k].valve, c[k].valve);
-    EXPECT_EQ(d[k].state, c[k].state);
-  }
-  EXPECT_EQ(d[0].valve, 5);
+  ASSERT_EQ(restored.Events().size(), 3u);
+  ExpectSameEvents(wrapped, restored);
+  EXPECT_EQ(restored.Events()[0].valve, 5);
 }
 
 TEST(ValveEventLog, AStateOfMoreEventsThanItsRoomIsAClearError) {
