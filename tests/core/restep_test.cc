@@ -113,6 +113,11 @@ TEST(Restep, FemSolidQuasiStaticNewtonIsBitwise) {
   ExpectRestepIsBitwise("land_beam.json", 0, 1);
 }
 
+TEST(Restep, MixedSolidIncompressibleIsBitwise) {
+  // The same beam fully incompressible on P2–P1 tets (UMFPACK, exact follower tangent).
+  ExpectRestepIsBitwise("land_beam_p2.json", 0, 1);
+}
+
 TEST(Restep, FemSolidUnderARigidToolIsBitwise) {
   // FemSolid, a RigidTool on its scripted path and the contact between them.
   ExpectRestepIsBitwise("probe_indentation.json", 0.5, 0.6);

@@ -13,6 +13,7 @@
 #include "gipsi/models/ep/grid_monodomain.h"
 #include "gipsi/models/ep/monodomain.h"
 #include "gipsi/models/fem/fem_solid.h"
+#include "gipsi/models/fem/mixed_solid.h"
 #include "gipsi/models/heart/heart.h"
 #include "gipsi/models/mass_spring/mass_spring.h"
 
@@ -24,6 +25,7 @@ void RegisterBuiltins(TypeRegistry& registry) {
   RegisterMassSpring(registry);
   RegisterSolidLaws(registry);
   RegisterFemSolid(registry);
+  RegisterMixedSolid(registry);
   RegisterCellModels(registry);
   RegisterMonodomain(registry);
   RegisterGridMonodomain(registry);

@@ -1,6 +1,6 @@
-// Direct solvers (Eigen SimplicialLDLT, CHOLMOD supernodal LLᵀ): SPD checks, indefinite matrices
-// once accepted, recovery after a failed factorisation, reuse of the symbolic analysis, and their
-// stats.
+// Direct solvers (Eigen SimplicialLDLT, CHOLMOD supernodal LLᵀ, UMFPACK LU): SPD checks, indefinite
+// matrices once accepted, recovery after a failed factorisation, reuse of the symbolic analysis,
+// and their stats.
 
 #include <string>
 
@@ -126,6 +126,111 @@ TEST(SerialOpenMp, RegionsInsideRunOnOneThreadAndTheSettingIsRestored) {
   EXPECT_EQ(inside, 1);
   EXPECT_EQ(omp_get_max_active_levels(), levels);
   EXPECT_EQ(after, levels > 0 ? 2 : 1);
+}
+
+}  // namespace
+}  // namespace gipsi
+
+namespace gipsi {
+namespace {
+
+/// The symmetric saddle-point matrix [[A, Bᵀ], [B, 0]] of a discrete Stokes-like problem: A the
+/// shifted 3D Laplacian on n³ nodes, B one constraint row per group of `stride` consecutive
+/// nodes (their sum), so B has full row rank and the matrix is nonsingular but indefinite,
+/// with a zero diagonal block.
+SparseMatrix SaddlePoint(int n, int stride) {
+  const SparseMatrix a = MakeLaplacian3D(n, 0.1);
+  const Index nu = a.rows();
+  const Index np = nu / stride;
+  std::vector<Eigen::Triplet<double, int>> t;
+  for (int k = 0; k < a.outerSize(); ++k)
+    for (SparseMatrix::InnerIterator it(a, k); it; ++it)
+      t.emplace_back(static_cast<int>(it.row()), static_cast<int>(it.col()), it.value());
+  for (Index c = 0; c < np; ++c) {
+    for (Index j = 0; j < stride; ++j) {
+      const int row = static_cast<int>(nu + c), col = static_cast<int>(c * stride + j);
+      t.emplace_back(row, col, 1.0);
+      t.emplace_back(col, row, 1.0);
+    }
+  }
+  SparseMatrix m(nu + np, nu + np);
+  m.setFromTriplets(t.begin(), t.end());
+  m.makeCompressed();
+  return m;
+}
+
+// The fully incompressible mixed elements give exactly such matrices: UMFPACK's pivoting
+// factorises them (with or without AcceptIndefinite, which it always grants) and solves to
+// round-off (condition number of order 1e3 here, so 1e-10 is a loose bound on a round-off
+// residual near 1e-15).
+TEST(Umfpack, SolvesASymmetricSaddlePointWithAZeroBlock) {
+  const SparseMatrix m = SaddlePoint(8, 4);
+  LinearSolverOptions options;
+  options.type = "umfpack";
+  auto solver = MakeLinearSolver(options);
+  EXPECT_EQ(solver->name(), "umfpack");
+  EXPECT_TRUE(solver->AcceptIndefinite());
+  solver->AnalyzePattern(m);
+  ASSERT_TRUE(solver->Factorize(m));
+  const auto problem = Manufacture(m, 3);
+  VecX x;
+  const LinearSolveStats stats = solver->Solve(problem.b, x);
+  EXPECT_TRUE(stats.converged);
+  EXPECT_LE(IndependentRelativeResidual(m, problem.b, x), 1e-10);
+  EXPECT_LE((x - problem.x_true).norm(), 1e-8 * problem.x_true.norm());
+}
+
+// A nonsymmetric matrix of symmetric pattern (the exact tangent of a follower load): the
+// Laplacian plus a skew part as large as its off-diagonal. Its residual check must use A x,
+// not the symmetric product (which computes Aᵀ x): a solution to round-off, 1e-10 as above.
+TEST(Umfpack, SolvesANonsymmetricMatrixOfSymmetricPattern) {
+  SparseMatrix m = MakeLaplacian3D(8, 0.1);
+  for (int k = 0; k < m.outerSize(); ++k)
+    for (SparseMatrix::InnerIterator it(m, k); it; ++it)
+      if (it.row() > it.col())
+        it.valueRef() += 0.5;
+      else if (it.row() < it.col())
+        it.valueRef() -= 0.5;
+  LinearSolverOptions options;
+  options.type = "umfpack";
+  auto solver = MakeLinearSolver(options);
+  solver->AnalyzePattern(m);
+  ASSERT_TRUE(solver->Factorize(m));
+  const VecX x_true = testing::RandomVector(m.rows(), 9);
+  const VecX b = m * x_true;
+  VecX x;
+  const LinearSolveStats stats = solver->Solve(b, x);
+  EXPECT_TRUE(stats.converged);
+  EXPECT_LE((b - m * x).norm(), 1e-10 * b.norm());
+  EXPECT_LE((x - x_true).norm(), 1e-8 * x_true.norm());
+}
+
+// A constraint row repeated makes the saddle point singular: Factorize says so.
+TEST(Umfpack, ASingularMatrixFailsFactorize) {
+  SparseMatrix m = SaddlePoint(4, 4);
+  const Index nu = 64;
+  // Make constraint 1 a copy of constraint 0 (same columns 0..3): rows nu and nu + 1 equal.
+  std::vector<Eigen::Triplet<double, int>> t;
+  for (int k = 0; k < m.outerSize(); ++k)
+    for (SparseMatrix::InnerIterator it(m, k); it; ++it) {
+      const bool touches_second = it.row() == nu + 1 || it.col() == nu + 1;
+      if (!touches_second)
+        t.emplace_back(static_cast<int>(it.row()), static_cast<int>(it.col()), it.value());
+    }
+  for (int j = 0; j < 4; ++j) {
+    t.emplace_back(static_cast<int>(nu + 1), j, 1.0);
+    t.emplace_back(j, static_cast<int>(nu + 1), 1.0);
+  }
+  SparseMatrix singular(m.rows(), m.cols());
+  singular.setFromTriplets(t.begin(), t.end());
+  singular.makeCompressed();
+  LinearSolverOptions options;
+  options.type = "umfpack";
+  auto solver = MakeLinearSolver(options);
+  solver->AnalyzePattern(singular);
+  EXPECT_FALSE(solver->Factorize(singular));
+  VecX x;
+  EXPECT_FALSE(solver->Solve(VecX::Ones(m.rows()), x).converged);
 }
 
 }  // namespace

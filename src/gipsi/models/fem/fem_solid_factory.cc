@@ -7,12 +7,23 @@
 #include "gipsi/geometry/region_json.h"
 #include "gipsi/models/fem/fem_local_model.h"
 #include "gipsi/models/fem/fem_solid.h"
+#include "gipsi/models/fem/solid_options.h"
 #include "gipsi/models/fibres/rule_based_fibres.h"
 
 namespace gipsi {
 namespace {
 
-NewtonOptions ParseNewton(const JsonNode& node, NewtonOptions options) {
+ImplicitSchemeKind ParseScheme(const JsonNode& node) {
+  const std::string name = node.AsChoice({"Static", "BackwardEuler", "BDF2", "Newmark"});
+  if (name == "Static") return ImplicitSchemeKind::kStatic;
+  if (name == "BDF2") return ImplicitSchemeKind::kBdf2;
+  if (name == "Newmark") return ImplicitSchemeKind::kNewmark;
+  return ImplicitSchemeKind::kBackwardEuler;
+}
+
+}  // namespace
+
+NewtonOptions ParseNewtonOptions(const JsonNode& node, NewtonOptions options) {
   node.CheckKeys({"max_iterations", "tolerance", "absolute_tolerance", "increment_tolerance",
                   "relative_increment_tolerance", "line_search", "monotonicity_test",
                   "fixed_iterations", "reuse_factorization"});
@@ -33,16 +44,6 @@ NewtonOptions ParseNewton(const JsonNode& node, NewtonOptions options) {
   options.reuse_factorization = node.Bool("reuse_factorization", options.reuse_factorization);
   return options;
 }
-
-ImplicitSchemeKind ParseScheme(const JsonNode& node) {
-  const std::string name = node.AsChoice({"Static", "BackwardEuler", "BDF2", "Newmark"});
-  if (name == "Static") return ImplicitSchemeKind::kStatic;
-  if (name == "BDF2") return ImplicitSchemeKind::kBdf2;
-  if (name == "Newmark") return ImplicitSchemeKind::kNewmark;
-  return ImplicitSchemeKind::kBackwardEuler;
-}
-
-}  // namespace
 
 void RegisterFemSolid(TypeRegistry& registry) {
   registry.local_models.Register(
@@ -80,7 +81,8 @@ void RegisterFemSolid(TypeRegistry& registry) {
                 "beta >= gamma/4 (average acceleration: beta 0.25, gamma 0.5)",
                 params.newmark_beta, params.newmark_gamma));
         }
-        if (auto newton = p.Find("newton")) params.newton = ParseNewton(*newton, params.newton);
+        if (auto newton = p.Find("newton"))
+          params.newton = ParseNewtonOptions(*newton, params.newton);
         if (auto solver = p.Find("linear_solver"))
           params.linear_solver = ParseLinearSolverOptions(*solver);
         if (auto steps = p.Find("load_steps")) {

@@ -154,6 +154,7 @@ class NeoHookeanSolid final : public IsotropicSolid {
  public:
   NeoHookeanSolid(double youngs_modulus, double poisson_ratio);
   [[nodiscard]] std::string_view law() const override { return "NeoHookean"; }
+  [[nodiscard]] double log_volumetric_modulus() const override { return lame_.lambda; }
   [[nodiscard]] double Energy(const Mat3& F, const MaterialPoint& mp) const override;
   [[nodiscard]] bool Stress(const Mat3& F, const MaterialPoint& mp, Mat3& P) const override;
   [[nodiscard]] bool StressAndTangent(const Mat3& F, const MaterialPoint& mp, Mat3& P,
@@ -206,6 +207,7 @@ class GuccioneSolid final : public SolidMaterial {
   [[nodiscard]] std::string_view law() const override { return "Guccione"; }
   [[nodiscard]] const GuccioneParams& params() const { return params_; }
   [[nodiscard]] bool needs_fibres() const override { return true; }
+  [[nodiscard]] double log_volumetric_modulus() const override { return params_.bulk_modulus; }
   [[nodiscard]] double small_strain_youngs_modulus() const override { return small_e_; }
   [[nodiscard]] double small_strain_poisson_ratio() const override { return small_nu_; }
   [[nodiscard]] double Energy(const Mat3& F, const MaterialPoint& mp) const override;

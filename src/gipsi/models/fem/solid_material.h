@@ -56,6 +56,10 @@ class SolidMaterial : public Material {
                                                        const TetGradients& g, double volume,
                                                        Mat3& P, Mat12& K) const;
 
+  /// κ [Pa] if the law's energy is W(F) = W̃(F) + κ/2 (ln J)² with that volumetric term split
+  /// off (NeoHookean: κ = λ; Guccione: its bulk modulus), else 0. The mixed displacement–
+  /// pressure elements (mixed_solid.h) replace the term by an independent pressure field.
+  [[nodiscard]] virtual double log_volumetric_modulus() const { return 0; }
   /// True if the law reads MaterialPoint::axes (a fibre field is required).
   [[nodiscard]] virtual bool needs_fibres() const { return false; }
   /// Small-strain Young's modulus [Pa] and Poisson ratio of the law at rest, for time-step

@@ -1,5 +1,5 @@
-// Direct sparse solvers: Eigen's simplicial LDLᵀ and CHOLMOD's supernodal LLᵀ (with an LDLᵀ
-// fallback for accepted indefinite matrices), behind one
+// Direct sparse solvers: Eigen's simplicial LDLᵀ, CHOLMOD's supernodal LLᵀ (with an LDLᵀ
+// fallback for accepted indefinite matrices) and UMFPACK's LU with pivoting, behind one
 // base class that owns the shared bookkeeping and the honest residual check.
 
 #include <cmath>
@@ -9,6 +9,7 @@
 #include <Eigen/CholmodSupport>
 #include <Eigen/OrderingMethods>
 #include <Eigen/SparseCholesky>
+#include <Eigen/UmfPackSupport>
 
 #include "gipsi/base/error.h"
 #include "gipsi/numerics/sparse/blas_threads.h"
@@ -64,7 +65,7 @@ class DirectSolver : public LinearSolver {
       return stats;
     }
     if (!std::isfinite(b_norm) || !SolveInto(b, x)) return stats;
-    SymmetricSpMV(*matrix_, x, residual_);
+    Multiply(*matrix_, x, residual_);
     const double* __restrict pb = b.data();
     double* __restrict pr = residual_.data();
     const double rr = DeterministicParallelSum(rows_, scratch_, [=](Index begin, Index end) {
@@ -88,6 +89,10 @@ class DirectSolver : public LinearSolver {
   virtual bool FactorizeNumeric(const SparseMatrix& A) = 0;
   /// x = A⁻¹ b with the current factorisation; false on failure.
   virtual bool SolveInto(const VecX& b, VecX& x) = 0;
+  /// y = A x for the residual check; the default is for symmetric A (stored in full).
+  virtual void Multiply(const SparseMatrix& A, const VecX& x, VecX& y) const {
+    SymmetricSpMV(A, x, y);
+  }
 
  private:
   LinearSolverOptions options_;
@@ -194,7 +199,51 @@ class CholmodSolver final : public DirectSolver {
   bool use_ldlt_ = false;  // the last factorisation fell back to LDLᵀ
 };
 
+/// UMFPACK LU with threshold partial pivoting (UMFPACK's default strategy, which picks its
+/// symmetric mode for a symmetric pattern). The matrices of this interface are symmetric and
+/// stored in full, so UMFPACK sees the whole matrix; unlike the LDLᵀ without pivoting it
+/// factorises symmetric saddle-point matrices with a zero block (fully incompressible mixed
+/// elements), whatever the ordering. Indefinite matrices are always accepted; a singular one
+/// fails. Unlike the others it also solves nonsymmetric matrices (of a symmetric pattern, as
+/// every matrix here: e.g. the exact tangent of a follower load).
+class UmfpackSolver final : public DirectSolver {
+ public:
+  explicit UmfpackSolver(const LinearSolverOptions& options) : DirectSolver(options) {
+    UseSingleThreadedBlasOnce();
+  }
+  [[nodiscard]] std::string name() const override { return "umfpack"; }
+  bool AcceptIndefinite() override { return true; }
+
+ protected:
+  void Analyze(const SparseMatrix& A) override {
+    const SerialOpenMp serial;
+    lu_.analyzePattern(A);
+  }
+  bool FactorizeNumeric(const SparseMatrix& A) override {
+    const SerialOpenMp serial;
+    lu_.factorize(A);
+    // Eigen reports any status but UMFPACK_OK, including UMFPACK_WARNING_singular_matrix (an
+    // exactly zero pivot), as a failure; Solve's residual check catches a nearly singular one.
+    return lu_.info() == Eigen::Success;
+  }
+  bool SolveInto(const VecX& b, VecX& x) override {
+    const SerialOpenMp serial;
+    x = lu_.solve(b);
+    return lu_.info() == Eigen::Success;
+  }
+  void Multiply(const SparseMatrix& A, const VecX& x, VecX& y) const override {
+    y.noalias() = A * x;
+  }
+
+ private:
+  Eigen::UmfPackLU<SparseMatrix> lu_;
+};
+
 }  // namespace
+
+std::unique_ptr<LinearSolver> MakeUmfpackSolver(const LinearSolverOptions& options) {
+  return std::make_unique<UmfpackSolver>(options);
+}
 
 std::unique_ptr<LinearSolver> MakeLdltSolver(const LinearSolverOptions& options) {
   return std::make_unique<LdltSolver>(options);

@@ -18,12 +18,12 @@
 namespace gipsi {
 namespace {
 
-constexpr std::array<std::string_view, 3> kTypes = {"cg", "ldlt", "cholmod"};
+constexpr std::array<std::string_view, 4> kTypes = {"cg", "ldlt", "cholmod", "umfpack"};
 constexpr std::array<std::string_view, 5> kPreconditioners = {"none", "jacobi", "ic", "cholesky",
                                                               "amg"};
 
 /// Empty if `value` is one of `choices`, else e.g. "unknown linear solver type 'gmres';
-/// choices: 'cg', 'ldlt', 'cholmod'" (with a "did you mean" for a near miss).
+/// choices: 'cg', 'ldlt', 'cholmod', 'umfpack'" (with a "did you mean" for a near miss).
 template <std::size_t N>
 std::optional<std::string> CheckChoice(std::string_view what, std::string_view value,
                                        const std::array<std::string_view, N>& choices) {
@@ -118,6 +118,7 @@ std::unique_ptr<LinearSolver> MakeLinearSolver(const LinearSolverOptions& option
                                  options.refactor_iterations));
   if (options.type == "ldlt") return MakeLdltSolver(options);
   if (options.type == "cholmod") return MakeCholmodSolver(options);
+  if (options.type == "umfpack") return MakeUmfpackSolver(options);
   return MakePcgSolver(options);
 }
 

@@ -56,8 +56,8 @@ void SymmetricSpMVRows(const SparseMatrix& A, const double* x, double* y, int be
 
 /// Which solver and how hard it works. Plain struct.
 struct LinearSolverOptions {
-  /// "cg" (preconditioned conjugate gradients), "ldlt" (Eigen SimplicialLDLT) or "cholmod"
-  /// (SuiteSparse CHOLMOD supernodal LLᵀ).
+  /// "cg" (preconditioned CG), "ldlt" (Eigen SimplicialLDLT), "cholmod" (SuiteSparse CHOLMOD
+  /// supernodal LLᵀ) or "umfpack" (UMFPACK LU with pivoting: saddle points, any nonsingular).
   std::string type = "cg";
   /// For "cg": "none", "jacobi", "ic" (incomplete Cholesky), "cholesky" (a CHOLMOD
   /// factorisation of an earlier matrix, refreshed when CG needs more than

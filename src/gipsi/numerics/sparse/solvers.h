@@ -17,6 +17,10 @@ std::unique_ptr<LinearSolver> MakeLdltSolver(const LinearSolverOptions& options)
 /// CHOLMOD supernodal LLᵀ (direct_solvers.cc); `options.tolerance` judges `converged`.
 std::unique_ptr<LinearSolver> MakeCholmodSolver(const LinearSolverOptions& options);
 
+/// UMFPACK sparse LU with partial pivoting (direct_solvers.cc): any nonsingular matrix, e.g.
+/// the saddle-point systems of mixed (displacement–pressure) elements; nonsymmetric ones too.
+std::unique_ptr<LinearSolver> MakeUmfpackSolver(const LinearSolverOptions& options);
+
 /// True if every stored value of A is finite.
 bool AllValuesFinite(const SparseMatrix& A);
 

@@ -1,0 +1,631 @@
+#include "gipsi/models/fem/mixed_solid.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <utility>
+
+#include <fmt/format.h>
+#include <Eigen/LU>
+
+#include "gipsi/base/error.h"
+#include "gipsi/base/state.h"
+#include "gipsi/models/fem/solid_laws.h"
+
+namespace gipsi {
+namespace {
+
+constexpr int kLocal = 34;  // 30 displacement and 4 pressure unknowns per element
+constexpr int kQuad = 4;    // quadrature points per element
+constexpr double kEps = std::numeric_limits<double>::epsilon();
+
+Mat3 Frame(const Vec3& fibre, const Vec3& sheet) {
+  Mat3 axes;
+  const Vec3 f = fibre.normalized();
+  Vec3 s = sheet - sheet.dot(f) * f;
+  if (s.norm() < 1e-8) s = f.unitOrthogonal();
+  s.normalize();
+  axes.col(0) = f;
+  axes.col(1) = s;
+  axes.col(2) = f.cross(s);
+  return axes;
+}
+
+Mat3 Cross(const Vec3& v) {
+  Mat3 m;
+  m << 0, -v.z(), v.y(), v.z(), 0, -v.x(), -v.y(), v.x(), 0;
+  return m;
+}
+
+/// Sorted, unique.
+void SortUnique(std::vector<int>& v) {
+  std::sort(v.begin(), v.end());
+  v.erase(std::unique(v.begin(), v.end()), v.end());
+}
+
+}  // namespace
+
+MixedSolid::MixedSolid(std::string name, std::shared_ptr<const Mesh> domain,
+                       MixedSolidParams params)
+    : SimObject(std::move(name)), params_(std::move(params)) {
+  if (!params_.material)
+    throw InputError(fmt::format("object '{}': MixedSolid needs a material", this->name()));
+  law_ = params_.material.get();
+  kappa_ = law_->log_volumetric_modulus();
+  if (!(kappa_ > 0))
+    throw InputError(fmt::format(
+        "object '{}': law '{}' has no volumetric term κ/2 (ln J)² for the mixed pressure to "
+        "replace; MixedSolid takes \"NeoHookean\" or \"Guccione\"",
+        this->name(), law_->law()));
+  if (params_.fibre.norm() == 0)
+    throw InputError(fmt::format("object '{}': the fibre direction is zero", this->name()));
+  axes_ = Frame(params_.fibre, params_.sheet);
+  mesh_ = ElevateToQuadratic(*domain);
+  SetGeometry(domain, MakeBoundary(*domain));
+
+  // Element geometry: volumes and P2 gradients at the quadrature points.
+  const Index ne = mesh_.num_elements();
+  const TetQuadrature& rule = TetRuleDegree2();
+  volume_.resize(ne);
+  grad_.resize(static_cast<std::size_t>(ne) * kQuad * 30);
+  for (Index e = 0; e < ne; ++e) {
+    Mat3 dm;
+    for (int k = 0; k < 3; ++k)
+      dm.col(k) = mesh_.rest.col(mesh_.elements(k + 1, e)) - mesh_.rest.col(mesh_.elements(0, e));
+    const double det = dm.determinant();
+    if (!(det > 0))
+      throw InputError(
+          fmt::format("object '{}': element {} is degenerate or inverted (rest "
+                      "volume {:.3g} m³)",
+                      this->name(), e, det / 6));
+    volume_[e] = det / 6;
+    const Mat3 inv = dm.inverse();
+    Eigen::Matrix<double, 3, 4> gl;
+    gl.rightCols<3>() = inv.transpose();
+    gl.col(0) = -gl.rightCols<3>().rowwise().sum();
+    for (int q = 0; q < kQuad; ++q) {
+      const Eigen::Matrix<double, 3, 10> g =
+          gl * QuadraticTetShapeDerivatives(rule.points[static_cast<std::size_t>(q)]).transpose();
+      Eigen::Map<Eigen::Matrix<double, 3, 10>>(grad_.data() +
+                                               (static_cast<std::size_t>(e) * kQuad + q) * 30) = g;
+    }
+  }
+  double edge_sum = 0;
+  for (Index k = 0; k < mesh_.edges.cols(); ++k)
+    edge_sum += (mesh_.rest.col(mesh_.edges(0, k)) - mesh_.rest.col(mesh_.edges(1, k))).norm();
+  const double h = edge_sum / static_cast<double>(std::max<Index>(mesh_.edges.cols(), 1));
+  pressure_scale_ = law_->small_strain_youngs_modulus() / h;
+  diag_scale_ = law_->small_strain_youngs_modulus() * h;
+
+  // Boundary faces as 6-node triangles, each with its tet's local numbering of its nodes.
+  const BoundarySurface& bnd = boundary();
+  faces_.resize(6, bnd.num_triangles());
+  for (Index f = 0; f < bnd.num_triangles(); ++f) {
+    int v[3];
+    for (int i = 0; i < 3; ++i)
+      v[i] = bnd.vertex_to_node[static_cast<std::size_t>(bnd.triangles(i, f))];
+    for (int i = 0; i < 3; ++i) faces_(i, f) = v[i];
+    for (int k = 0; k < 3; ++k)
+      faces_(3 + k, f) = mesh_.EdgeNode(v[kTriangleEdges[k][0]], v[kTriangleEdges[k][1]]);
+  }
+
+  // Sparsity: unknowns 3·node + i (displacements), then 3·nodes + vertex (pressures).
+  const Index nn = mesh_.num_nodes();
+  const Index nv = mesh_.num_vertices;
+  const Index nu = 3 * nn;
+  std::vector<std::vector<int>> node_nbrs(static_cast<std::size_t>(nn));
+  std::vector<std::vector<int>> vertex_nbrs(static_cast<std::size_t>(nn));
+  for (Index e = 0; e < ne; ++e)
+    for (int a = 0; a < 10; ++a) {
+      auto& nodes = node_nbrs[static_cast<std::size_t>(mesh_.elements(a, e))];
+      auto& verts = vertex_nbrs[static_cast<std::size_t>(mesh_.elements(a, e))];
+      for (int b = 0; b < 10; ++b) nodes.push_back(mesh_.elements(b, e));
+      for (int b = 0; b < 4; ++b) verts.push_back(mesh_.elements(b, e));
+    }
+  for (auto& v : node_nbrs) SortUnique(v);
+  for (auto& v : vertex_nbrs) SortUnique(v);
+  const Index n = nu + nv;
+  std::vector<int> col_start(static_cast<std::size_t>(n) + 1, 0), rows;
+  for (Index c = 0; c < n; ++c) {
+    const auto node = static_cast<std::size_t>(c < nu ? c / 3 : c - nu);
+    for (int b : node_nbrs[node])
+      for (int i = 0; i < 3; ++i) rows.push_back(3 * b + i);
+    for (int b : vertex_nbrs[node]) rows.push_back(static_cast<int>(nu) + b);
+    col_start[static_cast<std::size_t>(c) + 1] = static_cast<int>(rows.size());
+  }
+  jac_.resize(n, n);
+  jac_.resizeNonZeros(static_cast<Index>(rows.size()));
+  std::copy(col_start.begin(), col_start.end(), jac_.outerIndexPtr());
+  std::copy(rows.begin(), rows.end(), jac_.innerIndexPtr());
+  std::fill(jac_.valuePtr(), jac_.valuePtr() + rows.size(), 0.0);
+  auto position = [&](int row, int col) {
+    const int* begin = rows.data() + col_start[static_cast<std::size_t>(col)];
+    const int* end = rows.data() + col_start[static_cast<std::size_t>(col) + 1];
+    const int* it = std::lower_bound(begin, end, row);
+    GIPSI_CHECK(it != end && *it == row, "MixedSolid pattern lacks ({}, {})", row, col);
+    return static_cast<int>(it - rows.data());
+  };
+  element_value_index_.resize(static_cast<std::size_t>(ne) * kLocal * kLocal);
+  for (Index e = 0; e < ne; ++e) {
+    int dof[kLocal];
+    for (int a = 0; a < 10; ++a)
+      for (int i = 0; i < 3; ++i) dof[3 * a + i] = 3 * mesh_.elements(a, e) + i;
+    for (int b = 0; b < 4; ++b) dof[30 + b] = static_cast<int>(nu) + mesh_.elements(b, e);
+    int* out = element_value_index_.data() + static_cast<std::size_t>(e) * kLocal * kLocal;
+    for (int c = 0; c < kLocal; ++c)
+      for (int r = 0; r < kLocal; ++r) out[c * kLocal + r] = position(dof[r], dof[c]);
+  }
+  diag_index_.resize(static_cast<std::size_t>(n));
+  for (Index c = 0; c < n; ++c)
+    diag_index_[static_cast<std::size_t>(c)] = position(static_cast<int>(c), static_cast<int>(c));
+
+  constrained_.assign(static_cast<std::size_t>(nu), 0);
+  target_prev_ = VecX::Zero(nu);
+  target_new_ = VecX::Zero(nu);
+  force_prev_ = VecX::Zero(3 * nv);
+  force_new_ = VecX::Zero(3 * nv);
+  pressure_prev_ = VecX::Zero(bnd.num_triangles());
+  pressure_new_ = VecX::Zero(bnd.num_triangles());
+  traction_prev_ = Points::Zero(3, bnd.num_triangles());
+  traction_new_ = Points::Zero(3, bnd.num_triangles());
+  external_force_ = Points::Zero(3, nv);
+  z_ = VecX::Zero(n);
+  z_begin_ = z_;
+  vertex_positions_ = domain->nodes;
+
+  auto linear = MakeLinearSolver(params_.linear_solver);
+  linear->AcceptIndefinite();
+  exact_load_tangent_ = linear->name() == "umfpack";
+  newton_ = std::make_unique<NewtonSolver>(params_.newton, std::move(linear));
+  newton_->Prepare(jac_);
+
+  using L = FieldLocation;
+  using A = FieldAccess;
+  mech_ = DeclareMechanicalFields();
+  f_pressure_ = DeclareField({"pressure", L::kNode, 1, "Pa", A::kRead,
+                              "hydrostatic pressure of the mixed formulation (p = κ ln J)"});
+  f_jacobian_ = DeclareField({"volume_ratio", L::kElement, 1, "1", A::kRead,
+                              "volume ratio J = det F, mean over the element's quadrature points"});
+  f_volume_ = DeclareField({"volume", L::kGlobal, 1, "m^3", A::kRead, "current volume ∫ J dV"});
+  f_energy_ = DeclareField({"strain_energy", L::kGlobal, 1, "J", A::kRead,
+                            "stored elastic energy (the law's; without the volumetric term when "
+                            "incompressible)"});
+  f_newton_ = DeclareField({"newton_iterations", L::kGlobal, 1, "1", A::kRead,
+                            "Newton iterations of the last load increment"});
+}
+
+Points MixedSolid::NodeDisplacements() const {
+  return Eigen::Map<const Points>(z_.data(), 3, mesh_.num_nodes());
+}
+
+VecX MixedSolid::Pressures() const { return pressure_scale_ * z_.tail(mesh_.num_vertices); }
+
+double MixedSolid::CurrentVolume() const {
+  const TetQuadrature& rule = TetRuleDegree2();
+  double v = 0;
+  for (Index e = 0; e < mesh_.num_elements(); ++e)
+    for (int q = 0; q < kQuad; ++q) {
+      const auto g = Eigen::Map<const Eigen::Matrix<double, 3, 10>>(
+          grad_.data() + (static_cast<std::size_t>(e) * kQuad + q) * 30);
+      Mat3 F = Mat3::Identity();
+      for (int a = 0; a < 10; ++a)
+        F.noalias() += z_.segment<3>(3 * mesh_.elements(a, e)) * g.col(a).transpose();
+      v += volume_[e] * rule.weights[static_cast<std::size_t>(q)] * F.determinant();
+    }
+  return v;
+}
+
+double MixedSolid::ElementEnergy(Index e, const VecX& z) const {
+  const TetQuadrature& rule = TetRuleDegree2();
+  MaterialPoint mp;
+  mp.axes = axes_;
+  double w = 0;
+  for (int q = 0; q < kQuad; ++q) {
+    const auto g = Eigen::Map<const Eigen::Matrix<double, 3, 10>>(
+        grad_.data() + (static_cast<std::size_t>(e) * kQuad + q) * 30);
+    Mat3 F = Mat3::Identity();
+    for (int a = 0; a < 10; ++a)
+      F.noalias() += z.segment<3>(3 * mesh_.elements(a, e)) * g.col(a).transpose();
+    double energy = law_->Energy(F, mp);
+    if (params_.incompressible && std::isfinite(energy)) {
+      const double log_j = std::log(F.determinant());
+      energy -= 0.5 * kappa_ * log_j * log_j;
+    }
+    w += volume_[e] * rule.weights[static_cast<std::size_t>(q)] * energy;
+  }
+  return w;
+}
+
+bool MixedSolid::Assemble(const VecX& z, VecX& r, double* jv) const {
+  const Index nu = 3 * mesh_.num_nodes();
+  const TetQuadrature& rule = TetRuleDegree2();
+  const double s = pressure_scale_;
+  const double inv_kappa = params_.incompressible ? 0.0 : 1.0 / kappa_;
+  MaterialPoint mp;
+  mp.axes = axes_;
+  r.setZero(z.size());
+  if (jv != nullptr) std::fill(jv, jv + jac_.nonZeros(), 0.0);
+  double floor_sq = 0;
+  Mat3 P;
+  Mat9 C;
+  for (Index e = 0; e < mesh_.num_elements(); ++e) {
+    Eigen::Matrix<double, 3, 10> u;
+    for (int a = 0; a < 10; ++a) u.col(a) = z.segment<3>(3 * mesh_.elements(a, e));
+    Eigen::Vector4d pe;
+    for (int b = 0; b < 4; ++b) pe[b] = z[nu + mesh_.elements(b, e)];
+    Eigen::Matrix<double, kLocal, 1> re = Eigen::Matrix<double, kLocal, 1>::Zero();
+    Eigen::Matrix<double, kLocal, kLocal> ke;
+    if (jv != nullptr) ke.setZero();
+    double floor_e = 0;  // magnitude of the terms that cancel in this element's residual
+    for (int q = 0; q < kQuad; ++q) {
+      const auto g = Eigen::Map<const Eigen::Matrix<double, 3, 10>>(
+          grad_.data() + (static_cast<std::size_t>(e) * kQuad + q) * 30);
+      const Eigen::Vector4d& lq = rule.points[static_cast<std::size_t>(q)];
+      const double w = volume_[e] * rule.weights[static_cast<std::size_t>(q)];
+      const Mat3 F = Mat3::Identity() + u * g.transpose();
+      const double J = F.determinant();
+      if (!(J > kMinJacobian)) return false;
+      const bool ok = jv != nullptr ? law_->StressAndTangent(F, mp, P, C) : law_->Stress(F, mp, P);
+      if (!ok) return false;
+      const Mat3 H = F.inverse().transpose();
+      const double log_j = std::log(J);
+      const double p = s * lq.dot(pe);
+      // The law's volumetric stress κ ln J H is replaced by the independent pressure's p H.
+      const Mat3 Pm = P + (p - kappa_ * log_j) * H;
+      const Eigen::Matrix<double, 3, 10> f = w * Pm * g;  // nodal forces f_a = w Pm ∇N_a
+      // The law's stress and the volumetric stress it carries are formed and cancelled in
+      // double precision; ln J itself is known to a few ulps, which κ amplifies.
+      floor_e += w * g.norm() * (P.norm() + (std::abs(kappa_ * log_j) + 4 * kappa_ * kEps));
+      for (int a = 0; a < 10; ++a) re.segment<3>(3 * a) += f.col(a);
+      re.tail<4>() += (w * s * (log_j - p * inv_kappa)) * lq;
+      if (jv == nullptr) continue;
+      // dPm/dF = dP/dF − κ H_ij H_kl + (κ ln J − p) H_il H_kj (∂H_ij/∂F_kl = −H_il H_kj).
+      const double c2 = kappa_ * log_j - p;
+      for (int l = 0; l < 3; ++l)
+        for (int k = 0; k < 3; ++k)
+          for (int j = 0; j < 3; ++j)
+            for (int i = 0; i < 3; ++i)
+              C(i + 3 * j, k + 3 * l) += -kappa_ * H(i, j) * H(k, l) + c2 * H(i, l) * H(k, j);
+      for (int b = 0; b < 10; ++b) {
+        Eigen::Matrix<double, 9, 3> t;
+        for (int k = 0; k < 3; ++k)
+          t.col(k) = C.col(k) * g(0, b) + C.col(k + 3) * g(1, b) + C.col(k + 6) * g(2, b);
+        for (int a = 0; a < 10; ++a)
+          ke.block<3, 3>(3 * a, 3 * b) +=
+              w * (g(0, a) * t.block<3, 3>(0, 0) + g(1, a) * t.block<3, 3>(3, 0) +
+                   g(2, a) * t.block<3, 3>(6, 0));
+      }
+      const Eigen::Matrix<double, 3, 10> hg = H * g;  // ∂ ln J / ∂u_a = H ∇N_a
+      for (int b = 0; b < 4; ++b)
+        for (int a = 0; a < 10; ++a) {
+          const Vec3 coupling = (w * s * lq[b]) * hg.col(a);
+          ke.block<3, 1>(3 * a, 30 + b) += coupling;
+          ke.block<1, 3>(30 + b, 3 * a) += coupling.transpose();
+        }
+      ke.bottomRightCorner<4, 4>() -= (w * s * s * inv_kappa) * (lq * lq.transpose());
+    }
+    floor_sq += floor_e * floor_e;
+    for (int a = 0; a < 10; ++a) r.segment<3>(3 * mesh_.elements(a, e)) += re.segment<3>(3 * a);
+    for (int b = 0; b < 4; ++b) r[nu + mesh_.elements(b, e)] += re[30 + b];
+    if (jv == nullptr) continue;
+    const int* idx = element_value_index_.data() + static_cast<std::size_t>(e) * kLocal * kLocal;
+    for (int c = 0; c < kLocal; ++c)
+      for (int rr = 0; rr < kLocal; ++rr) jv[idx[c * kLocal + rr]] += ke(rr, c);
+  }
+  // Round-off of the assembled residual: a few ulps of the element terms that cancel in it.
+  residual_floor_ = 16 * kEps * std::sqrt(floor_sq);
+  return true;
+}
+
+void MixedSolid::AssembleLoads(const VecX& z, double s, VecX& r, double* jv) const {
+  const Index nv = mesh_.num_vertices;
+  for (Index v = 0; v < nv; ++v)
+    r.segment<3>(3 * v) -=
+        (1 - s) * force_prev_.segment<3>(3 * v) + s * force_new_.segment<3>(3 * v);
+  const TriangleQuadrature& rule = TriangleRuleDegree4();
+  const BoundarySurface& bnd = boundary();
+  for (Index f = 0; f < faces_.cols(); ++f) {
+    const double p = (1 - s) * pressure_prev_[f] + s * pressure_new_[f];
+    const Vec3 t = (1 - s) * traction_prev_.col(f) + s * traction_new_.col(f);
+    if (p == 0 && t.isZero()) continue;
+    Eigen::Matrix<double, 3, 6> x;
+    for (int a = 0; a < 6; ++a)
+      x.col(a) = mesh_.rest.col(faces_(a, f)) + z.segment<3>(3 * faces_(a, f));
+    Eigen::Matrix<double, 3, 6> load = Eigen::Matrix<double, 3, 6>::Zero();
+    Eigen::Matrix<double, 18, 18> k = Eigen::Matrix<double, 18, 18>::Zero();
+    for (std::size_t q = 0; q < rule.points.size(); ++q) {
+      const auto n_shape = QuadraticTriangleShape(rule.points[q]);
+      const auto dn = QuadraticTriangleParamDerivatives(rule.points[q]);
+      const Vec3 xi = x * dn.col(0), eta = x * dn.col(1);
+      const Vec3 normal = xi.cross(eta);  // outward, |normal| = area per reference area
+      const double area = normal.norm();
+      const double w = 0.5 * rule.weights[q];  // the reference triangle's area is 1/2
+      const Vec3 density = -p * normal + area * t;
+      for (int a = 0; a < 6; ++a) load.col(a) += (w * n_shape[a]) * density;
+      if (jv == nullptr) continue;
+      const Vec3 unit = area > 0 ? Vec3(normal / area) : Vec3::Zero();
+      for (int b = 0; b < 6; ++b) {
+        const Mat3 dnormal = -Cross(eta) * dn(b, 0) + Cross(xi) * dn(b, 1);
+        const Mat3 ddensity = -p * dnormal + t * (unit.transpose() * dnormal);
+        for (int a = 0; a < 6; ++a) k.block<3, 3>(3 * a, 3 * b) += (w * n_shape[a]) * ddensity;
+      }
+    }
+    for (int a = 0; a < 6; ++a) r.segment<3>(3 * faces_(a, f)) -= load.col(a);
+    if (jv == nullptr) continue;
+    // J −= sym(∂f_ext/∂x), through the face's tet (every face pair is a pair of that tet).
+    const Index tet = bnd.face_to_tet[static_cast<std::size_t>(f)];
+    int local[6];
+    for (int a = 0; a < 6; ++a) {
+      local[a] = -1;
+      for (int m = 0; m < 10; ++m)
+        if (mesh_.elements(m, tet) == faces_(a, f)) local[a] = m;
+    }
+    // The exact load tangent is not symmetric; the symmetric solvers get its symmetric part
+    // (Newton then converges linearly: in a slender body under follower pressure, such as the
+    // Land beam, the dropped part is of the order of the softest bending stiffness).
+    const Eigen::Matrix<double, 18, 18> sym =
+        exact_load_tangent_ ? Eigen::Matrix<double, 18, 18>(k)
+                            : Eigen::Matrix<double, 18, 18>(0.5 * (k + k.transpose()));
+    const int* idx = element_value_index_.data() + static_cast<std::size_t>(tet) * kLocal * kLocal;
+    for (int b = 0; b < 6; ++b)
+      for (int kk = 0; kk < 3; ++kk)
+        for (int a = 0; a < 6; ++a)
+          for (int i = 0; i < 3; ++i)
+            jv[idx[(3 * local[b] + kk) * kLocal + 3 * local[a] + i]] -= sym(3 * a + i, 3 * b + kk);
+  }
+}
+
+void MixedSolid::ApplyConstraints(VecX& r, double* jv) const {
+  for (int dof : constrained_dofs_) r[dof] = 0;
+  if (jv == nullptr || constrained_dofs_.empty()) return;
+  const Index nu = 3 * mesh_.num_nodes();
+  for (Index c = 0; c < jac_.outerSize(); ++c) {
+    const bool col_held = c < nu && constrained_[static_cast<std::size_t>(c)] != 0;
+    for (int k = jac_.outerIndexPtr()[c]; k < jac_.outerIndexPtr()[c + 1]; ++k) {
+      const int row = jac_.innerIndexPtr()[k];
+      if (col_held || (row < nu && constrained_[static_cast<std::size_t>(row)] != 0)) jv[k] = 0;
+    }
+  }
+  for (int dof : constrained_dofs_) jv[diag_index_[static_cast<std::size_t>(dof)]] = diag_scale_;
+}
+
+bool MixedSolid::CalcResidual(const VecX& z, VecX& r) {
+  if (!Assemble(z, r, nullptr)) return false;
+  AssembleLoads(z, s_, r, nullptr);
+  ApplyConstraints(r, nullptr);
+  return r.allFinite();
+}
+
+bool MixedSolid::CalcResidualAndJacobian(const VecX& z, VecX& r, SparseMatrix& J) {
+  if (!Assemble(z, r, J.valuePtr())) return false;
+  AssembleLoads(z, s_, r, J.valuePtr());
+  ApplyConstraints(r, J.valuePtr());
+  return r.allFinite();
+}
+
+bool MixedSolid::EvaluateUnconstrained(const VecX& z, double s, VecX& r,
+                                       SparseMatrix* jacobian) const {
+  if (jacobian != nullptr) *jacobian = jac_;
+  double* jv = jacobian != nullptr ? jacobian->valuePtr() : nullptr;
+  const bool ok = Assemble(z, r, jv);
+  if (ok) AssembleLoads(z, s, r, jv);
+  return ok;
+}
+
+void MixedSolid::GatherLoads() {
+  const BoundarySurface& bnd = boundary();
+  const BoundaryConditions& bcs = boundary_conditions();
+  const Index nv = mesh_.num_vertices;
+  for (Index v = 0; v < nv; ++v) force_new_.segment<3>(3 * v) = external_force_.col(v);
+  for (Index j = 0; j < bnd.num_vertices(); ++j)
+    force_new_.segment<3>(3 * bnd.vertex_to_node[static_cast<std::size_t>(j)]) += bcs.force(j);
+  for (Index f = 0; f < bnd.num_triangles(); ++f) {
+    pressure_new_[f] = bcs.pressure(f);
+    traction_new_.col(f) = bcs.traction(f);
+  }
+  // Constraints on the vertices; an edge node is held on the axes held at both of its ends,
+  // at their mean displacement.
+  std::fill(constrained_.begin(), constrained_.end(), 0);
+  for (Index j = 0; j < bnd.num_vertices(); ++j) {
+    const Index node = bnd.vertex_to_node[static_cast<std::size_t>(j)];
+    for (int a = 0; a < 3; ++a) {
+      if (bcs.kind(j, a) == ConstraintKind::kFree) continue;
+      if (bcs.kind(j, a) == ConstraintKind::kVelocity)
+        throw InputError(fmt::format(
+            "object '{}': MixedSolid is quasi-static; boundary vertex {} has a prescribed "
+            "velocity (prescribe a displacement instead)",
+            name(), j));
+      constrained_[static_cast<std::size_t>(3 * node + a)] = 1;
+      target_new_[3 * node + a] = bcs.value(j)[a];
+    }
+  }
+  for (Index k = 0; k < mesh_.edges.cols(); ++k) {
+    const Index node = mesh_.num_vertices + k;
+    for (int a = 0; a < 3; ++a) {
+      const auto d0 = static_cast<std::size_t>(3 * mesh_.edges(0, k) + a);
+      const auto d1 = static_cast<std::size_t>(3 * mesh_.edges(1, k) + a);
+      if (constrained_[d0] == 0 || constrained_[d1] == 0) continue;
+      constrained_[static_cast<std::size_t>(3 * node + a)] = 1;
+      target_new_[3 * node + a] =
+          0.5 * (target_new_[static_cast<Index>(d0)] + target_new_[static_cast<Index>(d1)]);
+    }
+  }
+  constrained_dofs_.clear();
+  for (std::size_t d = 0; d < constrained_.size(); ++d)
+    if (constrained_[d] != 0) constrained_dofs_.push_back(static_cast<int>(d));
+  if (!have_prev_) {
+    force_prev_.setZero();
+    pressure_prev_.setZero();
+    traction_prev_.setZero();
+  }
+}
+
+void MixedSolid::SetTargets(VecX& z, double s) const {
+  for (int dof : constrained_dofs_) z[dof] = (1 - s) * target_prev_[dof] + s * target_new_[dof];
+}
+
+StepStatus MixedSolid::Advance(double s0, double s1, int depth) {
+  const int n = depth == 0 ? params_.load_steps : 2;
+  for (int k = 1; k <= n; ++k) {
+    const double sa = s0 + (s1 - s0) * (k - 1) / n;
+    const double sb = k == n ? s1 : s0 + (s1 - s0) * k / n;
+    if (stop_token().stop_requested()) return StepStatus::Stopped();
+    const VecX z_start = z_;
+    s_ = sb;
+    SetTargets(z_, sb);
+    VecX loads = VecX::Zero(z_.size());
+    AssembleLoads(z_, sb, loads, nullptr);
+    ApplyConstraints(loads, nullptr);
+    force_scale_ = loads.norm();
+    last_newton_ = newton_->Solve(*this, z_, jac_, stop_token());
+    total_iterations_ += last_newton_.iterations;
+    if (last_newton_.converged) continue;
+    z_ = z_start;
+    if (last_newton_.interrupted) return StepStatus::Stopped();
+    if (depth >= params_.max_bisections) {
+      failure_detail_ =
+          fmt::format("load increment {:.6g} → {:.6g} of the step: {}", sa, sb,
+                      Describe(last_newton_, params_.newton, newton_->linear_solver().name()));
+      return StepStatus::Failed("Newton did not converge (bisections exhausted)");
+    }
+    const StepStatus status = Advance(sa, sb, depth + 1);
+    if (!status.ok()) return status;
+  }
+  return StepStatus::Ok();
+}
+
+StepStatus MixedSolid::DoStep(double /*t*/, double /*dt*/) {
+  failure_detail_.clear();
+  GatherLoads();
+  // Prescribed displacements ramp from where the constrained dofs are now.
+  for (int dof : constrained_dofs_) target_prev_[dof] = z_[dof];
+  z_begin_ = z_;
+  const StepStatus status = Advance(0, 1, 0);
+  if (!status.ok()) {
+    z_ = z_begin_;
+    UpdatePositions();
+    return status;
+  }
+  force_prev_ = force_new_;
+  pressure_prev_ = pressure_new_;
+  traction_prev_ = traction_new_;
+  have_prev_ = true;
+  UpdatePositions();
+  return StepStatus::Ok();
+}
+
+void MixedSolid::UpdatePositions() {
+  const Index nv = mesh_.num_vertices;
+  vertex_positions_ = domain().nodes + Eigen::Map<const Points>(z_.data(), 3, nv);
+}
+
+void MixedSolid::DoReadField(FieldId id, Eigen::Ref<Eigen::MatrixXd> out) const {
+  const Index nv = mesh_.num_vertices;
+  const Index nu = 3 * mesh_.num_nodes();
+  static const VecX kNoVelocity;
+  if (id == mech_.boundary_velocity || id == mech_.velocity) {
+    out.setZero();  // quasi-static
+    return;
+  }
+  if (ReadBoundaryKinematics(mech_, id, vertex_positions_, kNoVelocity.data(), out)) return;
+  if (id == mech_.position) {
+    out = vertex_positions_;
+  } else if (id == mech_.displacement) {
+    out = vertex_positions_ - domain().nodes;
+  } else if (id == mech_.external_force) {
+    out = external_force_;
+  } else if (id == mech_.reaction_force) {
+    // f_int − f_ext on the held axes of the vertices, at the current state and loads.
+    out.setZero();
+    VecX r;
+    if (!EvaluateUnconstrained(z_, 1.0, r, nullptr)) return;
+    // An edge node is held where both its vertices are; its reaction goes half to each, so
+    // the vertices carry the whole: for a uniform traction on a 6-node face the vertex nodes'
+    // own share is zero (∫ N_vertex dA = 0) and the edge nodes' is all of it.
+    const Index nv = mesh_.num_vertices;
+    for (Index k = 0; k < mesh_.edges.cols(); ++k)
+      for (int a = 0; a < 3; ++a) {
+        const Index dof = 3 * (nv + k) + a;
+        if (constrained_[static_cast<std::size_t>(dof)] == 0) continue;
+        r[3 * mesh_.edges(0, k) + a] += 0.5 * r[dof];
+        r[3 * mesh_.edges(1, k) + a] += 0.5 * r[dof];
+      }
+    const BoundaryConditions& bcs = boundary_conditions();
+    const auto& v2n = boundary().vertex_to_node;
+    for (std::size_t j = 0; j < v2n.size(); ++j)
+      for (int a = 0; a < 3; ++a)
+        if (bcs.kind(static_cast<Index>(j), a) != ConstraintKind::kFree)
+          out(a, static_cast<Index>(j)) = r[3 * v2n[j] + a];
+  } else if (id == f_pressure_) {
+    out = pressure_scale_ * z_.segment(nu, nv).transpose();
+  } else if (id == f_jacobian_) {
+    for (Index e = 0; e < mesh_.num_elements(); ++e) {
+      double mean = 0;
+      for (int q = 0; q < kQuad; ++q) {
+        const auto g = Eigen::Map<const Eigen::Matrix<double, 3, 10>>(
+            grad_.data() + (static_cast<std::size_t>(e) * kQuad + q) * 30);
+        Mat3 F = Mat3::Identity();
+        for (int a = 0; a < 10; ++a)
+          F.noalias() += z_.segment<3>(3 * mesh_.elements(a, e)) * g.col(a).transpose();
+        mean += F.determinant() / kQuad;
+      }
+      out(0, e) = mean;
+    }
+  } else if (id == f_volume_) {
+    out(0, 0) = CurrentVolume();
+  } else if (id == f_energy_) {
+    double w = 0;
+    for (Index e = 0; e < mesh_.num_elements(); ++e) w += ElementEnergy(e, z_);
+    out(0, 0) = w;
+  } else if (id == f_newton_) {
+    out(0, 0) = last_newton_.iterations;
+  }
+}
+
+void MixedSolid::DoWriteField(FieldId id, const Eigen::Ref<const Eigen::MatrixXd>& in) {
+  if (id == mech_.external_force) {
+    external_force_ = in;
+  } else if (id == mech_.position) {
+    // Vertices where written, edge nodes at the mean of their ends (straight edges).
+    const Index nv = mesh_.num_vertices;
+    const Points u = in - domain().nodes;
+    for (Index v = 0; v < nv; ++v) z_.segment<3>(3 * v) = u.col(v);
+    for (Index k = 0; k < mesh_.edges.cols(); ++k)
+      z_.segment<3>(3 * (nv + k)) = 0.5 * (u.col(mesh_.edges(0, k)) + u.col(mesh_.edges(1, k)));
+    UpdatePositions();
+  }
+  // Velocity writes are ignored: the object is quasi-static.
+}
+
+void MixedSolid::SaveObjectState(StateWriter& out) const {
+  out.BeginSection("MixedSolid", 1);
+  out.WriteMatrix(z_);
+  out.WriteBool(have_prev_);
+  out.WriteMatrix(force_prev_);
+  out.WriteMatrix(pressure_prev_);
+  out.WriteMatrix(traction_prev_);
+  out.WriteMatrix(external_force_);
+  out.WriteInt(last_newton_.iterations);
+  out.WriteInt(total_iterations_);
+  newton_->SaveState(out, jac_);
+  out.EndSection();
+}
+
+void MixedSolid::RestoreObjectState(StateReader& in) {
+  in.BeginSection("MixedSolid", 1);
+  in.ReadMatrixExact(z_, "the unknowns");
+  have_prev_ = in.ReadBool();
+  in.ReadMatrixExact(force_prev_, "the previous nodal forces");
+  in.ReadMatrixExact(pressure_prev_, "the previous face pressures");
+  in.ReadMatrixExact(traction_prev_, "the previous face tractions");
+  in.ReadMatrixExact(external_force_, "the external force");
+  last_newton_ = NewtonStats{};
+  last_newton_.iterations = static_cast<int>(in.ReadInt());
+  last_newton_.converged = true;
+  total_iterations_ = in.ReadInt();
+  newton_->RestoreState(in, jac_);
+  in.EndSection();
+  UpdatePositions();
+}
+
+}  // namespace gipsi

@@ -1,0 +1,182 @@
+#pragma once
+/// @file
+/// `MixedSolid`: quasi-static, nearly or fully incompressible hyperelasticity without locking —
+/// Taylor–Hood P2–P1 elements (quadratic displacements on 10-node tets, continuous linear
+/// pressure on the vertices), the inf–sup stable pair used by the cardiac-mechanics benchmark
+/// codes (Land et al., "Verification of cardiac mechanics software: benchmark problems and
+/// solutions for testing active and passive material behaviour", Proc. R. Soc. A 471, 2015).
+///
+/// The law's energy must split as W(F) = W̃(F) + κ/2 (ln J)² (SolidMaterial::
+/// log_volumetric_modulus(): NeoHookean, Guccione). The volumetric term is replaced by an
+/// independent pressure p (a perturbed Lagrangian; Simo & Taylor, "Quasi-incompressible finite
+/// elasticity in principal stretches", CMAME 85, 1991):
+///   Π(u, p) = ∫ W̃(F) + p ln J − p²/(2κ) dV − (work of the loads),
+/// whose stationarity in p gives p = κ ln J (for finite κ, the same solution as the penalty law
+/// in the limit of fine meshes, without its locking), and with `incompressible` the last term
+/// is dropped: ln J = 0 in the weak sense and p is the Lagrange multiplier (κ = ∞). Residuals:
+///   r_u,a = ∫ (P̃ + p F⁻ᵀ) ∇N_a dV − f_ext,a,     r_p,b = ∫ (ln J − p/κ) L_b dV,
+/// with P̃ = ∂W̃/∂F, N_a the P2 and L_b the P1 shape functions, integrated with the 4-point
+/// degree-2 rule (quadratic_tets.h). The tangent is exact: the element terms (symmetric,
+/// indefinite: [[K, Bᵀ], [B, −M/κ]]) plus the follower-load tangent (not symmetric), solved by
+/// a direct LU with pivoting ("umfpack", the default); with "ldlt" (finite κ only) the load
+/// tangent is symmetrised and Newton converges linearly under large follower loads. The pressure
+/// unknown is scaled to the displacements' units (p = s p̃, s = E/h with E the law's small-strain
+/// modulus and h the mean edge length) so that Newton's residual and increment tests weigh both
+/// alike.
+///
+/// Loads and constraints come from the boundary conditions on the boundary vertices (as for
+/// FemSolid): a displacement on an axis of both ends of a boundary edge holds the edge's
+/// midpoint node on that axis at the mean of the two; follower pressure and traction (per
+/// current area) act on the 6-node boundary faces; nodal forces act on the vertices. A step
+/// ramps the loads and prescribed displacements linearly from the previous step's values (zero
+/// before the first step) in `load_steps` increments, and bisects an increment whose Newton
+/// solve fails up to `max_bisections` times.
+///
+/// The vertex nodes are the domain mesh's nodes, so every node field, probe, boundary and
+/// display works on the linear mesh (displacements at vertices are the P2 solution's nodal
+/// values, exact); fields: the mechanical fields, "pressure" (node, Pa; the hydrostatic
+/// pressure p, positive in tension as p = κ ln J), "volume_ratio" (element, mean J over its
+/// quadrature points), "volume" (global, m³, ∫ J dV), "strain_energy" (global, J, ∫ W̃ dV +
+/// ∫ κ/2 (ln J)² dV for finite κ), "newton_iterations" (global, last increment).
+///
+/// Not yet: dynamics (mass, damping), cavities coupled to blood, active tension from a field,
+/// quadratic (curved) output, collision and haptic local models, checkpoints of the
+/// factorisation (the state saved is displacements, pressures and the previous loads).
+/// Units: SI.
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "gipsi/core/registry.h"
+#include "gipsi/core/sim_object.h"
+#include "gipsi/models/fem/quadratic_tets.h"
+#include "gipsi/models/fem/solid_material.h"
+#include "gipsi/numerics/newton.h"
+
+namespace gipsi {
+
+/// Parameters. Plain struct with defaults.
+struct MixedSolidParams {
+  /// Required; its log_volumetric_modulus() must be positive.
+  std::shared_ptr<const SolidMaterial> material;
+  /// κ = ∞: J = 1 enforced by a Lagrange-multiplier pressure (the law's κ is not used).
+  bool incompressible = false;
+  Vec3 fibre = Vec3::UnitX();  ///< uniform fibre direction (reference configuration)
+  Vec3 sheet = Vec3::UnitY();  ///< uniform sheet direction (orthogonalised against the fibre)
+  int load_steps = 1;          ///< increments per step
+  int max_bisections = 6;      ///< halvings of a failed increment before the step fails
+  NewtonOptions newton;
+  LinearSolverOptions linear_solver = [] {
+    LinearSolverOptions o;
+    o.type = "umfpack";
+    o.tolerance = 1e-8;
+    return o;
+  }();
+};
+
+/// Not copyable or movable (a SimObject).
+class MixedSolid final : public SimObject, private NonlinearSystem {
+ public:
+  /// Throws InputError for a mesh without tets, inverted or degenerate tets, a missing law or
+  /// one without a split volumetric term, or a zero fibre direction.
+  MixedSolid(std::string name, std::shared_ptr<const Mesh> domain, MixedSolidParams params);
+
+  [[nodiscard]] std::string_view type_name() const override { return "MixedSolid"; }
+  [[nodiscard]] const Points& domain_positions() const override { return vertex_positions_; }
+  [[nodiscard]] std::string failure_detail() const override { return failure_detail_; }
+
+  [[nodiscard]] const MixedSolidParams& params() const { return params_; }
+  [[nodiscard]] const QuadraticTets& quadratic_mesh() const { return mesh_; }
+  /// Displacements of every P2 node (3 by num_nodes, vertices first).
+  [[nodiscard]] Points NodeDisplacements() const;
+  /// Pressure at every vertex [Pa].
+  [[nodiscard]] VecX Pressures() const;
+  /// ∫ J dV over the body [m³] at the current state.
+  [[nodiscard]] double CurrentVolume() const;
+  /// Statistics of the last Newton solve.
+  [[nodiscard]] const NewtonStats& last_newton() const { return last_newton_; }
+  /// Total Newton iterations and factorisations over all steps (for benchmarks).
+  [[nodiscard]] std::int64_t total_newton_iterations() const { return total_iterations_; }
+
+  /// The residual r(z) and, if `jacobian` is not null, the Jacobian at the unknowns z =
+  /// (u node-major, p̃) for the loads at load fraction s of the current step, with no
+  /// constraint applied (for tests: finite-difference checks). False if an element is outside
+  /// its law's domain.
+  bool EvaluateUnconstrained(const VecX& z, double s, VecX& r, SparseMatrix* jacobian) const;
+  /// Number of unknowns (3 × nodes + vertices) and the pressure scale s [Pa/m].
+  [[nodiscard]] Index num_unknowns() const { return 3 * mesh_.num_nodes() + mesh_.num_vertices; }
+  [[nodiscard]] double pressure_scale() const { return pressure_scale_; }
+  /// The current unknowns z.
+  [[nodiscard]] const VecX& unknowns() const { return z_; }
+
+  void SaveObjectState(StateWriter& out) const override;
+  void RestoreObjectState(StateReader& in) override;
+
+ protected:
+  StepStatus DoStep(double t, double dt) override;
+  void DoReadField(FieldId id, Eigen::Ref<Eigen::MatrixXd> out) const override;
+  void DoWriteField(FieldId id, const Eigen::Ref<const Eigen::MatrixXd>& in) override;
+
+ private:
+  bool CalcResidual(const VecX& z, VecX& r) override;
+  bool CalcResidualAndJacobian(const VecX& z, VecX& r, SparseMatrix& J) override;
+  [[nodiscard]] double force_scale() const override { return force_scale_; }
+  [[nodiscard]] double residual_floor() const override { return residual_floor_; }
+
+  /// Element terms of r (and J's values if `jv` is not null) at z; false if an element is
+  /// outside its law's domain. Sets residual_floor_.
+  bool Assemble(const VecX& z, VecX& r, double* jv) const;
+  /// Adds −f_ext at load fraction s and its tangent (face loads) at z.
+  void AssembleLoads(const VecX& z, double s, VecX& r, double* jv) const;
+  /// Zeroes the constrained rows (and columns in J, unit diagonal times diag_scale_).
+  void ApplyConstraints(VecX& r, double* jv) const;
+  void GatherLoads();
+  void SetTargets(VecX& z, double s) const;
+  StepStatus Advance(double s0, double s1, int depth);
+  void UpdatePositions();
+  [[nodiscard]] double ElementEnergy(Index e, const VecX& z) const;
+
+  MixedSolidParams params_;
+  const SolidMaterial* law_ = nullptr;
+  double kappa_ = 0;
+  QuadraticTets mesh_;
+  std::vector<double> grad_;  // per element and quadrature point: 3 × 10 ∇N (column-major)
+  VecX volume_;               // rest volume per element
+  Mat3 axes_ = Mat3::Identity();
+  double pressure_scale_ = 1;
+  // Boundary faces as 6-node triangles (P2 node ids).
+  Eigen::Matrix<int, 6, Eigen::Dynamic> faces_;
+  // Sparse pattern and the value index of every (local row, local column) of every element.
+  SparseMatrix jac_;
+  std::vector<int> element_value_index_;  // 34 × 34 per element
+  std::vector<int> diag_index_;           // per unknown
+  // Constraints per P2-node dof: target displacement at s = 0 and s = 1.
+  std::vector<std::uint8_t> constrained_;
+  std::vector<int> constrained_dofs_;
+  VecX target_prev_, target_new_;
+  // Loads at s = 0 and s = 1.
+  VecX force_prev_, force_new_;  // 3 × vertices
+  VecX pressure_prev_, pressure_new_;
+  Points traction_prev_, traction_new_;
+  bool have_prev_ = false;
+  double s_ = 1;
+  double force_scale_ = 0;
+  mutable double residual_floor_ = 0;
+  double diag_scale_ = 1;
+  bool exact_load_tangent_ = false;  // the linear solver takes nonsymmetric matrices
+  VecX z_, z_begin_;
+  Points vertex_positions_;
+  Points external_force_;
+  std::unique_ptr<NewtonSolver> newton_;
+  NewtonStats last_newton_;
+  std::int64_t total_iterations_ = 0;
+  std::string failure_detail_;
+  MechanicalFieldIds mech_;
+  FieldId f_pressure_, f_jacobian_, f_volume_, f_energy_, f_newton_;
+};
+
+/// Registers "MixedSolid".
+void RegisterMixedSolid(TypeRegistry& registry);
+
+}  // namespace gipsi

@@ -1,0 +1,72 @@
+/// @file
+/// Scene-file factory of "MixedSolid" (its keys are documented in docs/scene-format.md).
+
+#include <fmt/format.h>
+
+#include "gipsi/base/error.h"
+#include "gipsi/models/fem/mixed_solid.h"
+#include "gipsi/models/fem/solid_options.h"
+
+namespace gipsi {
+
+void RegisterMixedSolid(TypeRegistry& registry) {
+  registry.objects.Register(
+      "MixedSolid",
+      [](const ObjectBuildContext& ctx) -> std::unique_ptr<SimObject> {
+        const JsonNode& p = ctx.params;
+        ctx.CheckKeys({"material", "formulation", "incompressible", "fibres", "load_steps",
+                       "max_bisections", "newton", "linear_solver"});
+        MixedSolidParams params;
+        params.material = ctx.registry.CreateMaterialAs<SolidMaterial>(p.At("material"), "solid");
+        if (auto formulation = p.Find("formulation"))
+          static_cast<void>(formulation->AsChoice({"P2-P1"}));
+        params.incompressible = p.Bool("incompressible", params.incompressible);
+        if (auto integrator = p.Find("integrator"))
+          static_cast<void>(integrator->AsChoice({"Static"}));
+        if (auto newton = p.Find("newton"))
+          params.newton = ParseNewtonOptions(*newton, params.newton);
+        if (auto solver = p.Find("linear_solver")) {
+          params.linear_solver = ParseLinearSolverOptions(*solver);
+          if (params.linear_solver.type == "cg" || params.linear_solver.type == "cholmod")
+            solver->At("type").Expected(
+                "\"umfpack\" or \"ldlt\": the mixed system is a saddle point, not positive "
+                "definite (\"ldlt\" only when the material is not incompressible)");
+        }
+        if (auto steps = p.Find("load_steps")) {
+          const std::int64_t n = steps->AsInt();
+          if (n < 1 || n > 100000) steps->Expected("an integer in [1, 100000]");
+          params.load_steps = static_cast<int>(n);
+        }
+        if (auto bisections = p.Find("max_bisections")) {
+          const std::int64_t n = bisections->AsInt();
+          if (n < 0 || n > 30) bisections->Expected("an integer in [0, 30]");
+          params.max_bisections = static_cast<int>(n);
+        }
+        if (auto fibres = p.Find("fibres")) {
+          fibres->CheckKeys({"direction", "sheet"});
+          params.fibre = fibres->Vector3("direction");
+          params.sheet = fibres->Vector3("sheet", params.sheet);
+          if (params.fibre.norm() == 0) fibres->At("direction").Expected("a non-zero vector");
+        } else if (params.material->needs_fibres()) {
+          p.At("material")
+              .Fail(fmt::format("law '{}' is anisotropic: give the object a fibre direction, "
+                                "e.g. \"fibres\": {{\"direction\": [1, 0, 0]}}",
+                                params.material->law()));
+        }
+        if (params.material->log_volumetric_modulus() <= 0)
+          p.At("material")
+              .Fail(fmt::format(
+                  "law '{}' has no volumetric term κ/2 (ln J)² for the mixed pressure to replace; "
+                  "MixedSolid takes \"NeoHookean\" or \"Guccione\"",
+                  params.material->law()));
+        try {
+          return std::make_unique<MixedSolid>(ctx.name, ctx.DomainMesh(), std::move(params));
+        } catch (const InputError& e) {
+          p.Fail(e.what());
+        }
+      },
+      "quasi-static nearly or fully incompressible solid on Taylor–Hood P2–P1 tetrahedra "
+      "(locking-free)");
+}
+
+}  // namespace gipsi
