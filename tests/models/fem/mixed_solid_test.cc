@@ -6,12 +6,15 @@
 #include <memory>
 #include <random>
 
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include <fmt/format.h>
 
 #include "gipsi/base/error.h"
 #include "gipsi/geometry/generators.h"
+#include "gipsi/io/builtins.h"
+#include "gipsi/io/scene.h"
 #include "gipsi/models/fem/mixed_solid.h"
 #include "gipsi/models/fem/quadratic_tets.h"
 #include "gipsi/models/fem/solid_laws.h"
@@ -336,6 +339,58 @@ TEST(MixedSolid, LandBeamConvergesToTheBenchmarkWithoutLocking) {
   const double stiff = 1e3 * LandBeam(2, 1e6, false).tip_z;
   EXPECT_NEAR(soft, stiff, 0.005 * stiff);
   EXPECT_NEAR(stiff, tips[1], 1e-5 * tips[1]);
+}
+
+/// A one-object scene with the given MixedSolid keys (after "domain").
+std::string MixedScene(const std::string& keys) {
+  return R"({"gipsi": 1, "units": "SI",
+    "meshes": {"m": {"generate": "box", "min": [0, 0, 0], "max": [0.01, 0.01, 0.01],
+                     "cells": [1, 1, 1]}},
+    "objects": {"s": {"type": "MixedSolid", "domain": "m", "dt": 1)" +
+         keys + R"(}}, "schedule": {"end": 1}})";
+}
+
+void ExpectSceneError(const std::string& keys, const std::string& message) {
+  TypeRegistry registry;
+  RegisterBuiltins(registry);
+  try {
+    (void)LoadSceneFromString(MixedScene(keys), "mixed.json", ".", registry);
+    ADD_FAILURE() << "no error for " << keys;
+  } catch (const InputError& e) {
+    EXPECT_THAT(e.what(), ::testing::HasSubstr("mixed.json")) << e.what();
+    EXPECT_THAT(e.what(), ::testing::HasSubstr(message)) << e.what();
+  }
+}
+
+// Bad input is refused at load with the file, the JSON path and what was expected.
+TEST(MixedSolid, SceneErrorsNameThePathAndWhatWasExpected) {
+  ExpectSceneError(R"(, "material": {"law": "Corotational", "youngs_modulus": 1e4,
+                      "poisson_ratio": 0.3})",
+                   "MixedSolid takes \"NeoHookean\" or \"Guccione\"");
+  ExpectSceneError(R"(, "material": {"law": "Guccione", "C": 2000, "bf": 8, "bt": 2, "bfs": 4,
+                      "bulk_modulus": 2e6})",
+                   "give the object a fibre direction");
+  ExpectSceneError(R"(, "material": {"law": "NeoHookean", "youngs_modulus": 1e4,
+                      "poisson_ratio": 0.3}, "linear_solver": {"type": "cholmod"})",
+                   "objects.s.linear_solver.type");
+  ExpectSceneError(R"(, "material": {"law": "NeoHookean", "youngs_modulus": 1e4,
+                      "poisson_ratio": 0.3}, "integrator": "BackwardEuler")",
+                   "objects.s.integrator");
+  ExpectSceneError(R"(, "material": {"law": "NeoHookean", "youngs_modulus": 1e4,
+                      "poisson_ratio": 0.3}, "formulation": "P1-P1")",
+                   "objects.s.formulation");
+}
+
+// A prescribed velocity cannot be honoured quasi-statically: the step fails with a diagnostic
+// naming the vertex (no exception out of Step, no state change).
+TEST(MixedSolid, APrescribedVelocityFailsTheStepWithADiagnostic) {
+  MixedSolid solid("s", Box(Vec3::Constant(1e-2), {1, 1, 1}), Params(kNeoHookean, false));
+  solid.boundary_conditions().PrescribeVelocity(3, Vec3(0, 0, 1e-3));
+  const StepStatus status = solid.Step(1);
+  EXPECT_EQ(status.code, StepStatus::Code::kFailed);
+  EXPECT_EQ(status.item, 3);
+  EXPECT_THAT(solid.failure_detail(), ::testing::HasSubstr("boundary vertex 3"));
+  EXPECT_EQ(solid.unknowns().norm(), 0.0);
 }
 
 }  // namespace

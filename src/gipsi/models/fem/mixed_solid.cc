@@ -412,7 +412,8 @@ bool MixedSolid::EvaluateUnconstrained(const VecX& z, double s, VecX& r,
   return ok;
 }
 
-void MixedSolid::GatherLoads() {
+Index MixedSolid::GatherLoads() {
+  Index velocity_vertex = -1;
   const BoundarySurface& bnd = boundary();
   const BoundaryConditions& bcs = boundary_conditions();
   const Index nv = mesh_.num_vertices;
@@ -430,11 +431,10 @@ void MixedSolid::GatherLoads() {
     const Index node = bnd.vertex_to_node[static_cast<std::size_t>(j)];
     for (int a = 0; a < 3; ++a) {
       if (bcs.kind(j, a) == ConstraintKind::kFree) continue;
-      if (bcs.kind(j, a) == ConstraintKind::kVelocity)
-        throw InputError(fmt::format(
-            "object '{}': MixedSolid is quasi-static; boundary vertex {} has a prescribed "
-            "velocity (prescribe a displacement instead)",
-            name(), j));
+      if (bcs.kind(j, a) == ConstraintKind::kVelocity) {
+        velocity_vertex = j;
+        continue;
+      }
       constrained_[static_cast<std::size_t>(3 * node + a)] = 1;
       target_new_[3 * node + a] = bcs.value(j)[a];
     }
@@ -458,6 +458,7 @@ void MixedSolid::GatherLoads() {
     pressure_prev_.setZero();
     traction_prev_.setZero();
   }
+  return velocity_vertex;
 }
 
 void MixedSolid::SetTargets(VecX& z, double s) const {
@@ -496,7 +497,13 @@ StepStatus MixedSolid::Advance(double s0, double s1, int depth) {
 
 StepStatus MixedSolid::DoStep(double /*t*/, double /*dt*/) {
   failure_detail_.clear();
-  GatherLoads();
+  if (const Index v = GatherLoads(); v >= 0) {
+    failure_detail_ = fmt::format(
+        "boundary vertex {} has a prescribed velocity; MixedSolid is quasi-static: prescribe a "
+        "displacement instead",
+        v);
+    return StepStatus::Failed("a prescribed velocity on a quasi-static object", v);
+  }
   // Prescribed displacements ramp from where the constrained dofs are now.
   for (int dof : constrained_dofs_) target_prev_[dof] = z_[dof];
   z_begin_ = z_;

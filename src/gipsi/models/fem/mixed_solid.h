@@ -131,7 +131,9 @@ class MixedSolid final : public SimObject, private NonlinearSystem {
   void AssembleLoads(const VecX& z, double s, VecX& r, double* jv) const;
   /// Zeroes the constrained rows (and columns in J, unit diagonal times diag_scale_).
   void ApplyConstraints(VecX& r, double* jv) const;
-  void GatherLoads();
+  /// This step's loads and constraints; returns a boundary vertex with a prescribed velocity
+  /// (which a quasi-static object cannot honour), or -1.
+  Index GatherLoads();
   void SetTargets(VecX& z, double s) const;
   StepStatus Advance(double s0, double s1, int depth);
   void UpdatePositions();
