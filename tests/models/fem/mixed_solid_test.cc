@@ -393,5 +393,24 @@ TEST(MixedSolid, APrescribedVelocityFailsTheStepWithADiagnostic) {
   EXPECT_EQ(solid.unknowns().norm(), 0.0);
 }
 
+// A step that cannot converge (one Newton iteration allowed, no bisection) fails with the
+// Newton history and the most compressed element at the last converged state, and leaves the
+// state as it was.
+TEST(MixedSolid, AFailedStepNamesTheMostCompressedElement) {
+  auto params = Params(kNeoHookean, true);
+  params.newton.max_iterations = 1;
+  params.max_bisections = 0;
+  MixedSolid solid("s", Box(Vec3::Constant(1e-2), {2, 2, 2}), params);
+  BoundaryConditions& bcs = solid.boundary_conditions();
+  for (Index v : VerticesWhere(solid, [](const Vec3& x) { return x.x() < 1e-12; })) bcs.Fix(v);
+  for (Index f : FacesWhere(solid, [](const Vec3& x) { return x.z() > 1e-2 - 1e-12; }))
+    bcs.SetPressure(f, 2e3);
+  const StepStatus status = solid.Step(1);
+  EXPECT_EQ(status.code, StepStatus::Code::kFailed);
+  EXPECT_THAT(solid.failure_detail(), ::testing::HasSubstr("Newton"));
+  EXPECT_THAT(solid.failure_detail(), ::testing::HasSubstr("smallest J at a quadrature point"));
+  EXPECT_EQ(solid.unknowns().norm(), 0.0);
+}
+
 }  // namespace
 }  // namespace gipsi

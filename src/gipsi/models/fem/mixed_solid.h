@@ -138,6 +138,8 @@ class MixedSolid final : public SimObject, private NonlinearSystem {
   StepStatus Advance(double s0, double s1, int depth);
   void UpdatePositions();
   [[nodiscard]] double ElementEnergy(Index e, const VecX& z) const;
+  /// "; … the smallest J … in tet N (centre …)" at the current state, for failure messages.
+  [[nodiscard]] std::string MostCompressedElement() const;
 
   MixedSolidParams params_;
   const SolidMaterial* law_ = nullptr;
