@@ -120,7 +120,8 @@ const char* kGuccione = R"({"law": "Guccione", "C": 2000, "bf": 8, "bt": 2, "bfs
                             "bulk_modulus": 2e5})";
 const char* kNeoHookean = R"({"law": "NeoHookean", "youngs_modulus": 1e4, "poisson_ratio": 0.45})";
 
-// The Jacobian (element terms: law, volumetric split, pressure coupling, 1/κ block; follower
+// The Jacobian (element terms: law with active tension, volumetric split, pressure coupling,
+// 1/κ block; follower
 // pressure and traction on curved 6-node faces, exact with the default LU solver) against
 // central differences of the residual, at a random moderately deformed state and pressure,
 // for both laws and both κ (finite, ∞). Central differences with step 1e-7 of the unknowns'
@@ -137,6 +138,8 @@ TEST(MixedSolid, JacobianMatchesFiniteDifferencesForEveryLawAndKappa) {
         bcs.SetPressure(f, 300);
       for (Index f : FacesWhere(solid, [](const Vec3& x) { return x.x() > 1e-2 - 1e-12; }))
         bcs.SetTraction(f, Vec3(100, -200, 50));
+      solid.WriteField(solid.FindField("active_tension"),
+                       Eigen::MatrixXd::Constant(1, solid.quadratic_mesh().num_elements(), 500));
       ASSERT_TRUE(solid.Step(1).ok()) << solid.failure_detail();
       std::mt19937 rng(3);
       std::uniform_real_distribution<double> jitter(-1, 1);
@@ -208,6 +211,41 @@ TEST(MixedSolid, IncompressibleUniaxialStretchMatchesTheClosedForm) {
   for (Index v : on(0, length)) total += reaction(0, v);
   EXPECT_NEAR(total, mu * (lambda - 1 / (lambda * lambda)) * length * length,
               1e-8 * mu * length * length);
+}
+
+// Active contraction of the same cube, fibres along x, tension Ta (second Piola–Kirchhoff
+// Ta f ⊗ f) written to the "active_tension" field, every face free but the symmetry planes:
+// F = diag(λ, λ^-½, λ^-½) with σ = μ (B − I) + p I + Ta λ² e_x ⊗ e_x = 0, so p = μ (1 − 1/λ)
+// and Ta = μ (1/λ³ − 1), i.e. λ = (1 + Ta/μ)^(-1/3). To 1e-9 (the Newton tolerance).
+TEST(MixedSolid, IncompressibleActiveContractionMatchesTheClosedForm) {
+  auto params = Params(kNeoHookean, true);
+  params.fibre = Vec3::UnitX();
+  params.load_steps = 4;
+  const double length = 1e-2;
+  MixedSolid solid("cube", Box(Vec3::Constant(length), {2, 2, 2}), params);
+  BoundaryConditions& bcs = solid.boundary_conditions();
+  for (int axis = 0; axis < 3; ++axis)
+    for (Index v : VerticesWhere(solid, [=](const Vec3& x) { return std::abs(x[axis]) < 1e-12; }))
+      bcs.Fix(v, static_cast<AxisMask>(1 << axis));
+  const double mu = dynamic_cast<const IsotropicSolid*>(params.material.get())->mu();
+  const double ta = 0.3 * mu;
+  const Index ne = solid.quadratic_mesh().num_elements();
+  solid.WriteField(solid.FindField("active_tension"), Eigen::MatrixXd::Constant(1, ne, ta));
+  ASSERT_TRUE(solid.Step(1).ok()) << solid.failure_detail();
+  const double lambda = std::pow(1 + ta / mu, -1.0 / 3);
+  const double lateral = 1 / std::sqrt(lambda);
+  const Points u = solid.NodeDisplacements();
+  const QuadraticTets& q = solid.quadratic_mesh();
+  for (Index n = 0; n < q.num_nodes(); ++n) {
+    const Vec3 X = q.rest.col(n);
+    const Vec3 expected((lambda - 1) * X.x(), (lateral - 1) * X.y(), (lateral - 1) * X.z());
+    EXPECT_LT((u.col(n) - expected).norm(), 1e-9 * length) << "node " << n;
+  }
+  const VecX p = solid.Pressures();
+  for (Index v = 0; v < p.size(); ++v) EXPECT_NEAR(p[v], mu * (1 - 1 / lambda), 1e-9 * mu);
+  Eigen::MatrixXd read(1, ne);
+  solid.ReadField(solid.FindField("active_tension"), read);
+  EXPECT_EQ(read(0, ne - 1), ta);
 }
 
 /// Land et al. 2015, problem 1: a 10 × 1 × 1 mm Guccione beam (C = 2 kPa, b_f 8, b_t 2,

@@ -63,8 +63,10 @@ MixedSolid::MixedSolid(std::string name, std::shared_ptr<const Mesh> domain,
         this->name(), law_->law()));
   if (params_.fibre.norm() == 0)
     throw InputError(fmt::format("object '{}': the fibre direction is zero", this->name()));
-  axes_ = Frame(params_.fibre, params_.sheet);
   mesh_ = ElevateToQuadratic(*domain);
+  axes_.assign(static_cast<std::size_t>(mesh_.num_elements()), Frame(params_.fibre, params_.sheet));
+  active_prev_ = VecX::Zero(mesh_.num_elements());
+  active_new_ = VecX::Zero(mesh_.num_elements());
   SetGeometry(domain, MakeBoundary(*domain));
 
   // Element geometry: volumes and P2 gradients at the quadrature points.
@@ -201,6 +203,11 @@ MixedSolid::MixedSolid(std::string name, std::shared_ptr<const Mesh> domain,
                               "hydrostatic pressure of the mixed formulation (p = κ ln J)"});
   f_jacobian_ = DeclareField({"volume_ratio", L::kElement, 1, "1", A::kRead,
                               "volume ratio J = det F, mean over the element's quadrature points"});
+  f_fibre_ = DeclareField(
+      {"fibre", L::kElement, 3, "1", A::kReadWrite, "fibre direction (reference configuration)"});
+  f_active_ = DeclareField({"active_tension", L::kElement, 1, "Pa", A::kReadWrite,
+                            "active tension along the fibre (second Piola-Kirchhoff); a step "
+                            "ramps it from the previous step's value with the loads"});
   f_volume_ = DeclareField({"volume", L::kGlobal, 1, "m^3", A::kRead, "current volume ∫ J dV"});
   f_energy_ = DeclareField({"strain_energy", L::kGlobal, 1, "J", A::kRead,
                             "stored elastic energy (the law's; without the volumetric term when "
@@ -230,10 +237,16 @@ double MixedSolid::CurrentVolume() const {
   return v;
 }
 
+MaterialPoint MixedSolid::PointOf(Index e, double load) const {
+  MaterialPoint mp;
+  mp.axes = axes_[static_cast<std::size_t>(e)];
+  mp.active_tension = (1 - load) * active_prev_[e] + load * active_new_[e];
+  return mp;
+}
+
 double MixedSolid::ElementEnergy(Index e, const VecX& z) const {
   const TetQuadrature& rule = TetRuleDegree2();
-  MaterialPoint mp;
-  mp.axes = axes_;
+  const MaterialPoint mp = PointOf(e, 1.0);
   double w = 0;
   for (int q = 0; q < kQuad; ++q) {
     const auto g = Eigen::Map<const Eigen::Matrix<double, 3, 10>>(
@@ -251,19 +264,18 @@ double MixedSolid::ElementEnergy(Index e, const VecX& z) const {
   return w;
 }
 
-bool MixedSolid::Assemble(const VecX& z, VecX& r, double* jv) const {
+bool MixedSolid::Assemble(const VecX& z, double load, VecX& r, double* jv) const {
   const Index nu = 3 * mesh_.num_nodes();
   const TetQuadrature& rule = TetRuleDegree2();
   const double s = pressure_scale_;
   const double inv_kappa = params_.incompressible ? 0.0 : 1.0 / kappa_;
-  MaterialPoint mp;
-  mp.axes = axes_;
   r.setZero(z.size());
   if (jv != nullptr) std::fill(jv, jv + jac_.nonZeros(), 0.0);
   double floor_sq = 0;
   Mat3 P;
   Mat9 C;
   for (Index e = 0; e < mesh_.num_elements(); ++e) {
+    const MaterialPoint mp = PointOf(e, load);
     Eigen::Matrix<double, 3, 10> u;
     for (int a = 0; a < 10; ++a) u.col(a) = z.segment<3>(3 * mesh_.elements(a, e));
     Eigen::Vector4d pe;
@@ -405,14 +417,14 @@ void MixedSolid::ApplyConstraints(VecX& r, double* jv) const {
 }
 
 bool MixedSolid::CalcResidual(const VecX& z, VecX& r) {
-  if (!Assemble(z, r, nullptr)) return false;
+  if (!Assemble(z, s_, r, nullptr)) return false;
   AssembleLoads(z, s_, r, nullptr);
   ApplyConstraints(r, nullptr);
   return r.allFinite();
 }
 
 bool MixedSolid::CalcResidualAndJacobian(const VecX& z, VecX& r, SparseMatrix& J) {
-  if (!Assemble(z, r, J.valuePtr())) return false;
+  if (!Assemble(z, s_, r, J.valuePtr())) return false;
   AssembleLoads(z, s_, r, J.valuePtr());
   ApplyConstraints(r, J.valuePtr());
   return r.allFinite();
@@ -422,7 +434,7 @@ bool MixedSolid::EvaluateUnconstrained(const VecX& z, double s, VecX& r,
                                        SparseMatrix* jacobian) const {
   if (jacobian != nullptr) *jacobian = jac_;
   double* jv = jacobian != nullptr ? jacobian->valuePtr() : nullptr;
-  const bool ok = Assemble(z, r, jv);
+  const bool ok = Assemble(z, s, r, jv);
   if (ok) AssembleLoads(z, s, r, jv);
   return ok;
 }
@@ -554,6 +566,7 @@ StepStatus MixedSolid::DoStep(double /*t*/, double /*dt*/) {
     return status;
   }
   force_prev_ = force_new_;
+  active_prev_ = active_new_;
   pressure_prev_ = pressure_new_;
   traction_prev_ = traction_new_;
   have_prev_ = true;
@@ -618,6 +631,11 @@ void MixedSolid::DoReadField(FieldId id, Eigen::Ref<Eigen::MatrixXd> out) const 
       }
       out(0, e) = mean;
     }
+  } else if (id == f_fibre_) {
+    for (Index e = 0; e < mesh_.num_elements(); ++e)
+      out.col(e) = axes_[static_cast<std::size_t>(e)].col(0);
+  } else if (id == f_active_) {
+    out = active_new_.transpose();
   } else if (id == f_volume_) {
     out(0, 0) = CurrentVolume();
   } else if (id == f_energy_) {
@@ -632,6 +650,14 @@ void MixedSolid::DoReadField(FieldId id, Eigen::Ref<Eigen::MatrixXd> out) const 
 void MixedSolid::DoWriteField(FieldId id, const Eigen::Ref<const Eigen::MatrixXd>& in) {
   if (id == mech_.external_force) {
     external_force_ = in;
+  } else if (id == f_fibre_) {
+    for (Index e = 0; e < mesh_.num_elements(); ++e) {
+      Mat3& axes = axes_[static_cast<std::size_t>(e)];
+      const Vec3 fibre = in.col(e);
+      if (fibre.squaredNorm() > 0) axes = Frame(fibre, axes.col(1));
+    }
+  } else if (id == f_active_) {
+    active_new_ = in.row(0).transpose();
   } else if (id == mech_.position) {
     // Vertices where written, edge nodes at the mean of their ends (straight edges).
     const Index nv = mesh_.num_vertices;
@@ -652,6 +678,12 @@ void MixedSolid::SaveObjectState(StateWriter& out) const {
   out.WriteMatrix(pressure_prev_);
   out.WriteMatrix(traction_prev_);
   out.WriteMatrix(external_force_);
+  out.WriteMatrix(active_prev_);
+  out.WriteMatrix(active_new_);
+  Eigen::MatrixXd axes(9, mesh_.num_elements());
+  for (Index e = 0; e < mesh_.num_elements(); ++e)
+    axes.col(e) = axes_[static_cast<std::size_t>(e)].reshaped();
+  out.WriteMatrix(axes);
   out.WriteInt(last_newton_.iterations);
   out.WriteInt(total_iterations_);
   newton_->SaveState(out, jac_);
@@ -666,6 +698,12 @@ void MixedSolid::RestoreObjectState(StateReader& in) {
   in.ReadMatrixExact(pressure_prev_, "the previous face pressures");
   in.ReadMatrixExact(traction_prev_, "the previous face tractions");
   in.ReadMatrixExact(external_force_, "the external force");
+  in.ReadMatrixExact(active_prev_, "the previous active tension");
+  in.ReadMatrixExact(active_new_, "the active tension");
+  Eigen::MatrixXd axes(9, mesh_.num_elements());
+  in.ReadMatrixExact(axes, "the material axes");
+  for (Index e = 0; e < mesh_.num_elements(); ++e)
+    axes_[static_cast<std::size_t>(e)] = axes.col(e).reshaped(3, 3);
   last_newton_ = NewtonStats{};
   last_newton_.iterations = static_cast<int>(in.ReadInt());
   last_newton_.converged = true;

@@ -39,10 +39,13 @@
 /// quadrature points), "volume" (global, m³, ∫ J dV), "strain_energy" (global, J, ∫ W̃ dV +
 /// ∫ κ/2 (ln J)² dV for finite κ), "newton_iterations" (global, last increment).
 ///
-/// Not yet: dynamics (mass, damping), cavities coupled to blood, active tension from a field,
-/// quadratic (curved) output, collision and haptic local models, checkpoints of the
-/// factorisation (the state saved is displacements, pressures and the previous loads).
-/// Units: SI.
+/// Fields "fibre" and "active_tension" (element, read/write) give per-element material axes and
+/// an active tension along the fibre (MaterialPoint), ramped from the previous step's values
+/// with the loads.
+///
+/// Not yet: dynamics (mass, damping), cavities coupled to blood, quadratic (curved) output,
+/// collision and haptic local models, checkpoints of the factorisation (the state saved is
+/// displacements, pressures and the previous loads). Units: SI.
 
 #include <memory>
 #include <string>
@@ -124,9 +127,12 @@ class MixedSolid final : public SimObject, private NonlinearSystem {
   [[nodiscard]] double force_scale() const override { return force_scale_; }
   [[nodiscard]] double residual_floor() const override { return residual_floor_; }
 
-  /// Element terms of r (and J's values if `jv` is not null) at z; false if an element is
+  /// Element terms of r (and J's values if `jv` is not null) at z and load fraction `load`
+  /// (the active tension is ramped with the loads); false if an element is
   /// outside its law's domain. Sets residual_floor_.
-  bool Assemble(const VecX& z, VecX& r, double* jv) const;
+  bool Assemble(const VecX& z, double load, VecX& r, double* jv) const;
+  /// Material axes and active tension of element e at load fraction `load`.
+  [[nodiscard]] MaterialPoint PointOf(Index e, double load) const;
   /// Adds −f_ext at load fraction s and its tangent (face loads) at z.
   void AssembleLoads(const VecX& z, double s, VecX& r, double* jv) const;
   /// Zeroes the constrained rows (and columns in J, unit diagonal times diag_scale_).
@@ -145,9 +151,10 @@ class MixedSolid final : public SimObject, private NonlinearSystem {
   const SolidMaterial* law_ = nullptr;
   double kappa_ = 0;
   QuadraticTets mesh_;
-  std::vector<double> grad_;  // per element and quadrature point: 3 × 10 ∇N (column-major)
-  VecX volume_;               // rest volume per element
-  Mat3 axes_ = Mat3::Identity();
+  std::vector<double> grad_;       // per element and quadrature point: 3 × 10 ∇N (column-major)
+  VecX volume_;                    // rest volume per element
+  std::vector<Mat3> axes_;         // per element: fibre, sheet, normal
+  VecX active_prev_, active_new_;  // per element active tension at s = 0 and s = 1 [Pa]
   double pressure_scale_ = 1;
   // Boundary faces as 6-node triangles (P2 node ids).
   Eigen::Matrix<int, 6, Eigen::Dynamic> faces_;
@@ -177,7 +184,7 @@ class MixedSolid final : public SimObject, private NonlinearSystem {
   std::int64_t total_iterations_ = 0;
   std::string failure_detail_;
   MechanicalFieldIds mech_;
-  FieldId f_pressure_, f_jacobian_, f_volume_, f_energy_, f_newton_;
+  FieldId f_fibre_, f_active_, f_pressure_, f_jacobian_, f_volume_, f_energy_, f_newton_;
 };
 
 /// Registers "MixedSolid".

@@ -6,6 +6,7 @@
 #include "gipsi/base/error.h"
 #include "gipsi/models/fem/mixed_solid.h"
 #include "gipsi/models/fem/solid_options.h"
+#include "gipsi/models/fibres/rule_based_fibres.h"
 
 namespace gipsi {
 
@@ -15,7 +16,7 @@ void RegisterMixedSolid(TypeRegistry& registry) {
       [](const ObjectBuildContext& ctx) -> std::unique_ptr<SimObject> {
         const JsonNode& p = ctx.params;
         ctx.CheckKeys({"material", "formulation", "incompressible", "fibres", "load_steps",
-                       "max_bisections", "newton", "linear_solver"});
+                       "max_bisections", "newton", "linear_solver", "active_tension"});
         MixedSolidParams params;
         params.material = ctx.registry.CreateMaterialAs<SolidMaterial>(p.At("material"), "solid");
         if (auto formulation = p.Find("formulation"))
@@ -42,7 +43,10 @@ void RegisterMixedSolid(TypeRegistry& registry) {
           if (n < 0 || n > 30) bisections->Expected("an integer in [0, 30]");
           params.max_bisections = static_cast<int>(n);
         }
-        if (auto fibres = p.Find("fibres")) {
+        std::optional<TransmuralFibreRule> fibre_rule;
+        if (auto fibres = p.Find("fibres"); fibres && fibres->Has("rule")) {
+          fibre_rule = ParseTransmuralFibreRule(*fibres);
+        } else if (auto fibres = p.Find("fibres")) {
           fibres->CheckKeys({"direction", "sheet"});
           params.fibre = fibres->Vector3("direction");
           params.sheet = fibres->Vector3("sheet", params.sheet);
@@ -59,8 +63,18 @@ void RegisterMixedSolid(TypeRegistry& registry) {
                   "law '{}' has no volumetric term κ/2 (ln J)² for the mixed pressure to replace; "
                   "MixedSolid takes \"NeoHookean\" or \"Guccione\"",
                   params.material->law()));
+        double active_tension = 0;
+        if (auto active = p.Find("active_tension")) active_tension = active->AsNonNegative();
         try {
-          return std::make_unique<MixedSolid>(ctx.name, ctx.DomainMesh(), std::move(params));
+          auto mesh = ctx.DomainMesh();
+          auto solid = std::make_unique<MixedSolid>(ctx.name, mesh, std::move(params));
+          if (fibre_rule)
+            solid->WriteField(solid->FindField("fibre"),
+                              MakeTransmuralFibres(*mesh, *fibre_rule).fibre);
+          if (active_tension > 0)
+            solid->WriteField(solid->FindField("active_tension"),
+                              Eigen::MatrixXd::Constant(1, mesh->num_tets(), active_tension));
+          return solid;
         } catch (const InputError& e) {
           p.Fail(e.what());
         }
