@@ -55,6 +55,7 @@ if [ "${1:-}" = "--full" ]; then
   asan_skip+='|GridMonodomainTest\.AgreesWithTetsOnTheSlabAsBothAreRefined'
   asan_skip+='|GridMonodomainTest\.NagumoFrontSpeedConvergesAtSecondOrder'
   asan_skip+='|RuleBasedFibres\.TransmuralCoordinateConvergesToTheSphericalShell'
+  asan_skip+='|MixedSolid\.LandBeamConvergesToTheBenchmarkWithoutLocking'
   asan_skip+='|PhenomenologicalModels\.ProductionStepAgreesWithAHundredTimesFinerStep'
   asan_skip+='|TenTusscherPanfilov2006\.ProductionStepAgreesWithAHundredTimesFinerStep'
   # Whole-scene runs of 10-25 s in release (minutes under ASan); their code paths run under the
