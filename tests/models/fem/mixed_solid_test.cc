@@ -5,13 +5,16 @@
 #include <cmath>
 #include <memory>
 #include <random>
+#include <sstream>
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
+#include <spdlog/sinks/ostream_sink.h>
 
 #include <fmt/format.h>
 
 #include "gipsi/base/error.h"
+#include "gipsi/base/log.h"
 #include "gipsi/geometry/generators.h"
 #include "gipsi/io/builtins.h"
 #include "gipsi/io/scene.h"
@@ -448,6 +451,20 @@ TEST(MixedSolid, AFailedStepNamesTheMostCompressedElement) {
   EXPECT_THAT(solid.failure_detail(), ::testing::HasSubstr("Newton"));
   EXPECT_THAT(solid.failure_detail(), ::testing::HasSubstr("smallest J at a quadrature point"));
   EXPECT_EQ(solid.unknowns().norm(), 0.0);
+}
+
+// A flat tet (here every tet of a 20:1 slab of one cell) draws a warning naming it when the
+// object is built: the mixed element can collapse in slivers (docs/incompressible.md).
+TEST(MixedSolid, WarnsOfSliversWhenBuilt) {
+  std::ostringstream captured;
+  auto sink = std::make_shared<spdlog::sinks::ostream_sink_mt>(captured);
+  Log().sinks().push_back(sink);
+  MixedSolid flat("flat", Box(Vec3(1e-2, 1e-2, 5e-4), {1, 1, 1}), Params(kNeoHookean, true));
+  MixedSolid cube("cube", Box(Vec3::Constant(1e-2), {1, 1, 1}), Params(kNeoHookean, true));
+  Log().sinks().pop_back();
+  EXPECT_THAT(captured.str(), ::testing::HasSubstr("flat: tet"));
+  EXPECT_THAT(captured.str(), ::testing::HasSubstr("aspect ratio"));
+  EXPECT_THAT(captured.str(), ::testing::Not(::testing::HasSubstr("cube:")));
 }
 
 }  // namespace
