@@ -415,6 +415,10 @@ TEST(MixedSolid, SceneErrorsNameThePathAndWhatWasExpected) {
                       "poisson_ratio": 0.3}, "linear_solver": {"type": "cholmod"})",
                    "objects.s.linear_solver.type");
   ExpectSceneError(R"(, "material": {"law": "NeoHookean", "youngs_modulus": 1e4,
+                      "poisson_ratio": 0.3}, "incompressible": true,
+                      "linear_solver": {"type": "ldlt"})",
+                   "objects.s.linear_solver.type");
+  ExpectSceneError(R"(, "material": {"law": "NeoHookean", "youngs_modulus": 1e4,
                       "poisson_ratio": 0.3}, "integrator": "BackwardEuler")",
                    "objects.s.integrator");
   ExpectSceneError(R"(, "material": {"law": "NeoHookean", "youngs_modulus": 1e4,

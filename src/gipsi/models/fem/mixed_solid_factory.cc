@@ -21,17 +21,22 @@ void RegisterMixedSolid(TypeRegistry& registry) {
         params.material = ctx.registry.CreateMaterialAs<SolidMaterial>(p.At("material"), "solid");
         if (auto formulation = p.Find("formulation"))
           static_cast<void>(formulation->AsChoice({"P2-P1"}));
-        params.incompressible = p.Bool("incompressible", params.incompressible);
+
         if (auto integrator = p.Find("integrator"))
           static_cast<void>(integrator->AsChoice({"Static"}));
         if (auto newton = p.Find("newton"))
           params.newton = ParseNewtonOptions(*newton, params.newton);
+        params.incompressible = p.Bool("incompressible", params.incompressible);
         if (auto solver = p.Find("linear_solver")) {
           params.linear_solver = ParseLinearSolverOptions(*solver);
           if (params.linear_solver.type == "cg" || params.linear_solver.type == "cholmod")
             solver->At("type").Expected(
                 "\"umfpack\" or \"ldlt\": the mixed system is a saddle point, not positive "
                 "definite (\"ldlt\" only when the material is not incompressible)");
+          if (params.incompressible && params.linear_solver.type == "ldlt")
+            solver->At("type").Expected(
+                "\"umfpack\": an incompressible material's saddle point has a zero pressure "
+                "block, which LDLT without pivoting cannot factorise");
         }
         if (auto steps = p.Find("load_steps")) {
           const std::int64_t n = steps->AsInt();
