@@ -21,6 +21,7 @@
 #include "gipsi/models/fem/mixed_solid.h"
 #include "gipsi/models/fem/quadratic_tets.h"
 #include "gipsi/models/fem/solid_laws.h"
+#include "gipsi/models/fibres/rule_based_fibres.h"
 #include "models/fem/fem_test_util.h"
 
 namespace gipsi {
@@ -469,6 +470,60 @@ TEST(MixedSolid, WarnsOfSliversWhenBuilt) {
   EXPECT_THAT(captured.str(), ::testing::HasSubstr("flat: tet"));
   EXPECT_THAT(captured.str(), ::testing::HasSubstr("aspect ratio"));
   EXPECT_THAT(captured.str(), ::testing::Not(::testing::HasSubstr("cube:")));
+}
+
+// Rule-based fibres are evaluated at the quadrature points, with the transmural coordinate
+// interpolated there: the helix angle (linear in that coordinate) then varies inside a tet,
+// and its mean over a tet's four points (whose barycentric coordinates average to the
+// centroid's) is the angle the rule gives at the centroid (FemSolid's fibre).
+TEST(MixedSolid, RuleFibresTurnInsideEachTet) {
+  const std::string text = R"({"gipsi": 1,
+    "meshes": {"lv": {"generate": "ellipsoid_shell", "endo": [0.007, 0.017],
+                      "epi": [0.010, 0.020], "base_z": 0.005, "size": 0.004}},
+    "objects": {"lv": {"type": "MixedSolid", "domain": "lv", "dt": 1,
+      "material": {"law": "Guccione", "C": 2000, "bf": 8, "bt": 2, "bfs": 4, "bulk_modulus": 2e6},
+      "fibres": {"rule": "transmural", "endo": {"group": "endo"}, "epi": {"group": "epi"},
+                 "endo_angle": 90, "epi_angle": -90}}},
+    "schedule": {"end": 1}})";
+  TypeRegistry registry;
+  RegisterBuiltins(registry);
+  Scene scene = LoadSceneFromString(text, "lv.json", ".", registry);
+  const auto& solid = dynamic_cast<const MixedSolid&>(scene.kernel->FindObject("lv"));
+  const Mesh& mesh = *scene.meshes.at("lv");
+  TransmuralFibreRule rule;
+  rule.endo = GroupRegion{"endo"};
+  rule.epi = GroupRegion{"epi"};
+  rule.endo_angle = 90;
+  rule.epi_angle = -90;
+  const FibreField centroid = MakeTransmuralFibres(mesh, rule);
+  const Vec3 k = Vec3::UnitZ();
+  int turning = 0;
+  for (Index e = 0; e < mesh.num_tets(); ++e) {
+    const Vec3 t = centroid.sheet.col(e);
+    const Vec3 c = k.cross(t).normalized();
+    const Vec3 l = t.cross(c);
+    if (k.cross(t).norm() < 1e-3) continue;  // at the apex c is defined otherwise
+    const auto angle = [&](const Vec3& f) { return std::atan2(f.dot(l), f.dot(c)); };
+    // Fibres are directions: fold angles into (−90°, 90°] before averaging.
+    const auto fold = [](double a) {
+      constexpr double kPi = 3.14159265358979323846;
+      return a > kPi / 2 ? a - kPi : (a <= -kPi / 2 ? a + kPi : a);
+    };
+    double mean = 0, lo = 10, hi = -10;
+    for (int q = 0; q < 4; ++q) {
+      const Vec3 f = solid.axes_at(e, q).col(0);
+      EXPECT_NEAR(f.norm(), 1.0, 1e-12);
+      EXPECT_NEAR(f.dot(t), 0.0, 1e-12);  // tangent to the wall
+      const double a = angle(f);
+      mean += a / 4;
+      lo = std::min(lo, a);
+      hi = std::max(hi, a);
+    }
+    EXPECT_NEAR(fold(mean), fold(angle(centroid.fibre.col(e))), 1e-9) << "tet " << e;
+    if (hi - lo > 0.1) ++turning;
+  }
+  // Most tets of a wall two or three tets thick span a good part of it.
+  EXPECT_GT(turning, mesh.num_tets() / 2);
 }
 
 }  // namespace

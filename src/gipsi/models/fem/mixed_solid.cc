@@ -64,7 +64,8 @@ MixedSolid::MixedSolid(std::string name, std::shared_ptr<const Mesh> domain,
   if (params_.fibre.norm() == 0)
     throw InputError(fmt::format("object '{}': the fibre direction is zero", this->name()));
   mesh_ = ElevateToQuadratic(*domain);
-  axes_.assign(static_cast<std::size_t>(mesh_.num_elements()), Frame(params_.fibre, params_.sheet));
+  axes_.assign(static_cast<std::size_t>(kQuad * mesh_.num_elements()),
+               Frame(params_.fibre, params_.sheet));
   active_prev_ = VecX::Zero(mesh_.num_elements());
   active_new_ = VecX::Zero(mesh_.num_elements());
   SetGeometry(domain, MakeBoundary(*domain));
@@ -237,18 +238,29 @@ double MixedSolid::CurrentVolume() const {
   return v;
 }
 
-MaterialPoint MixedSolid::PointOf(Index e, double load) const {
+void MixedSolid::SetFibreAt(Index e, int q, const Vec3& fibre) {
+  GIPSI_CHECK(e >= 0 && e < mesh_.num_elements() && q >= 0 && q < kQuad && fibre.norm() > 0,
+              "MixedSolid::SetFibreAt({}, {}): no such point or a zero fibre", e, q);
+  Mat3& axes = axes_[static_cast<std::size_t>(kQuad * e + q)];
+  axes = Frame(fibre, axes.col(1));
+}
+
+const Mat3& MixedSolid::axes_at(Index e, int q) const {
+  return axes_[static_cast<std::size_t>(kQuad * e + q)];
+}
+
+MaterialPoint MixedSolid::PointOf(Index e, int q, double load) const {
   MaterialPoint mp;
-  mp.axes = axes_[static_cast<std::size_t>(e)];
+  mp.axes = axes_[static_cast<std::size_t>(kQuad * e + q)];
   mp.active_tension = (1 - load) * active_prev_[e] + load * active_new_[e];
   return mp;
 }
 
 double MixedSolid::ElementEnergy(Index e, const VecX& z) const {
   const TetQuadrature& rule = TetRuleDegree2();
-  const MaterialPoint mp = PointOf(e, 1.0);
   double w = 0;
   for (int q = 0; q < kQuad; ++q) {
+    const MaterialPoint mp = PointOf(e, q, 1.0);
     const auto g = Eigen::Map<const Eigen::Matrix<double, 3, 10>>(
         grad_.data() + (static_cast<std::size_t>(e) * kQuad + q) * 30);
     Mat3 F = Mat3::Identity();
@@ -275,7 +287,6 @@ bool MixedSolid::Assemble(const VecX& z, double load, VecX& r, double* jv) const
   Mat3 P;
   Mat9 C;
   for (Index e = 0; e < mesh_.num_elements(); ++e) {
-    const MaterialPoint mp = PointOf(e, load);
     Eigen::Matrix<double, 3, 10> u;
     for (int a = 0; a < 10; ++a) u.col(a) = z.segment<3>(3 * mesh_.elements(a, e));
     Eigen::Vector4d pe;
@@ -289,6 +300,7 @@ bool MixedSolid::Assemble(const VecX& z, double load, VecX& r, double* jv) const
           grad_.data() + (static_cast<std::size_t>(e) * kQuad + q) * 30);
       const Eigen::Vector4d& lq = rule.points[static_cast<std::size_t>(q)];
       const double w = volume_[e] * rule.weights[static_cast<std::size_t>(q)];
+      const MaterialPoint mp = PointOf(e, q, load);
       const Mat3 F = Mat3::Identity() + u * g.transpose();
       const double J = F.determinant();
       if (!(J > kMinJacobian)) return false;
@@ -632,8 +644,7 @@ void MixedSolid::DoReadField(FieldId id, Eigen::Ref<Eigen::MatrixXd> out) const 
       out(0, e) = mean;
     }
   } else if (id == f_fibre_) {
-    for (Index e = 0; e < mesh_.num_elements(); ++e)
-      out.col(e) = axes_[static_cast<std::size_t>(e)].col(0);
+    for (Index e = 0; e < mesh_.num_elements(); ++e) out.col(e) = axes_at(e, 0).col(0);
   } else if (id == f_active_) {
     out = active_new_.transpose();
   } else if (id == f_volume_) {
@@ -652,9 +663,9 @@ void MixedSolid::DoWriteField(FieldId id, const Eigen::Ref<const Eigen::MatrixXd
     external_force_ = in;
   } else if (id == f_fibre_) {
     for (Index e = 0; e < mesh_.num_elements(); ++e) {
-      Mat3& axes = axes_[static_cast<std::size_t>(e)];
       const Vec3 fibre = in.col(e);
-      if (fibre.squaredNorm() > 0) axes = Frame(fibre, axes.col(1));
+      if (fibre.squaredNorm() > 0)
+        for (int q = 0; q < kQuad; ++q) SetFibreAt(e, q, fibre);
     }
   } else if (id == f_active_) {
     active_new_ = in.row(0).transpose();
@@ -680,9 +691,9 @@ void MixedSolid::SaveObjectState(StateWriter& out) const {
   out.WriteMatrix(external_force_);
   out.WriteMatrix(active_prev_);
   out.WriteMatrix(active_new_);
-  Eigen::MatrixXd axes(9, mesh_.num_elements());
-  for (Index e = 0; e < mesh_.num_elements(); ++e)
-    axes.col(e) = axes_[static_cast<std::size_t>(e)].reshaped();
+  Eigen::MatrixXd axes(9, static_cast<Index>(axes_.size()));
+  for (std::size_t i = 0; i < axes_.size(); ++i)
+    axes.col(static_cast<Index>(i)) = axes_[i].reshaped();
   out.WriteMatrix(axes);
   out.WriteInt(last_newton_.iterations);
   out.WriteInt(total_iterations_);
@@ -700,10 +711,10 @@ void MixedSolid::RestoreObjectState(StateReader& in) {
   in.ReadMatrixExact(external_force_, "the external force");
   in.ReadMatrixExact(active_prev_, "the previous active tension");
   in.ReadMatrixExact(active_new_, "the active tension");
-  Eigen::MatrixXd axes(9, mesh_.num_elements());
+  Eigen::MatrixXd axes(9, static_cast<Index>(axes_.size()));
   in.ReadMatrixExact(axes, "the material axes");
-  for (Index e = 0; e < mesh_.num_elements(); ++e)
-    axes_[static_cast<std::size_t>(e)] = axes.col(e).reshaped(3, 3);
+  for (std::size_t i = 0; i < axes_.size(); ++i)
+    axes_[i] = axes.col(static_cast<Index>(i)).reshaped(3, 3);
   last_newton_ = NewtonStats{};
   last_newton_.iterations = static_cast<int>(in.ReadInt());
   last_newton_.converged = true;

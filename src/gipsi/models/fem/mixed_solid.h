@@ -39,7 +39,8 @@
 /// quadrature points), "volume" (global, m³, ∫ J dV), "strain_energy" (global, J, ∫ W̃ dV +
 /// ∫ κ/2 (ln J)² dV for finite κ), "newton_iterations" (global, last increment).
 ///
-/// Fields "fibre" and "active_tension" (element, read/write) give per-element material axes and
+/// Fields "fibre" and "active_tension" (element, read/write; "fibre" reads the first quadrature
+/// point's and writes all four, SetFibreAt sets one) give the material axes and
 /// an active tension along the fibre (MaterialPoint), ramped from the previous step's values
 /// with the loads.
 ///
@@ -110,6 +111,12 @@ class MixedSolid final : public SimObject, private NonlinearSystem {
   /// Number of unknowns (3 × nodes + vertices) and the pressure scale s [Pa/m].
   [[nodiscard]] Index num_unknowns() const { return 3 * mesh_.num_nodes() + mesh_.num_vertices; }
   [[nodiscard]] double pressure_scale() const { return pressure_scale_; }
+  /// Sets the fibre at quadrature point q (0..3) of element e (the sheet is re-orthogonalised
+  /// against it): for fibre rules evaluated where the element integrates (rule-based fibres
+  /// through a wall only one or two tets thick). Preconditions checked.
+  void SetFibreAt(Index e, int q, const Vec3& fibre);
+  /// Material axes (columns fibre, sheet, normal) at quadrature point q of element e.
+  [[nodiscard]] const Mat3& axes_at(Index e, int q) const;
   /// The current unknowns z.
   [[nodiscard]] const VecX& unknowns() const { return z_; }
 
@@ -131,8 +138,8 @@ class MixedSolid final : public SimObject, private NonlinearSystem {
   /// (the active tension is ramped with the loads); false if an element is
   /// outside its law's domain. Sets residual_floor_.
   bool Assemble(const VecX& z, double load, VecX& r, double* jv) const;
-  /// Material axes and active tension of element e at load fraction `load`.
-  [[nodiscard]] MaterialPoint PointOf(Index e, double load) const;
+  /// Material axes at quadrature point q of element e, active tension at load fraction `load`.
+  [[nodiscard]] MaterialPoint PointOf(Index e, int q, double load) const;
   /// Adds −f_ext at load fraction s and its tangent (face loads) at z.
   void AssembleLoads(const VecX& z, double s, VecX& r, double* jv) const;
   /// Zeroes the constrained rows (and columns in J, unit diagonal times diag_scale_).
@@ -153,7 +160,7 @@ class MixedSolid final : public SimObject, private NonlinearSystem {
   QuadraticTets mesh_;
   std::vector<double> grad_;       // per element and quadrature point: 3 × 10 ∇N (column-major)
   VecX volume_;                    // rest volume per element
-  std::vector<Mat3> axes_;         // per element: fibre, sheet, normal
+  std::vector<Mat3> axes_;         // per quadrature point (4 per tet): fibre, sheet, normal
   VecX active_prev_, active_new_;  // per element active tension at s = 0 and s = 1 [Pa]
   double pressure_scale_ = 1;
   // Boundary faces as 6-node triangles (P2 node ids).

@@ -73,9 +73,21 @@ void RegisterMixedSolid(TypeRegistry& registry) {
         try {
           auto mesh = ctx.DomainMesh();
           auto solid = std::make_unique<MixedSolid>(ctx.name, mesh, std::move(params));
-          if (fibre_rule)
-            solid->WriteField(solid->FindField("fibre"),
-                              MakeTransmuralFibres(*mesh, *fibre_rule).fibre);
+          if (fibre_rule) {
+            // The rule at each quadrature point, with the transmural coordinate interpolated
+            // there: a 3 mm wall meshed with one or two tets across still sees its fibres turn.
+            const FibreField fibres = MakeTransmuralFibres(*mesh, *fibre_rule);
+            const TetQuadrature& rule = TetRuleDegree2();
+            for (Index e = 0; e < mesh->num_tets(); ++e)
+              for (int q = 0; q < 4; ++q) {
+                double coordinate = 0;
+                for (int b = 0; b < 4; ++b)
+                  coordinate += rule.points[static_cast<std::size_t>(q)][b] *
+                                fibres.transmural[mesh->tets(b, e)];
+                solid->SetFibreAt(e, q,
+                                  TransmuralFibreAt(*fibre_rule, fibres.sheet.col(e), coordinate));
+              }
+          }
           if (active_tension > 0)
             solid->WriteField(solid->FindField("active_tension"),
                               Eigen::MatrixXd::Constant(1, mesh->num_tets(), active_tension));

@@ -84,7 +84,6 @@ FibreField MakeTransmuralFibres(const Mesh& mesh, const TransmuralFibreRule& rul
   out.fibre.resize(3, ne);
   out.sheet.resize(3, ne);
   const Vec3 k = rule.axis.normalized();
-  constexpr double kDegree = std::numbers::pi / 180;
   for (Index e = 0; e < ne; ++e) {
     const Eigen::Matrix<double, 4, 3> grad = P1Gradients(mesh.nodes, mesh.tets, e);
     Vec3 g = Vec3::Zero();
@@ -104,18 +103,23 @@ FibreField MakeTransmuralFibres(const Mesh& mesh, const TransmuralFibreRule& rul
       if (t.norm() == 0) t = Vec3::UnitX();
     }
     t.normalize();
-    Vec3 c = k.cross(t);
-    if (c.norm() < 1e-6) {
-      for (int a = 0; a < 3 && c.norm() < 1e-6; ++a) c = Vec3::Unit(a).cross(t);
-    }
-    c.normalize();
-    const Vec3 l = t.cross(c);
-    const double alpha =
-        kDegree * (rule.endo_angle + (rule.epi_angle - rule.endo_angle) * centroid);
-    out.fibre.col(e) = std::cos(alpha) * c + std::sin(alpha) * l;
+    out.fibre.col(e) = TransmuralFibreAt(rule, t, centroid);
     out.sheet.col(e) = t;
   }
   return out;
+}
+
+Vec3 TransmuralFibreAt(const TransmuralFibreRule& rule, const Vec3& t, double e) {
+  constexpr double kDegree = std::numbers::pi / 180;
+  const Vec3 k = rule.axis.normalized();
+  Vec3 c = k.cross(t);
+  if (c.norm() < 1e-6) {
+    for (int a = 0; a < 3 && c.norm() < 1e-6; ++a) c = Vec3::Unit(a).cross(t);
+  }
+  c.normalize();
+  const Vec3 l = t.cross(c);
+  const double alpha = kDegree * (rule.endo_angle + (rule.epi_angle - rule.endo_angle) * e);
+  return std::cos(alpha) * c + std::sin(alpha) * l;
 }
 
 TransmuralFibreRule ParseTransmuralFibreRule(const JsonNode& node) {

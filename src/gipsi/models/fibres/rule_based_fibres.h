@@ -38,6 +38,13 @@ struct FibreField {
 /// or epi selects no node or they share a node, or if the Laplace solve fails.
 FibreField MakeTransmuralFibres(const Mesh& mesh, const TransmuralFibreRule& rule);
 
+/// The rule's fibre at transmural coordinate `e` in a tet whose unit transmural direction is
+/// `t` (FibreField::sheet): f = cos α c + sin α l, α = α_endo + (α_epi − α_endo) e (step 3
+/// above). MakeTransmuralFibres evaluates it at each tet's centroid; a solver may evaluate it
+/// at its quadrature points (e interpolated from FibreField::transmural), so that a wall only
+/// one or two tets thick still sees the fibre turn through it.
+[[nodiscard]] Vec3 TransmuralFibreAt(const TransmuralFibreRule& rule, const Vec3& t, double e);
+
 /// Reads {"rule": "transmural", "endo": region, "epi": region, "axis": [x, y, z],
 /// "endo_angle": degrees, "epi_angle": degrees}; throws InputError naming the JSON path.
 TransmuralFibreRule ParseTransmuralFibreRule(const JsonNode& node);
