@@ -10,6 +10,7 @@
 
 #include "gipsi/base/error.h"
 #include "gipsi/base/log.h"
+#include "gipsi/models/fem/fem_geometry.h"
 #include "gipsi/models/fem/surface_loads.h"
 
 namespace gipsi {
@@ -18,18 +19,6 @@ namespace {
 using Clock = std::chrono::steady_clock;
 double Seconds(Clock::time_point since) {
   return std::chrono::duration<double>(Clock::now() - since).count();
-}
-
-Mat3 FrameFrom(const Vec3& fibre, const Vec3& sheet) {
-  Mat3 axes;
-  const Vec3 f = fibre.normalized();
-  Vec3 s = sheet - sheet.dot(f) * f;
-  if (s.norm() < 1e-8) s = f.unitOrthogonal();
-  s.normalize();
-  axes.col(0) = f;
-  axes.col(1) = s;
-  axes.col(2) = f.cross(s);
-  return axes;
 }
 
 }  // namespace
@@ -48,7 +37,7 @@ FemSolid::FemSolid(std::string name, std::shared_ptr<const Mesh> domain, FemPara
   active_tension_ = VecX::Zero(ne);
   nodal_active_tension_ = VecX::Zero(n);
   if (law_->needs_fibres())
-    axes_.assign(static_cast<std::size_t>(ne), FrameFrom(params_.fibre, params_.sheet));
+    axes_.assign(static_cast<std::size_t>(ne), MaterialAxes(params_.fibre, params_.sheet));
   lumped_mass_ = assembly_.LumpedMass(params_.density);
   for (Index i = 0; i < n; ++i)
     if (!(lumped_mass_[i] > 0))
@@ -687,7 +676,7 @@ void FemSolid::DoReadField(FieldId id, Eigen::Ref<Eigen::MatrixXd> out) const {
     }
   } else if (id == f_fibre_) {
     for (Index e = 0; e < num_elements(); ++e)
-      out.col(e) = axes_.empty() ? Vec3(FrameFrom(params_.fibre, params_.sheet).col(0))
+      out.col(e) = axes_.empty() ? Vec3(MaterialAxes(params_.fibre, params_.sheet).col(0))
                                  : Vec3(axes_[static_cast<std::size_t>(e)].col(0));
   } else if (id == f_active_) {
     for (Index e = 0; e < num_elements(); ++e) out(0, e) = PointOf(e).active_tension;
@@ -731,11 +720,11 @@ void FemSolid::DoWriteField(FieldId id, const Eigen::Ref<const Eigen::MatrixXd>&
   } else if (id == f_fibre_) {
     if (axes_.empty())
       axes_.assign(static_cast<std::size_t>(num_elements()),
-                   FrameFrom(params_.fibre, params_.sheet));
+                   MaterialAxes(params_.fibre, params_.sheet));
     for (Index e = 0; e < num_elements(); ++e) {
       Mat3& axes = axes_[static_cast<std::size_t>(e)];
       const Vec3 fibre = in.col(e);
-      if (fibre.squaredNorm() > 0) axes = FrameFrom(fibre, axes.col(1));
+      if (fibre.squaredNorm() > 0) axes = MaterialAxes(fibre, axes.col(1));
     }
   } else if (id == f_active_) {
     active_tension_ = in.row(0).transpose();

@@ -12,6 +12,7 @@
 #include "gipsi/base/log.h"
 #include "gipsi/base/state.h"
 #include "gipsi/geometry/quality.h"
+#include "gipsi/models/fem/fem_geometry.h"
 #include "gipsi/models/fem/solid_laws.h"
 
 namespace gipsi {
@@ -22,24 +23,6 @@ constexpr int kQuad = 4;    // quadrature points per element
 constexpr double kEps = std::numeric_limits<double>::epsilon();
 /// Aspect ratio (CheckTetQuality: 1 regular) above which the constructor warns of a sliver.
 constexpr double kSliverAspect = 6;
-
-Mat3 Frame(const Vec3& fibre, const Vec3& sheet) {
-  Mat3 axes;
-  const Vec3 f = fibre.normalized();
-  Vec3 s = sheet - sheet.dot(f) * f;
-  if (s.norm() < 1e-8) s = f.unitOrthogonal();
-  s.normalize();
-  axes.col(0) = f;
-  axes.col(1) = s;
-  axes.col(2) = f.cross(s);
-  return axes;
-}
-
-Mat3 Cross(const Vec3& v) {
-  Mat3 m;
-  m << 0, -v.z(), v.y(), v.z(), 0, -v.x(), -v.y(), v.x(), 0;
-  return m;
-}
 
 /// Sorted, unique.
 void SortUnique(std::vector<int>& v) {
@@ -65,7 +48,7 @@ MixedSolid::MixedSolid(std::string name, std::shared_ptr<const Mesh> domain,
     throw InputError(fmt::format("object '{}': the fibre direction is zero", this->name()));
   mesh_ = ElevateToQuadratic(*domain);
   axes_.assign(static_cast<std::size_t>(kQuad * mesh_.num_elements()),
-               Frame(params_.fibre, params_.sheet));
+               MaterialAxes(params_.fibre, params_.sheet));
   active_prev_ = VecX::Zero(mesh_.num_elements());
   active_new_ = VecX::Zero(mesh_.num_elements());
   SetGeometry(domain, MakeBoundary(*domain));
@@ -223,16 +206,21 @@ Points MixedSolid::NodeDisplacements() const {
 
 VecX MixedSolid::Pressures() const { return pressure_scale_ * z_.tail(mesh_.num_vertices); }
 
+Mat3 MixedSolid::DeformationGradient(Index e, int q, const VecX& z) const {
+  const auto g = Eigen::Map<const Eigen::Matrix<double, 3, 10>>(
+      grad_.data() + (static_cast<std::size_t>(e) * kQuad + q) * 30);
+  Mat3 F = Mat3::Identity();
+  for (int a = 0; a < 10; ++a)
+    F.noalias() += z.segment<3>(3 * mesh_.elements(a, e)) * g.col(a).transpose();
+  return F;
+}
+
 double MixedSolid::CurrentVolume() const {
   const TetQuadrature& rule = TetRuleDegree2();
   double v = 0;
   for (Index e = 0; e < mesh_.num_elements(); ++e)
     for (int q = 0; q < kQuad; ++q) {
-      const auto g = Eigen::Map<const Eigen::Matrix<double, 3, 10>>(
-          grad_.data() + (static_cast<std::size_t>(e) * kQuad + q) * 30);
-      Mat3 F = Mat3::Identity();
-      for (int a = 0; a < 10; ++a)
-        F.noalias() += z_.segment<3>(3 * mesh_.elements(a, e)) * g.col(a).transpose();
+      const Mat3 F = DeformationGradient(e, q, z_);
       v += volume_[e] * rule.weights[static_cast<std::size_t>(q)] * F.determinant();
     }
   return v;
@@ -242,7 +230,7 @@ void MixedSolid::SetFibreAt(Index e, int q, const Vec3& fibre) {
   GIPSI_CHECK(e >= 0 && e < mesh_.num_elements() && q >= 0 && q < kQuad && fibre.norm() > 0,
               "MixedSolid::SetFibreAt({}, {}): no such point or a zero fibre", e, q);
   Mat3& axes = axes_[static_cast<std::size_t>(kQuad * e + q)];
-  axes = Frame(fibre, axes.col(1));
+  axes = MaterialAxes(fibre, axes.col(1));
 }
 
 const Mat3& MixedSolid::axes_at(Index e, int q) const {
@@ -261,11 +249,7 @@ double MixedSolid::ElementEnergy(Index e, const VecX& z) const {
   double w = 0;
   for (int q = 0; q < kQuad; ++q) {
     const MaterialPoint mp = PointOf(e, q, 1.0);
-    const auto g = Eigen::Map<const Eigen::Matrix<double, 3, 10>>(
-        grad_.data() + (static_cast<std::size_t>(e) * kQuad + q) * 30);
-    Mat3 F = Mat3::Identity();
-    for (int a = 0; a < 10; ++a)
-      F.noalias() += z.segment<3>(3 * mesh_.elements(a, e)) * g.col(a).transpose();
+    const Mat3 F = DeformationGradient(e, q, z);
     double energy = law_->Energy(F, mp);
     if (params_.incompressible && std::isfinite(energy)) {
       const double log_j = std::log(F.determinant());
@@ -384,7 +368,7 @@ void MixedSolid::AssembleLoads(const VecX& z, double s, VecX& r, double* jv) con
       if (jv == nullptr) continue;
       const Vec3 unit = area > 0 ? Vec3(normal / area) : Vec3::Zero();
       for (int b = 0; b < 6; ++b) {
-        const Mat3 dnormal = -Cross(eta) * dn(b, 0) + Cross(xi) * dn(b, 1);
+        const Mat3 dnormal = -CrossMatrix(eta) * dn(b, 0) + CrossMatrix(xi) * dn(b, 1);
         const Mat3 ddensity = -p * dnormal + t * (unit.transpose() * dnormal);
         for (int a = 0; a < 6; ++a) k.block<3, 3>(3 * a, 3 * b) += (w * n_shape[a]) * ddensity;
       }
@@ -540,11 +524,7 @@ std::string MixedSolid::MostCompressedElement() const {
   Index worst = -1;
   for (Index e = 0; e < mesh_.num_elements(); ++e)
     for (int q = 0; q < kQuad; ++q) {
-      const auto g = Eigen::Map<const Eigen::Matrix<double, 3, 10>>(
-          grad_.data() + (static_cast<std::size_t>(e) * kQuad + q) * 30);
-      Mat3 F = Mat3::Identity();
-      for (int a = 0; a < 10; ++a)
-        F.noalias() += z_.segment<3>(3 * mesh_.elements(a, e)) * g.col(a).transpose();
+      const Mat3 F = DeformationGradient(e, q, z_);
       if (const double j = F.determinant(); j < smallest) {
         smallest = j;
         worst = e;
@@ -634,11 +614,7 @@ void MixedSolid::DoReadField(FieldId id, Eigen::Ref<Eigen::MatrixXd> out) const 
     for (Index e = 0; e < mesh_.num_elements(); ++e) {
       double mean = 0;
       for (int q = 0; q < kQuad; ++q) {
-        const auto g = Eigen::Map<const Eigen::Matrix<double, 3, 10>>(
-            grad_.data() + (static_cast<std::size_t>(e) * kQuad + q) * 30);
-        Mat3 F = Mat3::Identity();
-        for (int a = 0; a < 10; ++a)
-          F.noalias() += z_.segment<3>(3 * mesh_.elements(a, e)) * g.col(a).transpose();
+        const Mat3 F = DeformationGradient(e, q, z_);
         mean += F.determinant() / kQuad;
       }
       out(0, e) = mean;

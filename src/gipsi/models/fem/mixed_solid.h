@@ -150,6 +150,8 @@ class MixedSolid final : public SimObject, private NonlinearSystem {
   void SetTargets(VecX& z, double s) const;
   StepStatus Advance(double s0, double s1, int depth);
   void UpdatePositions();
+  /// F = I + Σ_a u_a ⊗ ∇N_a at quadrature point q of element e for the unknowns z.
+  [[nodiscard]] Mat3 DeformationGradient(Index e, int q, const VecX& z) const;
   [[nodiscard]] double ElementEnergy(Index e, const VecX& z) const;
   /// "; … the smallest J … in tet N (centre …)" at the current state, for failure messages.
   [[nodiscard]] std::string MostCompressedElement() const;

@@ -1,20 +1,13 @@
 #include "gipsi/models/fem/surface_loads.h"
 
+#include "gipsi/models/fem/fem_geometry.h"
+
 namespace gipsi {
-namespace {
-
-Mat3 Cross(const Vec3& u) {
-  Mat3 m;
-  m << 0, -u.z(), u.y(), u.z(), 0, -u.x(), -u.y(), u.x(), 0;
-  return m;
-}
-
-}  // namespace
 
 void AreaNormalDerivatives(const Vec3& x0, const Vec3& x1, const Vec3& x2, Mat3 out[3]) {
   const Vec3 e1 = x1 - x0, e2 = x2 - x0;
-  out[1] = -Cross(e2);
-  out[2] = Cross(e1);
+  out[1] = -CrossMatrix(e2);
+  out[2] = CrossMatrix(e1);
   out[0] = -(out[1] + out[2]);
 }
 
