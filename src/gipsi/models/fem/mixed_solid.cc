@@ -101,6 +101,7 @@ MixedSolid::MixedSolid(std::string name, std::shared_ptr<const Mesh> domain,
   // Boundary faces as 6-node triangles, each with its tet's local numbering of its nodes.
   const BoundarySurface& bnd = boundary();
   faces_.resize(6, bnd.num_triangles());
+  face_local_.resize(6, bnd.num_triangles());
   for (Index f = 0; f < bnd.num_triangles(); ++f) {
     int v[3];
     for (int i = 0; i < 3; ++i)
@@ -108,6 +109,15 @@ MixedSolid::MixedSolid(std::string name, std::shared_ptr<const Mesh> domain,
     for (int i = 0; i < 3; ++i) faces_(i, f) = v[i];
     for (int k = 0; k < 3; ++k)
       faces_(3 + k, f) = mesh_.EdgeNode(v[kTriangleEdges[k][0]], v[kTriangleEdges[k][1]]);
+    // Where the face's nodes sit in its tet: the load tangent scatters through that tet.
+    const Index tet = bnd.face_to_tet[static_cast<std::size_t>(f)];
+    for (int a = 0; a < 6; ++a) {
+      face_local_(a, f) = -1;
+      for (int m = 0; m < 10; ++m)
+        if (mesh_.elements(m, tet) == faces_(a, f)) face_local_(a, f) = m;
+      GIPSI_CHECK(face_local_(a, f) >= 0, "MixedSolid: boundary face {} is not a face of tet {}", f,
+                  tet);
+    }
   }
 
   // Sparsity: unknowns 3·node + i (displacements), then 3·nodes + vertex (pressures).
@@ -377,12 +387,7 @@ void MixedSolid::AssembleLoads(const VecX& z, double s, VecX& r, double* jv) con
     if (jv == nullptr) continue;
     // J −= sym(∂f_ext/∂x), through the face's tet (every face pair is a pair of that tet).
     const Index tet = bnd.face_to_tet[static_cast<std::size_t>(f)];
-    int local[6];
-    for (int a = 0; a < 6; ++a) {
-      local[a] = -1;
-      for (int m = 0; m < 10; ++m)
-        if (mesh_.elements(m, tet) == faces_(a, f)) local[a] = m;
-    }
+    const auto local = face_local_.col(f);
     // The exact load tangent is not symmetric; the symmetric solvers get its symmetric part
     // (Newton then converges linearly: in a slender body under follower pressure, such as the
     // Land beam, the dropped part is of the order of the softest bending stiffness).

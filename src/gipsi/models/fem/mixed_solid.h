@@ -167,6 +167,7 @@ class MixedSolid final : public SimObject, private NonlinearSystem {
   double pressure_scale_ = 1;
   // Boundary faces as 6-node triangles (P2 node ids).
   Eigen::Matrix<int, 6, Eigen::Dynamic> faces_;
+  Eigen::Matrix<int, 6, Eigen::Dynamic> face_local_;  // their local numbers in the face's tet
   // Sparse pattern and the value index of every (local row, local column) of every element.
   SparseMatrix jac_;
   std::vector<int> element_value_index_;  // 34 × 34 per element
