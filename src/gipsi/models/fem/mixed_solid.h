@@ -2,8 +2,8 @@
 /// @file
 /// `MixedSolid`: quasi-static, nearly or fully incompressible hyperelasticity without locking —
 /// Taylor–Hood P2–P1 elements (quadratic displacements on 10-node tets, continuous linear
-/// pressure on the vertices), the inf–sup stable pair used by the cardiac-mechanics benchmark
-/// codes (Land et al., "Verification of cardiac mechanics software: benchmark problems and
+/// pressure on the vertices), the classic inf–sup stable pair, verified on the cardiac-mechanics
+/// benchmarks (Land et al., "Verification of cardiac mechanics software: benchmark problems and
 /// solutions for testing active and passive material behaviour", Proc. R. Soc. A 471, 2015).
 ///
 /// The law's energy must split as W(F) = W̃(F) + κ/2 (ln J)² (SolidMaterial::
@@ -33,8 +33,8 @@
 /// solve fails up to `max_bisections` times.
 ///
 /// The vertex nodes are the domain mesh's nodes, so every node field, probe, boundary and
-/// display works on the linear mesh (displacements at vertices are the P2 solution's nodal
-/// values, exact); fields: the mechanical fields, "pressure" (node, Pa; the hydrostatic
+/// display works on the linear mesh (they show the P2 solution's values at the vertices);
+/// fields: the mechanical fields, "pressure" (node, Pa; the hydrostatic
 /// pressure p, positive in tension as p = κ ln J), "volume_ratio" (element, mean J over its
 /// quadrature points), "volume" (global, m³, ∫ J dV), "strain_energy" (global, J, ∫ W̃ dV +
 /// ∫ κ/2 (ln J)² dV for finite κ), "newton_iterations" (global, last increment).
