@@ -45,6 +45,19 @@ NewtonOptions ParseNewtonOptions(const JsonNode& node, NewtonOptions options) {
   return options;
 }
 
+void ParseLoadStepping(const JsonNode& object, int& load_steps, int& max_bisections) {
+  if (auto steps = object.Find("load_steps")) {
+    const std::int64_t n = steps->AsInt();
+    if (n < 1 || n > 100000) steps->Expected("an integer in [1, 100000]");
+    load_steps = static_cast<int>(n);
+  }
+  if (auto bisections = object.Find("max_bisections")) {
+    const std::int64_t n = bisections->AsInt();
+    if (n < 0 || n > 30) bisections->Expected("an integer in [0, 30]");
+    max_bisections = static_cast<int>(n);
+  }
+}
+
 void RegisterFemSolid(TypeRegistry& registry) {
   registry.local_models.Register(
       "FemSolid",
@@ -85,16 +98,7 @@ void RegisterFemSolid(TypeRegistry& registry) {
           params.newton = ParseNewtonOptions(*newton, params.newton);
         if (auto solver = p.Find("linear_solver"))
           params.linear_solver = ParseLinearSolverOptions(*solver);
-        if (auto steps = p.Find("load_steps")) {
-          const std::int64_t n = steps->AsInt();
-          if (n < 1 || n > 100000) steps->Expected("an integer in [1, 100000]");
-          params.load_steps = static_cast<int>(n);
-        }
-        if (auto bisections = p.Find("max_bisections")) {
-          const std::int64_t n = bisections->AsInt();
-          if (n < 0 || n > 30) bisections->Expected("an integer in [0, 30]");
-          params.max_bisections = static_cast<int>(n);
-        }
+        ParseLoadStepping(p, params.load_steps, params.max_bisections);
         if (auto predictor = p.Find("predictor"))
           params.predict_velocity =
               predictor->AsChoice({"none", "constant_velocity"}) == "constant_velocity";

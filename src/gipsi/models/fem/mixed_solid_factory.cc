@@ -38,16 +38,7 @@ void RegisterMixedSolid(TypeRegistry& registry) {
                 "\"umfpack\": an incompressible material's saddle point has a zero pressure "
                 "block, which LDLT without pivoting cannot factorise");
         }
-        if (auto steps = p.Find("load_steps")) {
-          const std::int64_t n = steps->AsInt();
-          if (n < 1 || n > 100000) steps->Expected("an integer in [1, 100000]");
-          params.load_steps = static_cast<int>(n);
-        }
-        if (auto bisections = p.Find("max_bisections")) {
-          const std::int64_t n = bisections->AsInt();
-          if (n < 0 || n > 30) bisections->Expected("an integer in [0, 30]");
-          params.max_bisections = static_cast<int>(n);
-        }
+        ParseLoadStepping(p, params.load_steps, params.max_bisections);
         std::optional<TransmuralFibreRule> fibre_rule;
         if (auto fibres = p.Find("fibres"); fibres && fibres->Has("rule")) {
           fibre_rule = ParseTransmuralFibreRule(*fibres);

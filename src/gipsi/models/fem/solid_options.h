@@ -11,4 +11,8 @@ namespace gipsi {
 /// InputError naming the JSON path of a bad value.
 [[nodiscard]] NewtonOptions ParseNewtonOptions(const JsonNode& node, NewtonOptions defaults);
 
+/// The object's "load_steps" (an integer in [1, 100000]) and "max_bisections" (in [0, 30]),
+/// each left as given when absent; throws InputError naming the JSON path of a bad value.
+void ParseLoadStepping(const JsonNode& object, int& load_steps, int& max_bisections);
+
 }  // namespace gipsi
