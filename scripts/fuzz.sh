@@ -1,22 +1,20 @@
 #!/usr/bin/env bash
-# Builds the libFuzzer targets (clang, ASan + UBSan) and runs each for a bounded time, seeded
-# with the project's own meshes and scenes plus every earlier finding in fuzz/regressions/.
+# Builds the libFuzzer targets (in the asan preset's tree: clang, ASan + UBSan) and runs each for
+# a bounded time, seeded with the project's own meshes and scenes plus every earlier finding in
+# fuzz/regressions/.
 # A finding (crash, sanitizer report, escaped non-InputError exception, hang over 10 s, or
-# memory over the limits) fails the script and leaves the input in build/fuzz/findings/.
+# memory over the limits) fails the script and leaves the input in build/asan/fuzz/findings/.
 # Usage: bash scripts/fuzz.sh [SECONDS_PER_TARGET]   (default 30)
 set -euo pipefail
 cd "$(dirname "$0")/.."
-# Warnings are the gcc builds' business (errors there in CI); clang under sanitizers also warns
-# that some `omp simd` loops were not vectorised, which is expected in an instrumented build.
-export GIPSI_WERROR=OFF
 seconds="${1:-30}"
 
-cmake --preset fuzz >/dev/null
+cmake --preset asan >/dev/null
 targets=(scene gmsh obj stl vtu vtk tetgen)
-cmake --build --preset fuzz --target "${targets[@]/#/fuzz_}"
+cmake --build --preset asan --target "${targets[@]/#/fuzz_}"
 
-work="build/fuzz/corpus"
-findings="build/fuzz/findings"
+work="build/asan/fuzz/corpus"
+findings="build/asan/fuzz/findings"
 rm -rf "$work" && mkdir -p "$work" "$findings"
 seed() {  # seed TARGET FILES...
   local target="$1"; shift
@@ -42,14 +40,14 @@ export UBSAN_OPTIONS="print_stacktrace=1"
 status=0
 for target in "${targets[@]}"; do
   echo "== fuzz_$target for ${seconds} s"
-  if ! ./build/fuzz/fuzz/fuzz_"$target" "$work/$target" -max_total_time="$seconds" -timeout=10 \
+  if ! ./build/asan/fuzz/fuzz_"$target" "$work/$target" -max_total_time="$seconds" -timeout=10 \
       -rss_limit_mb=2048 -malloc_limit_mb=1024 -print_final_stats=1 \
-      -artifact_prefix="$findings/${target}_" 2>"build/fuzz/$target.log"; then
-    echo "fuzz_$target: FINDING (log build/fuzz/$target.log, input in $findings/)"
-    tail -40 "build/fuzz/$target.log"
+      -artifact_prefix="$findings/${target}_" 2>"build/asan/fuzz/$target.log"; then
+    echo "fuzz_$target: FINDING (log build/asan/fuzz/$target.log, input in $findings/)"
+    tail -40 "build/asan/fuzz/$target.log"
     status=1
   else
-    grep -E "stat::number_of_executed_units|stat::new_units_added" "build/fuzz/$target.log" |
+    grep -E "stat::number_of_executed_units|stat::new_units_added" "build/asan/fuzz/$target.log" |
       tr '\n' ' '
     echo
   fi
