@@ -8,9 +8,11 @@
 #include <fmt/format.h>
 
 #include "gipsi/base/error.h"
+#include "gipsi/haptics/realtime_haptics.h"
 #include "gipsi/io/builtins.h"
 #include "gipsi/io/scene.h"
 #include "gipsi/viz/csv_table.h"
+#include "gipsi/viz/display_manager.h"
 #include "gipsi/viz/render/offscreen.h"
 #include "gipsi/viz/render/plot.h"
 #include "viewer/viewer.h"
@@ -213,27 +215,23 @@ int VizCommands::View() {
   return viz::RunViewer(options);
 }
 
-std::vector<std::pair<std::string, viz::ColorSpec>> VizCommands::ParseColors() const {
+std::vector<std::pair<std::string, ColorSpec>> VizCommands::ParseColors() const {
   std::optional<std::pair<double, double>> range;
   if (!range_.empty()) {
     range = ParsePair(range_, ',', "--range", "LO,HI");
     if (!(range->second > range->first))
       ThrowInputError("command line", "--range", fmt::format("expected LO < HI, got '{}'", range_));
   }
-  std::vector<std::pair<std::string, viz::ColorSpec>> colors;
-  for (const auto& c : colors_) colors.push_back(viz::ParseColorOption(c, map_, range, "--color"));
+  std::vector<std::pair<std::string, ColorSpec>> colors;
+  for (const auto& c : colors_) colors.push_back(ParseColorOption(c, map_, range, "--color"));
   return colors;
 }
 
 int VizCommands::Snapshot() {
-  viz::SnapshotOptions options;
+  viz::FrameImageOptions options;
   std::tie(options.width, options.height) = ParseSize(size_, 16);
-  options.time = time_;
   if (!camera_.empty()) viz::ParseCamera(camera_, "--camera", options.camera);
-  options.colors = ParseColors();
-  options.show = show_;
-  options.hide = hide_;
-  options.as = as_;
+  const auto colors = ParseColors();
   options.render.wireframe = wireframe_;
   options.render.color_bar = !no_color_bar_;
   options.render.lighting = !unlit_;
@@ -242,12 +240,29 @@ int VizCommands::Snapshot() {
   RegisterBuiltins(registry);
   for (const auto& plugin : plugins_) registry.LoadPlugin(plugin);
   Scene scene = LoadScene(scene_, registry);
-  viz::SnapshotResult result;
-  const viz::Image image = viz::RenderSnapshot(scene, options, &result);
-  if (!result.run_ok) {
-    std::cerr << "gipsi: error: " << result.diagnostic << "\n";
-    return 3;
+  // Every object as the scene's "display" keys say, with the command line's choices on top;
+  // checked before anything runs.
+  viz::ApplyGeometryOptions(*scene.kernel, as_, "--as", scene.display);
+  viz::SceneDisplay display(*scene.kernel, scene.display, colors);
+  options.render.hidden = display.Hidden();
+  std::vector<std::string> names;
+  for (std::size_t i = 0; i < display.size(); ++i) names.push_back(display.manager(i).name());
+  viz::ApplyVisibility(*scene.kernel, names, show_, hide_, options.render.hidden);
+  if (time_ > scene.kernel->time()) {
+    RealtimeHaptics haptics(*scene.kernel);  // real-time probes tick while it runs
+    haptics.Start();
+    const RunResult run = scene.kernel->Run(time_);
+    haptics.Stop();
+    if (!run.ok()) {
+      std::cerr << "gipsi: error: " << run.diagnostic << "\n";
+      return 3;
+    }
   }
+  const double time = scene.kernel->time();
+  viz::FrameBuffers frame;
+  display.Fill(time, frame);
+  std::string gl;
+  const viz::Image image = viz::RenderFrame(frame, options, &gl);
   try {
     viz::WritePng(image, out_);
   } catch (const std::exception& e) {
@@ -255,8 +270,8 @@ int VizCommands::Snapshot() {
     return 4;
   }
   std::cout << fmt::format("{}: {} x {} at t = {:.6g} s ({})\n", out_, image.width, image.height,
-                           result.time, result.gl);
-  for (const auto& s : result.frame.surfaces)
+                           time, gl);
+  for (const auto& s : frame.surfaces)
     if (!s.field.empty())
       std::cout << fmt::format("  {}: {} [{}] from {:.6g} to {:.6g} ({})\n", s.object, s.field,
                                s.units, s.range_lo, s.range_hi, s.color_map);

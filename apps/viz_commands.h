@@ -30,7 +30,7 @@ class VizCommands {
   int Snapshot();
   int Plot();
   int View();
-  [[nodiscard]] std::vector<std::pair<std::string, viz::ColorSpec>> ParseColors() const;
+  [[nodiscard]] std::vector<std::pair<std::string, ColorSpec>> ParseColors() const;
 
   CLI::App* snapshot_ = nullptr;
   std::string scene_, out_, camera_, size_ = "800x600", map_ = "viridis", range_;

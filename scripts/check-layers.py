@@ -31,10 +31,7 @@ BELOW = {
 }
 
 # Upward includes still to be removed (issue 18): (file, included layer) -> why it is there.
-KNOWN = {
-    ("src/gipsi/io/scene.h", "viz"):
-        "the scene loader validates display and plot specifications against viz",
-}
+KNOWN = {}
 
 INCLUDE = re.compile(r'^\s*#\s*include\s*"gipsi/([a-z_]+)/')
 

@@ -9,7 +9,7 @@
 #include "gipsi/base/json_node.h"
 #include "gipsi/base/log.h"
 #include "gipsi/haptics/haptic_probe.h"
-#include "gipsi/viz/plot_spec.h"
+#include "gipsi/viz/plot_data.h"
 
 namespace gipsi::viz {
 namespace {

@@ -14,7 +14,7 @@
 #include "gipsi/io/outputs.h"
 #include "gipsi/io/scene.h"
 #include "gipsi/viz/csv_table.h"
-#include "gipsi/viz/plot_spec.h"
+#include "gipsi/viz/plot_data.h"
 #include "gipsi/viz/render/plot.h"
 #include "io/scene_test_util.h"
 

@@ -11,7 +11,7 @@
 
 #include "gipsi/io/builtins.h"
 #include "gipsi/io/scene.h"
-#include "gipsi/viz/plot_spec.h"
+#include "gipsi/viz/plot_data.h"
 #include "io/scene_test_util.h"
 
 namespace gipsi::viz {

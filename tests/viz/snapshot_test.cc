@@ -8,6 +8,7 @@
 #include "apps/cli_test_util.h"
 #include "gipsi/io/builtins.h"
 #include "gipsi/io/scene.h"
+#include "gipsi/viz/display_manager.h"
 #include "gipsi/viz/render/offscreen.h"
 #include "test_paths.h"
 
@@ -30,26 +31,38 @@ Scene LoadBlock(TypeRegistry& registry) {
   return LoadSceneFromString(kBlockScene, "block.json", ".", registry);
 }
 
-/// Renders the block head-on: the eye on the -y side at the height of the block's centre, so
-/// the face y = 0 hides the rest of the block and is seen exactly face-on.
-Image RenderHeadOn(SnapshotOptions options) {
-  TypeRegistry registry;
-  Scene scene = LoadBlock(registry);
-  options.camera.azimuth = 0;
-  options.camera.elevation = 0;
-  options.labels = false;  // text would count as object pixels
+/// Draws `scene` at its current time as its "display" keys say (colours replaced by `colors`),
+/// as `gipsi snapshot` does after running it.
+Image RenderScene(const Scene& scene, FrameImageOptions options,
+                  const std::vector<std::pair<std::string, ColorSpec>>& colors = {}) {
+  SceneDisplay display(*scene.kernel, scene.display, colors);
+  FrameBuffers frame;
+  display.Fill(scene.kernel->time(), frame);
+  options.render.hidden = display.Hidden();
   try {
-    return RenderSnapshot(scene, options);
+    return RenderFrame(frame, options);
   } catch (const std::runtime_error& e) {
     ADD_FAILURE() << "off-screen rendering (OSMesa) is unavailable: " << e.what();
     return {};
   }
 }
 
+/// Renders the block head-on: the eye on the -y side at the height of the block's centre, so
+/// the face y = 0 hides the rest of the block and is seen exactly face-on.
+Image RenderHeadOn(FrameImageOptions options,
+                   const std::vector<std::pair<std::string, ColorSpec>>& colors = {}) {
+  TypeRegistry registry;
+  Scene scene = LoadBlock(registry);
+  options.camera.azimuth = 0;
+  options.camera.elevation = 0;
+  options.labels = false;  // text would count as object pixels
+  return RenderScene(scene, options, colors);
+}
+
 bool IsBackground(const Rgb& c) { return c.r == 1.0f && c.g == 1.0f && c.b == 1.0f; }
 
 TEST(Snapshot, DrawsTheFaceOnBlockAsASquareOfItsColourOnTheBackground) {
-  SnapshotOptions options;
+  FrameImageOptions options;
   options.width = 240;
   options.height = 180;
   options.supersample = 1;
@@ -77,7 +90,7 @@ TEST(Snapshot, DrawsTheFaceOnBlockAsASquareOfItsColourOnTheBackground) {
 }
 
 TEST(Snapshot, ColoursFollowTheFieldAcrossTheFace) {
-  SnapshotOptions options;
+  FrameImageOptions options;
   options.width = 240;
   options.height = 180;
   options.supersample = 1;
@@ -85,9 +98,8 @@ TEST(Snapshot, ColoursFollowTheFieldAcrossTheFace) {
   spec.field = "position";
   spec.component = 0;  // x: 0 at the left edge of the face, 1 at the right
   spec.color_map = "grey";
-  options.colors = {{"block", spec}};
   options.render.lighting = false;  // smooth normals dim the face near its edges otherwise
-  const Image image = RenderHeadOn(options);
+  const Image image = RenderHeadOn(options, {{"block", spec}});
   ASSERT_EQ(image.width, 240);
   // The face's edges on the middle row, found outward from the centre of the scene's part of
   // the image (left of the colour bar's strip).
@@ -112,7 +124,7 @@ TEST(Snapshot, ColoursFollowTheFieldAcrossTheFace) {
 }
 
 TEST(Snapshot, IsDeterministic) {
-  SnapshotOptions options;
+  FrameImageOptions options;
   options.width = 160;
   options.height = 120;
   options.camera.azimuth = -60;
@@ -187,7 +199,7 @@ Image RenderBlockAs(const std::string& display, int width, int height) {
   TypeRegistry registry;
   RegisterBuiltins(registry);
   Scene scene = LoadSceneFromString(text, "block.json", ".", registry);
-  SnapshotOptions options;
+  FrameImageOptions options;
   options.width = width;
   options.height = height;
   options.supersample = 1;
@@ -195,12 +207,7 @@ Image RenderBlockAs(const std::string& display, int width, int height) {
   options.camera.elevation = 0;
   options.labels = false;
   options.render.color_bar = false;
-  try {
-    return RenderSnapshot(scene, options);
-  } catch (const std::runtime_error& e) {
-    ADD_FAILURE() << "off-screen rendering (OSMesa) is unavailable: " << e.what();
-    return {};
-  }
+  return RenderScene(scene, options);
 }
 
 bool Near(const Rgb& c, const Rgb& expected) {

@@ -48,14 +48,16 @@ struct Box3 {
         _mm_cmple_pd(_mm_sub_pd(_mm_set_pd(b.lo[2], lo[2]), g), _mm_set_pd(hi[2], b.hi[2]));
     return _mm_movemask_pd(_mm_and_pd(xy, z)) == 3;
 #else
-    return (lo[0] - gap <= b.hi[0]) & (b.lo[0] - gap <= hi[0]) & (lo[1] - gap <= b.hi[1]) &
-           (b.lo[1] - gap <= hi[1]) & (lo[2] - gap <= b.hi[2]) & (b.lo[2] - gap <= hi[2]);
+    return (int(lo[0] - gap <= b.hi[0]) & int(b.lo[0] - gap <= hi[0]) &
+            int(lo[1] - gap <= b.hi[1]) & int(b.lo[1] - gap <= hi[1]) &
+            int(lo[2] - gap <= b.hi[2]) & int(b.lo[2] - gap <= hi[2])) != 0;
 #endif
   }
   /// True if point p is within `gap` of the box along every axis. Branch-free like Near.
   [[nodiscard]] bool NearPoint(const Vec3& p, double gap) const {
-    return (p[0] >= lo[0] - gap) & (p[0] <= hi[0] + gap) & (p[1] >= lo[1] - gap) &
-           (p[1] <= hi[1] + gap) & (p[2] >= lo[2] - gap) & (p[2] <= hi[2] + gap);
+    // The comparisons as ints: `&` between bools is what clang warns of as a likely `&&`.
+    return (int(p[0] >= lo[0] - gap) & int(p[0] <= hi[0] + gap) & int(p[1] >= lo[1] - gap) &
+            int(p[1] <= hi[1] + gap) & int(p[2] >= lo[2] - gap) & int(p[2] <= hi[2] + gap)) != 0;
   }
   [[nodiscard]] double SurfaceArea() const {
     const Vec3 e = (hi - lo).cwiseMax(0.0);

@@ -80,7 +80,7 @@ class ObjectBuilder {
 
  private:
   void ApplyDisplay(SimObject& object, const JsonNode& node) {
-    viz::DrawSpec draw = viz::ParseDrawSpec(node, {"mesh", "mapping", "max_distance"});
+    DrawSpec draw = ParseDrawSpec(node, {"mesh", "mapping", "max_distance"});
     if (node.Has("mesh")) {
       auto mesh = meshes_.GetMesh(node.At("mesh").AsString(), node.At("mesh"));
       if (mesh->num_triangles() == 0)
@@ -101,7 +101,7 @@ class ObjectBuilder {
     if (node.Has("color") || node.Has("as") || node.Has("wireframe") || node.Has("visible") ||
         node.Has("size")) {
       try {  // resolve the field and geometry now, so errors name this JSON path
-        (void)viz::DisplayManager(object, draw);
+        (void)CheckDrawSpec(object, draw, object.name());
       } catch (const InputError& e) {
         // "object 'x': display: ..." is about the geometry, anything else about the colour.
         const bool geometry =
@@ -454,7 +454,7 @@ Scene LoadSceneFromString(std::string_view text, const std::string& name,
     outputs->CheckKeys({"directory", "vtu", "plots"});
     if (auto plots = outputs->Find("plots"))
       for (const auto& plot : plots->Items())
-        scene.plots.push_back(viz::ParsePlotSpec(plot, scene.probes));
+        scene.plots.push_back(ParsePlotSpec(plot, scene.probes));
     if (auto dir = outputs->Find("directory")) {
       // A scene may come from anyone: it names a folder under the working directory, and only
       // the person running it (`gipsi run --out`) may send the outputs elsewhere.

@@ -17,8 +17,8 @@
 #include "gipsi/core/registry.h"
 #include "gipsi/io/boundary_condition_spec.h"
 #include "gipsi/io/probes.h"
-#include "gipsi/viz/display_manager.h"
-#include "gipsi/viz/plot_spec.h"
+#include "gipsi/io/display_spec.h"
+#include "gipsi/io/plot_spec.h"
 
 namespace gipsi {
 
@@ -52,10 +52,10 @@ struct Scene {
   std::vector<Probe> probes;
   VtuOutputSpec vtu;
   /// Plots to draw from the probe CSVs when a run ends ("outputs": {"plots": [...]}).
-  std::vector<viz::PlotSpec> plots;
+  std::vector<PlotSpec> plots;
   /// How objects are drawn (their "display" keys other than the embedded mesh): colour,
   /// geometry, wireframe, visibility. Objects without an entry are drawn in the default way.
-  std::vector<std::pair<const SimObject*, viz::DrawSpec>> display;
+  std::vector<std::pair<const SimObject*, DrawSpec>> display;
   std::map<std::string, std::shared_ptr<const Mesh>> meshes;
   /// Boundary conditions by "object/name", for events and `gipsi validate`.
   std::map<std::string, BoundaryConditionSpec> boundary_conditions;

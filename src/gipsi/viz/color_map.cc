@@ -32,13 +32,12 @@ std::vector<Rgb> Anchors(std::string_view name) {
 
 }  // namespace
 
-std::vector<std::string> ColorMap::Names() { return {"viridis", "cool-warm", "grey", "rainbow"}; }
+std::vector<std::string> ColorMap::Names() { return ColorMapNames(); }
 
 ColorMap ColorMap::Named(std::string_view name) {
+  CheckColorMapName(name);
   std::vector<Rgb> anchors = Anchors(name);
-  if (anchors.empty())
-    throw InputError(fmt::format("unknown colour map '{}'{}; expected one of: {}", name,
-                                 SuggestClosest(name, Names()), fmt::join(Names(), ", ")));
+  GIPSI_CHECK(!anchors.empty(), "colour map '{}' is named but has no colours", name);
   return ColorMap(std::string(name), std::move(anchors));
 }
 

@@ -8,13 +8,9 @@
 #include <string_view>
 #include <vector>
 
-namespace gipsi::viz {
+#include "gipsi/io/display_spec.h"
 
-/// An sRGB colour with components in [0, 1].
-struct Rgb {
-  float r = 0, g = 0, b = 0;
-  friend bool operator==(const Rgb&, const Rgb&) = default;
-};
+namespace gipsi::viz {
 
 /// A named colour map, piecewise linear in sRGB between evenly spaced anchor colours.
 /// Copyable and movable.
@@ -25,7 +21,7 @@ class ColorMap {
   /// published end and mid points), "grey" (black to white) or "rainbow" (blue–cyan–green–
   /// yellow–red). Throws InputError listing the names for any other name.
   static ColorMap Named(std::string_view name);
-  /// The names Named accepts.
+  /// The names Named accepts (ColorMapNames of io/display_spec.h).
   static std::vector<std::string> Names();
 
   [[nodiscard]] const std::string& name() const { return name_; }

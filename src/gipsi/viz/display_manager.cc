@@ -68,96 +68,6 @@ bool HasOwnSegments(const SimObject& object) { return object.DisplaySegments().c
 
 }  // namespace
 
-DrawSpec ParseDrawSpec(const JsonNode& node, std::initializer_list<std::string_view> known_keys) {
-  std::vector<std::string> keys{"color", "as", "wireframe", "visible", "size"};
-  for (auto k : known_keys) keys.emplace_back(k);
-  node.CheckKeys(keys);
-  DrawSpec spec;
-  if (auto c = node.Find("color")) {
-    spec.color = ParseColorSpec(*c);
-    spec.solid_given = c->Has("color");
-  }
-  if (auto as = node.Find("as")) {
-    const std::string s = as->AsChoice({"surface", "lines", "points"});
-    spec.as = s == "surface" ? Primitive::kTriangles
-              : s == "lines" ? Primitive::kLines
-                             : Primitive::kPoints;
-  }
-  spec.wireframe = node.Bool("wireframe", false);
-  spec.visible = node.Bool("visible", true);
-  if (auto size = node.Find("size")) {
-    const double v = size->AsNumber();
-    if (!(v >= 1 && v <= 64)) size->Expected("a line width or point size in pixels, in [1, 64]");
-    spec.size = static_cast<float>(v);
-  }
-  return spec;
-}
-
-ColorSpec ParseColorSpec(const JsonNode& node) {
-  node.CheckKeys({"field", "component", "map", "range", "color"});
-  ColorSpec spec;
-  spec.field = node.String("field", "");
-  if (auto c = node.Find("component")) {
-    if (c->is_string()) {
-      const std::string s = c->AsChoice({"magnitude", "x", "y", "z"});
-      spec.component = s == "magnitude" ? -1 : s[0] - 'x';
-    } else {
-      const auto i = c->AsInt();
-      if (i < 0 || i > 8) c->Expected("\"magnitude\", \"x\", \"y\", \"z\" or an integer in [0, 8]");
-      spec.component = static_cast<int>(i);
-    }
-  }
-  if (auto m = node.Find("map")) {
-    try {
-      spec.color_map = ColorMap::Named(m->AsString()).name();
-    } catch (const InputError& e) {
-      m->Fail(e.what());
-    }
-  }
-  if (auto r = node.Find("range")) {
-    auto v = r->AsNumbers();
-    if (v.size() != 2 || !(v[1] > v[0])) r->Expected("[lo, hi] with lo < hi");
-    spec.range = std::pair{v[0], v[1]};
-  }
-  if (auto c = node.Find("color")) {
-    auto v = c->AsNumbers();
-    if (v.size() != 3 || std::any_of(v.begin(), v.end(), [](double x) { return x < 0 || x > 1; }))
-      c->Expected("[r, g, b] with components in [0, 1]");
-    spec.solid = {static_cast<float>(v[0]), static_cast<float>(v[1]), static_cast<float>(v[2])};
-  }
-  return spec;
-}
-
-std::pair<std::string, ColorSpec> ParseColorOption(std::string_view text, std::string_view map,
-                                                   std::optional<std::pair<double, double>> range,
-                                                   std::string_view option) {
-  const std::size_t colon = text.find(':');
-  if (colon == std::string_view::npos || colon == 0 || colon + 1 == text.size())
-    ThrowInputError("command line", option,
-                    fmt::format("expected OBJECT:FIELD[.COMPONENT], got '{}'", text));
-  ColorSpec spec;
-  spec.field = std::string(text.substr(colon + 1));
-  const std::size_t dot = spec.field.rfind('.');
-  if (dot != std::string::npos && dot + 2 == spec.field.size()) {
-    const char c = spec.field.back();
-    if (c >= 'x' && c <= 'z')
-      spec.component = c - 'x';
-    else if (c >= '0' && c <= '8')
-      spec.component = c - '0';
-    else
-      ThrowInputError("command line", option,
-                      fmt::format("component '{}' of '{}' is not x, y, z or 0 ... 8", c, text));
-    spec.field.resize(dot);
-  }
-  try {
-    spec.color_map = ColorMap::Named(map).name();
-  } catch (const InputError& e) {
-    ThrowInputError("command line", "--map", e.what());
-  }
-  spec.range = range;
-  return {std::string(text.substr(0, colon)), spec};
-}
-
 bool DisplayManager::HasDefaultGeometry(const SimObject& object) {
   return object.display().triangles.cols() > 0 || HasOwnSegments(object);
 }
@@ -171,93 +81,31 @@ DisplayManager::DisplayManager(const SimObject& object, DrawSpec spec, std::stri
       draw_(std::move(spec)),
       name_(name.empty() ? object.name() : std::move(name)),
       map_(ColorMap::Named("viridis")) {
-  if (draw_.as) {
-    primitive_ = *draw_.as;
-  } else if (object.display().triangles.cols() == 0 && HasOwnSegments(object)) {
-    primitive_ = Primitive::kLines;
-  }
-  auto fail_geometry = [&](const std::string& what) {
-    throw InputError(fmt::format("object '{}': display: {}", name_, what));
-  };
-  switch (primitive_) {
-    case Primitive::kTriangles:
-      if (object.display().triangles.cols() == 0)
-        fail_geometry("it has no display surface; draw it \"as\": \"lines\" or \"points\"");
-      break;
-    case Primitive::kLines:
-      segments_ = Segments(object);
-      if (segments_.empty()) fail_geometry("it has no springs or mesh edges to draw as lines");
-      break;
-    case Primitive::kPoints:
-      if (object.domain_positions().cols() == 0) fail_geometry("it has no nodes to draw as points");
-      break;
-  }
-  const bool surface = primitive_ == Primitive::kTriangles;
-  auto fail = [&](const std::string& what) {
-    throw InputError(fmt::format("object '{}': display colour: {}", name_, what));
-  };
-  try {
-    map_ = ColorMap::Named(draw_.color.color_map);
-  } catch (const InputError& e) {
-    fail(e.what());
-  }
-  if (draw_.color.range && !(draw_.color.range->second > draw_.color.range->first))
-    fail(fmt::format("range [{}, {}] is empty", draw_.color.range->first,
-                     draw_.color.range->second));
-  if (draw_.color.field.empty()) return;
-  field_ = object.TryFindField(draw_.color.field);
-  if (!field_) {
-    std::vector<std::string> names;
-    for (const FieldInfo& f : object.fields()) names.push_back(f.name);
-    fail(fmt::format("no field '{}'{}; its fields are: {}", draw_.color.field,
-                     SuggestClosest(draw_.color.field, names), fmt::join(names, ", ")));
-  }
+  const ResolvedDraw resolved = CheckDrawSpec(object, draw_, name_);  // throws for a bad spec
+  primitive_ = resolved.primitive;
+  if (primitive_ == Primitive::kLines) segments_ = Segments(object);
+  map_ = ColorMap::Named(draw_.color.color_map);
+  if (!resolved.field) return;
+  field_ = resolved.field;
   const FieldInfo& info = object.field_info(*field_);
-  if (!info.readable()) fail(fmt::format("field '{}' cannot be read", info.name));
-  if (draw_.color.component >= info.components)
-    fail(fmt::format("field '{}' has {} component(s); component {} does not exist", info.name,
-                     info.components, draw_.color.component));
   location_ = info.location;
-  const bool embedded = object.display().map.has_value();
-  switch (location_) {
-    case FieldLocation::kNode:
-      break;
-    case FieldLocation::kBoundaryVertex:
-      if (!surface)
-        fail(
-            fmt::format("field '{}' lives on boundary vertices, but the object is drawn as {}; "
-                        "colour by a node or element field",
-                        info.name, primitive_ == Primitive::kLines ? "lines" : "points"));
-      if (embedded)
-        fail(
-            fmt::format("field '{}' lives on boundary vertices, but the object is drawn with an "
-                        "embedded display surface; colour by a node or element field",
-                        info.name));
-      break;
-    case FieldLocation::kElement: {
-      const Mesh& mesh = object.domain();
-      const bool tets = mesh.num_tets() > 0;
-      const Index num_elems = tets ? mesh.num_tets() : mesh.num_triangles();
-      const int per = tets ? 4 : 3;
-      auto node_of = [&](Index e, int k) { return tets ? mesh.tets(k, e) : mesh.triangles(k, e); };
-      node_elem_start_.assign(static_cast<std::size_t>(mesh.num_nodes()) + 1, 0);
-      for (Index e = 0; e < num_elems; ++e)
-        for (int k = 0; k < per; ++k) ++node_elem_start_[std::size_t(node_of(e, k)) + 1];
-      for (std::size_t n = 1; n < node_elem_start_.size(); ++n)
-        node_elem_start_[n] += node_elem_start_[n - 1];
-      node_elems_.resize(std::size_t(node_elem_start_.back()));
-      std::vector<int> fill(node_elem_start_.begin(), node_elem_start_.end() - 1);
-      for (Index e = 0; e < num_elems; ++e)
-        for (int k = 0; k < per; ++k)
-          node_elems_[std::size_t(fill[std::size_t(node_of(e, k))]++)] = static_cast<int>(e);
-      node_.resize(mesh.num_nodes());
-      break;
-    }
-    default:
-      fail(
-          fmt::format("field '{}' lives on {}s; colour by a node, element or boundary-vertex "
-                      "field",
-                      info.name, ToString(location_)));
+  if (location_ == FieldLocation::kElement) {
+    const Mesh& mesh = object.domain();
+    const bool tets = mesh.num_tets() > 0;
+    const Index num_elems = tets ? mesh.num_tets() : mesh.num_triangles();
+    const int per = tets ? 4 : 3;
+    auto node_of = [&](Index e, int k) { return tets ? mesh.tets(k, e) : mesh.triangles(k, e); };
+    node_elem_start_.assign(static_cast<std::size_t>(mesh.num_nodes()) + 1, 0);
+    for (Index e = 0; e < num_elems; ++e)
+      for (int k = 0; k < per; ++k) ++node_elem_start_[std::size_t(node_of(e, k)) + 1];
+    for (std::size_t n = 1; n < node_elem_start_.size(); ++n)
+      node_elem_start_[n] += node_elem_start_[n - 1];
+    node_elems_.resize(std::size_t(node_elem_start_.back()));
+    std::vector<int> fill(node_elem_start_.begin(), node_elem_start_.end() - 1);
+    for (Index e = 0; e < num_elems; ++e)
+      for (int k = 0; k < per; ++k)
+        node_elems_[std::size_t(fill[std::size_t(node_of(e, k))]++)] = static_cast<int>(e);
+    node_.resize(mesh.num_nodes());
   }
   label_ = FieldLabel(info, draw_.color.component);
   raw_.resize(info.components, object.FieldCount(*field_));

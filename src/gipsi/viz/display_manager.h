@@ -2,67 +2,21 @@
 /// @file
 /// Display managers: convert a simulation object's display geometry into the standard render
 /// buffers (positions, normals, colours, indices), colouring by a named field through a colour
-/// map. Models never draw; renderers only see `SurfaceBuffers`.
+/// map. Models never draw; renderers only see `SurfaceBuffers`. What to draw comes as the plain
+/// specifications of io/display_spec.h (a scene's "display" keys, the command line's colours).
 
 #include <memory>
 #include <optional>
 #include <string>
 #include <vector>
 
-#include "gipsi/base/json_node.h"
 #include "gipsi/core/kernel.h"
 #include "gipsi/core/sim_object.h"
+#include "gipsi/io/display_spec.h"
 #include "gipsi/viz/color_map.h"
 #include "gipsi/viz/render_buffers.h"
 
 namespace gipsi::viz {
-
-/// How to colour one object. Plain struct.
-struct ColorSpec {
-  /// Field to colour by ("" = solid colour). Node, element (averaged to nodes) and, for objects
-  /// drawn with their own boundary, boundary-vertex fields.
-  std::string field;
-  /// Component of a vector or tensor field; -1 = magnitude (Euclidean/Frobenius norm).
-  int component = -1;
-  std::string color_map = "viridis";
-  /// Fixed value range; when absent the range follows the values every frame.
-  std::optional<std::pair<double, double>> range;
-  Rgb solid{0.80f, 0.45f, 0.40f};  ///< colour when `field` is empty
-};
-
-/// How to draw one object: its colour, which geometry (its display surface, its springs or
-/// mesh edges as lines, its nodes as points), wireframe, visibility. Plain struct.
-struct DrawSpec {
-  ColorSpec color;
-  /// Triangles: the display surface; lines: the object's own segments (a MassSpring's springs;
-  /// SimObject::DisplaySegments), else the unique edges of the domain's tets (or triangles);
-  /// points: the domain nodes. Absent: the display surface if the object has one, else its
-  /// own segments if it has some, else nothing is drawn.
-  std::optional<Primitive> as;
-  bool wireframe = false;  ///< draw the surface's triangle edges too
-  bool visible = true;     ///< initially shown (the viewer can toggle it)
-  /// Line width or point diameter in pixels; 0 = default (2 for lines, 6 for points).
-  float size = 0;
-  /// The scene gave `color.color` (then no palette colour replaces it).
-  bool solid_given = false;
-};
-
-/// Parses {"field": "displacement", "component": "magnitude"|0|1|2|"x"|"y"|"z",
-/// "map": "viridis", "range": [lo, hi], "color": [r, g, b]}; throws InputError naming the path.
-ColorSpec ParseColorSpec(const JsonNode& node);
-
-/// Parses the drawing keys of an object's "display" entry (other keys, e.g. "mesh", are the
-/// caller's): {"color": <ColorSpec>, "as": "surface"|"lines"|"points", "wireframe": bool,
-/// "visible": bool, "size": pixels}. `known_keys` lists the caller's keys, so unknown keys are
-/// reported together. Throws InputError naming the path.
-DrawSpec ParseDrawSpec(const JsonNode& node, std::initializer_list<std::string_view> known_keys);
-
-/// Parses a command-line colour choice "OBJECT:FIELD" where FIELD may end in ".x", ".y", ".z"
-/// (or ".0" ... ".8") for one component (else the magnitude), with colour map `map` and
-/// optional fixed `range`. Throws InputError naming `option` (e.g. "--color").
-std::pair<std::string, ColorSpec> ParseColorOption(std::string_view text, std::string_view map,
-                                                   std::optional<std::pair<double, double>> range,
-                                                   std::string_view option);
 
 /// Fills one object's `SurfaceBuffers` from its display geometry: its display surface
 /// (triangles), its springs or mesh edges (lines) or its nodes (points). Built once (it
@@ -70,9 +24,9 @@ std::pair<std::string, ColorSpec> ParseColorOption(std::string_view text, std::s
 /// nothing after the first call on the same buffers. Not copyable (holds a reference); movable.
 class DisplayManager {
  public:
-  /// Throws InputError (naming the object) for an unknown or unreadable field, a component out
-  /// of range, an unsupported field location, an unknown colour map, an empty range, or a
-  /// geometry the object does not have (no display surface, no springs or edges, no nodes).
+  /// Throws InputError (naming the object) for a spec that CheckDrawSpec refuses: an unknown or
+  /// unreadable field, a component out of range, an unsupported field location, an unknown
+  /// colour map, an empty range, or a geometry the object does not have.
   /// `name` is the object's full dotted name (Kernel::ObjectPath), used in the buffers and in
   /// messages; empty: the object's own name.
   DisplayManager(const SimObject& object, DrawSpec spec, std::string name = {});

@@ -9,11 +9,9 @@
 #include <string>
 #include <vector>
 
-namespace gipsi::viz {
+#include "gipsi/io/display_spec.h"  // Primitive
 
-/// What the indices of a `SurfaceBuffers` connect: triangles (3 each), line segments (2 each,
-/// drawn as GL_LINES) or points (1 each, GL_POINTS).
-enum class Primitive : std::uint8_t { kTriangles, kLines, kPoints };
+namespace gipsi::viz {
 
 /// One object's display geometry (a surface, a line set or a point set). Vectors are flat,
 /// vertex-major (x0 y0 z0 x1 ...), ready for OpenGL vertex buffers. Copyable and movable; refilling

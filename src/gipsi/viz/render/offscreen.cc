@@ -7,8 +7,6 @@
 #include <fmt/format.h>
 
 #include "gipsi/base/error.h"
-#include "gipsi/haptics/realtime_haptics.h"
-#include "gipsi/io/scene.h"
 #include "gipsi/viz/render/text.h"
 
 namespace gipsi::viz {
@@ -72,42 +70,22 @@ Image OffscreenContext::ReadImage() const {
   return image;
 }
 
-Image RenderSnapshot(Scene& scene, SnapshotOptions options, SnapshotResult* result) {
+Image RenderFrame(const FrameBuffers& frame, FrameImageOptions options, std::string* gl) {
   GIPSI_CHECK(options.supersample >= 1 && options.supersample <= 4);
-  ApplyGeometryOptions(*scene.kernel, options.as, "--as", scene.display);
-  SceneDisplay display(*scene.kernel, scene.display, options.colors);  // validate before running
-  if (options.render.hidden.empty()) {
-    options.render.hidden = display.Hidden();
-    std::vector<std::string> names;
-    for (std::size_t i = 0; i < display.size(); ++i) names.push_back(display.manager(i).name());
-    ApplyVisibility(*scene.kernel, names, options.show, options.hide, options.render.hidden);
-  }
-  SnapshotResult local;
-  SnapshotResult& r = result ? *result : local;
-  if (options.time > scene.kernel->time()) {
-    RealtimeHaptics haptics(*scene.kernel);  // real-time probes tick while it runs
-    haptics.Start();
-    const RunResult run = scene.kernel->Run(options.time);
-    haptics.Stop();
-    r.run_ok = run.ok();
-    r.diagnostic = run.diagnostic;
-  }
-  r.time = scene.kernel->time();
-  display.Fill(r.time, r.frame);
   const int k = options.supersample;
   options.render.pixel_scale = float(k);
-  const int scene_width = LegendSurface(r.frame, options.render)
+  const int scene_width = LegendSurface(frame, options.render)
                               ? LayoutColorBar(options.width * k, options.height * k).strip_x0
                               : options.width * k;
-  options.camera.FitTo(r.frame, double(scene_width) / (options.height * k));
+  options.camera.FitTo(frame, double(scene_width) / (options.height * k));
   OffscreenContext context(options.width * k, options.height * k);
-  r.gl = context.Description();
+  if (gl) *gl = context.Description();
   {
     SurfaceRenderer renderer(context.gl());
-    renderer.Draw(r.frame, options.camera, context.width(), context.height(), options.render);
+    renderer.Draw(frame, options.camera, context.width(), context.height(), options.render);
   }
   Image image = Downsample(context.ReadImage(), k);
-  if (options.labels) DrawLabels(image, r.frame, options.render, k);
+  if (options.labels) DrawLabels(image, frame, options.render, k);
   return image;
 }
 

@@ -1,8 +1,8 @@
 #pragma once
 /// @file
 /// Off-screen rendering without a window or display: an OSMesa (Mesa's software rasteriser,
-/// Debian package libosmesa6-dev) OpenGL 3.3 core context, and `gipsi snapshot`'s pipeline:
-/// run a scene to a time, fill its display buffers, draw them and write a PNG.
+/// Debian package libosmesa6-dev) OpenGL 3.3 core context, and drawing one frame of display
+/// buffers into an image (`gipsi snapshot`, after it has run the scene and filled them).
 
 #include <filesystem>
 #include <memory>
@@ -10,14 +10,10 @@
 #include <vector>
 
 #include "gipsi/viz/camera.h"
-#include "gipsi/viz/display_manager.h"
 #include "gipsi/viz/render/gl_api.h"
 #include "gipsi/viz/render/image.h"
 #include "gipsi/viz/render/surface_renderer.h"
-
-namespace gipsi {
-struct Scene;
-}
+#include "gipsi/viz/render_buffers.h"
 
 namespace gipsi::viz {
 
@@ -46,26 +42,13 @@ class OffscreenContext {
   int width_, height_;
 };
 
-/// Options of `gipsi snapshot`. Plain struct.
-struct SnapshotOptions {
-  double time = 0;  ///< simulated time to render at [s] (0: the initial state)
+/// How one frame becomes an image. Plain struct.
+struct FrameImageOptions {
   int width = 800, height = 600;
   int supersample = 2;  ///< anti-aliasing: render at this multiple of the size, then average
-  Camera camera;        ///< target and (unless distance_given) distance are fitted
+  Camera camera;        ///< target and (unless distance_given) distance are fitted to the frame
   RenderOptions render;
   bool labels = true;  ///< time, colour-bar values and field name (needs fonts-dejavu-core)
-  std::vector<std::pair<std::string, ColorSpec>> colors;  ///< per object
-  std::vector<std::string> show, hide;  ///< objects shown or hidden whatever the scene says
-  std::vector<std::string> as;          ///< "OBJECT:lines" etc.: geometry whatever the scene says
-};
-
-/// What a snapshot did, for the command line's summary. Plain struct.
-struct SnapshotResult {
-  double time = 0;         ///< simulated time reached
-  std::string gl;          ///< OffscreenContext::Description()
-  FrameBuffers frame;      ///< what was drawn
-  bool run_ok = true;      ///< false if the run diverged before `time`
-  std::string diagnostic;  ///< why, when !run_ok
 };
 
 /// Draws the time at the bottom left and, when `frame` has a colour bar, its range and field
@@ -74,11 +57,10 @@ struct SnapshotResult {
 void DrawLabels(Image& image, const FrameBuffers& frame, const RenderOptions& render,
                 int supersample);
 
-/// Runs `scene` (without outputs) to `options.time`, draws every object as the scene's
-/// "display" keys say (colours replaced by `options.colors`; hidden objects as
-/// `options.render.hidden` says, else as the scene's "visible") off screen and returns the
-/// image. Throws InputError for bad colour specs, std::runtime_error if rendering
-/// is unavailable.
-Image RenderSnapshot(Scene& scene, SnapshotOptions options, SnapshotResult* result = nullptr);
+/// Draws `frame` (filled by display managers, e.g. SceneDisplay::Fill) off screen with the
+/// camera fitted to it, and returns the image; `gl`, if given, receives the context's
+/// description (OffscreenContext::Description). Runs nothing: the caller brings the simulation
+/// to the time it wants drawn. Throws std::runtime_error if rendering is unavailable.
+Image RenderFrame(const FrameBuffers& frame, FrameImageOptions options, std::string* gl = nullptr);
 
 }  // namespace gipsi::viz

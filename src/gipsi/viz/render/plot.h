@@ -6,7 +6,7 @@
 #include <filesystem>
 #include <vector>
 
-#include "gipsi/viz/plot_spec.h"
+#include "gipsi/viz/plot_data.h"
 
 namespace gipsi::viz {
 

@@ -19,8 +19,10 @@
 ///
 ///     {"file": "pv.png", "x": "pv.lv_volume", "y": "pv.lv_pressure",
 ///      "x_unit": "mL", "y_unit": "mmHg"}
+///
+/// These are plain specifications, checked against the scene's probes when it loads; the viz
+/// layer reads the CSVs and draws them (viz/plot_data.h).
 
-#include <filesystem>
 #include <optional>
 #include <string>
 #include <vector>
@@ -28,7 +30,7 @@
 #include "gipsi/base/json_node.h"
 #include "gipsi/io/probes.h"
 
-namespace gipsi::viz {
+namespace gipsi {
 
 /// One probe column. Plain struct.
 struct ColumnRef {
@@ -57,34 +59,6 @@ struct PlotSpec {
 /// the column's SI unit.
 PlotSpec ParsePlotSpec(const JsonNode& node, const std::vector<Probe>& probes);
 
-/// A plot's data, ready to draw. Plain struct.
-struct PlotData {
-  struct Series {
-    std::string label;
-    std::vector<double> x, y;  ///< same length; non-finite points break the line
-  };
-  std::string title, x_label, y_label;
-  std::vector<Series> series;
-  int width = 800, height = 500;
-};
-
-/// Reads the columns of `spec` from `<probe_dir>/<probe>.csv`; throws InputError naming the
-/// file for a missing file or column.
-PlotData LoadPlotData(const PlotSpec& spec, const std::filesystem::path& probe_dir);
-
-/// Splits (x, y) into one series per run of equal `key` values (e.g. the rows of one sample
-/// time of a line probe), labelled "`label` at t = VALUE s" (`key_name` "time") or "`label` at
-/// KEY_NAME = VALUE" when there is more than one run, else `label`. Sizes must agree (checked).
-std::vector<PlotData::Series> SplitSeries(const std::string& label, const std::vector<double>& x,
-                                          const std::vector<double>& y,
-                                          const std::vector<double>& key,
-                                          const std::string& key_name = "time");
-
-/// A probe column as plots label it: its last dotted part with spaces for underscores
-/// ("blood.lv_pressure" → "lv pressure", "displacement_z" → "displacement z"), not the probe's
-/// internal path.
-std::string ReadableColumn(const std::string& column);
-
 /// The CSV columns a probe writes (its header split at commas).
 std::vector<std::string> ProbeColumns(const Probe& probe);
 
@@ -92,19 +66,4 @@ std::vector<std::string> ProbeColumns(const Probe& probe);
 /// and coordinates, else its field's unit); empty if the probe has no such column.
 std::string ProbeColumnUnits(const Probe& probe, const std::string& column);
 
-/// How a live plot shows one probe column (the viewer's traces). Plain struct.
-struct ColumnDisplay {
-  std::string label;  ///< readable: "lv pressure" for the column "blood.lv_pressure"
-  std::string unit;   ///< the unit it is shown in ("" for none)
-  double scale = 1;   ///< from the column's SI values to `unit`
-  /// The field's no-data marker (FieldInfo::no_data) in SI, if it has one: shown as "not yet".
-  std::optional<double> no_data;
-};
-
-/// How to show column `column` of `probe`: in the unit a plot of the scene (`plots`) draws it in
-/// (e.g. mmHg for a pressure the scene plots in mmHg), else its field's SI unit; labelled by the
-/// column's last dotted part with spaces for underscores.
-ColumnDisplay DisplayOfColumn(const Probe& probe, const std::string& column,
-                              const std::vector<PlotSpec>& plots);
-
-}  // namespace gipsi::viz
+}  // namespace gipsi
