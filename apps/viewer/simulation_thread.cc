@@ -281,7 +281,8 @@ void SimulationThread::Loop() {
         draw.color = spec;
         DisplayManager& manager = display_->manager(surface);
         manager = DisplayManager(manager.object(), draw, manager.name());
-        UpdateStatus([&](SimulationStatus& s) { s.draws[surface] = draw; });
+        const std::size_t index = surface;  // clang 14 cannot capture a structured binding
+        UpdateStatus([&](SimulationStatus& s) { s.draws[index] = draw; });
       } catch (const std::exception& e) {
         Report(e.what(), false);
       }
