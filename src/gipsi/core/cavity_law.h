@@ -7,9 +7,15 @@
 /// (pressure as the unknown that closes it), so the stiff isovolumetric phases, where a closed
 /// valve makes the blood volume independent of p, neither oscillate nor need iterations between
 /// the two objects. A connector implements the law for its blood object and attaches it to the
-/// wall object (SimObject::AttachCavityLaw).
+/// wall object through the wall's `CavityWall` capability.
+
+#include <string>
+#include <string_view>
+#include <vector>
 
 namespace gipsi {
+
+class SimObject;
 
 /// Interface; implementations are owned by connectors and outlive the attachment.
 class CavityLaw {
@@ -21,5 +27,25 @@ class CavityLaw {
   /// state is not at t, or it fails); then `volume` is unspecified. Must not allocate or throw.
   virtual bool EndVolume(double t, double dt, double p, double& volume) = 0;
 };
+
+/// Capability of an object whose boundary encloses cavities (e.g. a ventricle's endocardium,
+/// declared in its scene entry): a connector couples a cavity to a blood model through it.
+/// Objects that have cavities implement it beside SimObject (FemSolid, MassSpring); a connector
+/// asks for it with CavityWallOf, so no other object type carries cavity code.
+class CavityWall {
+ public:
+  virtual ~CavityWall() = default;
+  /// The names of its cavities, in declaration order (possibly none).
+  [[nodiscard]] virtual std::vector<std::string> cavity_names() const = 0;
+  /// Couples cavity `cavity` to blood: from now on each step solves for the cavity pressure
+  /// that makes the wall's enclosed volume equal `law`'s end volume. `law` must outlive the
+  /// object's steps. Throws InputError (naming the object and listing its cavities) if there
+  /// is no such cavity, or if the object cannot couple it (e.g. it is already coupled).
+  virtual void AttachCavityLaw(std::string_view cavity, CavityLaw* law) = 0;
+};
+
+/// `object` as a cavity wall. Throws InputError ("object 'NAME' (TYPE) has no cavities to
+/// couple to blood") for an object type without the capability.
+CavityWall& CavityWallOf(SimObject& object);
 
 }  // namespace gipsi

@@ -135,11 +135,6 @@ FieldId SimObject::FindField(std::string_view name) const {
                                type_name(), name, SuggestClosest(name, names), list));
 }
 
-void SimObject::AttachCavityLaw(std::string_view cavity, CavityLaw* /*law*/) {
-  throw InputError(fmt::format("object '{}' ({}) has no cavity '{}' to couple to blood", name_,
-                               type_name(), cavity));
-}
-
 const FieldInfo& SimObject::field_info(FieldId id) const {
   GIPSI_CHECK(id.is_valid() && id.value() < static_cast<std::int64_t>(fields_.size()),
               "invalid field id {} for object '{}'", id.value(), name_);

@@ -131,11 +131,6 @@ class SimObject {
     std::string unit;
   };
   [[nodiscard]] virtual std::vector<ProfileEntry> ProfileBreakdown() const { return {}; }
-  /// Couples the cavity called `cavity` (e.g. an endocardium declared by the object) to a
-  /// blood model: from now on each step solves for the cavity pressure that makes the wall's
-  /// enclosed volume equal `law`'s end volume (cavity_law.h). `law` must outlive the object's
-  /// steps. Throws InputError if the object has no such cavity (the default: no cavities).
-  virtual void AttachCavityLaw(std::string_view cavity, CavityLaw* law);
   /// Checkpoints and roll-back (gipsi/base/state.h): writes the clock, step count and applied
   /// boundary conditions, then the type's own state (SaveObjectState); coupling loads must have
   /// been cleared (BeginMacroStep). RestoreState reads it back; the object then continues

@@ -336,6 +336,12 @@ TEST(CavityCoupling, BadWiringGetsAClearError) {
   EXPECT_NE(replaced(R"("blood": "blood", "chamber")", R"("blood": "wall", "chamber")")
                 .find("a Circulation object"),
             std::string::npos);
+  // A wall of a type without cavities (the CavityWall capability) is refused at its key.
+  const std::string no_cavities = replaced(R"("wall": "wall")", R"("wall": "blood")");
+  EXPECT_NE(no_cavities.find("connectors.coupling.wall"), std::string::npos) << no_cavities;
+  EXPECT_NE(no_cavities.find("object 'blood' (Circulation) has no cavities to couple to blood"),
+            std::string::npos)
+      << no_cavities;
 }
 
 }  // namespace

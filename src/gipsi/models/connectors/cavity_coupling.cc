@@ -28,7 +28,8 @@ CavityCoupling::CavityCoupling(std::string name, SimObject& wall, const std::str
         "connector '{}': compartment '{}' of '{}' must be a chamber with \"driven_by\": "
         "\"pressure\" (the wall solves its pressure)",
         this->name(), chamber, blood_.name()));
-  wall_.AttachCavityLaw(cavity, this);  // throws for a wall without this cavity
+  // Throws for an object without cavities, or without this one.
+  CavityWallOf(wall_).AttachCavityLaw(cavity, this);
   const FieldId volume = wall_.FindField(cavity + "_volume");
   wall_pressure_ = wall_.FindField(cavity + "_pressure");
   blood_pressure_ = blood_.FindField(chamber + "_pressure_input");
@@ -73,6 +74,11 @@ void RegisterCavityCoupling(TypeRegistry& registry) {
         ctx.CheckKeys({"wall", "cavity", "blood", "chamber", "blood_bulk_modulus"});
         const JsonNode& p = ctx.params;
         SimObject& wall = ctx.Object("wall");
+        try {
+          (void)CavityWallOf(wall);
+        } catch (const InputError& e) {
+          p.At("wall").Fail(e.what());
+        }
         SimObject& blood_object = ctx.Object("blood");
         auto* blood = dynamic_cast<Circulation*>(&blood_object);
         if (blood == nullptr)

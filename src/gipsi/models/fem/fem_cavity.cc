@@ -44,6 +44,12 @@ bool SolvePressure(CavityLaw& law, double t, double dt, double v, double guess, 
 
 }  // namespace
 
+std::vector<std::string> FemSolid::cavity_names() const {
+  std::vector<std::string> names;
+  for (const FemCavitySpec& spec : params_.cavities) names.push_back(spec.name);
+  return names;
+}
+
 void FemSolid::AttachCavityLaw(std::string_view cavity, CavityLaw* law) {
   GIPSI_CHECK(law != nullptr);
   for (std::size_t i = 0; i < cavities_.size(); ++i) {

@@ -80,7 +80,7 @@ struct FemProfile {
 };
 
 /// Not copyable or movable (a SimObject).
-class FemSolid final : public SimObject, private NonlinearSystem {
+class FemSolid final : public SimObject, public CavityWall, private NonlinearSystem {
  public:
   /// Throws InputError for a mesh without tets, inverted/degenerate tets, a missing material,
   /// or a non-positive density.
@@ -135,6 +135,7 @@ class FemSolid final : public SimObject, private NonlinearSystem {
   /// at p (monolithic; the pressure's dependence on the wall enters the Newton tangent as a
   /// rank-one term). Its pressure field becomes read-only in effect (writes are ignored).
   void AttachCavityLaw(std::string_view cavity, CavityLaw* law) override;
+  [[nodiscard]] std::vector<std::string> cavity_names() const override;
   /// The cavity's pressure [Pa]: written (pressure mode) or solved (coupled to a CavityLaw).
   [[nodiscard]] double CavityPressure(std::size_t i) const;
 

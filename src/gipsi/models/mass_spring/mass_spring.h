@@ -109,7 +109,7 @@ struct MassSpringParams {
 };
 
 /// Not copyable or movable (a SimObject).
-class MassSpring final : public SimObject {
+class MassSpring final : public SimObject, public CavityWall {
  public:
   /// Builds springs from the unique edges of `domain`'s tets (or triangles if it has none) and
   /// lumped masses. Throws InputError if a node belongs to no element or a spring has zero rest
@@ -161,6 +161,7 @@ class MassSpring final : public SimObject {
   /// such cavity, it is already coupled, it shares a node with another coupled cavity, or the
   /// integrator is not SymplecticEuler.
   void AttachCavityLaw(std::string_view cavity, CavityLaw* law) override;
+  [[nodiscard]] std::vector<std::string> cavity_names() const override;
   [[nodiscard]] std::string failure_detail() const override { return failure_detail_; }
 
   [[nodiscard]] double KineticEnergy() const;

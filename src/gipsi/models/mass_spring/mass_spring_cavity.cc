@@ -61,6 +61,12 @@ double MassSpring::CavityPressure(std::size_t i) const {
   return cavities_[i].pressure;
 }
 
+std::vector<std::string> MassSpring::cavity_names() const {
+  std::vector<std::string> names;
+  for (const MassSpringCavitySpec& spec : params_.cavities) names.push_back(spec.name);
+  return names;
+}
+
 void MassSpring::AttachCavityLaw(std::string_view cavity, CavityLaw* law) {
   GIPSI_CHECK(law != nullptr);
   for (std::size_t i = 0; i < cavities_.size(); ++i) {
