@@ -4,10 +4,10 @@
 
 #include <benchmark/benchmark.h>
 
+#include "gipsi/base/latest_value.h"
 #include "gipsi/io/builtins.h"
 #include "gipsi/io/scene.h"
 #include "gipsi/viz/display_manager.h"
-#include "gipsi/viz/triple_buffer.h"
 
 namespace gipsi::viz {
 namespace {
@@ -30,7 +30,7 @@ void BM_FillAndPublishBlockSurface(benchmark::State& state) {
     colors.emplace_back("block", spec);
   }
   SceneDisplay display(*scene.kernel, colors);
-  TripleBuffer<FrameBuffers> frames;
+  LatestValue<FrameBuffers> frames;
   for (auto _ : state) {
     display.Fill(0, frames.back());
     frames.Publish();

@@ -77,7 +77,9 @@ if [ "${1:-}" = "--full" ]; then
   # runs this test, where that pointer happens to be null. Not GiPSi's memory; to be worked
   # around by rendering plots into memory (noted for an issue).
   asan_skip+='|GipsiExitCodes\.AFullDiskExits4WithTheReasonAndLeavesNoPartialFile)$'
-  echo "== asan (address + undefined behavior sanitizers)"
+  # clang, whose ASan build compiles in about 60 % of gcc's time; the same tree builds the
+  # libFuzzer targets that the fuzz stage runs, so the library is compiled once for both.
+  echo "== asan (address + undefined behavior sanitizers, clang; with the libFuzzer targets)"
   cmake --preset asan
   cmake --build --preset asan
   ctest --preset asan -E "$asan_skip"

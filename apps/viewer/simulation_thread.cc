@@ -21,7 +21,7 @@ constexpr std::size_t kMaxTraceSamples = 2000;
 
 SimulationThread::SimulationThread(LoadFn load,
                                    std::vector<std::pair<std::string, ColorSpec>> colors,
-                                   TripleBuffer<FrameBuffers>& frames,
+                                   LatestValue<FrameBuffers>& frames,
                                    const std::vector<std::string>& show,
                                    const std::vector<std::string>& hide)
     : load_(std::move(load)), initial_colors_(std::move(colors)), frames_(frames) {

@@ -16,13 +16,13 @@
 #include <thread>
 #include <vector>
 
+#include "gipsi/base/latest_value.h"
 #include "gipsi/haptics/mouse_device.h"
 #include "gipsi/haptics/realtime_haptics.h"
 #include "gipsi/io/scene.h"
 #include "gipsi/viz/display_manager.h"
 #include "gipsi/viz/mouse_tool.h"
 #include "gipsi/viz/playback.h"
-#include "gipsi/viz/triple_buffer.h"
 
 namespace gipsi::viz {
 
@@ -67,7 +67,7 @@ class SimulationThread {
   /// `show` and `hide` name objects to show or hide at first (ApplyVisibility); throws
   /// InputError for a name that is not drawn.
   SimulationThread(LoadFn load, std::vector<std::pair<std::string, ColorSpec>> colors,
-                   TripleBuffer<FrameBuffers>& frames, const std::vector<std::string>& show = {},
+                   LatestValue<FrameBuffers>& frames, const std::vector<std::string>& show = {},
                    const std::vector<std::string>& hide = {});
   ~SimulationThread();
   SimulationThread(const SimulationThread&) = delete;
@@ -130,7 +130,7 @@ class SimulationThread {
 
   LoadFn load_;
   std::vector<std::pair<std::string, ColorSpec>> initial_colors_;
-  TripleBuffer<FrameBuffers>& frames_;
+  LatestValue<FrameBuffers>& frames_;
   std::unique_ptr<TypeRegistry> registry_;  // the scene's types (plugins stay loaded)
   std::unique_ptr<Scene> scene_;
   std::unique_ptr<RealtimeHaptics> haptics_;  // after scene_: destroyed (loops joined) first

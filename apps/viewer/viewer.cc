@@ -85,7 +85,7 @@ int RunViewer(const ViewerOptions& options) {
     ApplyGeometryOptions(*scene.kernel, options.as, "--as", scene.display);
     return scene;
   };
-  TripleBuffer<FrameBuffers> frames;
+  LatestValue<FrameBuffers> frames;
   // Bad input (scene, colours, --show / --hide) throws here, before any window opens.
   SimulationThread sim(load, options.colors, frames, options.show, options.hide);
   const std::vector<bool> initially_hidden = sim.initially_hidden();
@@ -154,7 +154,7 @@ int RunViewer(const ViewerOptions& options) {
     while (!glfwWindowShouldClose(window)) {
       const auto frame_start = std::chrono::steady_clock::now();
       glfwPollEvents();
-      frames.Acquire();
+      frames.Fetch();
       const FrameBuffers& frame = frames.front();
       const SimulationStatus status = sim.status();
       int fb_width = 0, fb_height = 0, win_width = 0, win_height = 0;

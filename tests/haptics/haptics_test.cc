@@ -11,10 +11,10 @@
 #include <gtest/gtest.h>
 
 #include "gipsi/base/error.h"
+#include "gipsi/base/latest_value.h"
 #include "gipsi/haptics/force_safety.h"
 #include "gipsi/haptics/haptic_loop.h"
 #include "gipsi/haptics/haptic_tick.h"
-#include "gipsi/haptics/latest_value.h"
 #include "gipsi/haptics/virtual_device.h"
 #include "haptics/no_allocation_guard.h"
 #include "temp_dir.h"
@@ -148,36 +148,6 @@ TEST(ForceSafety, WatchdogFadesLinearlyToZeroAndBack) {
   // A disconnection fades out just the same.
   ForceSafety other(p);
   EXPECT_NEAR(other.Filter(f, dt, 0.0, false).z(), 2 * 0.99, 1e-9);
-}
-
-struct Stamped {
-  std::int64_t a = 0, b = 0, c = 0;
-};
-
-TEST(LatestValue, TheConsumerOnlySeesWholeValuesInOrder) {
-  LatestValue<Stamped> buffer;
-  constexpr std::int64_t kCount = 200000;
-  std::thread producer([&] {
-    for (std::int64_t k = 1; k <= kCount; ++k) {
-      Stamped& s = buffer.back();
-      s.a = k;
-      s.b = 2 * k;
-      s.c = 3 * k;
-      buffer.Publish();
-    }
-  });
-  std::int64_t last = 0, fetched = 0;
-  while (last < kCount) {
-    if (!buffer.Fetch()) continue;
-    ++fetched;
-    const Stamped& s = buffer.front();
-    ASSERT_EQ(s.b, 2 * s.a);
-    ASSERT_EQ(s.c, 3 * s.a);
-    ASSERT_GT(s.a, last);  // never older than what was already seen
-    last = s.a;
-  }
-  producer.join();
-  EXPECT_GT(fetched, 0);
 }
 
 TEST(RenderPlane, ProxyStaysOnThePlane) {

@@ -220,11 +220,11 @@ TEST(ParseColorOption, SplitsObjectFieldAndComponent) {
 TEST(DisplayPublisher, PublishesAFrameAfterEveryMacroStep) {
   TypeRegistry registry;
   Scene scene = LoadBlock(false, registry);
-  TripleBuffer<FrameBuffers> frames;
+  LatestValue<FrameBuffers> frames;
   scene.kernel->AddObserver(
       std::make_unique<DisplayPublisher>(SceneDisplay(*scene.kernel, {}), frames));
   ASSERT_TRUE(scene.kernel->Run(0.03).ok());
-  ASSERT_TRUE(frames.Acquire());
+  ASSERT_TRUE(frames.Fetch());
   // Observed at t = 0 and after each of the 3 macro steps: the newest is frame 3 at 0.03 s.
   EXPECT_EQ(frames.front().frame, 3);
   EXPECT_DOUBLE_EQ(frames.front().time, 0.03);

@@ -16,7 +16,7 @@
 #include <memory>
 
 #include "gipsi/core/local_model.h"
-#include "gipsi/haptics/latest_value.h"
+#include "gipsi/base/latest_value.h"
 #include "gipsi/haptics/local_model.h"
 #include "gipsi/haptics/local_model_tick.h"
 

@@ -11,7 +11,7 @@
 
 #include "gipsi/haptics/device.h"
 #include "gipsi/haptics/force_safety.h"
-#include "gipsi/haptics/latest_value.h"
+#include "gipsi/base/latest_value.h"
 
 namespace gipsi {
 

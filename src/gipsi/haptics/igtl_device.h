@@ -18,7 +18,7 @@
 #include <thread>
 
 #include "gipsi/haptics/device.h"
-#include "gipsi/haptics/latest_value.h"
+#include "gipsi/base/latest_value.h"
 
 namespace gipsi {
 

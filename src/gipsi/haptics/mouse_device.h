@@ -14,7 +14,7 @@
 #include <optional>
 
 #include "gipsi/haptics/device.h"
-#include "gipsi/haptics/latest_value.h"
+#include "gipsi/base/latest_value.h"
 
 namespace gipsi {
 

@@ -5,9 +5,9 @@
 /// renderer reads only published frames, so drawing never touches live simulation state and
 /// neither thread waits for the other.
 
+#include "gipsi/base/latest_value.h"
 #include "gipsi/core/kernel.h"
 #include "gipsi/viz/display_manager.h"
-#include "gipsi/viz/triple_buffer.h"
 
 namespace gipsi::viz {
 
@@ -15,7 +15,7 @@ namespace gipsi::viz {
 /// attached to). Not copyable or movable.
 class DisplayPublisher final : public Observer {
  public:
-  DisplayPublisher(SceneDisplay display, TripleBuffer<FrameBuffers>& buffer)
+  DisplayPublisher(SceneDisplay display, LatestValue<FrameBuffers>& buffer)
       : display_(std::move(display)), buffer_(buffer) {}
   DisplayPublisher(const DisplayPublisher&) = delete;
   DisplayPublisher& operator=(const DisplayPublisher&) = delete;
@@ -28,7 +28,7 @@ class DisplayPublisher final : public Observer {
 
  private:
   SceneDisplay display_;
-  TripleBuffer<FrameBuffers>& buffer_;
+  LatestValue<FrameBuffers>& buffer_;
 };
 
 }  // namespace gipsi::viz

@@ -1,10 +1,12 @@
 #pragma once
 /// @file
-/// `LatestValue<T>`: a lock-free, wait-free single-producer/single-consumer triple buffer. The
-/// producer (the simulation, publishing a local model at its own rate) fills `back()` and calls
-/// `Publish()`; the consumer (the haptic loop) calls `Fetch()` and reads `front()`, always the
-/// most recently published complete value, never a half-written one. No locks, no allocation
-/// after construction; T is copied only by the producer, into its own slot.
+/// `LatestValue<T>`: a lock-free, wait-free single-producer/single-consumer triple buffer, the
+/// one hand-over between GiPSi's threads: the simulation publishes haptic local models to the
+/// haptic loop and display frames to the renderer through it. The producer fills `back()` and
+/// calls `Publish()`; the consumer calls `Fetch()` and reads `front()`, always the most recently
+/// published complete value, never a half-written one. Neither side ever waits for the other.
+/// No locks, no allocation after construction; T is copied only by the producer, into its own
+/// slot. Slots are reused: back() holds an older value, to be overwritten.
 
 #include <array>
 #include <atomic>
