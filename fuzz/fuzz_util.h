@@ -21,6 +21,11 @@ extern "C" __attribute__((weak)) const char* __lsan_default_suppressions() {
   return "leak:libgmsh.so\n";
 }
 
+// See apps/gipsi_main.cc: libfreeimage (through Gmsh) mismatches new and free at exit.
+extern "C" __attribute__((weak)) const char* __asan_default_options() {
+  return "alloc_dealloc_mismatch=0";
+}
+
 namespace gipsi::fuzz {
 
 /// Writes `data` to a file named "input<extension>" in a per-process folder under /dev/shm
