@@ -15,8 +15,8 @@
 
 #include <memory>
 
-#include "gipsi/core/local_model.h"
 #include "gipsi/base/latest_value.h"
+#include "gipsi/core/local_model.h"
 #include "gipsi/haptics/local_model.h"
 #include "gipsi/haptics/local_model_tick.h"
 

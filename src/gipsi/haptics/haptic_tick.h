@@ -9,9 +9,9 @@
 /// `HapticRenderer` is what the haptic loop ticks; `LocalModelTick` (local_model_tick.h)
 /// renders the local dynamic models.
 
+#include "gipsi/base/latest_value.h"
 #include "gipsi/haptics/device.h"
 #include "gipsi/haptics/force_safety.h"
-#include "gipsi/base/latest_value.h"
 
 namespace gipsi {
 

@@ -17,8 +17,8 @@
 #include <string>
 #include <thread>
 
-#include "gipsi/haptics/device.h"
 #include "gipsi/base/latest_value.h"
+#include "gipsi/haptics/device.h"
 
 namespace gipsi {
 

@@ -13,8 +13,8 @@
 #include <cstdint>
 #include <optional>
 
-#include "gipsi/haptics/device.h"
 #include "gipsi/base/latest_value.h"
+#include "gipsi/haptics/device.h"
 
 namespace gipsi {
 

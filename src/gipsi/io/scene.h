@@ -16,9 +16,9 @@
 #include "gipsi/core/kernel.h"
 #include "gipsi/core/registry.h"
 #include "gipsi/io/boundary_condition_spec.h"
-#include "gipsi/io/probes.h"
 #include "gipsi/io/display_spec.h"
 #include "gipsi/io/plot_spec.h"
+#include "gipsi/io/probes.h"
 
 namespace gipsi {
 

@@ -3,7 +3,8 @@
 /// The standard format the visualization tool draws: per object, vertex positions, normals,
 /// colours and the indices of triangles, line segments or points (GiPSi's display-manager
 /// output). Plain data, filled by display
-/// managers on the simulation thread and published to renderers through a `LatestValue` (base/latest_value.h).
+/// managers on the simulation thread and published to renderers through a `LatestValue`
+/// (base/latest_value.h).
 
 #include <cstdint>
 #include <string>
