@@ -69,9 +69,12 @@ if [ "${1:-}" = "--full" ]; then
   # The heart's resume (three runs of the coupled heart, 10-30 s in release; minutes under ASan):
   # its kept-factorisation restore (numerics/newton_state.cc) is checked in the release stage.
   asan_skip+='|Resume\.HeartIsBitwiseIdentical'
-  # The viewer's 10-simulated-second pulls on the liver and both hearts (32-90 s each in release
-  # under Xvfb): the pull's code runs under the sanitizers in the short pull tests beside them.
-  asan_skip+='|Viewer\.APullKeepsThe(HangingLiverRunning|HeartBeating|MassSpringHeartBeating)For10SimulatedSeconds'
+  # The viewer's window tests (gipsi view under Xvfb): Mesa's GL driver is unloaded before the
+  # exit's leak check, so its one-time allocations show up from an "<unknown module>" that no
+  # LeakSanitizer suppression can name (clang's ASan; gcc's did not report them). They run in
+  # the release stage and under TSan; the viewer's simulation-side code (pull tool, display
+  # managers, publishing) runs under ASan in the display and mouse-tool tests.
+  asan_skip+='|Viewer\.(APullKeeps.*|AZeroLengthPull.*|Draws.*|TheMouse.*)'
   # A full disk simulated by the file-size limit: when its write fails, PLplot (5.15, Debian)
   # frees a pointer it never set (ASan's 0xbe fill pattern, SIGBUS in plend); the release stage
   # runs this test, where that pointer happens to be null. Not GiPSi's memory; to be worked
