@@ -5,10 +5,7 @@
 
 #include <fmt/format.h>
 
-#include <fmt/ranges.h>
-
 #include "gipsi/base/error.h"
-#include "gipsi/base/json_node.h"
 
 namespace gipsi::viz {
 namespace {
