@@ -4,6 +4,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
@@ -15,6 +16,11 @@
 #include "gipsi/base/error.h"
 
 namespace gipsi {
+
+std::uint64_t NewStateStamp() {
+  static std::atomic<std::uint64_t> last{0};
+  return last.fetch_add(1, std::memory_order_relaxed) + 1;
+}
 namespace {
 
 // Entry type codes.
@@ -233,7 +239,9 @@ std::pair<Index, Index> StateReader::ReadMatrixHeader(std::size_t element_size) 
     Fail(fmt::format("matrix of {}-byte values where {}-byte values were expected", size,
                      element_size));
   const std::uint64_t available = (bytes_.size() - pos_) / element_size;
-  if (rows > available || (rows > 0 && cols > available / rows))
+  // An empty matrix (3 by 0) holds no values: its shape alone must not be checked against
+  // what is left (it may be the last entry).
+  if (rows > 0 && cols > 0 && (rows > available || cols > available / rows))
     Fail("a matrix runs past the end of the data");
   return {static_cast<Index>(rows), static_cast<Index>(cols)};
 }

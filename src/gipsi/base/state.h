@@ -141,6 +141,11 @@ class StateReader {
   std::vector<Open> open_;
 };
 
+/// A new process-wide stamp, never 0 (thread-safe): marks the contents of a rarely written
+/// state field (Stamped in state_value.h, BoundaryConditions::Applied), so that equal stamps
+/// mean equal contents.
+[[nodiscard]] std::uint64_t NewStateStamp();
+
 /// Writes `payload` to `path` atomically and durably (temporary file `<path>.tmp`, fsync,
 /// rename, fsync of the directory), so a crash at any moment leaves either the previous file or
 /// the new one. Throws std::runtime_error naming the file on I/O errors.
