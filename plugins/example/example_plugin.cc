@@ -9,9 +9,11 @@
 /// Nothing here is known to the framework at compile time.
 
 #include <cmath>
+#include <memory>
 #include <numbers>
 
 #include "gipsi/base/error.h"
+#include "gipsi/base/object_state.h"
 #include "gipsi/base/state.h"
 #include "gipsi/core/coordinator.h"
 #include "gipsi/core/registry.h"
@@ -21,6 +23,16 @@
 namespace example {
 
 using Eigen::MatrixXd;
+
+/// What an Oscillator carries from one step to the next (a state value type). Copyable.
+struct OscillatorState {
+  gipsi::Points position = gipsi::Points::Zero(3, 1);  // the one node [m]
+
+  template <class Self, class V>
+  static void Fields(Self& s, V& v) {
+    v("position", s.position, gipsi::Shape::kFixed);
+  }
+};
 
 class Oscillator final : public gipsi::SimObject {
  public:
@@ -34,20 +46,29 @@ class Oscillator final : public gipsi::SimObject {
                               gipsi::FieldAccess::kRead, "current position"});
     velocity_ = DeclareField({"velocity", gipsi::FieldLocation::kGlobal, 3, "m/s",
                               gipsi::FieldAccess::kRead, "current velocity"});
-    positions_ = center;
+    state_.position = center;
   }
   std::string_view type_name() const override { return "Oscillator"; }
-  const gipsi::Points& domain_positions() const override { return positions_; }
-  // Checkpoints: the position is a function of time, so only the cached node is saved.
-  void SaveObjectState(gipsi::StateWriter& out) const override { out.WriteMatrix(positions_); }
-  void RestoreObjectState(gipsi::StateReader& in) override {
-    in.ReadMatrixExact(positions_, "the oscillator position");
-  }
+  const gipsi::Points& domain_positions() const override { return state_.position; }
+  // Checkpoints: the position is a function of time, so only the node is state. Written through
+  // the state's field list (gipsi/base/state_value.h).
+  void SaveObjectState(gipsi::StateWriter& out) const override { gipsi::WriteFields(out, state_); }
+  void RestoreObjectState(gipsi::StateReader& in) override { gipsi::ReadFields(in, state_); }
 
  protected:
   gipsi::StepStatus DoStep(double t, double dt) override {
-    positions_ = Position(t + dt);
+    state_.position = Position(t + dt);
     return gipsi::StepStatus::Ok();
+  }
+  // Step retries copy the state value instead of serialising it (gipsi/base/object_state.h).
+  std::unique_ptr<gipsi::ObjectState> NewObjectState() const override {
+    return std::make_unique<gipsi::StateBox<OscillatorState>>(state_);
+  }
+  void CopyObjectState(gipsi::ObjectState& into) const override {
+    gipsi::CopyFields(gipsi::StateBox<OscillatorState>::Of(into).value, state_);
+  }
+  void SetObjectState(const gipsi::ObjectState& from) override {
+    gipsi::CopyFields(state_, gipsi::StateBox<OscillatorState>::Of(from).value);
   }
   void DoReadField(gipsi::FieldId id, Eigen::Ref<MatrixXd> out) const override {
     const double t = time();
@@ -63,7 +84,7 @@ class Oscillator final : public gipsi::SimObject {
   gipsi::Vec3 center_, amplitude_;
   double frequency_;
   gipsi::FieldId position_, velocity_;
-  gipsi::Points positions_;
+  OscillatorState state_;
 };
 
 class Follow final : public gipsi::Connector {

@@ -30,10 +30,18 @@ class AggregateObject : public SimObject {
   [[nodiscard]] std::string failure_detail() const override { return failure_detail_; }
   /// Wall time per part and per connector, then each part's own breakdown ("part: entry").
   [[nodiscard]] std::vector<ProfileEntry> ProfileBreakdown() const override;
+  /// The parts, the connectors, then SaveAggregateState.
   void SaveObjectState(StateWriter& out) const override;
   void RestoreObjectState(StateReader& in) override;
 
  protected:
+  /// State of the subclass itself (e.g. a monitor's record), after the parts'. Default: none.
+  virtual void SaveAggregateState(StateWriter& /*out*/) const {}
+  virtual void RestoreAggregateState(StateReader& /*in*/) {}
+  /// Snapshots: the parts' snapshots (Coordinator::TakeSnapshot) and the subclass's own state.
+  [[nodiscard]] std::unique_ptr<ObjectState> NewObjectState() const override;
+  void CopyObjectState(ObjectState& into) const override;
+  void SetObjectState(const ObjectState& from) override;
   /// Number of fields that forward to parts (ids 0 … n−1); a subclass declares its own after.
   [[nodiscard]] std::size_t num_part_fields() const { return proxies_.size(); }
   StepStatus DoStep(double t, double dt) override;

@@ -1,6 +1,8 @@
 /// @file
-/// AggregateObject checkpoints: every part, then every connector, in the coordinator's order.
+/// AggregateObject checkpoints and snapshots: every part, then every connector, in the
+/// coordinator's order, then the subclass's own state (SaveAggregateState).
 
+#include "gipsi/base/object_state.h"
 #include "gipsi/base/state.h"
 #include "gipsi/core/aggregate.h"
 
@@ -11,6 +13,7 @@ void AggregateObject::SaveObjectState(StateWriter& out) const {
   out.WriteInt(static_cast<std::int64_t>(parts_.num_connectors()));
   for (std::size_t i = 0; i < parts_.num_objects(); ++i) parts_.object(i).SaveState(out);
   for (std::size_t i = 0; i < parts_.num_connectors(); ++i) parts_.connector(i).SaveState(out);
+  SaveAggregateState(out);
 }
 
 void AggregateObject::RestoreObjectState(StateReader& in) {
@@ -19,6 +22,30 @@ void AggregateObject::RestoreObjectState(StateReader& in) {
     in.Fail("the aggregate has a different number of parts or connectors in the checkpoint");
   for (std::size_t i = 0; i < parts_.num_objects(); ++i) parts_.object(i).RestoreState(in);
   for (std::size_t i = 0; i < parts_.num_connectors(); ++i) parts_.connector(i).RestoreState(in);
+  RestoreAggregateState(in);
+}
+
+// The snapshot: {the parts' composite snapshot, the subclass's own state serialised}.
+std::unique_ptr<ObjectState> AggregateObject::NewObjectState() const {
+  auto box = std::make_unique<CompositeState>();
+  box->parts.push_back(parts_.NewSnapshot());
+  box->parts.push_back(std::make_unique<ByteState>());
+  return box;
+}
+
+void AggregateObject::CopyObjectState(ObjectState& into) const {
+  CompositeState& box = CompositeState::Of(into);
+  parts_.TakeSnapshot(*box.parts[0]);
+  StateWriter out;
+  SaveAggregateState(out);
+  ByteState::Of(*box.parts[1]).bytes = out.TakeBytes();
+}
+
+void AggregateObject::SetObjectState(const ObjectState& from) {
+  const CompositeState& box = CompositeState::Of(from);
+  parts_.RestoreSnapshot(*box.parts[0]);
+  StateReader in(ByteState::Of(*box.parts[1]).bytes, "the snapshot of aggregate '" + name() + "'");
+  RestoreAggregateState(in);
 }
 
 }  // namespace gipsi

@@ -7,46 +7,67 @@
 namespace gipsi {
 
 BoundaryConditions::BoundaryConditions(Index num_vertices, Index num_faces)
-    : kind_(static_cast<std::size_t>(3 * num_vertices), ConstraintKind::kFree),
-      value_(Points::Zero(3, num_vertices)),
-      force_(Points::Zero(3, num_vertices)),
-      coupling_force_(Points::Zero(3, num_vertices)),
-      traction_(Points::Zero(3, num_faces)),
-      pressure_(VecX::Zero(num_faces)),
-      coupling_pressure_(VecX::Zero(num_faces)) {}
+    : coupling_force_(Points::Zero(3, num_vertices)), coupling_pressure_(VecX::Zero(num_faces)) {
+  applied_.kind.assign(static_cast<std::size_t>(3 * num_vertices), ConstraintKind::kFree);
+  applied_.value = Points::Zero(3, num_vertices);
+  applied_.force = Points::Zero(3, num_vertices);
+  applied_.traction = Points::Zero(3, num_faces);
+  applied_.pressure = VecX::Zero(num_faces);
+  Touch();
+}
+
+void BoundaryConditions::Touch() { applied_.stamp = NewStateStamp(); }
+
+void BoundaryConditions::SetApplied(const Applied& applied) {
+  GIPSI_CHECK(applied.kind.size() == applied_.kind.size() &&
+                  applied.pressure.size() == applied_.pressure.size(),
+              "boundary conditions of another object");
+  if (applied.stamp != applied_.stamp) applied_ = applied;
+}
+
+void BoundaryConditions::RestoreApplied(StateReader& in) {
+  Applied read = applied_;
+  ReadFields(in, read);
+  applied_ = std::move(read);
+  Touch();
+  ClearCouplingLoads();
+}
 
 void BoundaryConditions::PrescribeDisplacement(Index v, const Vec3& u, AxisMask axes) {
   GIPSI_CHECK(v >= 0 && v < num_vertices(), "boundary vertex {} out of range", v);
   for (int a = 0; a < 3; ++a) {
     if (axes & (1 << a)) {
-      kind_[static_cast<std::size_t>(3 * v + a)] = ConstraintKind::kDisplacement;
-      value_(a, v) = u[a];
+      applied_.kind[static_cast<std::size_t>(3 * v + a)] = ConstraintKind::kDisplacement;
+      applied_.value(a, v) = u[a];
     }
   }
+  Touch();
 }
 
 void BoundaryConditions::PrescribeVelocity(Index v, const Vec3& vel, AxisMask axes) {
   GIPSI_CHECK(v >= 0 && v < num_vertices(), "boundary vertex {} out of range", v);
   for (int a = 0; a < 3; ++a) {
     if (axes & (1 << a)) {
-      kind_[static_cast<std::size_t>(3 * v + a)] = ConstraintKind::kVelocity;
-      value_(a, v) = vel[a];
+      applied_.kind[static_cast<std::size_t>(3 * v + a)] = ConstraintKind::kVelocity;
+      applied_.value(a, v) = vel[a];
     }
   }
+  Touch();
 }
 
 void BoundaryConditions::Release(Index v, AxisMask axes) {
   GIPSI_CHECK(v >= 0 && v < num_vertices(), "boundary vertex {} out of range", v);
   for (int a = 0; a < 3; ++a) {
     if (axes & (1 << a)) {
-      kind_[static_cast<std::size_t>(3 * v + a)] = ConstraintKind::kFree;
-      value_(a, v) = 0;
+      applied_.kind[static_cast<std::size_t>(3 * v + a)] = ConstraintKind::kFree;
+      applied_.value(a, v) = 0;
     }
   }
+  Touch();
 }
 
 bool BoundaryConditions::any_constraint() const {
-  return std::any_of(kind_.begin(), kind_.end(),
+  return std::any_of(applied_.kind.begin(), applied_.kind.end(),
                      [](ConstraintKind k) { return k != ConstraintKind::kFree; });
 }
 
@@ -56,9 +77,11 @@ void BoundaryConditions::ClearCouplingLoads() {
 }
 
 bool BoundaryConditions::any_face_load() const {
-  return (pressure_.size() > 0 &&
-          (pressure_.cwiseAbs().maxCoeff() > 0 || coupling_pressure_.cwiseAbs().maxCoeff() > 0)) ||
-         (traction_.size() > 0 && traction_.cwiseAbs().maxCoeff() > 0);
+  const VecX& pressure = applied_.pressure;
+  const Points& traction = applied_.traction;
+  return (pressure.size() > 0 &&
+          (pressure.cwiseAbs().maxCoeff() > 0 || coupling_pressure_.cwiseAbs().maxCoeff() > 0)) ||
+         (traction.size() > 0 && traction.cwiseAbs().maxCoeff() > 0);
 }
 
 }  // namespace gipsi

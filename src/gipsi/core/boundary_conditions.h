@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "gipsi/base/math.h"
+#include "gipsi/base/state_value.h"
 
 namespace gipsi {
 
@@ -31,6 +32,28 @@ enum class ConstraintKind : std::uint8_t {
 /// Not copyable (objects hand out references); movable.
 class BoundaryConditions {
  public:
+  /// The applied (persistent) part: constraints and applied loads, as a state value type
+  /// (base/state_value.h) that object snapshots copy. `stamp` identifies the contents: every
+  /// change draws a new process-wide stamp, so equal stamps mean equal contents and a snapshot
+  /// copies only when they differ. Copyable.
+  struct Applied {
+    std::vector<ConstraintKind> kind;  // 3 per vertex
+    Points value = Points(3, 0);       // prescribed displacement or velocity, 3 by vertices
+    Points force = Points(3, 0);       // 3 by vertices [N]
+    Points traction = Points(3, 0);    // 3 by faces [Pa]
+    VecX pressure;                     // per face [Pa]
+    std::uint64_t stamp = 0;
+
+    template <class Self, class V>
+    static void Fields(Self& s, V& v) {
+      v("kind", s.kind, Shape::kFixed);
+      v("value", s.value, Shape::kFixed);
+      v("force", s.force, Shape::kFixed);
+      v("traction", s.traction, Shape::kFixed);
+      v("pressure", s.pressure, Shape::kFixed);
+    }
+  };
+
   BoundaryConditions() = default;
   /// Storage for `num_vertices` boundary vertices and `num_faces` boundary triangles.
   BoundaryConditions(Index num_vertices, Index num_faces);
@@ -39,8 +62,8 @@ class BoundaryConditions {
   BoundaryConditions(BoundaryConditions&&) = default;
   BoundaryConditions& operator=(BoundaryConditions&&) = default;
 
-  [[nodiscard]] Index num_vertices() const { return Index(kind_.size() / 3); }
-  [[nodiscard]] Index num_faces() const { return pressure_.size(); }
+  [[nodiscard]] Index num_vertices() const { return Index(applied_.kind.size() / 3); }
+  [[nodiscard]] Index num_faces() const { return applied_.pressure.size(); }
 
   // --- Kinematic constraints (vertex v in [0, num_vertices), checked) ---
   /// Holds the masked axes at the rest position (zero displacement).
@@ -52,21 +75,30 @@ class BoundaryConditions {
   /// Frees the masked axes.
   void Release(Index v, AxisMask axes = kAllAxes);
   [[nodiscard]] ConstraintKind kind(Index v, int axis) const {
-    return kind_[static_cast<std::size_t>(3 * v + axis)];
+    return applied_.kind[static_cast<std::size_t>(3 * v + axis)];
   }
   /// Prescribed displacement or velocity of vertex v (meaningful on constrained axes only).
-  [[nodiscard]] auto value(Index v) const { return value_.col(v); }
+  [[nodiscard]] auto value(Index v) const { return applied_.value.col(v); }
   /// True if any axis of any vertex is constrained.
   [[nodiscard]] bool any_constraint() const;
 
   // --- Applied loads (persistent) ---
   /// Sets (replaces) the applied nodal force on vertex v [N].
-  void SetForce(Index v, const Vec3& f) { force_.col(v) = f; }
+  void SetForce(Index v, const Vec3& f) {
+    applied_.force.col(v) = f;
+    Touch();
+  }
   /// Sets the applied traction on boundary face f [Pa = N/m²], a force per current area.
-  void SetTraction(Index f, const Vec3& t) { traction_.col(f) = t; }
+  void SetTraction(Index f, const Vec3& t) {
+    applied_.traction.col(f) = t;
+    Touch();
+  }
   /// Sets the applied pressure on boundary face f [Pa]; positive pushes against the outward
   /// normal (into the body).
-  void SetPressure(Index f, double p) { pressure_[f] = p; }
+  void SetPressure(Index f, double p) {
+    applied_.pressure[f] = p;
+    Touch();
+  }
 
   // --- Coupling loads (cleared every macro step by the kernel) ---
   void AddCouplingForce(Index v, const Vec3& f) { coupling_force_.col(v) += f; }
@@ -74,20 +106,31 @@ class BoundaryConditions {
   void ClearCouplingLoads();
 
   /// Total nodal force (applied + coupling) on vertex v.
-  [[nodiscard]] Vec3 force(Index v) const { return force_.col(v) + coupling_force_.col(v); }
-  [[nodiscard]] auto traction(Index f) const { return traction_.col(f); }
+  [[nodiscard]] Vec3 force(Index v) const { return applied_.force.col(v) + coupling_force_.col(v); }
+  [[nodiscard]] auto traction(Index f) const { return applied_.traction.col(f); }
   /// Total pressure (applied + coupling) on face f.
-  [[nodiscard]] double pressure(Index f) const { return pressure_[f] + coupling_pressure_[f]; }
+  [[nodiscard]] double pressure(Index f) const {
+    return applied_.pressure[f] + coupling_pressure_[f];
+  }
   /// True if any face carries a traction or pressure (lets objects skip the face loop).
   [[nodiscard]] bool any_face_load() const;
 
+  /// The applied part (constraints and applied loads), without the coupling loads.
+  [[nodiscard]] const Applied& applied() const { return applied_; }
+  /// Replaces the applied part by `applied` (a snapshot of this object's, checked sizes); the
+  /// coupling loads are kept. Copies nothing when the stamps agree.
+  void SetApplied(const Applied& applied);
+  /// Checkpoints: writes the applied part (state_value.h) / reads it back (checked sizes; a new
+  /// stamp) and clears the coupling loads.
+  void SaveApplied(StateWriter& out) const { WriteFields(out, applied_); }
+  void RestoreApplied(StateReader& in);
+
  private:
-  std::vector<ConstraintKind> kind_;  // 3 per vertex
-  Points value_ = Points(3, 0);
-  Points force_ = Points(3, 0);
+  /// Marks the applied part as changed (a new stamp).
+  void Touch();
+
+  Applied applied_;
   Points coupling_force_ = Points(3, 0);
-  Points traction_ = Points(3, 0);
-  VecX pressure_;
   VecX coupling_pressure_;
 };
 

@@ -4,6 +4,7 @@
 /// one → boundary conditions of the other) or through a shared volume (Get a field of one → Set a
 /// field of the other). Connectors convert semantics and map between different meshes.
 
+#include <memory>
 #include <string>
 #include <string_view>
 
@@ -11,6 +12,7 @@
 
 namespace gipsi {
 
+class ObjectState;
 class StateReader;
 class StateWriter;
 
@@ -34,7 +36,7 @@ class Connector {
     return DoFire(t);
   }
   [[nodiscard]] std::int64_t fire_count() const { return fire_count_; }
-  /// Checkpoints and roll-back (gipsi/base/state.h): the fire count, then the type's own state
+  /// Checkpoints (gipsi/base/state.h): the fire count, then the type's own state
   /// (SaveConnectorState). RestoreState throws InputError for state from another scene.
   void SaveState(StateWriter& out) const;
   void RestoreState(StateReader& in);
@@ -43,10 +45,20 @@ class Connector {
   /// does not support checkpoints").
   virtual void SaveConnectorState(StateWriter& out) const;
   virtual void RestoreConnectorState(StateReader& in);
+  /// Snapshots (gipsi/base/object_state.h), as SimObject's: a new box with the current state,
+  /// copying into it, and restoring from it.
+  [[nodiscard]] std::unique_ptr<ObjectState> NewSnapshot() const;
+  void TakeSnapshot(ObjectState& into) const;
+  void RestoreSnapshot(const ObjectState& from);
 
  protected:
   explicit Connector(std::string name) : name_(std::move(name)) {}
   virtual StepStatus DoFire(double t) = 0;
+  /// Hooks of the snapshots, as SimObject's; the defaults serialise through
+  /// SaveConnectorState / RestoreConnectorState into a ByteState.
+  [[nodiscard]] virtual std::unique_ptr<ObjectState> NewConnectorState() const;
+  virtual void CopyConnectorState(ObjectState& into) const;
+  virtual void SetConnectorState(const ObjectState& from);
 
  private:
   std::string name_;

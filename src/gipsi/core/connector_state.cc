@@ -1,9 +1,10 @@
 /// @file
-/// Connector checkpoints: the base-class part (fire count) and the default hooks.
+/// Connector checkpoints and snapshots: the base-class part (fire count) and the default hooks.
 
 #include <fmt/format.h>
 
 #include "gipsi/base/error.h"
+#include "gipsi/base/object_state.h"
 #include "gipsi/base/state.h"
 #include "gipsi/core/connector.h"
 
@@ -33,6 +34,80 @@ void Connector::RestoreState(StateReader& in) {
   in.EndSection();
   in.EndSection();
   fire_count_ = fired;
+}
+
+namespace {
+
+/// What Connector::TakeSnapshot copies: the fire count and the type's own state.
+class ConnectorSnapshot final : public ObjectState {
+ public:
+  ConnectorSnapshot(const Connector* connector, std::unique_ptr<ObjectState> own)
+      : connector(connector), own(std::move(own)) {}
+
+  void Assign(const ObjectState& other) override {
+    const ConnectorSnapshot& o = Of(other);
+    GIPSI_CHECK(o.connector == connector, "a snapshot of another connector");
+    fire_count = o.fire_count;
+    own->Assign(*o.own);
+  }
+  [[nodiscard]] std::string FirstDifference(const ObjectState& other) const override {
+    const ConnectorSnapshot& o = Of(other);
+    if (fire_count != o.fire_count) return "fire count";
+    return own->FirstDifference(*o.own);
+  }
+  static const ConnectorSnapshot& Of(const ObjectState& box) {
+    const auto* typed = dynamic_cast<const ConnectorSnapshot*>(&box);
+    GIPSI_CHECK(typed != nullptr, "not a connector snapshot");
+    return *typed;
+  }
+  static ConnectorSnapshot& Of(ObjectState& box) {
+    return const_cast<ConnectorSnapshot&>(Of(static_cast<const ObjectState&>(box)));
+  }
+
+  const Connector* connector;
+  std::int64_t fire_count = 0;
+  std::unique_ptr<ObjectState> own;
+};
+
+}  // namespace
+
+std::unique_ptr<ObjectState> Connector::NewSnapshot() const {
+  auto box = std::make_unique<ConnectorSnapshot>(this, NewConnectorState());
+  TakeSnapshot(*box);
+  return box;
+}
+
+void Connector::TakeSnapshot(ObjectState& into) const {
+  ConnectorSnapshot& s = ConnectorSnapshot::Of(into);
+  GIPSI_CHECK(s.connector == this, "connector '{}': a snapshot of another connector", name_);
+  s.fire_count = fire_count_;
+  CopyConnectorState(*s.own);
+}
+
+void Connector::RestoreSnapshot(const ObjectState& from) {
+  const ConnectorSnapshot& s = ConnectorSnapshot::Of(from);
+  GIPSI_CHECK(s.connector == this, "connector '{}': a snapshot of another connector", name_);
+  fire_count_ = s.fire_count;
+  SetConnectorState(*s.own);
+}
+
+std::unique_ptr<ObjectState> Connector::NewConnectorState() const {
+  return std::make_unique<ByteState>();
+}
+
+void Connector::CopyConnectorState(ObjectState& into) const {
+  StateWriter out;
+  out.BeginSection(type_name(), 1);
+  SaveConnectorState(out);
+  out.EndSection();
+  ByteState::Of(into).bytes = out.TakeBytes();
+}
+
+void Connector::SetConnectorState(const ObjectState& from) {
+  StateReader in(ByteState::Of(from).bytes, fmt::format("the snapshot of connector '{}'", name_));
+  in.BeginSection(type_name(), 1);
+  RestoreConnectorState(in);
+  in.EndSection();
 }
 
 void Connector::SaveConnectorState(StateWriter& /*out*/) const {

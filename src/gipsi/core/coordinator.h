@@ -62,6 +62,11 @@ class Coordinator {
   /// Hands `token` to every object (SimObject::SetStopToken).
   void SetStopToken(StopToken token);
 
+  /// Snapshots of every object and connector (a CompositeState, gipsi/base/object_state.h):
+  /// the kernel's step retry and an aggregate's state. Objects first, then connectors.
+  [[nodiscard]] std::unique_ptr<ObjectState> NewSnapshot() const;
+  void TakeSnapshot(ObjectState& into) const;
+  void RestoreSnapshot(const ObjectState& from);
   [[nodiscard]] std::size_t num_objects() const { return objects_.size(); }
   [[nodiscard]] std::size_t num_connectors() const { return connectors_.size(); }
   [[nodiscard]] SimObject& object(std::size_t i) { return *objects_[i].object; }

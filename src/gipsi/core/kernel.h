@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "gipsi/base/object_state.h"
 #include "gipsi/core/coordinator.h"
 
 namespace gipsi {
@@ -110,9 +111,9 @@ class Kernel {
   /// is stopped on request. Atomic: a crash mid-write leaves the previous checkpoint.
   void SetCheckpointing(std::filesystem::path file, std::int64_t every);
   /// The complete state between macro steps: clock, event queue position, every object and
-  /// connector, and every observer's position. Clears the coupling loads first (as the next
-  /// macro step would). Throws InputError if an object, connector or observer does not
-  /// support checkpoints.
+  /// connector, and every observer's position. Coupling loads are not state (the next macro
+  /// step clears them) and are left as they are. Throws InputError if an object, connector or
+  /// observer does not support checkpoints.
   void SaveState(StateWriter& out);
   /// Restores what SaveState wrote for the same scene (after Initialize and AddObserver, before
   /// Run); throws InputError naming what differs for a checkpoint of another scene.
@@ -171,7 +172,9 @@ class Kernel {
   bool started_ = false;
   FailurePolicy policy_;
   std::int64_t retried_ = 0;
-  std::string rollback_;  // state at the start of the current macro step (retry policy)
+  // The whole simulation at the start of the current macro step (retry policy): one snapshot,
+  // made at the first retried step and copied into at every one after.
+  std::unique_ptr<ObjectState> rollback_;
   std::filesystem::path checkpoint_file_;
   std::int64_t checkpoint_every_ = 0;
   std::atomic<bool> stop_requested_{false};

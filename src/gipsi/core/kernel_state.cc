@@ -5,6 +5,7 @@
 
 #include "gipsi/base/error.h"
 #include "gipsi/base/log.h"
+#include "gipsi/base/object_state.h"
 #include "gipsi/base/state.h"
 #include "gipsi/core/kernel.h"
 
@@ -59,7 +60,6 @@ void Kernel::SetCheckpointing(std::filesystem::path file, std::int64_t every) {
 
 void Kernel::SaveState(StateWriter& out) {
   GIPSI_CHECK(macro_dt_ > 0, "Kernel::Initialize was not called");
-  coordinator_.BeginMacroStep();  // coupling loads are not state: the next step clears them
   out.BeginSection("Kernel", 1);
   out.WriteString(SceneSignature(coordinator_));
   out.WriteDouble(macro_dt_);
@@ -140,15 +140,11 @@ void Kernel::ReadCheckpoint(const std::filesystem::path& file) {
 std::optional<ScheduleFailure> Kernel::StepWithPolicy(double t, std::string& retry_note) {
   coordinator_.BeginMacroStep();
   if (policy_.max_halvings <= 0) return coordinator_.MacroStep(t, macro_index_);
-  {
-    StateWriter out;
-    SaveSimulation(coordinator_, out);
-    rollback_ = out.TakeBytes();
-  }
-  auto restore = [&] {
-    StateReader in(rollback_, "the roll-back state");
-    RestoreSimulation(coordinator_, in);
-  };
+  if (rollback_)
+    coordinator_.TakeSnapshot(*rollback_);
+  else
+    rollback_ = coordinator_.NewSnapshot();
+  auto restore = [&] { coordinator_.RestoreSnapshot(*rollback_); };
   std::optional<ScheduleFailure> failure = coordinator_.MacroStep(t, macro_index_);
   auto stopped = [&] { return failure && failure->status.code == StepStatus::Code::kStopped; };
   for (int h = 1; failure && !stopped() && h <= policy_.max_halvings; ++h) {

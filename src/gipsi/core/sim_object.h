@@ -22,6 +22,7 @@
 
 namespace gipsi {
 
+class ObjectState;
 class StateReader;
 class StateWriter;
 
@@ -131,16 +132,30 @@ class SimObject {
     std::string unit;
   };
   [[nodiscard]] virtual std::vector<ProfileEntry> ProfileBreakdown() const { return {}; }
-  /// Checkpoints and roll-back (gipsi/base/state.h): writes the clock, step count and applied
-  /// boundary conditions, then the type's own state (SaveObjectState); coupling loads must have
-  /// been cleared (BeginMacroStep). RestoreState reads it back; the object then continues
-  /// bitwise identically. Throw InputError for state from another scene or object type.
+  /// Checkpoints (gipsi/base/state.h): writes the clock, step count and applied boundary
+  /// conditions (not the coupling loads, which the next macro step clears), then the type's own
+  /// state (SaveObjectState). RestoreState reads it back; the object then continues bitwise
+  /// identically. Throw InputError for state from another scene or object type.
   void SaveState(StateWriter& out) const;
   void RestoreState(StateReader& in);
   /// Everything of the subclass that influences the future (state, integrator history, event
-  /// logs). The defaults throw InputError("object type X does not support checkpoints").
+  /// logs), and the solver caches a bitwise continuation needs (a kept factorisation). The
+  /// defaults throw InputError("object type X does not support checkpoints").
   virtual void SaveObjectState(StateWriter& out) const;
   virtual void RestoreObjectState(StateReader& in);
+
+  /// Snapshots (gipsi/base/object_state.h), the kernel's step retry: a new box holding the
+  /// object's current state (clock, step count, applied boundary conditions, the type's state).
+  [[nodiscard]] std::unique_ptr<ObjectState> NewSnapshot() const;
+  /// Copies the current state into `into`, a box from this object's NewSnapshot. For a type
+  /// with a state value type this is a copy of values, allocation-free when shapes agree; the
+  /// boundary conditions are copied only if they changed.
+  void TakeSnapshot(ObjectState& into) const;
+  /// Returns to the state in `from` (from this object's NewSnapshot). Stepping on from there
+  /// gives the same bits every time; solver caches are rebuilt or dropped by the type's rule
+  /// (docs/architecture.md, "State"), so the result may differ from the first time the state
+  /// was stepped from only where that rule says.
+  void RestoreSnapshot(const ObjectState& from);
   /// Called by the kernel at the start of every macro step (aggregates forward it).
   virtual void BeginMacroStep() { bcs_.ClearCouplingLoads(); }
   /// The run's stop request (the kernel hands it down when it is initialised; aggregates pass
@@ -169,6 +184,13 @@ class SimObject {
                               const double* velocities, Eigen::Ref<Eigen::MatrixXd> out) const;
 
   virtual StepStatus DoStep(double t, double dt) = 0;
+  /// Hooks of the snapshots: a box for the type's state, copying into it, and restoring from
+  /// it (then rebuilding what derives from the state). The defaults serialise through
+  /// SaveObjectState / RestoreObjectState into a ByteState; a type with a state value type `S`
+  /// returns a StateBox<S> and copies values.
+  [[nodiscard]] virtual std::unique_ptr<ObjectState> NewObjectState() const;
+  virtual void CopyObjectState(ObjectState& into) const;
+  virtual void SetObjectState(const ObjectState& from);
   /// Hook of SetStopToken (an aggregate forwards the token to its parts). Default: nothing.
   virtual void DoSetStopToken(StopToken /*token*/) {}
   virtual void DoReadField(FieldId id, Eigen::Ref<Eigen::MatrixXd> out) const = 0;

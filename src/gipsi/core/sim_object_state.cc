@@ -1,41 +1,24 @@
 /// @file
-/// SimObject checkpoints: the base-class part (clock, step count, applied boundary conditions)
-/// and the default hooks.
+/// SimObject checkpoints and snapshots: the base-class part (clock, step count, applied boundary
+/// conditions) and the default hooks (the type's state serialised, for types without a state
+/// value type).
 
 #include <fmt/format.h>
 
 #include "gipsi/base/error.h"
+#include "gipsi/base/object_state.h"
 #include "gipsi/base/state.h"
 #include "gipsi/core/sim_object.h"
 
 namespace gipsi {
 
 void SimObject::SaveState(StateWriter& out) const {
-  out.BeginSection("SimObject", 1);
+  out.BeginSection("SimObject", 2);
   out.WriteString(name_);
   out.WriteString(type_name());
   out.WriteDouble(time_);
   out.WriteInt(step_count_);
-  // Applied boundary conditions (scene and events); coupling loads are cleared by then.
-  const Index nv = bcs_.num_vertices(), nf = bcs_.num_faces();
-  std::vector<std::uint8_t> kinds(static_cast<std::size_t>(3 * nv));
-  Points values(3, nv), forces(3, nv), tractions(3, nf);
-  VecX pressures(nf);
-  for (Index v = 0; v < nv; ++v) {
-    for (int a = 0; a < 3; ++a)
-      kinds[static_cast<std::size_t>(3 * v + a)] = static_cast<std::uint8_t>(bcs_.kind(v, a));
-    values.col(v) = bcs_.value(v);
-    forces.col(v) = bcs_.force(v);
-  }
-  for (Index f = 0; f < nf; ++f) {
-    tractions.col(f) = bcs_.traction(f);
-    pressures[f] = bcs_.pressure(f);
-  }
-  out.WriteArray(kinds);
-  out.WriteMatrix(values);
-  out.WriteMatrix(forces);
-  out.WriteMatrix(tractions);
-  out.WriteMatrix(pressures);
+  bcs_.SaveApplied(out);  // the coupling loads are not state: the next macro step clears them
   out.BeginSection(type_name(), 1);
   SaveObjectState(out);
   out.EndSection();
@@ -43,7 +26,7 @@ void SimObject::SaveState(StateWriter& out) const {
 }
 
 void SimObject::RestoreState(StateReader& in) {
-  in.BeginSection("SimObject", 1);
+  in.BeginSection("SimObject", 2);
   const std::string name = in.ReadString();
   const std::string type = in.ReadString();
   if (name != name_ || type != type_name())
@@ -51,40 +34,99 @@ void SimObject::RestoreState(StateReader& in) {
                         type, name_, type_name()));
   const double time = in.ReadDouble();
   const std::int64_t steps = in.ReadInt();
-  const Index nv = bcs_.num_vertices(), nf = bcs_.num_faces();
-  std::vector<std::uint8_t> kinds(static_cast<std::size_t>(3 * nv));
-  Points values(3, nv), forces(3, nv), tractions(3, nf);
-  VecX pressures(nf);
-  in.ReadArrayExact(kinds, "the boundary constraints of '" + name_ + "'");
-  in.ReadMatrixExact(values, "the boundary values");
-  in.ReadMatrixExact(forces, "the boundary forces");
-  in.ReadMatrixExact(tractions, "the boundary tractions");
-  in.ReadMatrixExact(pressures, "the boundary pressures");
-  bcs_.ClearCouplingLoads();
-  for (Index v = 0; v < nv; ++v) {
-    bcs_.Release(v);
-    for (int a = 0; a < 3; ++a) {
-      const auto kind = static_cast<ConstraintKind>(kinds[static_cast<std::size_t>(3 * v + a)]);
-      const auto mask = static_cast<AxisMask>(1 << a);
-      if (kind == ConstraintKind::kDisplacement)
-        bcs_.PrescribeDisplacement(v, values.col(v), mask);
-      else if (kind == ConstraintKind::kVelocity)
-        bcs_.PrescribeVelocity(v, values.col(v), mask);
-      else if (kind != ConstraintKind::kFree)
-        in.Fail("corrupted boundary constraint kind");
-    }
-    bcs_.SetForce(v, forces.col(v));
-  }
-  for (Index f = 0; f < nf; ++f) {
-    bcs_.SetTraction(f, tractions.col(f));
-    bcs_.SetPressure(f, pressures[f]);
-  }
+  bcs_.RestoreApplied(in);
   in.BeginSection(type_name(), 1);
   RestoreObjectState(in);
   in.EndSection();
   in.EndSection();
   time_ = time;
   step_count_ = steps;
+}
+
+namespace {
+
+/// What SimObject::TakeSnapshot copies: the clock, the step count, the applied boundary
+/// conditions (only when their stamp changed) and the type's own state.
+class SimObjectSnapshot final : public ObjectState {
+ public:
+  SimObjectSnapshot(const SimObject* object, std::unique_ptr<ObjectState> own)
+      : object(object), own(std::move(own)) {}
+
+  void Assign(const ObjectState& other) override {
+    const SimObjectSnapshot& o = Of(other);
+    GIPSI_CHECK(o.object == object, "a snapshot of another object");
+    time = o.time;
+    steps = o.steps;
+    if (bcs.stamp != o.bcs.stamp) bcs = o.bcs;
+    own->Assign(*o.own);
+  }
+  [[nodiscard]] std::string FirstDifference(const ObjectState& other) const override {
+    const SimObjectSnapshot& o = Of(other);
+    if (!state_detail::SameBits(&time, &o.time, 1)) return "time";
+    if (steps != o.steps) return "step count";
+    std::string d = gipsi::FirstDifference(bcs, o.bcs);
+    if (!d.empty()) return "boundary conditions: " + d;
+    return own->FirstDifference(*o.own);
+  }
+  static const SimObjectSnapshot& Of(const ObjectState& box) {
+    const auto* typed = dynamic_cast<const SimObjectSnapshot*>(&box);
+    GIPSI_CHECK(typed != nullptr, "not an object snapshot");
+    return *typed;
+  }
+  static SimObjectSnapshot& Of(ObjectState& box) {
+    return const_cast<SimObjectSnapshot&>(Of(static_cast<const ObjectState&>(box)));
+  }
+
+  const SimObject* object;
+  double time = 0;
+  std::int64_t steps = 0;
+  BoundaryConditions::Applied bcs;
+  std::unique_ptr<ObjectState> own;
+};
+
+}  // namespace
+
+std::unique_ptr<ObjectState> SimObject::NewSnapshot() const {
+  auto box = std::make_unique<SimObjectSnapshot>(this, NewObjectState());
+  TakeSnapshot(*box);
+  return box;
+}
+
+void SimObject::TakeSnapshot(ObjectState& into) const {
+  SimObjectSnapshot& s = SimObjectSnapshot::Of(into);
+  GIPSI_CHECK(s.object == this, "object '{}': a snapshot of another object", name_);
+  s.time = time_;
+  s.steps = step_count_;
+  if (s.bcs.stamp != bcs_.applied().stamp) s.bcs = bcs_.applied();
+  CopyObjectState(*s.own);
+}
+
+void SimObject::RestoreSnapshot(const ObjectState& from) {
+  const SimObjectSnapshot& s = SimObjectSnapshot::Of(from);
+  GIPSI_CHECK(s.object == this, "object '{}': a snapshot of another object", name_);
+  time_ = s.time;
+  step_count_ = s.steps;
+  bcs_.SetApplied(s.bcs);
+  SetObjectState(*s.own);
+}
+
+std::unique_ptr<ObjectState> SimObject::NewObjectState() const {
+  return std::make_unique<ByteState>();
+}
+
+void SimObject::CopyObjectState(ObjectState& into) const {
+  StateWriter out;
+  out.BeginSection(type_name(), 1);
+  SaveObjectState(out);
+  out.EndSection();
+  ByteState::Of(into).bytes = out.TakeBytes();
+}
+
+void SimObject::SetObjectState(const ObjectState& from) {
+  StateReader in(ByteState::Of(from).bytes, fmt::format("the snapshot of object '{}'", name_));
+  in.BeginSection(type_name(), 1);
+  RestoreObjectState(in);
+  in.EndSection();
 }
 
 void SimObject::SaveObjectState(StateWriter& /*out*/) const {

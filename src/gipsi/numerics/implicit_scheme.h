@@ -20,6 +20,7 @@
 #include <string_view>
 
 #include "gipsi/base/math.h"
+#include "gipsi/base/state_value.h"
 
 namespace gipsi {
 
@@ -65,9 +66,21 @@ class ImplicitScheme {
   void SetPositions(const VecX& x);
   /// Overwrites the current accelerations (Newmark's initial a_0).
   void SetAcceleration(const VecX& a) { a_ = a; }
-  /// Checkpoints (gipsi/base/state.h): the state and the multistep history.
-  void SaveState(StateWriter& out) const;
-  void RestoreState(StateReader& in);
+  /// State value fields (gipsi/base/state_value.h): the kind (checked on reading), the state
+  /// and the multistep history. The per-step coefficients (c_a, c_v, a_hat, v_hat) are not
+  /// state: Begin rebuilds them.
+  template <class Self, class V>
+  static void Fields(Self& s, V& v) {
+    v("kind", s.kind_, Shape::kFixed);
+    v("x", s.x_, Shape::kFixed);
+    v("v", s.v_, Shape::kFixed);
+    v("a", s.a_);
+    v("dx_prev", s.dx_prev_);
+    v("v_prev", s.v_prev_);
+    v("dt_prev", s.dt_prev_);
+    v("dt", s.dt_);
+    v("bdf2_now", s.bdf2_now_);
+  }
 
  private:
   ImplicitSchemeKind kind_ = ImplicitSchemeKind::kBackwardEuler;

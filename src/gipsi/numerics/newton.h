@@ -35,6 +35,7 @@
 #include <vector>
 
 #include "gipsi/base/math.h"
+#include "gipsi/base/state_value.h"
 #include "gipsi/base/stop_token.h"
 #include "gipsi/numerics/sparse/linear_solver.h"
 
@@ -116,8 +117,7 @@ enum class LinearFailure : std::uint8_t {
   kNotConverged,         ///< an iterative solve missed its tolerance or gave non-finite values
 };
 
-/// Outcome of one solve. Plain struct, trivially copyable (FemSolid checkpoints save it field by
-/// field: models/fem/fem_solid_state.cc).
+/// Outcome of one solve. Plain struct, trivially copyable.
 struct NewtonStats {
   bool converged = false;
   bool inadmissible = false;  ///< stopped because no admissible state was found
@@ -138,6 +138,26 @@ struct NewtonStats {
   double final_residual = 0;
   static constexpr int kHistory = 8;
   std::array<double, kHistory> residual_history{};  ///< first ‖r‖ values (for diagnostics)
+
+  /// State value fields (gipsi/base/state_value.h): an object keeps its last statistics as
+  /// state (failure messages and profiles read them).
+  template <class Self, class V>
+  static void Fields(Self& s, V& v) {
+    v("converged", s.converged);
+    v("inadmissible", s.inadmissible);
+    v("linear_failure", s.linear_failure);
+    v("interrupted", s.interrupted);
+    v("switched_to_indefinite", s.switched_to_indefinite);
+    v("linear_failure_kind", s.linear_failure_kind);
+    v("iterations", s.iterations);
+    v("linear_iterations", s.linear_iterations);
+    v("refactorizations", s.refactorizations);
+    v("monotonicity_accepts", s.monotonicity_accepts);
+    v("backtracks", s.backtracks);
+    v("initial_residual", s.initial_residual);
+    v("final_residual", s.final_residual);
+    v("residual_history", s.residual_history, Shape::kFixed);
+  }
 };
 
 /// Not copyable.
@@ -167,6 +187,13 @@ class NewtonSolver {
   /// factors), so a resumed run iterates exactly like an uninterrupted one.
   void SaveState(StateWriter& out, const SparseMatrix& J) const;
   void RestoreState(StateReader& in, SparseMatrix& J);
+  /// Forgets what one Solve hands to the next (the warm start and the kept factorisation), so
+  /// the next Solve starts cold and factorises at its first iterate: after the owner returned
+  /// to an earlier state (a snapshot), whose future these belonged to.
+  void ForgetHandOver() {
+    warm_valid_ = false;
+    factor_valid_ = false;
+  }
 
  private:
   NewtonOptions options_;

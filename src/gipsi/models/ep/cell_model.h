@@ -21,6 +21,8 @@
 #include <string_view>
 #include <vector>
 
+#include "gipsi/base/state_value.h"
+
 namespace gipsi {
 
 class CellModel;
@@ -57,6 +59,8 @@ struct CellStateView {
 /// contiguous array per state variable). Copyable and movable.
 class CellStates {
  public:
+  /// No cells (a placeholder until the owner knows its model and size).
+  CellStates() = default;
   /// `num_nodes` cells, each in `model`'s resting state.
   CellStates(const CellModel& model, std::size_t num_nodes);
 
@@ -75,9 +79,18 @@ class CellStates {
   /// Sets all state variables of `node`; `values` has num_states() entries.
   void SetNode(std::size_t node, std::span<const double> values);
 
+  /// State value fields (gipsi/base/state_value.h): the sizes (checked on reading) and every
+  /// variable of every cell.
+  template <class Self, class V>
+  static void Fields(Self& s, V& v) {
+    v("num_nodes", s.num_nodes_, Shape::kFixed);
+    v("num_states", s.num_states_, Shape::kFixed);
+    v("values", s.data_, Shape::kFixed);
+  }
+
  private:
-  std::size_t num_nodes_;
-  int num_states_;
+  std::size_t num_nodes_ = 0;
+  int num_states_ = 0;
   std::vector<double> data_;
 };
 

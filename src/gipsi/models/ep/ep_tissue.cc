@@ -89,9 +89,9 @@ EpTissue::EpTissue(std::string name, EpTissueParams params)
 void EpTissue::InitTissue() {
   const CellModel& model = *params_.cell;
   const auto n = static_cast<std::size_t>(domain().num_nodes());
-  states_ = std::make_unique<CellStates>(model, n);
+  state_.cells = CellStates(model, n);
   if (!params_.initial_state.empty())
-    for (std::size_t i = 0; i < n; ++i) states_->SetNode(i, params_.initial_state);
+    for (std::size_t i = 0; i < n; ++i) state_.cells.SetNode(i, params_.initial_state);
   i_stim_ = VecX::Zero(static_cast<Index>(n));
   for (const StimulusSpec& s : params_.stimuli) {
     stim_nodes_.push_back(SelectNodes(s.region, domain()));
@@ -105,12 +105,12 @@ void EpTissue::InitTissue() {
   }
   const Index count = static_cast<Index>(n);
   v_prev_ = voltage();
-  activation_time_ = VecX::Constant(count, -1);
-  last_activation_ = VecX::Constant(count, -1);
-  apd_ = VecX::Constant(count, -1);
-  v_min_ = v_prev_;
-  v_peak_ = v_prev_;
-  depolarised_.assign(n, 0);
+  state_.activation_time = VecX::Constant(count, -1);
+  state_.last_activation = VecX::Constant(count, -1);
+  state_.apd = VecX::Constant(count, -1);
+  state_.v_min = v_prev_;
+  state_.v_peak = v_prev_;
+  state_.depolarised.assign(n, 0);
   solver_ = MakeLinearSolver(params_.linear);
   // Tables for the reaction sub-step now, so the first step does not build them (with no
   // reaction dt the sub-step is the object's dt, known at the first step).
@@ -128,7 +128,7 @@ void EpTissue::SetDiffusionOperator(SparseMatrix stiffness, VecX lumped_mass,
 }
 
 Eigen::Map<const VecX> EpTissue::voltage() const {
-  return {states_->var(params_.cell->v_index()), static_cast<Index>(states_->num_nodes())};
+  return {state_.cells.var(params_.cell->v_index()), static_cast<Index>(state_.cells.num_nodes())};
 }
 
 double EpTissue::VoltageIntegral() const { return lumped_mass_.dot(voltage()); }
@@ -162,7 +162,7 @@ void EpTissue::ReactionSteps(double t0_ms, double length_ms) {
   const double h = length_ms / substeps;
   const CellModel& model = *params_.cell;
   model.Prepare(h);
-  const CellStateView view = states_->view();
+  const CellStateView view = state_.cells.view();
   const std::size_t n = view.num_nodes;
   const auto chunks = static_cast<std::ptrdiff_t>((n + kReactionChunk - 1) / kReactionChunk);
   for (int k = 0; k < substeps; ++k) {
@@ -237,7 +237,7 @@ StepStatus EpTissue::Diffuse(double dt_ms) {
   }
   solution_ = v;  // warm start
   const LinearSolveStats stats = solver_->Solve(rhs_, solution_);
-  last_iterations_ = stats.iterations;
+  state_.last_iterations = stats.iterations;
   profile_.cg_iterations += stats.iterations;
   profile_.diffusion += Seconds(start);
   if (!stats.converged) {
@@ -274,25 +274,25 @@ void EpTissue::TrackActivation(double t0_ms, double dt_ms) {
   for (Index i = 0; i < n; ++i) {
     const double v0 = v_prev_[i];
     const double v1 = v[i];
-    if (!depolarised_[static_cast<std::size_t>(i)]) {
+    if (!state_.depolarised[static_cast<std::size_t>(i)]) {
       if (v0 < threshold && v1 >= threshold) {
         // Linear interpolation of the crossing within the step.
         const double tc = t0_ms + dt_ms * (threshold - v0) / (v1 - v0);
-        if (activation_time_[i] < 0) activation_time_[i] = tc;
-        last_activation_[i] = tc;
-        v_peak_[i] = v1;
-        depolarised_[static_cast<std::size_t>(i)] = 1;
+        if (state_.activation_time[i] < 0) state_.activation_time[i] = tc;
+        state_.last_activation[i] = tc;
+        state_.v_peak[i] = v1;
+        state_.depolarised[static_cast<std::size_t>(i)] = 1;
       } else {
-        v_min_[i] = std::min(v_min_[i], v1);
+        state_.v_min[i] = std::min(state_.v_min[i], v1);
       }
     } else {
-      v_peak_[i] = std::max(v_peak_[i], v1);
-      const double level = v_peak_[i] - fraction * (v_peak_[i] - v_min_[i]);
+      state_.v_peak[i] = std::max(state_.v_peak[i], v1);
+      const double level = state_.v_peak[i] - fraction * (state_.v_peak[i] - state_.v_min[i]);
       if (v0 > level && v1 <= level) {
         const double tc = t0_ms + dt_ms * (v0 - level) / (v0 - v1);
-        apd_[i] = tc - last_activation_[i];
-        depolarised_[static_cast<std::size_t>(i)] = 0;
-        v_min_[i] = v1;
+        state_.apd[i] = tc - state_.last_activation[i];
+        state_.depolarised[static_cast<std::size_t>(i)] = 0;
+        state_.v_min[i] = v1;
       }
     }
   }
@@ -309,29 +309,29 @@ std::vector<SimObject::ProfileEntry> EpTissue::ProfileBreakdown() const {
 void EpTissue::DoReadField(FieldId id, Eigen::Ref<Eigen::MatrixXd> out) const {
   for (std::size_t k = 0; k < state_fields_.size(); ++k) {
     if (id != state_fields_[k]) continue;
-    out = Eigen::Map<const VecX>(states_->var(static_cast<int>(k)), num_nodes()).transpose();
+    out = Eigen::Map<const VecX>(state_.cells.var(static_cast<int>(k)), num_nodes()).transpose();
     return;
   }
   if (id == f_activation_) {
-    out = activation_time_.transpose();
+    out = state_.activation_time.transpose();
   } else if (id == f_last_activation_) {
-    out = last_activation_.transpose();
+    out = state_.last_activation.transpose();
   } else if (id == f_apd_) {
-    out = apd_.transpose();
+    out = state_.apd.transpose();
   } else if (id == f_activated_) {
-    const auto activated = (activation_time_.array() >= 0).count();
+    const auto activated = (state_.activation_time.array() >= 0).count();
     out(0, 0) = num_nodes() > 0 ? static_cast<double>(activated) / num_nodes() : 0.0;
   } else if (id == f_integral_) {
     out(0, 0) = 1e-9 * VoltageIntegral();  // mV·mm³ → mV·m³
   } else if (id == f_cg_) {
-    out(0, 0) = last_iterations_;
+    out(0, 0) = state_.last_iterations;
   }
 }
 
 void EpTissue::DoWriteField(FieldId id, const Eigen::Ref<const Eigen::MatrixXd>& in) {
   for (std::size_t k = 0; k < state_fields_.size(); ++k) {
     if (id != state_fields_[k]) continue;
-    Eigen::Map<VecX>(states_->var(static_cast<int>(k)), num_nodes()) = in.row(0).transpose();
+    Eigen::Map<VecX>(state_.cells.var(static_cast<int>(k)), num_nodes()) = in.row(0).transpose();
     return;
   }
 }

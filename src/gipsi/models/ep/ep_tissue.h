@@ -97,25 +97,55 @@ struct EpTissueParams {
   [[nodiscard]] bool anisotropic() const { return sigma_longitudinal != sigma_transverse; }
 };
 
+/// What a monodomain object carries from one step to the next, as a state value type
+/// (gipsi/base/state_value.h): every cell's state variables and the activation/APD tracking.
+/// The stimuli and clamps are functions of time, the cell models are immutable and the
+/// diffusion solve starts from the current voltage. Copyable.
+struct EpState {
+  CellStates cells;
+  VecX activation_time;  ///< first activation [ms] per node, −1 where none
+  VecX last_activation;  ///< latest activation [ms] per node, −1 where none
+  VecX apd;              ///< last completed APD [ms] per node, −1 where none
+  VecX v_min;            ///< lowest voltage since the last repolarisation [mV] (the APD's base)
+  VecX v_peak;           ///< highest voltage since the last activation [mV]
+  std::vector<unsigned char> depolarised;  ///< per node: activated and not yet repolarised
+  int last_iterations = 0;                 ///< of the last diffusion solve
+
+  template <class Self, class V>
+  static void Fields(Self& s, V& v) {
+    v("cells", s.cells);
+    v("activation_time", s.activation_time, Shape::kFixed);
+    v("last_activation", s.last_activation, Shape::kFixed);
+    v("apd", s.apd, Shape::kFixed);
+    v("v_min", s.v_min, Shape::kFixed);
+    v("v_peak", s.v_peak, Shape::kFixed);
+    v("depolarised", s.depolarised, Shape::kFixed);
+    v("last_iterations", s.last_iterations);
+  }
+};
+
 /// Base of the monodomain objects (see the file comment). Not copyable or movable.
 class EpTissue : public SimObject {
  public:
   [[nodiscard]] const EpTissueParams& params() const { return params_; }
   [[nodiscard]] const CellModel& cell() const { return *params_.cell; }
-  [[nodiscard]] Index num_nodes() const { return static_cast<Index>(states_->num_nodes()); }
+  [[nodiscard]] Index num_nodes() const { return static_cast<Index>(state_.cells.num_nodes()); }
   /// Transmembrane voltage [mV] of every node (a view of the cell states).
   [[nodiscard]] Eigen::Map<const VecX> voltage() const;
   /// First activation time [ms] per node, −1 where not activated yet.
-  [[nodiscard]] const VecX& activation_time() const { return activation_time_; }
+  [[nodiscard]] const VecX& activation_time() const { return state_.activation_time; }
   /// Last completed APD [ms] per node, −1 where none.
-  [[nodiscard]] const VecX& apd() const { return apd_; }
+  [[nodiscard]] const VecX& apd() const { return state_.apd; }
   /// ∫ V dΩ with the diffusion mass [mV·mm³] (conserved by diffusion alone).
   [[nodiscard]] double VoltageIntegral() const;
   /// Nodes driven by each stimulus / clamp (in declaration order).
   [[nodiscard]] const std::vector<std::vector<int>>& stimulus_nodes() const { return stim_nodes_; }
   [[nodiscard]] std::vector<ProfileEntry> ProfileBreakdown() const override;
+  /// Checkpoints: the state (EpState).
   void SaveObjectState(StateWriter& out) const override;
   void RestoreObjectState(StateReader& in) override;
+  /// The state that evolves.
+  [[nodiscard]] const EpState& state() const { return state_; }
   [[nodiscard]] std::string failure_detail() const override { return failure_detail_; }
 
  protected:
@@ -134,6 +164,11 @@ class EpTissue : public SimObject {
   [[nodiscard]] virtual Vec3 NodePositionMm(Index node) const;
 
   StepStatus DoStep(double t, double dt) override;
+  /// Snapshots copy EpState; the diffusion factorisation depends on the step size only and is
+  /// kept.
+  [[nodiscard]] std::unique_ptr<ObjectState> NewObjectState() const override;
+  void CopyObjectState(ObjectState& into) const override;
+  void SetObjectState(const ObjectState& from) override;
   void DoReadField(FieldId id, Eigen::Ref<Eigen::MatrixXd> out) const override;
   void DoWriteField(FieldId id, const Eigen::Ref<const Eigen::MatrixXd>& in) override;
 
@@ -146,9 +181,9 @@ class EpTissue : public SimObject {
   [[nodiscard]] StepStatus Diffuse(double dt_ms);
   void TrackActivation(double t0_ms, double dt_ms);
   [[nodiscard]] StepStatus CheckVoltage();
-  [[nodiscard]] double* v_data() { return states_->var(params_.cell->v_index()); }
+  [[nodiscard]] double* v_data() { return state_.cells.var(params_.cell->v_index()); }
 
-  std::unique_ptr<CellStates> states_;
+  EpState state_;
   std::vector<FieldId> state_fields_;  // one per cell state (V included)
   FieldId f_activation_, f_last_activation_, f_apd_, f_activated_, f_integral_, f_cg_;
   std::vector<std::vector<int>> stim_nodes_, clamp_nodes_;
@@ -160,11 +195,9 @@ class EpTissue : public SimObject {
   VecX lumped_mass_, rhs_, solution_, work_;
   std::unique_ptr<LinearSolver> solver_;
   double system_dt_ = -1;  // Δt [ms] of system_
-  int last_iterations_ = 0;
 
   // Activation and APD.
-  VecX v_prev_, activation_time_, last_activation_, apd_, v_min_, v_peak_;
-  std::vector<unsigned char> depolarised_;
+  VecX v_prev_;  // V at the start of the step (a copy of the state's)
 
   struct Profile {
     double reaction = 0, diffusion = 0, tracking = 0;

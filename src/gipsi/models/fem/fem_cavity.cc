@@ -77,11 +77,13 @@ void FemSolid::AttachCavityLaw(std::string_view cavity, CavityLaw* law) {
 
 double FemSolid::CavityPressure(std::size_t i) const {
   GIPSI_CHECK(i < cavities_.size());
-  return cavities_[i].pressure;
+  return state_.cavities[i].pressure;
 }
 
 bool FemSolid::AddCoupledCavityLoads(const double* u) {
-  for (Cavity& cavity : cavities_) {
+  for (std::size_t c = 0; c < cavities_.size(); ++c) {
+    Cavity& cavity = cavities_[c];
+    FemCavityState& cs = state_.cavities[c];
     if (cavity.law == nullptr) continue;
     for (std::size_t k = 0; k < cavity.nodes.size(); ++k) {
       const auto node = static_cast<Index>(cavity.nodes[k]);
@@ -89,13 +91,12 @@ bool FemSolid::AddCoupledCavityLoads(const double* u) {
           rest_.segment<3>(3 * node) + Eigen::Map<const Vec3>(u + 3 * node);
     }
     const double v = cavity.volume.Compute(cavity.positions, &cavity.local_gradient);
-    double p = cavity.pressure;
-    if (!SolvePressure(*cavity.law, step_time_, step_dt_, v, cavity.pressure, cavity.stiffness,
-                       p)) {
-      failed_cavity_ = static_cast<int>(&cavity - cavities_.data());
+    double p = cs.pressure;
+    if (!SolvePressure(*cavity.law, step_time_, step_dt_, v, cs.pressure, cs.stiffness, p)) {
+      failed_cavity_ = static_cast<int>(c);
       return false;
     }
-    cavity.pressure = p;
+    cs.pressure = p;
     cavity.gradient.setZero();
     for (std::size_t k = 0; k < cavity.nodes.size(); ++k) {
       const auto node = static_cast<Index>(cavity.nodes[k]);
@@ -108,40 +109,43 @@ bool FemSolid::AddCoupledCavityLoads(const double* u) {
 }
 
 void FemSolid::AddCoupledCavityTangent(const double* u, double* jv) {
-  for (Cavity& cavity : cavities_) {
+  for (std::size_t c = 0; c < cavities_.size(); ++c) {
+    const Cavity& cavity = cavities_[c];
+    FemCavityState& cs = state_.cavities[c];
     if (cavity.law == nullptr) continue;
     // The follower part p ∂²V/∂x² is the faces' pressure tangent (the cap of an open rim moves
     // only with the rim; its curvature terms are left out, exact when the rim is held). It can
     // make the sparse part indefinite (the rank-one term restores definiteness), so it is left
     // out for solvers that need SPD matrices: Newton then converges linearly.
     if (cavity_follower_tangent_)
-      for (int f : cavity.faces) AddFaceLoadTangent(f, u, cavity.pressure, Vec3::Zero(), jv);
+      for (int f : cavity.faces) AddFaceLoadTangent(f, u, cs.pressure, Vec3::Zero(), jv);
     // C = −dV_b/dp by a one-sided difference of 1e-6 of the pressure (at least 1 mPa).
-    const double p = cavity.pressure;
+    const double p = cs.pressure;
     const double dp = std::max(1e-3, 1e-6 * std::abs(p));
     double v0 = 0, v1 = 0;
-    cavity.stiffness = 0;
+    cs.stiffness = 0;
     if (cavity.law->EndVolume(step_time_, step_dt_, p, v0) &&
         cavity.law->EndVolume(step_time_, step_dt_, p + dp, v1) && v0 > v1)
-      cavity.stiffness = dp / (v0 - v1);
+      cs.stiffness = dp / (v0 - v1);
   }
 }
 
 void FemSolid::AddCoupledCavityForces(VecX& f) const {
-  for (const Cavity& cavity : cavities_) {
+  for (std::size_t c = 0; c < cavities_.size(); ++c) {
+    const Cavity& cavity = cavities_[c];
     if (cavity.law == nullptr) continue;
     for (std::size_t k = 0; k < cavity.nodes.size(); ++k)
       cavity.positions.col(static_cast<Index>(k)) = positions_.col(cavity.nodes[k]);
     cavity.volume.Compute(cavity.positions, &cavity.local_gradient);
     for (std::size_t k = 0; k < cavity.nodes.size(); ++k)
       f.segment<3>(3 * static_cast<Index>(cavity.nodes[k])) +=
-          cavity.pressure * cavity.local_gradient.col(static_cast<Index>(k));
+          state_.cavities[c].pressure * cavity.local_gradient.col(static_cast<Index>(k));
   }
 }
 
 void FemSolid::RestoreCavityPressures() {
-  for (Cavity& cavity : cavities_)
-    if (cavity.law != nullptr) cavity.pressure = cavity.pressure_begin;
+  for (std::size_t c = 0; c < cavities_.size(); ++c)
+    if (cavities_[c].law != nullptr) state_.cavities[c].pressure = cavities_[c].pressure_begin;
 }
 
 int FemSolid::num_low_rank_terms() const {
@@ -151,11 +155,11 @@ int FemSolid::num_low_rank_terms() const {
 }
 
 void FemSolid::LowRankTerm(int k, const VecX*& b, double& w) const {
-  for (const Cavity& cavity : cavities_) {
-    if (cavity.law == nullptr) continue;
+  for (std::size_t c = 0; c < cavities_.size(); ++c) {
+    if (cavities_[c].law == nullptr) continue;
     if (k-- == 0) {
-      b = &cavity.gradient;
-      w = cavity.stiffness;
+      b = &cavities_[c].gradient;
+      w = state_.cavities[c].stiffness;
       return;
     }
   }

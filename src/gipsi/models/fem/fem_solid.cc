@@ -34,10 +34,11 @@ FemSolid::FemSolid(std::string name, std::shared_ptr<const Mesh> domain, FemPara
   const Index n = domain->num_nodes();
   const Index ne = assembly_.num_elements();
 
-  active_tension_ = VecX::Zero(ne);
-  nodal_active_tension_ = VecX::Zero(n);
+  state_.active_tension = VecX::Zero(ne);
+  state_.nodal_active_tension = VecX::Zero(n);
   if (law_->needs_fibres())
-    axes_.assign(static_cast<std::size_t>(ne), MaterialAxes(params_.fibre, params_.sheet));
+    state_.axes.Write().assign(static_cast<std::size_t>(ne),
+                               MaterialAxes(params_.fibre, params_.sheet));
   lumped_mass_ = assembly_.LumpedMass(params_.density);
   for (Index i = 0; i < n; ++i)
     if (!(lumped_mass_[i] > 0))
@@ -56,21 +57,21 @@ FemSolid::FemSolid(std::string name, std::shared_ptr<const Mesh> domain, FemPara
 
   rest_ = Eigen::Map<const VecX>(domain->nodes.data(), 3 * n);
   x_ = rest_;
-  scheme_ = ImplicitScheme(params_.scheme, params_.newmark_beta, params_.newmark_gamma);
-  scheme_.Reset(VecX::Zero(3 * n), VecX::Zero(3 * n), VecX::Zero(3 * n));
-  saved_scheme_ = begin_scheme_ = scheme_;
+  state_.scheme = ImplicitScheme(params_.scheme, params_.newmark_beta, params_.newmark_gamma);
+  state_.scheme.Reset(VecX::Zero(3 * n), VecX::Zero(3 * n), VecX::Zero(3 * n));
+  saved_scheme_ = begin_scheme_ = state_.scheme;
   newton_ = std::make_unique<NewtonSolver>(params_.newton, MakeLinearSolver(params_.linear_solver));
   // Rigid-body modes of the rest shape: what an AMG preconditioner coarsens (others ignore it).
   newton_->linear_solver().SetNearNullSpace(RigidBodyModes(rest_));
   newton_->Prepare(jac_);
   positions_ = domain->nodes;
-  external_force_ = Points::Zero(3, n);
+  state_.external_force.Write() = Points::Zero(3, n);
 
   const BoundarySurface& bnd = boundary();
   const Index nf = bnd.num_triangles();
-  f_nodal_prev_ = f_nodal_new_ = VecX::Zero(3 * n);
-  pressure_prev_ = pressure_new_ = VecX::Zero(nf);
-  traction_prev_ = traction_new_ = Points::Zero(3, nf);
+  state_.f_nodal_prev = f_nodal_new_ = VecX::Zero(3 * n);
+  state_.pressure_prev = pressure_new_ = VecX::Zero(nf);
+  state_.traction_prev = traction_new_ = Points::Zero(3, nf);
   constraint_.assign(static_cast<std::size_t>(3 * n), 0);
   target_ = x_begin_ = VecX::Zero(3 * n);
   face_local_.resize(static_cast<std::size_t>(nf));
@@ -131,17 +132,18 @@ FemSolid::FemSolid(std::string name, std::shared_ptr<const Mesh> domain, FemPara
                                                    .f_pressure = f_pressure});
     cavity.gradient = VecX::Zero(3 * n);
   }
+  state_.cavities.resize(cavities_.size());
 }
 
 MaterialPoint FemSolid::PointOf(Index e) const {
   MaterialPoint mp;
-  if (!axes_.empty()) mp.axes = axes_[static_cast<std::size_t>(e)];
-  if (active_from_nodes_) {
+  if (!state_.axes.get().empty()) mp.axes = state_.axes.get()[static_cast<std::size_t>(e)];
+  if (state_.active_from_nodes) {
     double sum = 0;
-    for (int a = 0; a < 4; ++a) sum += nodal_active_tension_[assembly_.tets()(a, e)];
+    for (int a = 0; a < 4; ++a) sum += state_.nodal_active_tension[assembly_.tets()(a, e)];
     mp.active_tension = 0.25 * sum;
   } else {
-    mp.active_tension = active_tension_[e];
+    mp.active_tension = state_.active_tension[e];
   }
   return mp;
 }
@@ -191,9 +193,9 @@ bool FemSolid::AssembleElements(const double* u, VecX& f, double* k_values) cons
   // Assembling contributions of magnitude |f| into a residual loses ~ε|f| each, and forces
   // evaluated at a displacement u carry ~ε ‖K‖ ‖u‖: 100 ε times their sum bounds what any
   // iterate's residual can be told apart from zero (still ~1e-14 of the element forces).
-  residual_floor_ =
-      100 * std::numeric_limits<double>::epsilon() *
-      (element_force_sum_.sum() + jacobian_norm_ * Eigen::Map<const VecX>(u, f.size()).norm());
+  residual_floor_ = 100 * std::numeric_limits<double>::epsilon() *
+                    (element_force_sum_.sum() +
+                     state_.jacobian_norm * Eigen::Map<const VecX>(u, f.size()).norm());
   if (any_invalid.load()) {
     first_invalid_ = -1;
     for (Index e = 0; e < num_elements(); ++e)
@@ -220,11 +222,12 @@ bool FemSolid::CalcStiffness(const VecX& x, SparseMatrix& K) const {
 }
 
 void FemSolid::AssembleExternal(const double* u, double s) const {
-  f_ext_ = f_nodal_prev_ + s * (f_nodal_new_ - f_nodal_prev_);
+  f_ext_ = state_.f_nodal_prev + s * (f_nodal_new_ - state_.f_nodal_prev);
   const BoundarySurface& bnd = boundary();
   for (Index f = 0; f < bnd.num_triangles(); ++f) {
-    const double p = pressure_prev_[f] + s * (pressure_new_[f] - pressure_prev_[f]);
-    const Vec3 t = traction_prev_.col(f) + s * (traction_new_.col(f) - traction_prev_.col(f));
+    const double p = state_.pressure_prev[f] + s * (pressure_new_[f] - state_.pressure_prev[f]);
+    const Vec3 t =
+        state_.traction_prev.col(f) + s * (traction_new_.col(f) - state_.traction_prev.col(f));
     if (p == 0 && t.squaredNorm() == 0) continue;
     int node[3];
     for (int v = 0; v < 3; ++v)
@@ -242,8 +245,8 @@ void FemSolid::FinishResidual(const VecX& d, VecX& r) {
   r = f_int_ - f_ext_;
   if (params_.scheme != ImplicitSchemeKind::kStatic) {
     // Inertia M a and damping α M v + β K_n v.
-    work_ = scheme_.c_a() * d + scheme_.a_hat();
-    work2_ = scheme_.c_v() * d + scheme_.v_hat();
+    work_ = state_.scheme.c_a() * d + state_.scheme.a_hat();
+    work2_ = state_.scheme.c_v() * d + state_.scheme.v_hat();
     if (params_.rayleigh_mass > 0) work_ += params_.rayleigh_mass * work2_;
     if (params_.lumped_mass) {
       for (Index i = 0; i < num_nodes(); ++i)
@@ -263,7 +266,7 @@ void FemSolid::FinishResidual(const VecX& d, VecX& r) {
 
 bool FemSolid::CalcResidual(const VecX& d, VecX& r) {
   const auto start = Clock::now();
-  work_ = scheme_.x() + d;
+  work_ = state_.scheme.x() + d;
   bool ok = AssembleElements(work_.data(), f_int_, nullptr);
   if (ok) {
     AssembleExternal(work_.data(), s_);
@@ -289,7 +292,7 @@ void FemSolid::TakeLoadScale() {
 
 bool FemSolid::CalcResidualAndJacobian(const VecX& d, VecX& r, SparseMatrix& J) {
   const auto start = Clock::now();
-  work_ = scheme_.x() + d;
+  work_ = state_.scheme.x() + d;
   if (!AssembleElements(work_.data(), f_int_, J.valuePtr())) {
     profile_.assembly_seconds += Seconds(start);
     return false;
@@ -308,8 +311,9 @@ bool FemSolid::CalcResidualAndJacobian(const VecX& d, VecX& r, SparseMatrix& J) 
   // Symmetric part of the follower-load tangent: J −= sym(∂f_ext/∂x).
   const BoundarySurface& bnd = boundary();
   for (Index f = 0; f < bnd.num_triangles(); ++f) {
-    const double p = pressure_prev_[f] + s_ * (pressure_new_[f] - pressure_prev_[f]);
-    const Vec3 t = traction_prev_.col(f) + s_ * (traction_new_.col(f) - traction_prev_.col(f));
+    const double p = state_.pressure_prev[f] + s_ * (pressure_new_[f] - state_.pressure_prev[f]);
+    const Vec3 t =
+        state_.traction_prev.col(f) + s_ * (traction_new_.col(f) - state_.traction_prev.col(f));
     if (p == 0 && t.squaredNorm() == 0) continue;
     AddFaceLoadTangent(f, work_.data(), p, t, jv);
   }
@@ -317,8 +321,9 @@ bool FemSolid::CalcResidualAndJacobian(const VecX& d, VecX& r, SparseMatrix& J) 
   // Inertia and damping: J += (c_a + c_v α) M + c_v β K_n, added in the same parallel pass
   // over the values as the constraints below (one sweep of the matrix instead of three).
   const bool dynamic = params_.scheme != ImplicitSchemeKind::kStatic;
-  const double cm = dynamic ? scheme_.c_a() + scheme_.c_v() * params_.rayleigh_mass : 0.0;
-  const double ck = dynamic ? scheme_.c_v() * params_.rayleigh_stiffness : 0.0;
+  const double cm =
+      dynamic ? state_.scheme.c_a() + state_.scheme.c_v() * params_.rayleigh_mass : 0.0;
+  const double ck = dynamic ? state_.scheme.c_v() * params_.rayleigh_stiffness : 0.0;
   if (dynamic && params_.lumped_mass) {
     const auto& diag = assembly_.diagonal_index();
     for (std::size_t i = 0; i < diag.size(); ++i)
@@ -356,7 +361,7 @@ bool FemSolid::CalcResidualAndJacobian(const VecX& d, VecX& r, SparseMatrix& J) 
     }
     max_row_sum = std::max(max_row_sum, row_sum);
   }
-  jacobian_norm_ = max_row_sum;
+  state_.jacobian_norm = max_row_sum;
   FinishResidual(d, r);
   profile_.assembly_seconds += Seconds(start);
   return true;
@@ -389,16 +394,17 @@ void FemSolid::GatherTargets() {
   const BoundarySurface& bnd = boundary();
   const BoundaryConditions& bcs = boundary_conditions();
   for (Index i = 0; i < n; ++i)
-    f_nodal_new_.segment<3>(3 * i) = lumped_mass_[i] * params_.gravity + external_force_.col(i);
+    f_nodal_new_.segment<3>(3 * i) =
+        lumped_mass_[i] * params_.gravity + state_.external_force.get().col(i);
   for (Index j = 0; j < bnd.num_vertices(); ++j)
     f_nodal_new_.segment<3>(3 * bnd.vertex_to_node[static_cast<std::size_t>(j)]) += bcs.force(j);
   for (Index f = 0; f < bnd.num_triangles(); ++f) {
     pressure_new_[f] = bcs.pressure(f);
     traction_new_.col(f) = bcs.traction(f);
   }
-  for (const Cavity& cavity : cavities_)
-    if (cavity.law == nullptr)
-      for (int f : cavity.faces) pressure_new_[f] += cavity.pressure;
+  for (std::size_t c = 0; c < cavities_.size(); ++c)
+    if (cavities_[c].law == nullptr)
+      for (int f : cavities_[c].faces) pressure_new_[f] += state_.cavities[c].pressure;
   constrained_dofs_.clear();
   std::fill(constraint_.begin(), constraint_.end(), 0);
   for (Index j = 0; j < bnd.num_vertices(); ++j) {
@@ -420,18 +426,18 @@ void FemSolid::GatherTargets() {
       constrained_dofs_.push_back(static_cast<int>(dof));
     }
   }
-  if (!have_prev_loads_) {
+  if (!state_.have_prev_loads) {
     // Quasi-static analysis starts unloaded and ramps; dynamics starts with its loads applied.
     if (params_.scheme == ImplicitSchemeKind::kStatic) {
-      f_nodal_prev_.setZero();
-      pressure_prev_.setZero();
-      traction_prev_.setZero();
+      state_.f_nodal_prev.setZero();
+      state_.pressure_prev.setZero();
+      state_.traction_prev.setZero();
     } else {
-      f_nodal_prev_ = f_nodal_new_;
-      pressure_prev_ = pressure_new_;
-      traction_prev_ = traction_new_;
+      state_.f_nodal_prev = f_nodal_new_;
+      state_.pressure_prev = pressure_new_;
+      state_.traction_prev = traction_new_;
     }
-    have_prev_loads_ = true;
+    state_.have_prev_loads = true;
   }
 }
 
@@ -439,16 +445,16 @@ void FemSolid::InitialAcceleration() {
   // Newmark needs a_0 from M a_0 = f_ext − f_int − C v_0 (lumped: nodal division; consistent:
   // solved with a direct factorisation of M, once).
   s_ = 0;
-  if (!AssembleElements(scheme_.x().data(), f_int_, nullptr)) return;
-  AssembleExternal(scheme_.x().data(), s_);
+  if (!AssembleElements(state_.scheme.x().data(), f_int_, nullptr)) return;
+  AssembleExternal(state_.scheme.x().data(), s_);
   VecX rhs = f_ext_ - f_int_;
   if (params_.rayleigh_mass > 0) {
     if (params_.lumped_mass) {
       for (Index i = 0; i < num_nodes(); ++i)
         rhs.segment<3>(3 * i) -=
-            params_.rayleigh_mass * lumped_mass_[i] * scheme_.v().segment<3>(3 * i);
+            params_.rayleigh_mass * lumped_mass_[i] * state_.scheme.v().segment<3>(3 * i);
     } else {
-      SymmetricSpMV(mass_, scheme_.v(), work_);
+      SymmetricSpMV(mass_, state_.scheme.v(), work_);
       rhs -= params_.rayleigh_mass * work_;
     }
   }
@@ -462,35 +468,35 @@ void FemSolid::InitialAcceleration() {
     if (solver->Factorize(mass_)) solver->Solve(rhs, a0);
   }
   for (int dof : constrained_dofs_) a0[dof] = 0;
-  scheme_.SetAcceleration(a0);
+  state_.scheme.SetAcceleration(a0);
 }
 
 StepStatus FemSolid::Advance(double s0, double s1, double dt, int depth) {
   // A stop request is honoured before every load increment and bisection, and inside Newton.
   if (stop_token().stop_requested()) return StepStatus::Stopped();
-  saved_scheme_ = scheme_;
-  scheme_.Begin((s1 - s0) * dt);
+  saved_scheme_ = state_.scheme;
+  state_.scheme.Begin((s1 - s0) * dt);
   s_ = s1;
   const bool predict = params_.predict_velocity && params_.scheme != ImplicitSchemeKind::kStatic;
   auto solve = [&](bool predicted) {
     first_iteration_ = true;
     if (predicted)
-      d_ = ((s1 - s0) * dt) * scheme_.v();
+      d_ = ((s1 - s0) * dt) * state_.scheme.v();
     else
       d_.setZero();
-    const VecX& xn = scheme_.x();
+    const VecX& xn = state_.scheme.x();
     for (int dof : constrained_dofs_) {
       if (constraint_[static_cast<std::size_t>(dof)] == 1)
         d_[dof] = x_begin_[dof] + s1 * (target_[dof] - x_begin_[dof]) - xn[dof];
       else
-        d_[dof] = scheme_.IncrementForVelocity(dof, target_[dof]);
+        d_[dof] = state_.scheme.IncrementForVelocity(dof, target_[dof]);
     }
     // The force scale for the convergence test: applied loads and the weight, raised to the
     // loads at the first iterate (TakeLoadScale) once Newton evaluates it.
-    force_scale_ = (f_nodal_prev_ + s1 * (f_nodal_new_ - f_nodal_prev_)).norm();
+    force_scale_ = (state_.f_nodal_prev + s1 * (f_nodal_new_ - state_.f_nodal_prev)).norm();
     load_scale_pending_ = true;
-    last_newton_ = newton_->Solve(*this, d_, jac_, stop_token());
-    if (last_newton_.switched_to_indefinite)  // once per run: the switch is for good
+    state_.last_newton = newton_->Solve(*this, d_, jac_, stop_token());
+    if (state_.last_newton.switched_to_indefinite)  // once per run: the switch is for good
       Log().warn(
           "{}: t = {:.6g} s, load increment to {:.4g} % of the step: the tangent is not "
           "positive definite (a large load increment, a follower pressure or a stiff "
@@ -498,20 +504,20 @@ StepStatus FemSolid::Advance(double s0, double s1, double dt, int depth) {
           name(), time(), 100 * s1, newton_->linear_solver().name());
   };
   solve(predict);
-  if (predict && last_newton_.inadmissible && last_newton_.iterations == 0) {
+  if (predict && state_.last_newton.inadmissible && state_.last_newton.iterations == 0) {
     RestoreCavityPressures();  // the predicted state was not admissible: start from x_n
     solve(false);
   }
-  profile_.newton_iterations += last_newton_.iterations;
-  profile_.linear_iterations += last_newton_.linear_iterations;
-  profile_.factorizations += last_newton_.refactorizations;
-  if (last_newton_.converged && d_.allFinite()) {
-    scheme_.Commit(d_);
+  profile_.newton_iterations += state_.last_newton.iterations;
+  profile_.linear_iterations += state_.last_newton.linear_iterations;
+  profile_.factorizations += state_.last_newton.refactorizations;
+  if (state_.last_newton.converged && d_.allFinite()) {
+    state_.scheme.Commit(d_);
     return StepStatus::Ok();
   }
-  scheme_ = saved_scheme_;
+  state_.scheme = saved_scheme_;
   RestoreCavityPressures();
-  if (last_newton_.interrupted) return StepStatus::Stopped();
+  if (state_.last_newton.interrupted) return StepStatus::Stopped();
   // Newton extends its budget while it converges (newton.h), so what arrives here is not
   // converging: a smaller increment is the remedy.
   if (depth < params_.max_bisections) {
@@ -520,38 +526,39 @@ StepStatus FemSolid::Advance(double s0, double s1, double dt, int depth) {
     if (!status.ok()) return status;
     return Advance(mid, s1, dt, depth + 1);
   }
-  failure_detail_ = Describe(last_newton_, params_.newton, newton_->linear_solver().name());
+  failure_detail_ = Describe(state_.last_newton, params_.newton, newton_->linear_solver().name());
   if (failed_cavity_ >= 0)
     failure_detail_ += fmt::format(
         "; the blood coupled to cavity '{}' found no pressure for the wall's volume (is the blood "
         "object stepped right after this one?)",
         params_.cavities[static_cast<std::size_t>(failed_cavity_)].name);
-  if (last_newton_.inadmissible && first_invalid_ >= 0)
+  if (state_.last_newton.inadmissible && first_invalid_ >= 0)
     failure_detail_ +=
         fmt::format("; element {} is outside its law's domain (det F <= 0?)", first_invalid_);
-  if (last_newton_.inadmissible && failed_cavity_ >= 0)
+  if (state_.last_newton.inadmissible && failed_cavity_ >= 0)
     return StepStatus::Failed("the blood coupled to a cavity could not answer; cavity",
                               failed_cavity_);
-  if (last_newton_.inadmissible)
+  if (state_.last_newton.inadmissible)
     return StepStatus::Failed("no admissible state: an element inverted; element", first_invalid_);
-  if (last_newton_.linear_failure)
+  if (state_.last_newton.linear_failure)
     return StepStatus::Failed(
-        last_newton_.linear_failure_kind == LinearFailure::kNotConverged
+        state_.last_newton.linear_failure_kind == LinearFailure::kNotConverged
             ? "the linear solve of the Newton step failed"
             : "the tangent matrix could not be factorised (indefinite or singular)");
   return StepStatus::Failed("Newton did not converge; final residual", -1,
-                            last_newton_.final_residual);
+                            state_.last_newton.final_residual);
 }
 
 StepStatus FemSolid::DoStep(double t, double dt) {
   step_time_ = t;
   step_dt_ = dt;
   failed_cavity_ = -1;
-  for (Cavity& cavity : cavities_) cavity.pressure_begin = cavity.pressure;
+  for (std::size_t c = 0; c < cavities_.size(); ++c)
+    cavities_[c].pressure_begin = state_.cavities[c].pressure;
   GatherTargets();
   if (params_.scheme == ImplicitSchemeKind::kNewmark && step_count() == 0) InitialAcceleration();
-  x_begin_ = scheme_.x();
-  begin_scheme_ = scheme_;  // for a stop inside the step (allocation-free: same sizes)
+  x_begin_ = state_.scheme.x();
+  begin_scheme_ = state_.scheme;  // for a stop inside the step (allocation-free: same sizes)
   failure_detail_.clear();
   const auto start = Clock::now();
   const double solve_before = profile_.assembly_seconds;
@@ -564,15 +571,15 @@ StepStatus FemSolid::DoStep(double t, double dt) {
   if (status.code == StepStatus::Code::kStopped) {
     // Abandon the whole step, committed load increments and bisections included: the object
     // is back at the start of the step, consistent with its clock.
-    scheme_ = begin_scheme_;
+    state_.scheme = begin_scheme_;
     RestoreCavityPressures();
   }
   UpdatePositions();
   if (!status.ok()) return status;
-  f_nodal_prev_ = f_nodal_new_;
-  pressure_prev_ = pressure_new_;
-  traction_prev_ = traction_new_;
-  if (!scheme_.x().allFinite() || !scheme_.v().allFinite())
+  state_.f_nodal_prev = f_nodal_new_;
+  state_.pressure_prev = pressure_new_;
+  state_.traction_prev = traction_new_;
+  if (!state_.scheme.x().allFinite() || !state_.scheme.v().allFinite())
     return StepStatus::Diverged("non-finite position or velocity");
   return StepStatus::Ok();
 }
@@ -587,7 +594,7 @@ std::vector<SimObject::ProfileEntry> FemSolid::ProfileBreakdown() const {
 }
 
 void FemSolid::UpdatePositions() {
-  x_ = rest_ + scheme_.x();
+  x_ = rest_ + state_.scheme.x();
   positions_ = Eigen::Map<const Points>(x_.data(), 3, num_nodes());
 }
 
@@ -651,7 +658,7 @@ void FemSolid::DoReadField(FieldId id, Eigen::Ref<Eigen::MatrixXd> out) const {
   } else if (id == mech_.displacement) {
     out = positions_ - domain().nodes;
   } else if (id == mech_.external_force) {
-    out = external_force_;
+    out = state_.external_force.get();
   } else if (id == mech_.reaction_force) {
     // Reaction = M a + C v + f_int − f_ext on constrained axes, at the current state.
     out.setZero();
@@ -676,12 +683,13 @@ void FemSolid::DoReadField(FieldId id, Eigen::Ref<Eigen::MatrixXd> out) const {
     }
   } else if (id == f_fibre_) {
     for (Index e = 0; e < num_elements(); ++e)
-      out.col(e) = axes_.empty() ? Vec3(MaterialAxes(params_.fibre, params_.sheet).col(0))
-                                 : Vec3(axes_[static_cast<std::size_t>(e)].col(0));
+      out.col(e) = state_.axes.get().empty()
+                       ? Vec3(MaterialAxes(params_.fibre, params_.sheet).col(0))
+                       : Vec3(state_.axes.get()[static_cast<std::size_t>(e)].col(0));
   } else if (id == f_active_) {
     for (Index e = 0; e < num_elements(); ++e) out(0, e) = PointOf(e).active_tension;
   } else if (id == f_nodal_active_) {
-    out = nodal_active_tension_.transpose();
+    out = state_.nodal_active_tension.transpose();
   } else if (id == f_von_mises_) {
     for (Index e = 0; e < num_elements(); ++e) {
       const Mat3 s = CauchyStress(e);
@@ -696,13 +704,13 @@ void FemSolid::DoReadField(FieldId id, Eigen::Ref<Eigen::MatrixXd> out) const {
   } else if (id == f_strain_energy_) {
     out(0, 0) = StrainEnergy();
   } else if (id == f_newton_) {
-    out(0, 0) = last_newton_.iterations;
+    out(0, 0) = state_.last_newton.iterations;
   } else if (id == f_inverted_) {
     out(0, 0) = static_cast<double>(CountInvertedElements());
   } else {
     for (std::size_t i = 0; i < cavities_.size(); ++i) {
       if (id == cavities_[i].f_volume) out(0, 0) = CavityVolume(i);
-      if (id == cavities_[i].f_pressure) out(0, 0) = cavities_[i].pressure;
+      if (id == cavities_[i].f_pressure) out(0, 0) = state_.cavities[i].pressure;
     }
   }
 }
@@ -711,30 +719,32 @@ void FemSolid::DoWriteField(FieldId id, const Eigen::Ref<const Eigen::MatrixXd>&
   const Index n = num_nodes();
   if (id == mech_.position) {
     positions_ = in;
-    scheme_.SetPositions(Eigen::Map<const VecX>(positions_.data(), 3 * n) - rest_);
+    state_.scheme.SetPositions(Eigen::Map<const VecX>(positions_.data(), 3 * n) - rest_);
     UpdatePositions();
   } else if (id == mech_.velocity) {
-    scheme_.SetVelocity(Eigen::Map<const VecX>(in.data(), 3 * n));
+    state_.scheme.SetVelocity(Eigen::Map<const VecX>(in.data(), 3 * n));
   } else if (id == mech_.external_force) {
-    external_force_ = in;
+    state_.external_force.Write() = in;
   } else if (id == f_fibre_) {
-    if (axes_.empty())
-      axes_.assign(static_cast<std::size_t>(num_elements()),
-                   MaterialAxes(params_.fibre, params_.sheet));
+    std::vector<Mat3>& all = state_.axes.Write();
+    if (all.empty())
+      all.assign(static_cast<std::size_t>(num_elements()),
+                 MaterialAxes(params_.fibre, params_.sheet));
     for (Index e = 0; e < num_elements(); ++e) {
-      Mat3& axes = axes_[static_cast<std::size_t>(e)];
+      Mat3& axes = all[static_cast<std::size_t>(e)];
       const Vec3 fibre = in.col(e);
       if (fibre.squaredNorm() > 0) axes = MaterialAxes(fibre, axes.col(1));
     }
   } else if (id == f_active_) {
-    active_tension_ = in.row(0).transpose();
-    active_from_nodes_ = false;
+    state_.active_tension = in.row(0).transpose();
+    state_.active_from_nodes = false;
   } else if (id == f_nodal_active_) {
-    nodal_active_tension_ = in.row(0).transpose();
-    active_from_nodes_ = true;
+    state_.nodal_active_tension = in.row(0).transpose();
+    state_.active_from_nodes = true;
   } else {
-    for (Cavity& cavity : cavities_)
-      if (id == cavity.f_pressure && cavity.law == nullptr) cavity.pressure = in(0, 0);
+    for (std::size_t c = 0; c < cavities_.size(); ++c)
+      if (id == cavities_[c].f_pressure && cavities_[c].law == nullptr)
+        state_.cavities[c].pressure = in(0, 0);
   }
 }
 

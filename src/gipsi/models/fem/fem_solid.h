@@ -31,6 +31,7 @@
 #include "gipsi/core/sim_object.h"
 #include "gipsi/geometry/enclosed_volume.h"
 #include "gipsi/geometry/region.h"
+#include "gipsi/models/fem/fem_state.h"
 #include "gipsi/models/fem/solid_material.h"
 #include "gipsi/models/fem/tet_assembly.h"
 #include "gipsi/numerics/implicit_scheme.h"
@@ -97,20 +98,24 @@ class FemSolid final : public SimObject, public CavityWall, private NonlinearSys
   /// Positions (3N, node-major), updated after every step and field write.
   [[nodiscard]] const VecX& x() const { return x_; }
   /// Displacements from the rest positions (3N): the state the integrator advances.
-  [[nodiscard]] const VecX& u() const { return scheme_.x(); }
+  [[nodiscard]] const VecX& u() const { return state_.scheme.x(); }
   /// Velocities and accelerations (3N).
-  [[nodiscard]] const VecX& v() const { return scheme_.v(); }
-  [[nodiscard]] const VecX& a() const { return scheme_.a(); }
+  [[nodiscard]] const VecX& v() const { return state_.scheme.v(); }
+  [[nodiscard]] const VecX& a() const { return state_.scheme.a(); }
   /// Statistics of the last Newton solve.
-  [[nodiscard]] const NewtonStats& last_newton() const { return last_newton_; }
+  [[nodiscard]] const NewtonStats& last_newton() const { return state_.last_newton; }
   [[nodiscard]] const FemProfile& profile() const { return profile_; }
   /// The force scale [N] of the last increment's Newton convergence test: the norm of the
   /// applied loads (nodal, weight, surface and cavity pressures) at its first iterate, over the
   /// unconstrained unknowns; Newton converges at tolerance · max(‖r(d₀)‖, this).
   [[nodiscard]] double load_scale() const { return force_scale_; }
   [[nodiscard]] std::vector<ProfileEntry> ProfileBreakdown() const override;
+  /// Checkpoints: the state (FemState) and the Newton solver's warm start and kept
+  /// factorisation, which a bitwise continuation needs.
   void SaveObjectState(StateWriter& out) const override;
   void RestoreObjectState(StateReader& in) override;
+  /// The state that evolves (fem_state.h).
+  [[nodiscard]] const FemState& state() const { return state_; }
 
   /// Internal forces f_int(x) (3N) for positions x (3N); false if an element is outside its
   /// law's domain. For tests and connectors.
@@ -141,6 +146,11 @@ class FemSolid final : public SimObject, public CavityWall, private NonlinearSys
 
  protected:
   StepStatus DoStep(double t, double dt) override;
+  /// Snapshots copy FemState. Restoring one drops the Newton solver's warm start and kept
+  /// factorisation (they belong to the abandoned future; the next step factorises afresh).
+  [[nodiscard]] std::unique_ptr<ObjectState> NewObjectState() const override;
+  void CopyObjectState(ObjectState& into) const override;
+  void SetObjectState(const ObjectState& from) override;
   void DoReadField(FieldId id, Eigen::Ref<Eigen::MatrixXd> out) const override;
   void DoWriteField(FieldId id, const Eigen::Ref<const Eigen::MatrixXd>& in) override;
 
@@ -187,27 +197,21 @@ class FemSolid final : public SimObject, public CavityWall, private NonlinearSys
   FemParams params_;
   TetAssembly assembly_;
   const SolidMaterial* law_ = nullptr;
-  std::vector<Mat3> axes_;     // per element, empty if the law needs none and none were set
-  VecX active_tension_;        // per element [Pa]
-  VecX nodal_active_tension_;  // per node [Pa], used when active_from_nodes_
-  bool active_from_nodes_ = false;
   VecX lumped_mass_;        // per node
   SparseMatrix mass_;       // consistent mass (pattern layout); empty values if lumped
   SparseMatrix jac_;        // Newton matrix
   SparseMatrix damping_k_;  // K_n for Rayleigh β
-  ImplicitScheme scheme_, saved_scheme_;
+  FemState state_;          // everything that evolves (fem_state.h)
+  ImplicitScheme saved_scheme_;
   ImplicitScheme begin_scheme_;  // at the start of the step (a stop abandons the step)
   std::unique_ptr<NewtonSolver> newton_;
-  NewtonStats last_newton_;
   FemProfile profile_;
 
-  // Loads: previous step's (s = 0) and this step's (s = 1) values, interpolated at s_.
-  VecX f_nodal_prev_, f_nodal_new_;  // 3N: gravity + nodal forces + external_force
-  VecX pressure_prev_, pressure_new_;
-  Points traction_prev_, traction_new_;
-  bool have_prev_loads_ = false;
+  // This step's loads (s = 1; the previous step's, s = 0, are state), interpolated at s_.
+  VecX f_nodal_new_;  // 3N: gravity + nodal forces + external_force
+  VecX pressure_new_;
+  Points traction_new_;
   double s_ = 1;
-  Points external_force_;  // field, 3 by N
   // Constraints: mask per dof, displacement target (absolute position) or velocity.
   std::vector<std::uint8_t> constraint_;  // 0 free, 1 displacement, 2 velocity
   VecX target_, x_begin_;
@@ -222,7 +226,6 @@ class FemSolid final : public SimObject, public CavityWall, private NonlinearSys
   mutable std::vector<std::uint8_t> invalid_;  // per element
   mutable VecX element_force_sum_;             // per element Σ|f_e| (round-off floor)
   mutable double residual_floor_ = 0;
-  double jacobian_norm_ = 0;  // largest absolute row sum of the last Jacobian
   mutable Index first_invalid_ = -1;
   VecX d_;
   VecX rest_;  // 3N rest positions
@@ -235,12 +238,10 @@ class FemSolid final : public SimObject, public CavityWall, private NonlinearSys
     std::vector<int> nodes;    // domain node of each cavity vertex
     EnclosedVolume volume;     // over the faces, oriented out of the cavity
     mutable Points positions;  // work buffer, 3 by nodes.size()
-    double pressure = 0;       // Pa, written through the field, or solved when coupled
     FieldId f_volume, f_pressure;
     CavityLaw* law = nullptr;   // coupled to blood when set
     double pressure_begin = 0;  // at the start of the step
     VecX gradient{};            // 3N: ∂V/∂x, zero on constrained dofs (coupled)
-    double stiffness = 0;       // −∂p/∂V of the law at the current pressure [Pa/m³]
     mutable Points local_gradient{};
   };
   std::vector<Cavity> cavities_;

@@ -228,8 +228,7 @@ void Heart::DoWriteField(FieldId id, const Eigen::Ref<const Eigen::MatrixXd>& in
   AggregateObject::DoWriteField(id, in);
 }
 
-void Heart::SaveObjectState(StateWriter& out) const {
-  AggregateObject::SaveObjectState(out);
+void Heart::SaveAggregateState(StateWriter& out) const {
   out.BeginSection("HeartMonitor", 1);
   std::vector<double> flat;
   for (const BeatSummary& b : beats_)
@@ -242,8 +241,7 @@ void Heart::SaveObjectState(StateWriter& out) const {
   out.EndSection();
 }
 
-void Heart::RestoreObjectState(StateReader& in) {
-  AggregateObject::RestoreObjectState(in);
+void Heart::RestoreAggregateState(StateReader& in) {
   in.BeginSection("HeartMonitor", 1);
   std::vector<double> flat, running;
   in.ReadArray(flat);

@@ -59,11 +59,11 @@ class Heart final : public AggregateObject {
   [[nodiscard]] std::string_view type_name() const override { return "Heart"; }
   /// Every completed beat so far.
   [[nodiscard]] const std::vector<BeatSummary>& beats() const { return beats_; }
-  /// The aggregate's state, then the monitor's (completed beats, the beat in progress).
-  void SaveObjectState(StateWriter& out) const override;
-  void RestoreObjectState(StateReader& in) override;
 
  protected:
+  /// The monitor's state (completed beats, the beat in progress), after the aggregate's.
+  void SaveAggregateState(StateWriter& out) const override;
+  void RestoreAggregateState(StateReader& in) override;
   StepStatus DoStep(double t, double dt) override;
   void DoReadField(FieldId id, Eigen::Ref<Eigen::MatrixXd> out) const override;
   void DoWriteField(FieldId id, const Eigen::Ref<const Eigen::MatrixXd>& in) override;
