@@ -32,6 +32,7 @@
 #include "gipsi/base/file_io.h"
 #include "gipsi/base/log.h"
 #include "gipsi/base/state.h"
+#include "gipsi/core/aggregate.h"
 #include "gipsi/haptics/realtime_haptics.h"
 #include "gipsi/io/builtins.h"
 #include "gipsi/io/mesh_io.h"
@@ -443,6 +444,23 @@ int Run(const std::string& file, const std::string& out_dir, double until, bool 
   return 0;
 }
 
+/// Each connector with its ports and order rules (gipsi/core/port.h), those inside aggregates
+/// under the aggregate's name ("heart.cavity_coupling").
+void PrintConnectors(const gipsi::Coordinator& coordinator, const std::string& prefix) {
+  for (std::size_t i = 0; i < coordinator.num_connectors(); ++i) {
+    const auto& connector = coordinator.connector(i);
+    std::cout << fmt::format("  connector {:<11} {}\n", prefix + connector.name(),
+                             connector.type_name());
+    for (const auto& port : connector.ports())
+      std::cout << fmt::format("      {}\n", gipsi::DescribePort(port));
+    for (const auto& rule : connector.order_rules())
+      std::cout << fmt::format("      {}\n", gipsi::DescribeOrderRule(rule));
+  }
+  for (std::size_t i = 0; i < coordinator.num_objects(); ++i)
+    if (const auto* aggregate = dynamic_cast<const gipsi::AggregateObject*>(&coordinator.object(i)))
+      PrintConnectors(aggregate->parts(), prefix + aggregate->name() + ".");
+}
+
 int Validate(const std::string& file, const std::vector<std::string>& plugins,
              const gipsi::SceneLimits& limits) {
   gipsi::TypeRegistry registry;
@@ -465,9 +483,7 @@ int Validate(const std::string& file, const std::vector<std::string>& plugins,
           field.components, field.units,
           field.writable() ? (field.readable() ? "read/write" : "write") : "read");
   }
-  for (std::size_t i = 0; i < coordinator.num_connectors(); ++i)
-    std::cout << fmt::format("  connector {:<11} {}\n", coordinator.connector(i).name(),
-                             coordinator.connector(i).type_name());
+  PrintConnectors(coordinator, "");
   for (const auto& [key, bc] : scene.boundary_conditions)
     std::cout << fmt::format("  condition {:<22} {} vertices, {} faces\n", key, bc.vertices.size(),
                              bc.faces.size());

@@ -96,7 +96,12 @@ class Follow final : public gipsi::Connector {
         field_(field),
         target_(target),
         vertices_(std::move(vertices)),
-        value_(3, 1) {}
+        value_(3, 1) {
+    // Its ports: the coordinator checks them before the first step, `gipsi validate` lists
+    // them. The velocity is read in m/s and prescribed on the target's boundary.
+    UseField("from", source, source.field_info(field).name, gipsi::FieldAccess::kRead, "m/s", 3);
+    UseBoundaryConditions("to", target);
+  }
   std::string_view type_name() const override { return "Follow"; }
   // Checkpoints: Follow only transfers values (the prescribed velocities are the target's
   // boundary conditions, saved with it).

@@ -169,6 +169,21 @@ TEST(GipsiValidate, AcceptsTheDemoScenes) {
   }
 }
 
+TEST(GipsiValidate, ListsEachConnectorsPortsAndOrderRules) {
+  // The heart's connectors live inside its aggregate and are listed under its name.
+  const Result r = Gipsi("validate " + Scene("heart.json"));
+  ASSERT_EQ(r.code, 0) << r.output;
+  for (const char* line : {
+           "connector heart.cavity_coupling CavityCoupling",
+           "      reads muscle.lumen_volume [m^3] (wall)",
+           "      calls blood as lumped chambers (blood)",
+           "      writes blood.lv_pressure_input [Pa] (blood)",
+           "      fires after muscle steps, before blood steps, same time step, every macro step",
+           "      reads bioelectricity.V [mV] (from)",
+       })
+    EXPECT_THAT(r.output, HasSubstr(line));
+}
+
 TEST(GipsiRun, ResourceLimitsRefuseOversizedRunsBeforeWriting) {
   // hanging_sheet.json until 0.2 s writes 5 frames of the 441-node sheet (about 60 kB each).
   fs::path out = TempDir("limits");
@@ -276,6 +291,26 @@ TEST(GipsiPlugins, TypesFromAPluginAreListedAndUsable) {
   ASSERT_EQ(std::sscanf(last.c_str(), "%lf,%lf,%lf,%lf", &t, &ux, &uy, &uz), 4) << last;
   EXPECT_DOUBLE_EQ(t, 0.25);
   EXPECT_NEAR(uz, 0.02, 2e-4);
+}
+
+TEST(GipsiPlugins, APluginConnectorsPortsAreCheckedWhenTheSceneLoads) {
+  // The example's Follow declares that it reads a velocity [m/s]; wired to the oscillator's
+  // position [m], the scene is refused before anything runs, naming both ends.
+  const fs::path dir = TempDir("plugin_ports");
+  nlohmann::json scene = nlohmann::json::parse(std::ifstream(Scene("plugin_oscillator.json")));
+  scene["connectors"]["shake"]["from"] = "driver.position";
+  std::ofstream(dir / "wrong.json") << scene.dump(2);
+  const std::string plugin = std::string(GIPSI_BINARY_DIR) + "/plugins/gipsi_example_plugin.so";
+  const Result r = Gipsi("validate " + (dir / "wrong.json").string() + " --plugin " + plugin);
+  EXPECT_EQ(r.code, 1) << r.output;
+  EXPECT_THAT(r.output, HasSubstr("wrong.json: connectors.shake: connector 'shake' (Follow) "
+                                  "reads field 'position' of 'driver' (Oscillator) at its 'from' "
+                                  "key, but the field is in [m], which does not convert to the "
+                                  "connector's [m/s]"));
+  const Result right = Gipsi("validate " + Scene("plugin_oscillator.json"));
+  ASSERT_EQ(right.code, 0) << right.output;
+  EXPECT_THAT(right.output, HasSubstr("reads driver.velocity [m/s] (from)"));
+  EXPECT_THAT(right.output, HasSubstr("sets the boundary conditions of curtain (to)"));
 }
 
 TEST(GipsiPlugins, NotAPluginIsAClearError) {

@@ -160,6 +160,79 @@ TEST(Contact, SphereToolPushesWithThePenaltyLaw) {
   EXPECT_LT((Vec3(f.col(0)) + expected_total).norm(), 1e-12);
 }
 
+/// A plugin-style instrument: not a RigidTool, but a sphere offering the RigidCollider
+/// capability (its boundary is the same tessellated sphere a RigidTool would have).
+class Pointer final : public SimObject, public RigidCollider {
+ public:
+  Pointer(std::string name, const Vec3& centre, double radius)
+      : SimObject(std::move(name)), centre_(centre), radius_(radius) {
+    Mesh surface = MakeCapsuleSurface(radius, 0, 16);
+    surface.nodes.colwise() += centre;
+    auto mesh = std::make_shared<const Mesh>(surface);
+    SetGeometry(mesh, MakeBoundary(*mesh));
+    position_ = DeclareField({"boundary_position", FieldLocation::kBoundaryVertex, 3, "m",
+                              FieldAccess::kRead, "vertex position"});
+    velocity_ = DeclareField({"boundary_velocity", FieldLocation::kBoundaryVertex, 3, "m/s",
+                              FieldAccess::kRead, "vertex velocity"});
+  }
+  std::string_view type_name() const override { return "Pointer"; }
+  const Points& domain_positions() const override { return domain().nodes; }
+  std::optional<Capsule> ExactCapsule() const override {
+    return Capsule{centre_, centre_, radius_};
+  }
+  Vec3 RigidVelocity() const override { return Vec3::Zero(); }
+
+ protected:
+  StepStatus DoStep(double, double) override { return StepStatus::Ok(); }
+  void DoReadField(FieldId id, Eigen::Ref<Eigen::MatrixXd> out) const override {
+    if (id == position_) {
+      Points x;
+      boundary().Gather(domain().nodes, x);
+      out = x;
+    } else {
+      out.setZero();
+    }
+  }
+  void DoWriteField(FieldId, const Eigen::Ref<const Eigen::MatrixXd>&) override {}
+
+ private:
+  Vec3 centre_;
+  double radius_;
+  FieldId position_, velocity_;
+};
+
+TEST(Contact, AnyRigidColliderIsATool) {
+  // The same sphere as a RigidTool and as a foreign type with the RigidCollider capability:
+  // Contact treats both as tools (exact sphere), so the block gets the same forces, bit for bit.
+  ContactMaterial m;
+  m.thickness = 0.02;
+  m.stiffness = 100;
+  const Vec3 centre(0.5, 0.5, 2.995);
+  auto with_tool = Block("block", Vec3(0, 0, 0), Vec3(1, 1, 1), 4);
+  RigidToolSpec spec;
+  spec.radius = 2;
+  spec.position = centre;
+  RigidTool tool("probe", spec, nullptr);
+  Contact by_tool("c", {with_tool.get(), &tool}, m, {});
+  ASSERT_TRUE(by_tool.Fire(0).ok());
+  auto with_pointer = Block("block", Vec3(0, 0, 0), Vec3(1, 1, 1), 4);
+  Pointer pointer("pointer", centre, 2);
+  Contact by_pointer("c", {with_pointer.get(), &pointer}, m, {});
+  ASSERT_TRUE(by_pointer.Fire(0).ok());
+  EXPECT_EQ(by_pointer.stats().tool_contacts, 5);
+  EXPECT_EQ(by_pointer.stats().vertex_contacts, 0);  // no mesh pair: the exact sphere
+  for (Index v = 0; v < with_tool->boundary().num_vertices(); ++v)
+    EXPECT_EQ(with_pointer->boundary_conditions().force(v),
+              with_tool->boundary_conditions().force(v))
+        << v;
+  // Its ports say so.
+  bool calls = false;
+  for (const PortUse& port : by_pointer.ports())
+    calls = calls || (port.kind == PortUse::Kind::kCapability && port.object == &pointer &&
+                      port.name == "rigid collider");
+  EXPECT_TRUE(calls);
+}
+
 TEST(Contact, ProjectionHoldsVerticesOnTheToolAndBalancesTheBase) {
   // A sphere (radius 0.3) indents a mass-spring block (1 x 1 x 0.5, bottom fixed, no gravity)
   // by 0.09 and holds. With position projection no vertex ends inside the sphere, and at rest

@@ -8,14 +8,14 @@
 
 #include "gipsi/base/error.h"
 #include "gipsi/base/state.h"
-#include "gipsi/collision/rigid_tool.h"
+#include "gipsi/collision/rigid_collider.h"
 #include "gipsi/core/coordinator.h"
 
 namespace gipsi {
 
 struct Contact::Body {
   SimObject& object;
-  RigidTool* tool = nullptr;  // non-null for tools
+  const RigidCollider* tool = nullptr;  // non-null for tools
   FieldId position, velocity;
   CollisionSurface surface;
   Points velocities;
@@ -25,12 +25,12 @@ struct Contact::Body {
   std::optional<FieldId> reaction;
   Points reactions;
   std::vector<char> held;
-  Body(SimObject& o, RigidTool* t, FieldId p, FieldId v, CollisionSurface s)
+  Body(SimObject& o, const RigidCollider* t, FieldId p, FieldId v, CollisionSurface s)
       : object(o), tool(t), position(p), velocity(v), surface(std::move(s)) {
     velocities.setZero(3, surface.num_vertices());
     forces.setZero(3, surface.num_vertices());
   }
-  [[nodiscard]] bool primitive() const { return tool != nullptr && tool->is_primitive(); }
+  [[nodiscard]] bool primitive() const { return tool != nullptr && tool->ExactCapsule(); }
 };
 
 Contact::Contact(std::string name, const std::vector<SimObject*>& objects,
@@ -45,18 +45,26 @@ Contact::Contact(std::string name, const std::vector<SimObject*>& objects,
           fmt::format("connector '{}': object '{}' is listed twice", this->name(), o->name()));
     const FieldId p = o->FindField("boundary_position");
     const FieldId v = o->FindField("boundary_velocity");
+    const std::string key = fmt::format("objects[{}]", bodies_.size());
+    UseField(key, *o, "boundary_position", FieldAccess::kRead, "m", 3);
+    UseField(key, *o, "boundary_velocity", FieldAccess::kRead, "m/s", 3);
+    UseBoundaryConditions(key, *o);
     const BoundarySurface& b = o->boundary();
     if (b.num_triangles() == 0)
       throw InputError(
           fmt::format("connector '{}': object '{}' has no boundary triangles to collide with",
                       this->name(), o->name()));
-    auto* tool = dynamic_cast<RigidTool*>(o);
-    if (!tool) ++deformables;
+    const auto* tool = dynamic_cast<const RigidCollider*>(o);
+    if (tool)
+      UseCapability(key, *o, "rigid collider");
+    else
+      ++deformables;
     const bool closed = !b.face_to_tet.empty() && b.face_to_tet.front() >= 0;
     bodies_.push_back(std::make_unique<Body>(
         *o, tool, p, v, CollisionSurface(b.triangles, b.num_vertices(), closed)));
     if (!tool && options_.tool_response == ContactOptions::ToolResponse::kProjection) {
       bodies_.back()->reaction = o->FindField("reaction_force");
+      UseField(key, *o, "reaction_force", FieldAccess::kRead, "N", 3);
       bodies_.back()->reactions.setZero(3, b.num_vertices());
       bodies_.back()->held.assign(static_cast<std::size_t>(b.num_vertices()), 0);
     }
@@ -143,14 +151,15 @@ void Contact::MeshPair(Body& a, Body& b, bool self) {
 }
 
 void Contact::ToolPair(Body& tool, Body& body) {
-  const RigidTool& t = *tool.tool;
-  query_.QueryCapsule(body.surface, t.axis_start(), t.axis_end(), t.spec().radius,
-                      material_.thickness, primitive_);
+  const Capsule capsule = *tool.tool->ExactCapsule();
+  const Vec3 tool_velocity = tool.tool->RigidVelocity();
+  query_.QueryCapsule(body.surface, capsule.start, capsule.end, capsule.radius, material_.thickness,
+                      primitive_);
   stats_.tool_contacts += static_cast<std::int64_t>(primitive_.size());
   const Points& tool_x = tool.surface.positions();
   for (const PrimitiveContact& c : primitive_) {
     const Vec3 f = PenaltyForce(material_, c.gap, c.normal,
-                                Vec3(body.velocities.col(c.vertex)) - t.velocity());
+                                Vec3(body.velocities.col(c.vertex)) - tool_velocity);
     body.forces.col(c.vertex) += f;
     // The reaction acts on the tool at the contact point; it is given to the tool's nearest
     // surface vertex (the total force is exact; its point of application is within one
@@ -164,10 +173,9 @@ void Contact::ToolPair(Body& tool, Body& body) {
 }
 
 void Contact::ToolProjection(Body& tool, Body& body) {
-  const RigidTool& t = *tool.tool;
-  const Vec3 p0 = t.axis_start(), p1 = t.axis_end();
-  const double r = t.spec().radius;
-  query_.QueryCapsule(body.surface, p0, p1, r, material_.thickness, primitive_);
+  const Capsule capsule = *tool.tool->ExactCapsule();
+  query_.QueryCapsule(body.surface, capsule.start, capsule.end, capsule.radius, material_.thickness,
+                      primitive_);
   stats_.tool_contacts += static_cast<std::int64_t>(primitive_.size());
   BoundaryConditions& bcs = body.object.boundary_conditions();
   const auto& v2n = body.object.boundary().vertex_to_node;

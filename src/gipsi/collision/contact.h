@@ -33,8 +33,6 @@
 
 namespace gipsi {
 
-class RigidTool;
-
 /// Options besides the contact material. Plain struct with defaults.
 struct ContactOptions {
   /// How sphere/capsule tools act on objects: penalty forces, or position projection (a
@@ -65,8 +63,10 @@ struct ContactStats {
 /// Not copyable or movable.
 class Contact final : public Connector {
  public:
-  /// Throws InputError if an object lacks the boundary fields or triangles, a name repeats, or
-  /// there is nothing to collide (one object without self-collision, or only tools).
+  /// An object with the RigidCollider capability (rigid_collider.h; e.g. a RigidTool) is a
+  /// tool, every other one deformable. Throws InputError if an object lacks the boundary
+  /// fields or triangles, a name repeats, or there is nothing to collide (one object without
+  /// self-collision, or only tools).
   Contact(std::string name, const std::vector<SimObject*>& objects, const ContactMaterial& material,
           const ContactOptions& options);
   ~Contact() override;

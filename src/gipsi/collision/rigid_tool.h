@@ -16,6 +16,7 @@
 #include <optional>
 #include <vector>
 
+#include "gipsi/collision/rigid_collider.h"
 #include "gipsi/core/registry.h"
 #include "gipsi/core/sim_object.h"
 
@@ -37,7 +38,7 @@ struct RigidToolSpec {
 };
 
 /// Not copyable or movable (a SimObject).
-class RigidTool final : public SimObject {
+class RigidTool final : public SimObject, public RigidCollider {
  public:
   /// `mesh` is the tool's triangle surface (in the tool frame) for Shape::kMesh, ignored (and
   /// may be null) otherwise. Throws InputError for a bad spec or mesh.
@@ -55,6 +56,13 @@ class RigidTool final : public SimObject {
   [[nodiscard]] Vec3 axis_end() const {
     return spec_.position + offset_ + Vec3(0, 0, spec_.length);
   }
+  /// RigidCollider: the capsule of a sphere or capsule tool (none for a mesh tool), and its
+  /// velocity.
+  [[nodiscard]] std::optional<Capsule> ExactCapsule() const override {
+    if (!is_primitive()) return std::nullopt;
+    return Capsule{axis_start(), axis_end(), spec_.radius};
+  }
+  [[nodiscard]] Vec3 RigidVelocity() const override { return velocity_; }
   /// Current translation from the rest placement [m] and velocity [m/s].
   [[nodiscard]] const Vec3& offset() const { return offset_; }
   [[nodiscard]] const Vec3& velocity() const { return velocity_; }

@@ -93,6 +93,9 @@ Coordinator BuildAggregateParts(const ObjectBuildContext& ctx, const JsonNode& p
   JsonNode dt = p.At("dt");
   try {
     parts.Prepare(ReadPositiveQuantity(dt, "s"));
+  } catch (const WiringError& e) {
+    if (e.order_path().empty()) p.At("connectors").At(e.connector()).Fail(e.what());
+    p.At("order").Fail(e.what());
   } catch (const InputError& e) {
     dt.Fail(e.what());
   }

@@ -17,4 +17,14 @@ CavityWall& CavityWallOf(SimObject& object) {
   return *wall;
 }
 
+LumpedChambers& LumpedChambersOf(SimObject& object) {
+  auto* chambers = dynamic_cast<LumpedChambers*>(&object);
+  if (chambers == nullptr)
+    throw InputError(fmt::format(
+        "object '{}' ({}) has no lumped chambers to take a cavity's pressure; the blood side "
+        "of a cavity coupling is a Circulation (or a plugin type implementing LumpedChambers)",
+        object.name(), object.type_name()));
+  return *chambers;
+}
+
 }  // namespace gipsi

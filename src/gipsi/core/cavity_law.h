@@ -44,6 +44,29 @@ class CavityWall {
   virtual void AttachCavityLaw(std::string_view cavity, CavityLaw* law) = 0;
 };
 
+/// Capability of a lumped (0D) blood model whose chambers can take their pressure from a wall
+/// (Circulation's chambers with "driven_by": "pressure"): the blood side of a cavity coupling,
+/// which asks for it with LumpedChambersOf, so the coupling needs no concrete blood type.
+class LumpedChambers {
+ public:
+  virtual ~LumpedChambers() = default;
+  /// The index of the pressure-driven chamber `name`. Throws InputError naming the object if it
+  /// has no such chamber or the chamber is not pressure-driven (listing those that are).
+  [[nodiscard]] virtual int FindPressureDrivenChamber(std::string_view name) const = 0;
+  /// The blood volume [m³] of chamber `chamber` (an index from FindPressureDrivenChamber).
+  [[nodiscard]] virtual double chamber_volume(int chamber) const = 0;
+  /// Sets it (before the first step: the wall's cavity volume).
+  virtual void SetChamberVolume(int chamber, double volume) = 0;
+  /// The chamber's blood volume [m³] at time() + dt if its pressure is held at p [Pa] over the
+  /// step, integrated exactly as the object's Step would, leaving the object unchanged. False
+  /// if the integration fails. Must not throw, nor allocate after its first call.
+  virtual bool PredictChamberVolume(int chamber, double dt, double p, double& volume) = 0;
+};
+
+/// `object` as lumped chambers. Throws InputError ("object 'NAME' (TYPE) has no lumped
+/// chambers …") for an object type without the capability.
+LumpedChambers& LumpedChambersOf(SimObject& object);
+
 /// `object` as a cavity wall. Throws InputError ("object 'NAME' (TYPE) has no cavities to
 /// couple to blood") for an object type without the capability.
 CavityWall& CavityWallOf(SimObject& object);

@@ -5,21 +5,28 @@
 /// field of the other). Connectors convert semantics and map between different meshes.
 
 #include <memory>
+#include <span>
 #include <string>
 #include <string_view>
+#include <vector>
 
+#include "gipsi/core/port.h"
 #include "gipsi/core/step_status.h"
 
 namespace gipsi {
 
 class ObjectState;
+class SimObject;
 class StateReader;
 class StateWriter;
 
 /// Base class of connectors. Not copyable or movable.
 ///
 /// A connector resolves everything it needs (objects, field ids, mappings, buffers) when it is
-/// built, throwing InputError for bad wiring; `Fire` then only transfers values: it never
+/// built, throwing InputError for bad wiring, and declares its ports there (gipsi/core/port.h):
+/// every field it reads or writes, with the units it works in, every object whose boundary
+/// conditions it sets, every capability it calls, and what it needs of the order. The
+/// coordinator checks them before the first step. `Fire` then only transfers values: it never
 /// throws and allocates nothing.
 class Connector {
  public:
@@ -36,6 +43,10 @@ class Connector {
     return DoFire(t);
   }
   [[nodiscard]] std::int64_t fire_count() const { return fire_count_; }
+  /// What it uses of the objects it couples, and its constraints on the order, as declared by
+  /// its constructor (checked by Coordinator::Prepare, listed by `gipsi validate`).
+  [[nodiscard]] std::span<const PortUse> ports() const { return ports_; }
+  [[nodiscard]] std::span<const OrderRule> order_rules() const { return order_rules_; }
   /// Checkpoints (gipsi/base/state.h): the fire count, then the type's own state
   /// (SaveConnectorState). RestoreState throws InputError for state from another scene.
   void SaveState(StateWriter& out) const;
@@ -54,6 +65,17 @@ class Connector {
  protected:
   explicit Connector(std::string name) : name_(std::move(name)) {}
   virtual StepStatus DoFire(double t) = 0;
+  /// Port declarations; call from the constructor. `key` is the connector's parameter naming
+  /// that end ("from", "wall"). A field is read and/or written (`access`) in `units` (a
+  /// UDUNITS-2 expression the field's units must convert to with factor 1; empty for any) with
+  /// `components` (0 for any).
+  void UseField(std::string key, const SimObject& object, std::string field, FieldAccess access,
+                std::string units = {}, int components = 0);
+  /// The connector sets boundary conditions (coupling loads or prescribed values) of `object`.
+  void UseBoundaryConditions(std::string key, const SimObject& object);
+  /// The connector calls `object` through the capability interface called `capability`.
+  void UseCapability(std::string key, const SimObject& object, std::string capability);
+  void RequireOrder(OrderRule rule) { order_rules_.push_back(std::move(rule)); }
   /// Hooks of the snapshots, as SimObject's; the defaults serialise through
   /// SaveConnectorState / RestoreConnectorState into a ByteState.
   [[nodiscard]] virtual std::unique_ptr<ObjectState> NewConnectorState() const;
@@ -63,6 +85,8 @@ class Connector {
  private:
   std::string name_;
   std::int64_t fire_count_ = 0;
+  std::vector<PortUse> ports_;
+  std::vector<OrderRule> order_rules_;
 };
 
 }  // namespace gipsi

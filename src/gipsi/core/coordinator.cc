@@ -71,6 +71,7 @@ void Coordinator::SetOrder(const std::vector<std::string>& names, std::string_vi
                       where, name));
   order_ = std::move(order);
   has_order_ = true;
+  order_where_ = where;
 }
 
 double Coordinator::max_object_dt() const {
@@ -98,6 +99,7 @@ void Coordinator::Prepare(double macro_dt) {
     for (std::size_t i = 0; i < connectors_.size(); ++i) order_.push_back({true, i});
     for (std::size_t i = 0; i < objects_.size(); ++i) order_.push_back({false, i});
   }
+  CheckWiring();
 }
 
 void Coordinator::BeginMacroStep() {

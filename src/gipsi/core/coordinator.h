@@ -44,8 +44,11 @@ class Coordinator {
   /// InputError for unknown, repeated or missing names (`where` is prefixed to messages).
   void SetOrder(const std::vector<std::string>& names, std::string_view where = "schedule.order");
 
-  /// Fixes the macro step and each object's sub-step count. Every object dt must divide
-  /// `macro_dt` to within 1e-9 relative; otherwise throws InputError naming the object.
+  /// Fixes the macro step and each object's sub-step count, and checks the wiring. Every object
+  /// dt must divide `macro_dt` to within 1e-9 relative; otherwise throws InputError naming the
+  /// object. Every connector's ports (gipsi/core/port.h) must match the objects' fields (name,
+  /// access, components, units) and the order must meet its order rules; otherwise throws
+  /// WiringError naming the connector and both ends.
   void Prepare(double macro_dt);
   /// Largest object dt (the natural macro step), or 0 when there are no objects.
   [[nodiscard]] double max_object_dt() const;
@@ -103,8 +106,16 @@ class Coordinator {
   };
   std::vector<ObjectSlot> objects_;
   std::vector<ConnectorSlot> connectors_;
+  /// Throws WiringError for a port or order rule the scene does not meet (coordinator_wiring.cc).
+  void CheckWiring() const;
+  /// The index of the top-level object that is or contains `object` (in an aggregate), or -1.
+  [[nodiscard]] int TopLevelIndex(const SimObject* object) const;
+  /// The order as names, "[a, b, c]", for messages.
+  [[nodiscard]] std::string OrderText() const;
+
   std::vector<Entry> order_;
   bool has_order_ = false;
+  std::string order_where_;
   double macro_dt_ = 0;
 };
 

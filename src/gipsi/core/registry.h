@@ -20,8 +20,9 @@
 /// Version of the plugin interface; a plugin built against another version is refused.
 /// 2: checkpoint hooks; 3: haptic local models by type; 4: SimObject's stop token, local models
 /// in core; 5: cavities through the CavityWall capability, not a SimObject virtual; 6: snapshot
-/// hooks (NewObjectState, CopyObjectState, SetObjectState) on SimObject and Connector.
-#define GIPSI_PLUGIN_ABI_VERSION 6
+/// hooks (NewObjectState, CopyObjectState, SetObjectState) on SimObject and Connector; 7:
+/// connector ports (Connector::UseField, …, RequireOrder; gipsi/core/port.h).
+#define GIPSI_PLUGIN_ABI_VERSION 7
 
 namespace gipsi {
 

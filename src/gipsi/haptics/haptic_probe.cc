@@ -169,6 +169,9 @@ HapticCoupling::HapticCoupling(std::string name, std::unique_ptr<LocalModelBuild
   const SimObject& object = builder_->object();
   if (object.boundary().num_vertices() == 0)
     throw InputError(fmt::format("object '{}' has no boundary surface", object.name()));
+  UseCapability("object", object, "haptic local model");
+  UseBoundaryConditions("object", object);
+  UseCapability("device", probe, "haptic device");
   bridge_ = std::make_unique<HapticBridge>(*builder_, params);
   bridge_->SeedTool(probe.initial_position());
   probe.Attach(bridge_->models(), bridge_->feedback());

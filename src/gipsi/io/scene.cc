@@ -431,6 +431,9 @@ Scene LoadSceneFromString(std::string_view text, const std::string& name,
   }
   try {
     scene.kernel->Initialize(macro_dt);
+  } catch (const WiringError& e) {
+    ThrowInputError(name, e.order_path().empty() ? "connectors." + e.connector() : e.order_path(),
+                    e.what());
   } catch (const InputError& e) {
     ThrowInputError(name, "objects", e.what());
   }

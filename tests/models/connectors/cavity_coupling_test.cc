@@ -311,15 +311,35 @@ TEST(CavityCoupling, IsovolumetricContractionThenEjection) {
   EXPECT_NEAR(blood.total_volume(), total0, 1e-12 * total0);
 }
 
-TEST(CavityCoupling, WrongOrderIsReported) {
-  // The connector before the wall: the blood has not waited for the wall's pressure.
-  std::string text = kEjectionScene;
-  const std::string order = R"("order": ["wall", "coupling", "blood"])";
-  text.replace(text.find(order), order.size(), R"("order": ["coupling", "wall", "blood"])");
-  SceneHolder holder(text);
-  const RunResult result = holder.scene().kernel->Run(0.01);
-  EXPECT_FALSE(result.ok());
-  EXPECT_NE(result.diagnostic.find("after the wall"), std::string::npos) << result.diagnostic;
+TEST(CavityCoupling, AScheduleItsOrderRuleRefusesIsRefusedBeforeTheFirstStep) {
+  auto replaced = [](const std::string& from, const std::string& to) {
+    std::string t = kEjectionScene;
+    t.replace(t.find(from), from.size(), to);
+    return testing::SceneLoadError(t);
+  };
+  // The connector before the wall: the blood would not wait for the wall's pressure.
+  const std::string before = replaced(R"("order": ["wall", "coupling", "blood"])",
+                                      R"("order": ["coupling", "wall", "blood"])");
+  EXPECT_NE(before.find("schedule.order: connector 'coupling' (CavityCoupling) must fire after "
+                        "'wall' steps and before 'blood' steps"),
+            std::string::npos)
+      << before;
+  EXPECT_NE(before.find("the order [coupling, wall, blood]"), std::string::npos) << before;
+  // No order at all: the default (connectors first) is refused the same way, at the connector.
+  const std::string unordered = replaced(R"(, "order": ["wall", "coupling", "blood"])", "");
+  EXPECT_NE(unordered.find("connectors.coupling: connector 'coupling' (CavityCoupling) must "
+                           "fire after 'wall' steps"),
+            std::string::npos)
+      << unordered;
+  EXPECT_NE(unordered.find("the default order"), std::string::npos) << unordered;
+  // Blood on another time step, and a connector that skips macro steps.
+  const std::string other_dt = replaced(R"("blood": {"type": "Circulation", "dt": "5 ms")",
+                                        R"("blood": {"type": "Circulation", "dt": "2.5 ms")");
+  EXPECT_NE(other_dt.find("needs 'wall' and 'blood' to step with the same time step"),
+            std::string::npos)
+      << other_dt;
+  const std::string skipping = replaced(R"("chamber": "lv"})", R"("chamber": "lv", "every": 2})");
+  EXPECT_NE(skipping.find("must fire every macro step"), std::string::npos) << skipping;
 }
 
 TEST(CavityCoupling, BadWiringGetsAClearError) {
@@ -333,9 +353,13 @@ TEST(CavityCoupling, BadWiringGetsAClearError) {
             std::string::npos);
   EXPECT_NE(replaced(R"("chamber": "lv")", R"("chamber": "aorta")").find("must be a chamber"),
             std::string::npos);
-  EXPECT_NE(replaced(R"("blood": "blood", "chamber")", R"("blood": "wall", "chamber")")
-                .find("a Circulation object"),
-            std::string::npos);
+  // Blood without the LumpedChambers capability is refused at its key.
+  const std::string no_chambers =
+      replaced(R"("blood": "blood", "chamber")", R"("blood": "wall", "chamber")");
+  EXPECT_NE(no_chambers.find("connectors.coupling.blood: object 'wall' (FemSolid) has no lumped "
+                             "chambers"),
+            std::string::npos)
+      << no_chambers;
   // A wall of a type without cavities (the CavityWall capability) is refused at its key.
   const std::string no_cavities = replaced(R"("wall": "wall")", R"("wall": "blood")");
   EXPECT_NE(no_cavities.find("connectors.coupling.wall"), std::string::npos) << no_cavities;

@@ -29,13 +29,49 @@ TEST(FieldCopy, SetOnOneObjectIsReadOnTheOther) {
   FieldId va = a->FindField("velocity");
   Eigen::MatrixXd v = Eigen::MatrixXd::Random(3, 27);
   a->WriteField(va, v);
-  FieldCopy copy("copy", *a, va, *b, b->FindField("external_force"), FieldCopy::Mapping::kAuto,
-                 1.0);
+  // Velocity [m/s] into force [N]: the scale carries the units, kg/s.
+  FieldCopy copy("copy", *a, va, *b, b->FindField("external_force"), FieldCopy::Mapping::kAuto, 1.0,
+                 "kg/s");
   EXPECT_EQ(copy.mapping(), FieldCopy::Mapping::kDirect);
   ASSERT_TRUE(copy.Fire(0).ok());
   Eigen::MatrixXd got(3, 27);
   b->ReadField(b->FindField("external_force"), got);
   EXPECT_EQ(got, v);
+}
+
+TEST(FieldCopy, UnitsAreCheckedAndConverted) {
+  auto a = Block("a", Vec3::Zero(), Vec3::Ones(), 1);
+  auto b = Block("b", Vec3::Zero(), Vec3::Ones(), 1);
+  const FieldId velocity = a->FindField("velocity"), force = b->FindField("external_force");
+  // 2 g/s is 0.002 kg/s: the factor carries the conversion into the target's units.
+  FieldCopy grams("copy", *a, velocity, *b, force, FieldCopy::Mapping::kAuto, 2.0, "g/s");
+  EXPECT_NEAR(grams.factor(), 0.002, 1e-15);
+  // Same units, plain scale: the scale itself.
+  FieldCopy same("copy", *a, velocity, *b, b->FindField("velocity"), FieldCopy::Mapping::kAuto,
+                 3.0);
+  EXPECT_EQ(same.factor(), 3.0);
+  // Another dimension without scale units, or scale units that do not give the target's.
+  auto error = [&](const std::string& units) {
+    try {
+      FieldCopy bad("copy", *a, velocity, *b, force, FieldCopy::Mapping::kAuto, 1.0, units);
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_NE(error("").find("the source is in [m/s] and the target in [N]; give \"scale\" with "
+                           "the units"),
+            std::string::npos)
+      << error("");
+  EXPECT_NE(error("kg").find("[m/s] times the scale's [kg] does not give the target's [N]"),
+            std::string::npos)
+      << error("kg");
+  // The ports: the source read, the target written.
+  ASSERT_EQ(grams.ports().size(), 2u);
+  EXPECT_EQ(grams.ports()[0].object, a.get());
+  EXPECT_EQ(grams.ports()[0].access, FieldAccess::kRead);
+  EXPECT_EQ(grams.ports()[1].name, "external_force");
+  EXPECT_EQ(grams.ports()[1].access, FieldAccess::kWrite);
 }
 
 TEST(FieldCopy, BarycentricMappingReproducesLinearFieldsAcrossMeshes) {
@@ -48,7 +84,7 @@ TEST(FieldCopy, BarycentricMappingReproducesLinearFieldsAcrossMeshes) {
   Eigen::MatrixXd v = (A * coarse->domain().nodes).colwise() + b;
   coarse->WriteField(coarse->FindField("velocity"), v);
   FieldCopy copy("copy", *coarse, coarse->FindField("velocity"), *fine,
-                 fine->FindField("external_force"), FieldCopy::Mapping::kAuto, 1.0);
+                 fine->FindField("external_force"), FieldCopy::Mapping::kAuto, 1.0, "N*s/m");
   EXPECT_EQ(copy.mapping(), FieldCopy::Mapping::kBarycentric);
   ASSERT_TRUE(copy.Fire(0).ok());
   Eigen::MatrixXd got(3, fine->num_nodes());

@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include "gipsi/base/error.h"
 #include "gipsi/base/log.h"
@@ -97,6 +98,29 @@ int Circulation::FindCompartment(std::string_view name) const {
   for (int c = 0; c < circuit_.num_compartments(); ++c)
     if (circuit_.compartments()[static_cast<std::size_t>(c)].name == name) return c;
   return -1;
+}
+
+int Circulation::FindPressureDrivenChamber(std::string_view name) const {
+  std::vector<std::string> driven;
+  for (const CompartmentSpec& spec : circuit_.compartments())
+    if (spec.kind == CompartmentSpec::Kind::kChamber &&
+        spec.drive == CompartmentSpec::Drive::kPressure)
+      driven.push_back(spec.name);
+  const int c = FindCompartment(name);
+  const std::string those =
+      driven.empty() ? std::string("it has none; give a chamber \"driven_by\": \"pressure\"")
+                     : fmt::format("those that are: {}", fmt::join(driven, ", "));
+  if (c < 0)
+    throw InputError(
+        fmt::format("object '{}' has no compartment '{}' ({})", this->name(), name, those));
+  const CompartmentSpec& spec = circuit_.compartments()[static_cast<std::size_t>(c)];
+  if (spec.kind != CompartmentSpec::Kind::kChamber ||
+      spec.drive != CompartmentSpec::Drive::kPressure)
+    throw InputError(fmt::format(
+        "compartment '{}' of '{}' must be a chamber with \"driven_by\": \"pressure\" (the wall "
+        "solves its pressure; {})",
+        name, this->name(), those));
+  return c;
 }
 
 int Circulation::FindConnection(std::string_view name) const {

@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "gipsi/core/cavity_law.h"
 #include "gipsi/core/registry.h"
 #include "gipsi/core/sim_object.h"
 #include "gipsi/models/circulation/circuit.h"
@@ -35,7 +36,7 @@ struct CirculationParams {
 };
 
 /// Not copyable or movable (a SimObject).
-class Circulation final : public SimObject {
+class Circulation final : public SimObject, public LumpedChambers {
  public:
   /// Builds the circuit and sets each valve open or closed from the initial pressures.
   /// Preconditions as Circuit's (the factory checks the scene and throws InputError).
@@ -67,11 +68,12 @@ class Circulation final : public SimObject {
   [[nodiscard]] std::int64_t accepted_steps() const { return accepted_; }
   [[nodiscard]] std::int64_t rejected_steps() const { return rejected_; }
   [[nodiscard]] std::vector<ProfileEntry> ProfileBreakdown() const override;
-  /// For monolithic cavity coupling (cavity_law.h): the blood volume [m³] of pressure-driven
-  /// chamber `c` at time() + dt if its pressure is held at p [Pa] over the step, integrated
-  /// exactly as Step would (same steps, events located the same way), leaving this object
-  /// unchanged. False if the integration fails. Allocation-free after the first call.
-  bool PredictChamberVolume(int c, double dt, double p, double& volume);
+  /// LumpedChambers (cavity_law.h), for the monolithic cavity coupling. The prediction
+  /// integrates exactly as Step would: same steps, events located the same way.
+  [[nodiscard]] int FindPressureDrivenChamber(std::string_view name) const override;
+  [[nodiscard]] double chamber_volume(int c) const override { return volume(c); }
+  void SetChamberVolume(int c, double volume) override { SetVolume(c, volume); }
+  bool PredictChamberVolume(int c, double dt, double p, double& volume) override;
   /// Sets the blood volume of compartment `c` [m³] (before the first step: a 3-D cavity's
   /// volume), and re-initialises the valves from the new pressures.
   void SetVolume(int c, double volume);

@@ -16,6 +16,10 @@ BoundaryCoupling::BoundaryCoupling(std::string name, SimObject& driver, SimObjec
   follower_reaction_ = follower.FindField("reaction_force");
   (void)driver.FindField("reaction_force");
   (void)follower.FindField("boundary_displacement");
+  UseField("driver", driver, "boundary_displacement", FieldAccess::kRead, "m", 3);
+  UseBoundaryConditions("driver", driver);
+  UseField("follower", follower, "reaction_force", FieldAccess::kRead, "N", 3);
+  UseBoundaryConditions("follower", follower);
 
   const BoundarySurface& db = driver.boundary();
   const BoundarySurface& fb = follower.boundary();

@@ -7,29 +7,28 @@
 #include "gipsi/base/error.h"
 #include "gipsi/base/log.h"
 #include "gipsi/base/units.h"
-#include "gipsi/models/circulation/circulation.h"
 
 namespace gipsi {
 
 CavityCoupling::CavityCoupling(std::string name, SimObject& wall, const std::string& cavity,
-                               Circulation& blood, const std::string& chamber, double bulk_modulus)
-    : Connector(std::move(name)), wall_(wall), blood_(blood), bulk_modulus_(bulk_modulus) {
+                               SimObject& blood, const std::string& chamber, double bulk_modulus)
+    : Connector(std::move(name)),
+      wall_(wall),
+      blood_(blood),
+      chambers_(LumpedChambersOf(blood)),
+      bulk_modulus_(bulk_modulus) {
   if (!(bulk_modulus_ > 0))
     throw InputError(
         fmt::format("connector '{}': the blood bulk modulus must be positive", this->name()));
-  chamber_ = blood_.FindCompartment(chamber);
-  if (chamber_ < 0)
-    throw InputError(fmt::format("connector '{}': object '{}' has no compartment '{}'",
-                                 this->name(), blood_.name(), chamber));
-  const CompartmentSpec& spec = blood_.circuit().compartments()[static_cast<std::size_t>(chamber_)];
-  if (spec.kind != CompartmentSpec::Kind::kChamber ||
-      spec.drive != CompartmentSpec::Drive::kPressure)
-    throw InputError(fmt::format(
-        "connector '{}': compartment '{}' of '{}' must be a chamber with \"driven_by\": "
-        "\"pressure\" (the wall solves its pressure)",
-        this->name(), chamber, blood_.name()));
+  chamber_ = chambers_.FindPressureDrivenChamber(chamber);
   // Throws for an object without cavities, or without this one.
   CavityWallOf(wall_).AttachCavityLaw(cavity, this);
+  UseCapability("wall", wall_, "cavity wall");
+  UseField("wall", wall_, cavity + "_volume", FieldAccess::kRead, "m^3", 1);
+  UseField("wall", wall_, cavity + "_pressure", FieldAccess::kRead, "Pa", 1);
+  UseCapability("blood", blood_, "lumped chambers");
+  UseField("blood", blood_, chamber + "_pressure_input", FieldAccess::kWrite, "Pa", 1);
+  RequireOrder({&wall_, &blood_, true, "the blood integrates with the pressure the wall solved"});
   const FieldId volume = wall_.FindField(cavity + "_volume");
   wall_pressure_ = wall_.FindField(cavity + "_pressure");
   blood_pressure_ = blood_.FindField(chamber + "_pressure_input");
@@ -39,8 +38,8 @@ CavityCoupling::CavityCoupling(std::string name, SimObject& wall, const std::str
   wall_.ReadField(wall_pressure_, p);
   const double blood_volume = v(0, 0) / (1 - p(0, 0) / bulk_modulus_);
   Log().info("connector '{}': chamber '{}' starts with the cavity's {:.2f} mL (was {:.2f} mL)",
-             this->name(), chamber, 1e6 * blood_volume, 1e6 * blood_.volume(chamber_));
-  blood_.SetVolume(chamber_, blood_volume);
+             this->name(), chamber, 1e6 * blood_volume, 1e6 * chambers_.chamber_volume(chamber_));
+  chambers_.SetChamberVolume(chamber_, blood_volume);
   blood_.WriteField(blood_pressure_, p);
 }
 
@@ -49,7 +48,7 @@ bool CavityCoupling::EndVolume(double t, double dt, double p, double& volume) {
   if (std::abs(blood_.time() - t) > 1e-9 * std::max(1.0, std::abs(t))) return false;
   ++trials_;
   double blood_volume = 0;
-  if (!blood_.PredictChamberVolume(chamber_, dt, p, blood_volume)) return false;
+  if (!chambers_.PredictChamberVolume(chamber_, dt, p, blood_volume)) return false;
   volume = blood_volume * (1 - p / bulk_modulus_);
   return true;
 }
@@ -79,15 +78,16 @@ void RegisterCavityCoupling(TypeRegistry& registry) {
         } catch (const InputError& e) {
           p.At("wall").Fail(e.what());
         }
-        SimObject& blood_object = ctx.Object("blood");
-        auto* blood = dynamic_cast<Circulation*>(&blood_object);
-        if (blood == nullptr)
-          p.At("blood").Expected(fmt::format("a Circulation object ('{}' is a {})",
-                                             blood_object.name(), blood_object.type_name()));
+        SimObject& blood = ctx.Object("blood");
+        try {
+          (void)LumpedChambersOf(blood);
+        } catch (const InputError& e) {
+          p.At("blood").Fail(e.what());
+        }
         double bulk = 2.2e9;
         if (auto k = p.Find("blood_bulk_modulus")) bulk = ReadPositiveQuantity(*k, "Pa");
         try {
-          return std::make_unique<CavityCoupling>(ctx.name, wall, p.At("cavity").AsString(), *blood,
+          return std::make_unique<CavityCoupling>(ctx.name, wall, p.At("cavity").AsString(), blood,
                                                   p.At("chamber").AsString(), bulk);
         } catch (const InputError& e) {
           p.Fail(e.what());

@@ -18,8 +18,11 @@
 ///          K the blood's bulk modulus (2.2 GPa by default): blood is slightly compressible,
 ///          which keeps the pressure a well-defined function of the wall's volume when both
 ///          valves are closed (a 100 mL cavity at 16 kPa is compressed by 0.7 µL).
-/// Order: the blood must step right after the wall with the same time step, and the connector
-/// fires between the two; a wrong order is reported as a failed step, not silently accepted.
+/// Ports: the wall's "cavity wall" capability and its two fields above (read), the blood's
+/// "lumped chambers" capability and its pressure input (written).
+/// Order: the wall steps, then the connector fires, then the blood steps, with the same time
+/// step, every macro step; the coordinator refuses any other schedule before the first step
+/// (and a step that still finds them out of order fails rather than going on).
 
 #include <string>
 
@@ -30,15 +33,14 @@
 
 namespace gipsi {
 
-class Circulation;
-
 /// Not copyable or movable (a Connector).
 class CavityCoupling final : public Connector, public CavityLaw {
  public:
   /// Attaches itself to `wall`'s cavity `cavity` and sets `blood`'s chamber `chamber` (which
-  /// must be pressure-driven) to the cavity's current volume. Throws InputError for a missing
-  /// cavity or chamber, a chamber that is not pressure-driven, or a bulk modulus ≤ 0.
-  CavityCoupling(std::string name, SimObject& wall, const std::string& cavity, Circulation& blood,
+  /// must be pressure-driven) to the cavity's current volume. Throws InputError for a wall
+  /// without cavities (CavityWall) or without this one, blood without lumped chambers
+  /// (LumpedChambers) or without this pressure-driven chamber, or a bulk modulus ≤ 0.
+  CavityCoupling(std::string name, SimObject& wall, const std::string& cavity, SimObject& blood,
                  const std::string& chamber, double bulk_modulus);
 
   [[nodiscard]] std::string_view type_name() const override { return "CavityCoupling"; }
@@ -54,7 +56,8 @@ class CavityCoupling final : public Connector, public CavityLaw {
 
  private:
   SimObject& wall_;
-  Circulation& blood_;
+  SimObject& blood_;
+  LumpedChambers& chambers_;
   int chamber_ = -1;
   FieldId wall_pressure_, blood_pressure_;
   double bulk_modulus_;

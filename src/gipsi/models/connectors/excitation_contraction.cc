@@ -37,6 +37,9 @@ ExcitationContraction::ExcitationContraction(std::string name, const SimObject& 
                     "active tension); '{}.{}' is not",
                     muscle.name(), ta.name));
   if (!(params.v_peak > params.v_rest)) throw InputError("v_peak must exceed v_rest");
+  // v_rest and v_peak are in mV; the tension it writes in Pa.
+  UseField("from", ep, v.name, FieldAccess::kRead, "mV", 1);
+  UseField("to", muscle, ta.name, FieldAccess::kWrite, "Pa", 1);
   const Points src = ItemRestPositions(ep, FieldLocation::kNode);
   const Points dst = ItemRestPositions(muscle, ta.location);
   const bool coincide = src.cols() == dst.cols() && (src - dst).cwiseAbs().maxCoeff() <= 1e-12;

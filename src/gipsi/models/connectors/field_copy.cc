@@ -6,12 +6,14 @@
 #include <fmt/format.h>
 
 #include "gipsi/base/error.h"
+#include "gipsi/base/units.h"
 #include "gipsi/models/connectors/item_positions.h"
 
 namespace gipsi {
 
 FieldCopy::FieldCopy(std::string name, SimObject& from, FieldId from_field, SimObject& to,
-                     FieldId to_field, Mapping mapping, double scale)
+                     FieldId to_field, Mapping mapping, double scale,
+                     const std::string& scale_units)
     : Connector(std::move(name)),
       from_(from),
       from_field_(from_field),
@@ -25,14 +27,30 @@ FieldCopy::FieldCopy(std::string name, SimObject& from, FieldId from_field, SimO
     throw InputError(fmt::format("connector '{}' ({}.{} → {}.{}): {}", this->name(), from.name(),
                                  src.name, to.name(), dst.name, what));
   };
-  if (!src.readable()) fail("the source field is not readable");
-  if (!dst.writable()) fail("the target field is not writable");
+  UseField("from", from, src.name, FieldAccess::kRead);
+  UseField("to", to, dst.name, FieldAccess::kWrite, dst.units, dst.components);
   if (src.components != dst.components)
     fail(fmt::format("component counts differ ({} vs {})", src.components, dst.components));
   const Index n_src = from.FieldCount(from_field), n_dst = to.FieldCount(to_field);
   if ((src.location == FieldLocation::kGlobal) != (dst.location == FieldLocation::kGlobal))
     fail("a global field can only be copied to a global field");
 
+  // The units: source × scale must give the target's, up to a factor we apply.
+  const std::string carried =
+      scale_units.empty() ? src.units : fmt::format("({})*({})", src.units, scale_units);
+  try {
+    scale_ = scale * UnitFactor(carried, dst.units);
+  } catch (const std::invalid_argument&) {
+    fail(scale_units.empty()
+             ? fmt::format("the source is in [{}] and the target in [{}]; give \"scale\" with "
+                           "the units that convert one into the other (e.g. \"1 {}/{}\")",
+                           src.units, dst.units, dst.units,
+                           src.units.find_first_of("/* .") == std::string::npos
+                               ? src.units
+                               : "(" + src.units + ")")
+             : fmt::format("[{}] times the scale's [{}] does not give the target's [{}]", src.units,
+                           scale_units, dst.units));
+  }
   Points src_pos = ItemRestPositions(from, src.location);
   Points dst_pos = ItemRestPositions(to, dst.location);
   if (mapping_ == Mapping::kAuto) {
@@ -101,9 +119,29 @@ void RegisterFieldCopy(TypeRegistry& registry) {
                     : s == "nearest"     ? Mapping::kNearest
                                          : Mapping::kAuto;
         }
+        // "scale": a number (dimensionless) or "VALUE UNIT".
+        double scale = 1.0;
+        std::string scale_units;
+        if (auto node = ctx.params.Find("scale")) {
+          if (node->is_number()) {
+            scale = node->AsNumber();
+          } else {
+            const std::string text = node->is_string() ? node->AsString() : std::string();
+            std::size_t end = 0;
+            try {
+              scale = std::stod(text, &end);
+            } catch (const std::exception&) {
+              end = 0;
+            }
+            const std::size_t unit = text.find_first_not_of(' ', end);
+            if (end == 0 || unit == std::string::npos || unit == end || !std::isfinite(scale))
+              node->Expected("a number, or a string \"VALUE UNIT\" (e.g. \"2 kPa/mV\")");
+            scale_units = text.substr(unit);
+          }
+        }
         try {
           return std::make_unique<FieldCopy>(ctx.name, *from, from_field, *to, to_field, mapping,
-                                             ctx.params.Number("scale", 1.0));
+                                             scale, scale_units);
         } catch (const InputError& e) {
           ctx.params.Fail(e.what());
         }

@@ -5,6 +5,10 @@
 ///
 /// Scene: {"type": "FieldCopy", "from": "a.field", "to": "b.field",
 ///         "mapping": "auto" | "direct" | "barycentric" | "nearest", "scale": 1.0}
+/// Units: the target gets (source units) × (scale units). A plain-number scale is
+/// dimensionless, so the two fields must have the same dimension; a scale with units
+/// ("scale": "2 kPa/mV") carries the conversion. Fields declared in different units of that
+/// dimension (ms and s) are converted.
 /// "direct" needs equal item counts; "barycentric" interpolates node fields inside the source's
 /// tets (or on its triangles); "nearest" takes the closest source item; "auto" picks direct when
 /// the item positions coincide, barycentric for node fields, nearest otherwise.
@@ -25,16 +29,20 @@ class FieldCopy final : public Connector {
  public:
   enum class Mapping { kAuto, kDirect, kBarycentric, kNearest };
   /// Resolves the mapping and buffers; throws InputError for incompatible fields (component
-  /// counts differ, not readable/writable, direct with different counts, a global field to a
-  /// non-global one).
+  /// counts differ, direct with different counts, a global field to a non-global one, units
+  /// that do not give the target's: source units × `scale_units` must convert to the target's,
+  /// an empty `scale_units` being dimensionless). Declares the ports (the source read, the
+  /// target written, so the coordinator checks their access).
   FieldCopy(std::string name, SimObject& from, FieldId from_field, SimObject& to, FieldId to_field,
-            Mapping mapping, double scale);
+            Mapping mapping, double scale, const std::string& scale_units = {});
 
   [[nodiscard]] std::string_view type_name() const override { return "FieldCopy"; }
   void SaveConnectorState(StateWriter& out) const override;
   void RestoreConnectorState(StateReader& in) override;
   /// The mapping in use (kDirect when values are copied item by item).
   [[nodiscard]] Mapping mapping() const { return mapping_; }
+  /// The factor applied: the scale times the conversion of its units into the target's.
+  [[nodiscard]] double factor() const { return scale_; }
 
  protected:
   StepStatus DoFire(double t) override;
