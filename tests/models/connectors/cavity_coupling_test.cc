@@ -30,7 +30,7 @@ std::unique_ptr<FemSolid> MakeCylinder() {
   FemParams params =
       AccurateParams(R"({"law": "Linear", "youngs_modulus": 1e6, "poisson_ratio": 0.3})",
                      ImplicitSchemeKind::kStatic);
-  params.cavities.push_back(FemCavitySpec{"lumen", GroupRegion{"inner"}});
+  params.cavities.push_back(CavitySpec{"lumen", GroupRegion{"inner"}});
   auto fem = std::make_unique<FemSolid>("cylinder", mesh, params);
   auto& bcs = fem->boundary_conditions();
   for (Index j : VerticesWhere(*fem, [&](const Vec3& X) {
@@ -173,7 +173,7 @@ std::unique_ptr<FemSolid> MakeVentricle(double size) {
   FemParams params =
       AccurateParams(R"({"law": "Linear", "youngs_modulus": 1e5, "poisson_ratio": 0.3})",
                      ImplicitSchemeKind::kStatic);
-  params.cavities.push_back(FemCavitySpec{"lumen", GroupRegion{"endo"}});
+  params.cavities.push_back(CavitySpec{"lumen", GroupRegion{"endo"}});
   auto fem = std::make_unique<FemSolid>("lv", mesh, params);
   for (Index j : VerticesWhere(*fem, [](const Vec3& X) { return X.z() > 0.012 - 1e-9; }))
     fem->boundary_conditions().Fix(j, 7);

@@ -342,7 +342,7 @@ TEST(FemSolid, CavityPressureInflatesItsVolumeAsLame) {
   FemParams params =
       AccurateParams(R"({"law": "Linear", "youngs_modulus": 1e6, "poisson_ratio": 0.3})",
                      ImplicitSchemeKind::kStatic);
-  params.cavities.push_back(FemCavitySpec{"lumen", GroupRegion{"inner"}});
+  params.cavities.push_back(CavitySpec{"lumen", GroupRegion{"inner"}});
   FemSolid fem("cylinder", mesh, params);
   auto& bcs = fem.boundary_conditions();
   for (Index j : VerticesWhere(fem, [&](const Vec3& X) {

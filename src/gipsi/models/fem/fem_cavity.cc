@@ -44,35 +44,21 @@ bool SolvePressure(CavityLaw& law, double t, double dt, double v, double guess, 
 
 }  // namespace
 
-std::vector<std::string> FemSolid::cavity_names() const {
-  std::vector<std::string> names;
-  for (const FemCavitySpec& spec : params_.cavities) names.push_back(spec.name);
-  return names;
-}
+std::vector<std::string> FemSolid::cavity_names() const { return CavityNames(params_.cavities); }
 
 void FemSolid::AttachCavityLaw(std::string_view cavity, CavityLaw* law) {
   GIPSI_CHECK(law != nullptr);
-  for (std::size_t i = 0; i < cavities_.size(); ++i) {
-    if (params_.cavities[i].name != cavity) continue;
-    if (cavities_[i].law != nullptr)
-      throw InputError(
-          fmt::format("object '{}': cavity '{}' is already coupled to blood", name(), cavity));
-    cavities_[i].law = law;
-    cavity_follower_tangent_ = newton_->linear_solver().AcceptIndefinite();
-    if (!cavity_follower_tangent_)
-      Log().warn(
-          "object '{}': cavity '{}' is coupled to blood but the linear solver '{}' needs "
-          "positive definite matrices, so the pressure's follower tangent is left out and "
-          "Newton converges linearly; \"linear_solver\": {{\"type\": \"cholmod\"}} or "
-          "{{\"type\": \"ldlt\"}} keeps it",
-          name(), cavity, newton_->linear_solver().name());
-    return;
-  }
-  std::string names;
-  for (const FemCavitySpec& spec : params_.cavities)
-    names += (names.empty() ? "" : ", ") + spec.name;
-  throw InputError(fmt::format("object '{}' (FemSolid) has no cavity '{}'; its cavities: {}",
-                               name(), cavity, names.empty() ? "none" : names));
+  const std::size_t i =
+      FindUncoupledCavity(name(), type_name(), params_.cavities, cavities_, cavity);
+  cavities_[i].law = law;
+  cavity_follower_tangent_ = newton_->linear_solver().AcceptIndefinite();
+  if (!cavity_follower_tangent_)
+    Log().warn(
+        "object '{}': cavity '{}' is coupled to blood but the linear solver '{}' needs "
+        "positive definite matrices, so the pressure's follower tangent is left out and "
+        "Newton converges linearly; \"linear_solver\": {{\"type\": \"cholmod\"}} or "
+        "{{\"type\": \"ldlt\"}} keeps it",
+        name(), cavity, newton_->linear_solver().name());
 }
 
 double FemSolid::CavityPressure(std::size_t i) const {

@@ -110,28 +110,11 @@ FemSolid::FemSolid(std::string name, std::shared_ptr<const Mesh> domain, FemPara
       {"newton_iterations", L::kGlobal, 1, "1", A::kRead, "Newton iterations of the last step"});
   f_inverted_ = DeclareField(
       {"inverted_elements", L::kGlobal, 1, "1", A::kRead, "number of elements with det F <= 0"});
-  for (const FemCavitySpec& spec : params_.cavities) {
-    std::vector<int> faces = SelectBoundaryFaces(spec.region, *domain, bnd);
-    if (faces.empty())
-      throw InputError(fmt::format("object '{}': cavity '{}' selects no boundary face",
-                                   this->name(), spec.name));
-    CavitySurface surface = MakeCavitySurface(bnd, faces);
-    std::vector<int> nodes = std::move(surface.nodes);
-    EnclosedVolume volume(surface.triangles, static_cast<Index>(nodes.size()));
-    Points positions(3, static_cast<Index>(nodes.size()));
-    const FieldId f_volume = DeclareField({spec.name + "_volume", L::kGlobal, 1, "m^3", A::kRead,
-                                           "volume enclosed by the cavity's faces (rim capped)"});
-    const FieldId f_pressure =
-        DeclareField({spec.name + "_pressure", L::kGlobal, 1, "Pa", A::kReadWrite,
-                      "pressure in the cavity, acting on its faces (follower load)"});
-    Cavity& cavity = cavities_.emplace_back(Cavity{.faces = std::move(faces),
-                                                   .nodes = std::move(nodes),
-                                                   .volume = std::move(volume),
-                                                   .positions = std::move(positions),
-                                                   .f_volume = f_volume,
-                                                   .f_pressure = f_pressure});
-    cavity.gradient = VecX::Zero(3 * n);
-  }
+  for (WallCavity& wall : MakeWallCavities(
+           this->name(), params_.cavities, *domain, bnd,
+           [this](FieldInfo info) { return DeclareField(std::move(info)); },
+           "pressure in the cavity, acting on its faces (follower load)"))
+    cavities_.emplace_back(std::move(wall)).gradient = VecX::Zero(3 * n);
   state_.cavities.resize(cavities_.size());
 }
 
@@ -626,10 +609,7 @@ double FemSolid::GravityEnergy() const {
 
 double FemSolid::CavityVolume(std::size_t i) const {
   GIPSI_CHECK(i < cavities_.size());
-  const Cavity& cavity = cavities_[i];
-  for (std::size_t k = 0; k < cavity.nodes.size(); ++k)
-    cavity.positions.col(static_cast<Index>(k)) = positions_.col(cavity.nodes[k]);
-  return cavity.volume.Compute(cavity.positions);
+  return cavities_[i].Volume(positions_);
 }
 
 Index FemSolid::CountInvertedElements() const {

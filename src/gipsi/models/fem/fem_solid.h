@@ -34,17 +34,11 @@
 #include "gipsi/models/fem/fem_state.h"
 #include "gipsi/models/fem/solid_material.h"
 #include "gipsi/models/fem/tet_assembly.h"
+#include "gipsi/models/wall_cavity.h"
 #include "gipsi/numerics/implicit_scheme.h"
 #include "gipsi/numerics/newton.h"
 
 namespace gipsi {
-
-/// A cavity bounded by part of the boundary (an endocardium): its volume is a field, and a
-/// pressure written to it acts as follower pressure on its faces. Plain struct.
-struct FemCavitySpec {
-  std::string name;  ///< fields "<name>_volume" [m³] and "<name>_pressure" [Pa]
-  Region region;     ///< selects the boundary faces that bound the cavity
-};
 
 /// Parameters. Plain struct with defaults.
 struct FemParams {
@@ -67,7 +61,9 @@ struct FemParams {
   bool predict_velocity = false;
   Vec3 fibre = Vec3::UnitX();  ///< uniform fibre direction (reference configuration)
   Vec3 sheet = Vec3::UnitY();  ///< uniform sheet direction (orthogonalised against the fibre)
-  std::vector<FemCavitySpec> cavities;
+  /// Cavities (wall_cavity.h): each one's volume is a field, and a pressure written to it acts
+  /// as follower pressure on its faces.
+  std::vector<CavitySpec> cavities;
 };
 
 /// Time spent in one object's steps, for `gipsi run --profile`. Plain struct.
@@ -233,16 +229,10 @@ class FemSolid final : public SimObject, public CavityWall, private NonlinearSys
   Points positions_;
   std::string failure_detail_;
 
-  struct Cavity {
-    std::vector<int> faces;    // boundary faces
-    std::vector<int> nodes;    // domain node of each cavity vertex
-    EnclosedVolume volume;     // over the faces, oriented out of the cavity
-    mutable Points positions;  // work buffer, 3 by nodes.size()
-    FieldId f_volume, f_pressure;
-    CavityLaw* law = nullptr;   // coupled to blood when set
+  struct Cavity : WallCavity {
+    explicit Cavity(WallCavity wall) : WallCavity(std::move(wall)) {}
     double pressure_begin = 0;  // at the start of the step
     VecX gradient{};            // 3N: ∂V/∂x, zero on constrained dofs (coupled)
-    mutable Points local_gradient{};
   };
   std::vector<Cavity> cavities_;
   double step_time_ = 0, step_dt_ = 0;   // of the step in progress (the laws' interval)

@@ -117,9 +117,7 @@ void RegisterFemSolid(TypeRegistry& registry) {
                   "{{\"direction\": [1, 0, 0]}}",
                   params.material->law()));
         }
-        if (auto cavities = p.Find("cavities"))
-          for (const auto& [name, region] : cavities->Members())
-            params.cavities.push_back(FemCavitySpec{name, ParseRegion(region)});
+        if (auto cavities = p.Find("cavities")) params.cavities = ParseCavitySpecs(*cavities);
         try {
           auto mesh = ctx.DomainMesh();
           auto solid = std::make_unique<FemSolid>(ctx.name, mesh, std::move(params));

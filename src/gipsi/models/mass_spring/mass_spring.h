@@ -73,15 +73,10 @@
 #include "gipsi/geometry/enclosed_volume.h"
 #include "gipsi/geometry/region.h"
 #include "gipsi/models/mass_spring/spring_law.h"
+#include "gipsi/models/wall_cavity.h"
 #include "gipsi/numerics/ode.h"
 
 namespace gipsi {
-
-/// A cavity bounded by part of the boundary (an endocardium). Plain struct.
-struct MassSpringCavitySpec {
-  std::string name;  ///< fields "<name>_volume" [m³] and "<name>_pressure" [Pa]
-  Region region;     ///< selects the boundary faces that bound the cavity
-};
 
 /// Parameters; plain struct with defaults.
 struct MassSpringParams {
@@ -105,7 +100,7 @@ struct MassSpringParams {
   /// can be written to the "fibre" field. Only used by the active tension.
   Vec3 fibre = Vec3::UnitX();
   /// Cavities bounded by boundary faces (tet domains), as FemSolid's.
-  std::vector<MassSpringCavitySpec> cavities;
+  std::vector<CavitySpec> cavities;  ///< wall_cavity.h
 };
 
 /// Not copyable or movable (a SimObject).
@@ -222,16 +217,12 @@ class MassSpring final : public SimObject, public CavityWall {
   VecX nodal_active_tension_;  // per node [Pa]
   bool any_active_ = false;    // some node has non-zero tension
 
-  struct Cavity {
-    std::vector<int> nodes;         // domain node of each cavity vertex
-    EnclosedVolume volume;          // over the faces, oriented out of the cavity
-    mutable Points positions;       // work buffer, 3 by nodes.size()
-    mutable Points local_gradient;  // work buffer, 3 by nodes.size()
-    Points step_gradient;           // g at the start of the step, zero on held axes
-    double pressure = 0;            // Pa
-    double compliance = 0;          // −dV_b/dp of the law at the last solve [m³/Pa]
-    FieldId f_volume, f_pressure;
-    CavityLaw* law = nullptr;
+  struct Cavity : WallCavity {
+    explicit Cavity(WallCavity wall)
+        : WallCavity(std::move(wall)), step_gradient(Points::Zero(3, positions.cols())) {}
+    Points step_gradient;   // g at the start of the step, zero on held axes
+    double pressure = 0;    // Pa
+    double compliance = 0;  // −dV_b/dp of the law at the last solve [m³/Pa]
   };
   std::vector<Cavity> cavities_;
   bool symplectic_ = false;                 // the integrator is SymplecticEuler

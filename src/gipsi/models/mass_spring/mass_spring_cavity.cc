@@ -13,47 +13,16 @@
 namespace gipsi {
 
 void MassSpring::SetUpCavities() {
-  using L = FieldLocation;
-  using A = FieldAccess;
-  const Mesh& mesh = domain();
-  const BoundarySurface& bnd = boundary();
-  for (const MassSpringCavitySpec& spec : params_.cavities) {
-    const std::vector<int> faces = SelectBoundaryFaces(spec.region, mesh, bnd);
-    if (faces.empty())
-      throw InputError(
-          fmt::format("object '{}': cavity '{}' selects no boundary face", name(), spec.name));
-    CavitySurface surface = MakeCavitySurface(bnd, faces);  // as FemSolid's cavities
-    std::vector<int> nodes = std::move(surface.nodes);
-    const Triangles& tris = surface.triangles;
-    const auto nc = static_cast<Index>(nodes.size());
-    EnclosedVolume volume = [&] {
-      try {
-        return EnclosedVolume(tris, nc);
-      } catch (const InputError& e) {
-        throw InputError(fmt::format("object '{}': cavity '{}': {}", name(), spec.name, e.what()));
-      }
-    }();
-    const FieldId f_volume = DeclareField({spec.name + "_volume", L::kGlobal, 1, "m^3", A::kRead,
-                                           "volume enclosed by the cavity's faces (rim capped)"});
-    const FieldId f_pressure = DeclareField(
-        {spec.name + "_pressure", L::kGlobal, 1, "Pa", A::kReadWrite,
-         "pressure in the cavity, the follower load p dV/dx on its nodes (solved if coupled)"});
-    cavities_.push_back(Cavity{.nodes = std::move(nodes),
-                               .volume = std::move(volume),
-                               .positions = Points::Zero(3, nc),
-                               .local_gradient = Points::Zero(3, nc),
-                               .step_gradient = Points::Zero(3, nc),
-                               .f_volume = f_volume,
-                               .f_pressure = f_pressure});
-  }
+  for (WallCavity& wall : MakeWallCavities(
+           name(), params_.cavities, domain(), boundary(),
+           [this](FieldInfo info) { return DeclareField(std::move(info)); },
+           "pressure in the cavity, the follower load p dV/dx on its nodes (solved if coupled)"))
+    cavities_.emplace_back(std::move(wall));
 }
 
 double MassSpring::CavityVolume(std::size_t i) const {
   GIPSI_CHECK(i < cavities_.size());
-  const Cavity& cavity = cavities_[i];
-  for (std::size_t k = 0; k < cavity.nodes.size(); ++k)
-    cavity.positions.col(static_cast<Index>(k)) = positions_.col(cavity.nodes[k]);
-  return cavity.volume.Compute(cavity.positions);
+  return cavities_[i].Volume(positions_);
 }
 
 double MassSpring::CavityPressure(std::size_t i) const {
@@ -61,41 +30,27 @@ double MassSpring::CavityPressure(std::size_t i) const {
   return cavities_[i].pressure;
 }
 
-std::vector<std::string> MassSpring::cavity_names() const {
-  std::vector<std::string> names;
-  for (const MassSpringCavitySpec& spec : params_.cavities) names.push_back(spec.name);
-  return names;
-}
+std::vector<std::string> MassSpring::cavity_names() const { return CavityNames(params_.cavities); }
 
 void MassSpring::AttachCavityLaw(std::string_view cavity, CavityLaw* law) {
   GIPSI_CHECK(law != nullptr);
-  for (std::size_t i = 0; i < cavities_.size(); ++i) {
-    if (params_.cavities[i].name != cavity) continue;
-    if (cavities_[i].law != nullptr)
-      throw InputError(
-          fmt::format("object '{}': cavity '{}' is already coupled to blood", name(), cavity));
-    if (!symplectic_)
-      throw InputError(fmt::format(
-          "object '{}' (MassSpring): a cavity coupled to blood needs \"integrator\": "
-          "\"SymplecticEuler\" (its end positions are affine in the pressure), not '{}'",
-          name(), integrator_->name()));
-    for (const Cavity& other : cavities_) {
-      if (other.law == nullptr) continue;
-      for (int node : cavities_[i].nodes)
-        if (std::find(other.nodes.begin(), other.nodes.end(), node) != other.nodes.end())
-          throw InputError(fmt::format(
-              "object '{}': cavity '{}' shares node {} with another cavity coupled to blood; "
-              "coupled cavities must be disjoint",
-              name(), cavity, node));
-    }
-    cavities_[i].law = law;
-    return;
+  const std::size_t i =
+      FindUncoupledCavity(name(), type_name(), params_.cavities, cavities_, cavity);
+  if (!symplectic_)
+    throw InputError(
+        fmt::format("object '{}' (MassSpring): a cavity coupled to blood needs \"integrator\": "
+                    "\"SymplecticEuler\" (its end positions are affine in the pressure), not '{}'",
+                    name(), integrator_->name()));
+  for (const Cavity& other : cavities_) {
+    if (other.law == nullptr) continue;
+    for (int node : cavities_[i].nodes)
+      if (std::find(other.nodes.begin(), other.nodes.end(), node) != other.nodes.end())
+        throw InputError(fmt::format(
+            "object '{}': cavity '{}' shares node {} with another cavity coupled to blood; "
+            "coupled cavities must be disjoint",
+            name(), cavity, node));
   }
-  std::string names;
-  for (const MassSpringCavitySpec& spec : params_.cavities)
-    names += (names.empty() ? "" : ", ") + spec.name;
-  throw InputError(fmt::format("object '{}' (MassSpring) has no cavity '{}'; its cavities: {}",
-                               name(), cavity, names.empty() ? "none" : names));
+  cavities_[i].law = law;
 }
 
 void MassSpring::AddCavityForces(Eigen::Ref<const VecX> q, Eigen::Ref<VecX> f,

@@ -69,9 +69,7 @@ void RegisterMassSpring(TypeRegistry& registry) {
           params.fibre = fibres->Vector3("direction");
           if (params.fibre.norm() == 0) fibres->At("direction").Expected("a non-zero vector");
         }
-        if (auto cavities = p.Find("cavities"))
-          for (const auto& [name, region] : cavities->Members())
-            params.cavities.push_back(MassSpringCavitySpec{name, ParseRegion(region)});
+        if (auto cavities = p.Find("cavities")) params.cavities = ParseCavitySpecs(*cavities);
         auto integrator = p.Has("integrator") ? ctx.registry.CreateIntegrator(p.At("integrator"))
                                               : std::make_unique<SymplecticEuler>();
         std::unique_ptr<MassSpring> object;
