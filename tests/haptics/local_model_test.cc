@@ -78,7 +78,7 @@ TEST(MassSpringNeighbourhood, StiffnessIsTheDerivativeOfTheSpringForces) {
   const std::vector<int>& nodes = builder.local_nodes();
   ASSERT_GT(nodes.size(), 5u);  // the contact node and its first ring
   const Index n = block.num_nodes();
-  VecX x = block.state(), xdot(block.ode_size());
+  VecX x = block.state().x, xdot(block.ode_size());
   auto forces = [&](const VecX& state) {
     block.CalcDerivative(0, state, xdot);
     VecX f(3 * nodes.size());

@@ -113,19 +113,19 @@ void MassSpring::Finish() {
                       "or only to degenerate ones)",
                       this->name(), i));
 
-  x_ = VecX::Zero(6 * n);
-  x_.head(3 * n) = Eigen::Map<const VecX>(mesh.nodes.data(), 3 * n);
+  state_.x = VecX::Zero(6 * n);
+  state_.x.head(3 * n) = Eigen::Map<const VecX>(mesh.nodes.data(), 3 * n);
   positions_ = mesh.nodes;
-  external_force_ = Points::Zero(3, n);
+  state_.external_force = Points::Zero(3, n);
   force_.resize(3 * n);
   integrator_->Prepare(ode_size());
   symplectic_ = dynamic_cast<const SymplecticEuler*>(integrator_.get()) != nullptr;
-  nodal_active_tension_ = VecX::Zero(n);
-  fibres_ = Points(3, mesh.num_tets());
+  state_.nodal_active_tension = VecX::Zero(n);
+  state_.fibres.Write() = Points(3, mesh.num_tets());
   const Vec3 fibre = params_.fibre.normalized();
   if (!fibre.allFinite())
     throw InputError(fmt::format("object '{}': the fibre direction must be non-zero", name()));
-  fibres_.colwise() = fibre;
+  state_.fibres.Write().colwise() = fibre;
   tet_rest_volume_.resize(mesh.num_tets());
   for (Index e = 0; e < mesh.num_tets(); ++e)
     tet_rest_volume_[e] =
@@ -160,8 +160,8 @@ void MassSpring::CalcForces(double /*t*/, Eigen::Ref<const VecX> x, Eigen::Ref<V
   const auto v = x.tail(3 * n);
   const SpringLaw& law = *params_.law;
   for (Index i = 0; i < n; ++i) {
-    f.segment<3>(3 * i) =
-        mass_[i] * (params_.gravity - params_.drag * v.segment<3>(3 * i)) + external_force_.col(i);
+    f.segment<3>(3 * i) = mass_[i] * (params_.gravity - params_.drag * v.segment<3>(3 * i)) +
+                          state_.external_force.col(i);
   }
   for (Index s = 0; s < num_springs(); ++s) {
     const Index a = springs_(0, s), b = springs_(1, s);
@@ -174,9 +174,9 @@ void MassSpring::CalcForces(double /*t*/, Eigen::Ref<const VecX> x, Eigen::Ref<V
     const double tension = hooke_ ? params_.stiffness * (length - rest_length_[s])
                                   : law.Tension(length, rest_length_[s], params_.stiffness);
     const double active =
-        any_active_
-            ? 0.5 * (nodal_active_tension_[a] + nodal_active_tension_[b]) * active_weight_[s]
-            : 0.0;
+        any_active_ ? 0.5 * (state_.nodal_active_tension[a] + state_.nodal_active_tension[b]) *
+                          active_weight_[s]
+                    : 0.0;
     const Vec3 fs = (tension + active + params_.damping * rate) * dir;
     f.segment<3>(3 * a) += fs;
     f.segment<3>(3 * b) -= fs;
@@ -236,11 +236,11 @@ void MassSpring::ApplyConstraints(double /*dt*/) {
         case ConstraintKind::kFree:
           break;
         case ConstraintKind::kDisplacement:
-          x_[3 * node + a] = rest(a, node) + bcs.value(j)[a];
-          x_[3 * n + 3 * node + a] = 0;
+          state_.x[3 * node + a] = rest(a, node) + bcs.value(j)[a];
+          state_.x[3 * n + 3 * node + a] = 0;
           break;
         case ConstraintKind::kVelocity:
-          x_[3 * n + 3 * node + a] = bcs.value(j)[a];
+          state_.x[3 * n + 3 * node + a] = bcs.value(j)[a];
           break;
       }
     }
@@ -248,14 +248,14 @@ void MassSpring::ApplyConstraints(double /*dt*/) {
 }
 
 StepStatus MassSpring::CheckState() const {
-  for (Index i = 0; i < x_.size(); ++i)
-    if (!std::isfinite(x_[i]))
+  for (Index i = 0; i < state_.x.size(); ++i)
+    if (!std::isfinite(state_.x[i]))
       return StepStatus::Diverged("non-finite position or velocity at node",
-                                  (i % (3 * num_nodes())) / 3, x_[i]);
+                                  (i % (3 * num_nodes())) / 3, state_.x[i]);
   const Index n = num_nodes();
   for (Index s = 0; s < num_springs(); ++s) {
     const double length =
-        (x_.segment<3>(3 * springs_(1, s)) - x_.segment<3>(3 * springs_(0, s))).norm();
+        (state_.x.segment<3>(3 * springs_(1, s)) - state_.x.segment<3>(3 * springs_(0, s))).norm();
     if (length > params_.max_stretch * rest_length_[s])
       return StepStatus::Diverged(
           "spring stretched beyond max_stretch times its rest length (time step too large for "
@@ -281,12 +281,12 @@ StepStatus MassSpring::DoStep(double t, double dt) {
     BeginCoupledStep();
     coupled_predictor_ = true;
   }
-  integrator_->Step(OdeView(*this), t, dt, x_);
+  integrator_->Step(OdeView(*this), t, dt, state_.x);
   coupled_predictor_ = false;
   if (coupled && !SolveCoupledCavities(t, dt))
     return StepStatus::Failed("the cavity pressure could not be solved with the blood");
   const Index n = num_nodes();
-  positions_ = Eigen::Map<const Points>(x_.data(), 3, n);
+  positions_ = Eigen::Map<const Points>(state_.x.data(), 3, n);
   return CheckState();
 }
 
@@ -315,7 +315,8 @@ double MassSpring::stable_dt_estimate() const {
 double MassSpring::KineticEnergy() const {
   const Index n = num_nodes();
   double e = 0;
-  for (Index i = 0; i < n; ++i) e += 0.5 * mass_[i] * x_.segment<3>(3 * n + 3 * i).squaredNorm();
+  for (Index i = 0; i < n; ++i)
+    e += 0.5 * mass_[i] * state_.x.segment<3>(3 * n + 3 * i).squaredNorm();
   return e;
 }
 
@@ -323,28 +324,28 @@ double MassSpring::PotentialEnergy() const {
   double e = 0;
   for (Index s = 0; s < num_springs(); ++s) {
     const double length =
-        (x_.segment<3>(3 * springs_(1, s)) - x_.segment<3>(3 * springs_(0, s))).norm();
+        (state_.x.segment<3>(3 * springs_(1, s)) - state_.x.segment<3>(3 * springs_(0, s))).norm();
     e += params_.law->Energy(length, rest_length_[s], params_.stiffness);
   }
   for (Index i = 0; i < num_nodes(); ++i)
-    e -= mass_[i] * params_.gravity.dot(x_.segment<3>(3 * i) - domain().nodes.col(i));
+    e -= mass_[i] * params_.gravity.dot(state_.x.segment<3>(3 * i) - domain().nodes.col(i));
   return e + VolumeEnergy();
 }
 
 Vec3 MassSpring::Momentum() const {
   const Index n = num_nodes();
   Vec3 p = Vec3::Zero();
-  for (Index i = 0; i < n; ++i) p += mass_[i] * x_.segment<3>(3 * n + 3 * i);
+  for (Index i = 0; i < n; ++i) p += mass_[i] * state_.x.segment<3>(3 * n + 3 * i);
   return p;
 }
 
 void MassSpring::DoReadField(FieldId id, Eigen::Ref<Eigen::MatrixXd> out) const {
   const Index n = num_nodes();
   const auto& v2n = boundary().vertex_to_node;
-  auto node_block = [&](Index offset) {  // 3 by N view into x_
-    return Eigen::Map<const Points>(x_.data() + offset, 3, n);
+  auto node_block = [&](Index offset) {  // 3 by N view into state_.x
+    return Eigen::Map<const Points>(state_.x.data() + offset, 3, n);
   };
-  if (ReadBoundaryKinematics(mech_, id, positions_, x_.data() + 3 * n, out)) return;
+  if (ReadBoundaryKinematics(mech_, id, positions_, state_.x.data() + 3 * n, out)) return;
   if (id == mech_.position) {
     out = positions_;
   } else if (id == mech_.velocity) {
@@ -352,12 +353,12 @@ void MassSpring::DoReadField(FieldId id, Eigen::Ref<Eigen::MatrixXd> out) const 
   } else if (id == mech_.displacement) {
     out = positions_ - domain().nodes;
   } else if (id == mech_.external_force) {
-    out = external_force_;
+    out = state_.external_force;
   } else if (id == f_mass_) {
     out = mass_.transpose();
   } else if (id == mech_.reaction_force) {
     // Reaction = m·a_prescribed − f = −f on constrained axes (prescribed acceleration is zero).
-    CalcForces(time(), x_, force_);
+    CalcForces(time(), state_.x, force_);
     const BoundaryConditions& bcs = boundary_conditions();
     for (std::size_t j = 0; j < v2n.size(); ++j) {
       const auto col = static_cast<Index>(j);
@@ -371,13 +372,13 @@ void MassSpring::DoReadField(FieldId id, Eigen::Ref<Eigen::MatrixXd> out) const 
   } else if (id == f_momentum_) {
     out.col(0) = Momentum();
   } else if (id == f_fibre_) {
-    out = fibres_;
+    out = state_.fibres.get();
   } else if (id == f_nodal_active_) {
-    out = nodal_active_tension_.transpose();
+    out = state_.nodal_active_tension.transpose();
   } else {
     for (std::size_t i = 0; i < cavities_.size(); ++i) {
       if (id == cavities_[i].f_volume) out(0, 0) = CavityVolume(i);
-      if (id == cavities_[i].f_pressure) out(0, 0) = cavities_[i].pressure;
+      if (id == cavities_[i].f_pressure) out(0, 0) = state_.cavities[i].pressure;
     }
   }
 }
@@ -386,24 +387,26 @@ void MassSpring::DoWriteField(FieldId id, const Eigen::Ref<const Eigen::MatrixXd
   const Index n = num_nodes();
   if (id == mech_.position) {
     positions_ = in;
-    x_.head(3 * n) = Eigen::Map<const VecX>(positions_.data(), 3 * n);
+    state_.x.head(3 * n) = Eigen::Map<const VecX>(positions_.data(), 3 * n);
   } else if (id == mech_.velocity) {
-    Eigen::Map<Points>(x_.data() + 3 * n, 3, n) = in;
+    Eigen::Map<Points>(state_.x.data() + 3 * n, 3, n) = in;
   } else if (id == mech_.external_force) {
-    external_force_ = in;
+    state_.external_force = in;
   } else if (id == f_fibre_) {
-    for (Index e = 0; e < fibres_.cols(); ++e) {
+    Points& fibres = state_.fibres.Write();
+    for (Index e = 0; e < fibres.cols(); ++e) {
       const Vec3 f = in.col(e);
-      if (f.squaredNorm() > 0 && f.allFinite()) fibres_.col(e) = f.normalized();
+      if (f.squaredNorm() > 0 && f.allFinite()) fibres.col(e) = f.normalized();
     }
     UpdateActiveWeights();  // allocates: fibres are set up before a run, not per step
   } else if (id == f_nodal_active_) {
-    nodal_active_tension_ = in.row(0).transpose();
-    any_active_ = (nodal_active_tension_.array() != 0).any();
+    state_.nodal_active_tension = in.row(0).transpose();
+    any_active_ = (state_.nodal_active_tension.array() != 0).any();
   } else {
     // A coupled cavity's pressure is solved each step; writes to it are ignored.
-    for (Cavity& cavity : cavities_)
-      if (id == cavity.f_pressure && cavity.law == nullptr) cavity.pressure = in(0, 0);
+    for (std::size_t i = 0; i < cavities_.size(); ++i)
+      if (id == cavities_[i].f_pressure && cavities_[i].law == nullptr)
+        state_.cavities[i].pressure = in(0, 0);
   }
 }
 

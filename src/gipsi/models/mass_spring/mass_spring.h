@@ -78,6 +78,39 @@
 
 namespace gipsi {
 
+/// A cavity's state. Copyable.
+struct MassSpringCavityState {
+  double pressure = 0;    ///< [Pa]: written through the field, or solved when coupled
+  double compliance = 0;  ///< −dV_b/dp of the coupled law at the last solve [m³/Pa]
+
+  template <class Self, class V>
+  static void Fields(Self& s, V& v) {
+    v("pressure", s.pressure);
+    v("compliance", s.compliance);
+  }
+};
+
+/// What a MassSpring carries from one step to the next, as a state value type
+/// (gipsi/base/state_value.h); the rest is its model (springs, rest lengths, masses) or derived
+/// from this (positions, the springs' active weights, which follow the fibres). Copyable.
+/// Shapes: N nodes, E tets.
+struct MassSpringState {
+  VecX x;                     ///< [q; v], 6N: positions then velocities
+  Points external_force;      ///< 3 by N [N], the volume-coupling input
+  VecX nodal_active_tension;  ///< per node [Pa]
+  Stamped<Points> fibres;     ///< 3 by E, a unit fibre per tet (rarely written)
+  std::vector<MassSpringCavityState> cavities;
+
+  template <class Self, class V>
+  static void Fields(Self& s, V& v) {
+    v("x", s.x, Shape::kFixed);
+    v("external_force", s.external_force, Shape::kFixed);
+    v("nodal_active_tension", s.nodal_active_tension, Shape::kFixed);
+    v("fibres", s.fibres, Shape::kFixed);
+    v("cavities", s.cavities, Shape::kFixed);
+  }
+};
+
 /// Parameters; plain struct with defaults.
 struct MassSpringParams {
   double density = 1000;             ///< kg/m³
@@ -140,7 +173,7 @@ class MassSpring final : public SimObject, public CavityWall {
   [[nodiscard]] const VecX& rest_lengths() const { return rest_length_; }
   [[nodiscard]] const MassSpringParams& params() const { return params_; }
   /// Full state [q; v] (6N).
-  [[nodiscard]] const VecX& state() const { return x_; }
+  [[nodiscard]] const MassSpringState& state() const { return state_; }
   /// Largest stable explicit time step estimate at rest, 2 / ω_max with ω_max² ≈ 4 max_i Σ k / m_i
   /// (a strain-stiffening law lowers the limit as springs stretch).
   [[nodiscard]] double stable_dt_estimate() const;
@@ -165,6 +198,9 @@ class MassSpring final : public SimObject, public CavityWall {
   [[nodiscard]] Vec3 Momentum() const;
 
  protected:
+  [[nodiscard]] std::unique_ptr<ObjectState> NewObjectState() const override;
+  void CopyObjectState(ObjectState& into) const override;
+  void SetObjectState(const ObjectState& from) override;
   StepStatus DoStep(double t, double dt) override;
   void DoReadField(FieldId id, Eigen::Ref<Eigen::MatrixXd> out) const override;
   void DoWriteField(FieldId id, const Eigen::Ref<const Eigen::MatrixXd>& in) override;
@@ -190,10 +226,13 @@ class MassSpring final : public SimObject, public CavityWall {
   /// Adds p ∂V/∂x of every cavity at positions q (3N) to f; coupled ones only if
   /// `include_coupled`.
   void AddCavityForces(Eigen::Ref<const VecX> q, Eigen::Ref<VecX> f, bool include_coupled) const;
+  /// After the state was replaced: any_active_, positions_, and the active weights if the
+  /// fibres changed (UpdateActiveWeights allocates).
+  void UpdateDerived(bool fibres_changed);
   /// ∂V/∂x at the start of the step (g) of every coupled cavity, zero on held axes.
   void BeginCoupledStep();
-  /// Solves each coupled cavity's pressure after the p = 0 step and moves x_ by it; false (with
-  /// failure_detail_ set) if a law cannot answer or no pressure fits.
+  /// Solves each coupled cavity's pressure after the p = 0 step and moves the state by it; false
+  /// (with failure_detail_ set) if a law cannot answer or no pressure fits.
   bool SolveCoupledCavities(double t, double dt);
 
   MassSpringParams params_;
@@ -202,27 +241,22 @@ class MassSpring final : public SimObject, public CavityWall {
   Eigen::Matrix2Xi springs_;
   VecX rest_length_;
   VecX mass_;
-  VecX x_;                 // [q; v]
-  Points positions_;       // q as 3 by N (kept in sync)
-  Points external_force_;  // volume-coupling input, 3 by N
-  mutable VecX force_;     // work buffer, 3N
+  MassSpringState state_;
+  Points positions_;    // q as 3 by N (kept in sync with state_.x)
+  mutable VecX force_;  // work buffer, 3N
   MechanicalFieldIds mech_;
   FieldId f_mass_;
   FieldId f_kinetic_, f_potential_, f_momentum_;
   FieldId f_fibre_, f_nodal_active_;
 
-  VecX tet_rest_volume_;       // signed, per tet
-  Points fibres_;              // 3 by E unit fibre per tet (E = 0 for element-free networks)
-  VecX active_weight_;         // per spring [m²]
-  VecX nodal_active_tension_;  // per node [Pa]
-  bool any_active_ = false;    // some node has non-zero tension
+  VecX tet_rest_volume_;     // signed, per tet
+  VecX active_weight_;       // per spring [m²], from state_.fibres (E = 0: no fibres)
+  bool any_active_ = false;  // some node has non-zero tension
 
   struct Cavity : WallCavity {
     explicit Cavity(WallCavity wall)
         : WallCavity(std::move(wall)), step_gradient(Points::Zero(3, positions.cols())) {}
-    Points step_gradient;   // g at the start of the step, zero on held axes
-    double pressure = 0;    // Pa
-    double compliance = 0;  // −dV_b/dp of the law at the last solve [m³/Pa]
+    Points step_gradient;  // g at the start of the step, zero on held axes
   };
   std::vector<Cavity> cavities_;
   bool symplectic_ = false;                 // the integrator is SymplecticEuler

@@ -18,6 +18,7 @@ void MassSpring::SetUpCavities() {
            [this](FieldInfo info) { return DeclareField(std::move(info)); },
            "pressure in the cavity, the follower load p dV/dx on its nodes (solved if coupled)"))
     cavities_.emplace_back(std::move(wall));
+  state_.cavities.resize(cavities_.size());
 }
 
 double MassSpring::CavityVolume(std::size_t i) const {
@@ -27,7 +28,7 @@ double MassSpring::CavityVolume(std::size_t i) const {
 
 double MassSpring::CavityPressure(std::size_t i) const {
   GIPSI_CHECK(i < cavities_.size());
-  return cavities_[i].pressure;
+  return state_.cavities[i].pressure;
 }
 
 std::vector<std::string> MassSpring::cavity_names() const { return CavityNames(params_.cavities); }
@@ -55,14 +56,16 @@ void MassSpring::AttachCavityLaw(std::string_view cavity, CavityLaw* law) {
 
 void MassSpring::AddCavityForces(Eigen::Ref<const VecX> q, Eigen::Ref<VecX> f,
                                  bool include_coupled) const {
-  for (const Cavity& cavity : cavities_) {
-    if ((cavity.law != nullptr && !include_coupled) || cavity.pressure == 0) continue;
+  for (std::size_t c = 0; c < cavities_.size(); ++c) {
+    const Cavity& cavity = cavities_[c];
+    const double pressure = state_.cavities[c].pressure;
+    if ((cavity.law != nullptr && !include_coupled) || pressure == 0) continue;
     for (std::size_t k = 0; k < cavity.nodes.size(); ++k)
       cavity.positions.col(static_cast<Index>(k)) = q.segment<3>(3 * cavity.nodes[k]);
     cavity.volume.Compute(cavity.positions, &cavity.local_gradient);
     for (std::size_t k = 0; k < cavity.nodes.size(); ++k)
       f.segment<3>(3 * cavity.nodes[k]) +=
-          cavity.pressure * cavity.local_gradient.col(static_cast<Index>(k));
+          pressure * cavity.local_gradient.col(static_cast<Index>(k));
   }
 }
 
@@ -72,7 +75,7 @@ void MassSpring::BeginCoupledStep() {
   for (Cavity& cavity : cavities_) {
     if (cavity.law == nullptr) continue;
     for (std::size_t k = 0; k < cavity.nodes.size(); ++k)
-      cavity.positions.col(static_cast<Index>(k)) = x_.segment<3>(3 * cavity.nodes[k]);
+      cavity.positions.col(static_cast<Index>(k)) = state_.x.segment<3>(3 * cavity.nodes[k]);
     cavity.volume.Compute(cavity.positions, &cavity.step_gradient);
     // Held axes do not accelerate (CalcDerivative): the pressure cannot move them either. Cavity
     // nodes are boundary vertices; v2n is sorted, so find each one's vertex by bisection.
@@ -102,8 +105,8 @@ bool MassSpring::SolveCoupledCavities(double t, double dt) {
     auto h = [&](double p, double& out) {
       for (Index k = 0; k < nc; ++k) {
         const int node = cavity.nodes[static_cast<std::size_t>(k)];
-        cavity.positions.col(k) =
-            x_.segment<3>(3 * node) + (p * dt * dt / mass_[node]) * cavity.step_gradient.col(k);
+        cavity.positions.col(k) = state_.x.segment<3>(3 * node) +
+                                  (p * dt * dt / mass_[node]) * cavity.step_gradient.col(k);
       }
       if (!cavity.law->EndVolume(t, dt, p, blood_volume) || !std::isfinite(blood_volume)) {
         law_failed = true;
@@ -113,13 +116,14 @@ bool MassSpring::SolveCoupledCavities(double t, double dt) {
       return true;
     };
     const double v_now = CavityVolume(i);
-    double p = cavity.pressure, slope = 0;
-    const double estimate = wall_slope + cavity.compliance;  // dh/dp
+    MassSpringCavityState& cs = state_.cavities[i];
+    double p = cs.pressure, slope = 0;
+    const double estimate = wall_slope + cs.compliance;  // dh/dp
     auto first_step = [estimate](double h0) {  // a Newton step on the estimate, else ±1 Pa
       const double step = -h0 / estimate;
       return std::abs(step) > 0 && std::isfinite(step) ? step : (h0 > 0 ? -1.0 : 1.0);
     };
-    if (!SolveIncreasingRoot(h, cavity.pressure, first_step, 1e-13 * v_now, p, &slope)) {
+    if (!SolveIncreasingRoot(h, cs.pressure, first_step, 1e-13 * v_now, p, &slope)) {
       const std::string& cname = params_.cavities[i].name;
       failure_detail_ =
           law_failed ? fmt::format(
@@ -132,13 +136,13 @@ bool MassSpring::SolveCoupledCavities(double t, double dt) {
                            cname, t, dt);
       return false;
     }
-    if (slope > wall_slope) cavity.compliance = slope - wall_slope;
-    cavity.pressure = p;
+    if (slope > wall_slope) cs.compliance = slope - wall_slope;
+    cs.pressure = p;
     for (Index k = 0; k < nc; ++k) {
       const int node = cavity.nodes[static_cast<std::size_t>(k)];
       const Vec3 dv = (p * dt / mass_[node]) * cavity.step_gradient.col(k);
-      x_.segment<3>(3 * n + 3 * node) += dv;
-      x_.segment<3>(3 * node) += dt * dv;
+      state_.x.segment<3>(3 * n + 3 * node) += dv;
+      state_.x.segment<3>(3 * node) += dt * dv;
     }
   }
   return true;

@@ -51,7 +51,7 @@ bool MassSpringNeighbourhood::Build(Index vertex, const Vec3& normal, double anc
   }
   const Index m = static_cast<Index>(local_.size());
   const Index n = ms.num_nodes();
-  const VecX& x = ms.state();
+  const VecX& x = ms.state().x;
   const MassSpringParams& params = ms.params();
   const HookeSpring hooke;
   const SpringLaw& law = params.law ? *params.law : static_cast<const SpringLaw&>(hooke);

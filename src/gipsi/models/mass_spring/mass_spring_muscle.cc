@@ -16,12 +16,12 @@ namespace gipsi {
 void MassSpring::UpdateActiveWeights() {
   active_weight_ = VecX::Zero(num_springs());
   const Mesh& mesh = domain();
-  if (mesh.num_tets() == 0 || fibres_.cols() != mesh.num_tets()) return;
+  if (mesh.num_tets() == 0 || state_.fibres.get().cols() != mesh.num_tets()) return;
   std::map<std::pair<int, int>, Index> spring_of;
   for (Index s = 0; s < num_springs(); ++s)
     spring_of.emplace(std::minmax(springs_(0, s), springs_(1, s)), s);
   for (Index e = 0; e < mesh.num_tets(); ++e) {
-    const Vec3 f = fibres_.col(e);
+    const Vec3 f = state_.fibres.get().col(e);
     const double volume =
         std::abs(TetSignedVolume(mesh.nodes.col(mesh.tets(0, e)), mesh.nodes.col(mesh.tets(1, e)),
                                  mesh.nodes.col(mesh.tets(2, e)), mesh.nodes.col(mesh.tets(3, e))));
@@ -72,8 +72,8 @@ Index MassSpring::FirstInvertedTet() const {
   const Tets& tets = domain().tets;
   for (Index e = 0; e < tets.cols(); ++e) {
     const double volume =
-        TetSignedVolume(x_.segment<3>(3 * tets(0, e)), x_.segment<3>(3 * tets(1, e)),
-                        x_.segment<3>(3 * tets(2, e)), x_.segment<3>(3 * tets(3, e)));
+        TetSignedVolume(state_.x.segment<3>(3 * tets(0, e)), state_.x.segment<3>(3 * tets(1, e)),
+                        state_.x.segment<3>(3 * tets(2, e)), state_.x.segment<3>(3 * tets(3, e)));
     if (!(volume / tet_rest_volume_[e] > 0)) return e;
   }
   return -1;
@@ -85,8 +85,8 @@ double MassSpring::VolumeEnergy() const {
   double energy = 0;
   for (Index e = 0; e < tets.cols(); ++e) {
     const double volume =
-        TetSignedVolume(x_.segment<3>(3 * tets(0, e)), x_.segment<3>(3 * tets(1, e)),
-                        x_.segment<3>(3 * tets(2, e)), x_.segment<3>(3 * tets(3, e)));
+        TetSignedVolume(state_.x.segment<3>(3 * tets(0, e)), state_.x.segment<3>(3 * tets(1, e)),
+                        state_.x.segment<3>(3 * tets(2, e)), state_.x.segment<3>(3 * tets(3, e)));
     const double j = volume / tet_rest_volume_[e];
     const double log_j = j > 0 ? std::log(j) : std::numeric_limits<double>::infinity();
     energy += 0.5 * params_.volume_stiffness * std::abs(tet_rest_volume_[e]) * log_j * log_j;

@@ -1,45 +1,50 @@
 /// @file
-/// MassSpring checkpoints. The explicit integrators are one-step methods whose buffers are
-/// rewritten every step, so the state is [q; v], the external force and active tension fields,
-/// the fibres, and the cavities' pressures and blood compliance estimates (the coupled solve's
-/// starting point).
+/// MassSpring checkpoints and snapshots. The state is MassSpringState (mass_spring.h): the
+/// explicit integrators are one-step methods whose buffers are rewritten every step, so it is
+/// [q; v], the external force and active tension fields, the fibres, and the cavities' pressures
+/// and blood compliance estimates (the coupled solve's starting point). Positions, the springs'
+/// active weights (from the fibres) and whether any tension acts are rebuilt from it.
 
-#include <vector>
-
+#include "gipsi/base/object_state.h"
 #include "gipsi/base/state.h"
 #include "gipsi/models/mass_spring/mass_spring.h"
 
 namespace gipsi {
 
 void MassSpring::SaveObjectState(StateWriter& out) const {
-  out.WriteMatrix(x_);
-  out.WriteMatrix(external_force_);
-  out.WriteMatrix(nodal_active_tension_);
-  out.WriteMatrix(fibres_);
-  std::vector<double> cavity_state;
-  for (const Cavity& c : cavities_)
-    cavity_state.insert(cavity_state.end(), {c.pressure, c.compliance});
-  out.WriteArray(cavity_state);
+  out.BeginSection("MassSpringState", 1);
+  WriteFields(out, state_);
+  out.EndSection();
 }
 
 void MassSpring::RestoreObjectState(StateReader& in) {
-  in.ReadMatrixExact(x_, "the state [q; v]");
-  in.ReadMatrixExact(external_force_, "the external force field");
-  in.ReadMatrixExact(nodal_active_tension_, "the nodal active tension");
-  any_active_ = (nodal_active_tension_.array() != 0).any();
-  Points fibres = fibres_;
-  in.ReadMatrixExact(fibres, "the fibres");
-  if (fibres != fibres_) {
-    fibres_ = fibres;
-    UpdateActiveWeights();
-  }
-  std::vector<double> cavity_state(2 * cavities_.size());
-  in.ReadArrayExact(cavity_state, "the cavity pressures");
-  for (std::size_t c = 0; c < cavities_.size(); ++c) {
-    cavities_[c].pressure = cavity_state[2 * c];
-    cavities_[c].compliance = cavity_state[2 * c + 1];
-  }
-  positions_ = Eigen::Map<const Points>(x_.data(), 3, num_nodes());
+  MassSpringState read = state_;  // all or nothing: the object is untouched if the read fails
+  in.BeginSection("MassSpringState", 1);
+  ReadFields(in, read);
+  in.EndSection();
+  const bool fibres_changed = read.fibres.get() != state_.fibres.get();
+  state_ = std::move(read);
+  UpdateDerived(fibres_changed);
+}
+
+std::unique_ptr<ObjectState> MassSpring::NewObjectState() const {
+  return std::make_unique<StateBox<MassSpringState>>(state_);
+}
+
+void MassSpring::CopyObjectState(ObjectState& into) const {
+  CopyFields(StateBox<MassSpringState>::Of(into).value, state_);
+}
+
+void MassSpring::SetObjectState(const ObjectState& from) {
+  const std::uint64_t fibres = state_.fibres.stamp();
+  CopyFields(state_, StateBox<MassSpringState>::Of(from).value);
+  UpdateDerived(state_.fibres.stamp() != fibres);
+}
+
+void MassSpring::UpdateDerived(bool fibres_changed) {
+  any_active_ = (state_.nodal_active_tension.array() != 0).any();
+  if (fibres_changed) UpdateActiveWeights();
+  positions_ = Eigen::Map<const Points>(state_.x.data(), 3, num_nodes());
 }
 
 }  // namespace gipsi
