@@ -521,8 +521,10 @@ int Types(const std::vector<std::string>& plugins) {
   print("connectors", registry.connectors.List());
   print("integrators", registry.integrators.List());
   print("material laws", registry.materials.List());
-  print("cell models", registry.cell_models.List());
-  print("haptic local models (by object type)", registry.local_models.List());
+  // Tables the layers above the kernel declare (cell models, haptic local models by object
+  // type, and any a plugin adds).
+  for (const std::string& kind : registry.TableKinds())
+    print(fmt::format("{}s", kind).c_str(), registry.ListTable(kind));
   return 0;
 }
 

@@ -8,6 +8,7 @@
 
 #include "gipsi/base/json_node.h"
 #include "gipsi/base/log.h"
+#include "gipsi/core/local_model.h"
 #include "gipsi/haptics/haptic_probe.h"
 #include "gipsi/viz/plot_data.h"
 
@@ -106,7 +107,7 @@ void SimulationThread::Load(const std::vector<std::pair<std::string, ColorSpec>>
       // Pulled is the tissue it is drawn on (a heart's bioelectricity: its muscle).
       const SimObject& tissue = display_->manager(i).geometry_object();
       const auto external = tissue.TryFindField("external_force");
-      const bool pullable = registry_->local_models.Contains(tissue.type_name()) && external &&
+      const bool pullable = LocalModels(*registry_).Contains(tissue.type_name()) && external &&
                             tissue.field_info(*external).writable() &&
                             tissue.boundary().num_vertices() > 0;
       s.objects.push_back({display_->manager(i).name(), std::move(fields), pullable});
@@ -292,13 +293,13 @@ void SimulationThread::Loop() {
       // The viewer owns the scene (non-const); the display manager only holds it for reading.
       auto& object = const_cast<SimObject&>(display_->manager(c.tool_surface).geometry_object());
       std::string why;
-      if (!registry_->local_models.Contains(object.type_name())) {
+      if (!LocalModels(*registry_).Contains(object.type_name())) {
         why = fmt::format("object '{}' ({}) cannot be pulled: no haptic local model for its type",
                           object.name(), object.type_name());
       } else {
         try {
           const JsonNode where(nlohmann::ordered_json(), "viewer", "mouse pull");
-          why = tool_.Grab(registry_->local_models.Get(object.type_name(), where)(object, 3),
+          why = tool_.Grab(LocalModels(*registry_).Get(object.type_name(), where)(object, 3),
                            c.tool_point, scene_->kernel->macro_dt());
         } catch (const std::exception& e) {
           why = e.what();

@@ -31,7 +31,7 @@ struct DrawnObject {
   std::string name;                 ///< the object's full (dotted) name
   std::vector<std::string> fields;  ///< fields it can be coloured by
   /// The mouse can pull it: it has a free boundary, an `external_force` node field and a
-  /// haptic local model (TypeRegistry::local_models) to scale the pull's spring.
+  /// haptic local model (LocalModels, gipsi/core/local_model.h) to scale the pull's spring.
   bool pullable = false;
 };
 

@@ -13,8 +13,6 @@
 #include <numbers>
 
 #include "gipsi/base/error.h"
-#include "gipsi/base/object_state.h"
-#include "gipsi/base/state.h"
 #include "gipsi/core/coordinator.h"
 #include "gipsi/core/registry.h"
 #include "gipsi/core/sim_object.h"
@@ -24,7 +22,8 @@ namespace example {
 
 using Eigen::MatrixXd;
 
-/// What an Oscillator carries from one step to the next (a state value type). Copyable.
+/// What an Oscillator carries from one step to the next (a state value type). Copyable. The
+/// position is a function of time, so only the node is state.
 struct OscillatorState {
   gipsi::Points position = gipsi::Points::Zero(3, 1);  // the one node [m]
 
@@ -47,28 +46,16 @@ class Oscillator final : public gipsi::SimObject {
     velocity_ = DeclareField({"velocity", gipsi::FieldLocation::kGlobal, 3, "m/s",
                               gipsi::FieldAccess::kRead, "current velocity"});
     state_.position = center;
+    // Checkpoints save, and step retries copy, this state (gipsi/base/state_value.h).
+    BindState(state_);
   }
   std::string_view type_name() const override { return "Oscillator"; }
   const gipsi::Points& domain_positions() const override { return state_.position; }
-  // Checkpoints: the position is a function of time, so only the node is state. Written through
-  // the state's field list (gipsi/base/state_value.h).
-  void SaveObjectState(gipsi::StateWriter& out) const override { gipsi::WriteFields(out, state_); }
-  void RestoreObjectState(gipsi::StateReader& in) override { gipsi::ReadFields(in, state_); }
 
  protected:
   gipsi::StepStatus DoStep(double t, double dt) override {
     state_.position = Position(t + dt);
     return gipsi::StepStatus::Ok();
-  }
-  // Step retries copy the state value instead of serialising it (gipsi/base/object_state.h).
-  std::unique_ptr<gipsi::ObjectState> NewObjectState() const override {
-    return std::make_unique<gipsi::StateBox<OscillatorState>>(state_);
-  }
-  void CopyObjectState(gipsi::ObjectState& into) const override {
-    gipsi::CopyFields(gipsi::StateBox<OscillatorState>::Of(into).value, state_);
-  }
-  void SetObjectState(const gipsi::ObjectState& from) override {
-    gipsi::CopyFields(state_, gipsi::StateBox<OscillatorState>::Of(from).value);
   }
   void DoReadField(gipsi::FieldId id, Eigen::Ref<MatrixXd> out) const override {
     const double t = time();

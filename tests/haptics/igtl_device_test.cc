@@ -346,6 +346,17 @@ TEST(IgtlDeviceScene, SendsTheDeformedBoundaryOfTheNamedObject) {
     "slicer": {"type": "OpenIGTLinkSurface", "object": "cube", "device": "probe", "rate": 1000})"),
                                     "igtl.json", ".", registry);
   ASSERT_TRUE(server.Accept());
+  // Its port: the cube's boundary positions, read in metres (checked when the scene loaded).
+  const Coordinator& coordinator = scene.kernel->coordinator();
+  const Connector* slicer = nullptr;
+  for (std::size_t i = 0; i < coordinator.num_connectors(); ++i)
+    if (coordinator.connector(i).name() == "slicer") slicer = &coordinator.connector(i);
+  ASSERT_NE(slicer, nullptr);
+  ASSERT_EQ(slicer->ports().size(), 1u);
+  EXPECT_EQ(slicer->ports()[0].object, &scene.kernel->FindObject("cube"));
+  EXPECT_EQ(slicer->ports()[0].name, "boundary_position");
+  EXPECT_EQ(slicer->ports()[0].access, FieldAccess::kRead);
+  EXPECT_EQ(slicer->ports()[0].units, "m");
   // Connectors fire before the objects step: the surface sent at the firing of t = 0.02 is the
   // cube's boundary after the step to 0.02 (sagging under gravity from its fixed bottom).
   RunResult run = scene.kernel->Run(0.02);

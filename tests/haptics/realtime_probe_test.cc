@@ -250,7 +250,7 @@ TEST(HapticLocalModels, TheCouplingUsesTheModelRegisteredForTheObjectsType) {
   registry.objects.Register(
       "FemSolid", builtins.objects.Get("FemSolid", JsonNode(type, "test", "type")), "FemSolid");
   RegisterHaptics(registry);
-  registry.local_models.Register(
+  LocalModels(registry).Register(
       "FemSolid",
       [&builds](SimObject& object, int) -> std::unique_ptr<LocalModelBuilder> {
         return std::make_unique<CountingCondensation>(dynamic_cast<FemSolid&>(object), &builds);

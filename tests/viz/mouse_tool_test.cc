@@ -51,7 +51,7 @@ TEST(PickSurface, FindsTheFirstFaceAlongTheRay) {
 /// The haptic local-model builder of `object` (as the viewer makes it).
 std::unique_ptr<LocalModelBuilder> Builder(TypeRegistry& registry, SimObject& object) {
   const JsonNode where(nlohmann::ordered_json(), "test", "");
-  return registry.local_models.Get(object.type_name(), where)(object, 3);
+  return LocalModels(registry).Get(object.type_name(), where)(object, 3);
 }
 
 Vec3 Node(const SimObject& object, Index node) { return object.domain_positions().col(node); }

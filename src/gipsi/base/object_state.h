@@ -36,9 +36,27 @@ class ObjectState {
   [[nodiscard]] virtual std::string FirstDifference(const ObjectState& other) const = 0;
 };
 
+/// An ObjectState of type `T` (the CRTP base of every box type): `T::Of(box)` is `box` as a
+/// `T`, checked (aborts naming both types if the box holds another).
+template <class T>
+class TypedState : public ObjectState {
+ public:
+  static const T& Of(const ObjectState& box) {
+    const auto* typed = dynamic_cast<const T*>(&box);
+    GIPSI_CHECK(typed != nullptr, "a snapshot of type {} where {} was expected", typeid(box).name(),
+                typeid(T).name());
+    return *typed;
+  }
+  static T& Of(ObjectState& box) {
+    return const_cast<T&>(Of(static_cast<const ObjectState&>(box)));
+  }
+};
+
 /// A state value type `S` in a box.
 template <class S>
-class StateBox final : public ObjectState {
+class StateBox final : public TypedState<StateBox<S>> {
+  using Base = TypedState<StateBox<S>>;
+
  public:
   explicit StateBox(const S& initial) : value(initial) {}
 
@@ -47,22 +65,13 @@ class StateBox final : public ObjectState {
     return gipsi::FirstDifference(value, Of(other).value);
   }
 
-  /// `box` as a StateBox<S> (checked: aborts if it holds another type).
-  static const StateBox& Of(const ObjectState& box) {
-    const auto* typed = dynamic_cast<const StateBox*>(&box);
-    GIPSI_CHECK(typed != nullptr, "a snapshot of type {} where {} was expected", typeid(box).name(),
-                typeid(StateBox).name());
-    return *typed;
-  }
-  static StateBox& Of(ObjectState& box) {
-    return const_cast<StateBox&>(Of(static_cast<const ObjectState&>(box)));
-  }
+  using Base::Of;
 
   S value;
 };
 
 /// A serialised state (the bytes StateWriter wrote).
-class ByteState final : public ObjectState {
+class ByteState final : public TypedState<ByteState> {
  public:
   void Assign(const ObjectState& other) override { bytes = Of(other).bytes; }
   [[nodiscard]] std::string FirstDifference(const ObjectState& other) const override {
@@ -75,22 +84,13 @@ class ByteState final : public ObjectState {
                ? std::string()
                : "the serialised state at byte " + std::to_string(mine - bytes.begin());
   }
-  static const ByteState& Of(const ObjectState& box) {
-    const auto* typed = dynamic_cast<const ByteState*>(&box);
-    GIPSI_CHECK(typed != nullptr, "a snapshot of type {} where serialised bytes were expected",
-                typeid(box).name());
-    return *typed;
-  }
-  static ByteState& Of(ObjectState& box) {
-    return const_cast<ByteState&>(Of(static_cast<const ObjectState&>(box)));
-  }
 
   std::string bytes;
 };
 
 /// Snapshots of several parts side by side (a coordinator's objects and connectors, an
 /// aggregate and its own monitor). Assign and compare part by part.
-class CompositeState final : public ObjectState {
+class CompositeState final : public TypedState<CompositeState> {
  public:
   void Assign(const ObjectState& other) override {
     const CompositeState& o = Of(other);
@@ -105,15 +105,6 @@ class CompositeState final : public ObjectState {
       if (!d.empty()) return "part " + std::to_string(i) + ": " + d;
     }
     return {};
-  }
-  static const CompositeState& Of(const ObjectState& box) {
-    const auto* typed = dynamic_cast<const CompositeState*>(&box);
-    GIPSI_CHECK(typed != nullptr, "a snapshot of type {} where a composite was expected",
-                typeid(box).name());
-    return *typed;
-  }
-  static CompositeState& Of(ObjectState& box) {
-    return const_cast<CompositeState&>(Of(static_cast<const ObjectState&>(box)));
   }
 
   std::vector<std::unique_ptr<ObjectState>> parts;

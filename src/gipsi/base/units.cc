@@ -75,10 +75,9 @@ double UnitFactor(std::string_view unit, std::string_view si_unit) {
   return Convert(1.0, unit, si_unit);
 }
 
-double ReadQuantity(const JsonNode& node, std::string_view si_unit) {
-  if (node.is_number()) return node.AsNumber();
-  const std::string expected =
-      fmt::format("a number in {} or a string \"VALUE UNIT\" (e.g. \"1.5 {}\")", si_unit, si_unit);
+WrittenQuantity ReadWrittenQuantity(const JsonNode& node, std::string_view expected,
+                                    std::string_view hint_unit) {
+  if (node.is_number()) return {node.AsNumber(), {}};
   if (!node.is_string()) node.Expected(expected);
   const std::string text = node.AsString();
   std::size_t pos = 0;
@@ -86,17 +85,28 @@ double ReadQuantity(const JsonNode& node, std::string_view si_unit) {
   try {
     value = std::stod(text, &pos);
   } catch (const std::exception&) {
-    node.Expected(expected + fmt::format(", got \"{}\"", text));
+    node.Expected(fmt::format("{}, got \"{}\"", expected, text));
   }
   const std::size_t unit_begin = text.find_first_not_of(' ', pos);
   if (unit_begin == std::string::npos || unit_begin == pos)
     node.Expected(
-        fmt::format("a value and a unit separated by a space (in SI: \"{} {}\"), got "
+        fmt::format("a value and a unit separated by a space (e.g. \"{} {}\"), got "
                     "\"{}\"",
-                    text.substr(0, pos), si_unit, text));
+                    text.substr(0, pos), hint_unit, text));
+  if (!std::isfinite(value)) node.Expected(fmt::format("a finite quantity, got \"{}\"", text));
+  return {value, text.substr(unit_begin)};
+}
+
+double ReadQuantity(const JsonNode& node, std::string_view si_unit) {
+  if (node.is_number()) return node.AsNumber();
+  const WrittenQuantity q = ReadWrittenQuantity(
+      node,
+      fmt::format("a number in {} or a string \"VALUE UNIT\" (e.g. \"1.5 {}\")", si_unit, si_unit),
+      si_unit);
+  const std::string text = node.AsString();
   double result = 0;
   try {
-    result = Convert(value, std::string_view(text).substr(unit_begin), si_unit);
+    result = Convert(q.value, q.unit, si_unit);
   } catch (const std::invalid_argument& e) {
     node.Fail(
         fmt::format("\"{}\": {}; expected a quantity convertible to {}", text, e.what(), si_unit));

@@ -7,6 +7,7 @@
 /// a unit of another dimension is rejected with an error naming the file, the JSON path, the
 /// unit given and the dimension expected.
 
+#include <string>
 #include <string_view>
 
 #include "gipsi/base/json_node.h"
@@ -21,6 +22,17 @@ double ReadQuantity(const JsonNode& node, std::string_view si_unit);
 /// As ReadQuantity, and the result must be > 0 (or >= 0 with `allow_zero`).
 double ReadPositiveQuantity(const JsonNode& node, std::string_view si_unit,
                             bool allow_zero = false);
+
+/// A quantity as written, not converted: a plain number (empty `unit`) or "VALUE UNIT".
+struct WrittenQuantity {
+  double value = 0;
+  std::string unit;
+};
+/// Reads `node` as a finite number or a "VALUE UNIT" string with a finite value (the unit is
+/// not checked). Throws InputError at the node otherwise: `expected` says what was expected,
+/// `hint_unit` is the unit shown in the example of a value without its unit.
+WrittenQuantity ReadWrittenQuantity(const JsonNode& node, std::string_view expected,
+                                    std::string_view hint_unit);
 
 /// Factor f such that a value in `unit` times f is in `si_unit`; throws std::invalid_argument if
 /// either does not parse or they are not convertible (used by tests and ReadQuantity).

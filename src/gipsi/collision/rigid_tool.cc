@@ -35,6 +35,7 @@ RigidTool::RigidTool(std::string name, const RigidToolSpec& spec, std::shared_pt
   surface_only.tets.resize(4, 0);
   BoundarySurface boundary = MakeBoundary(surface_only);
   SetGeometry(domain, std::move(boundary));
+  BindState(state_);
   using L = FieldLocation;
   using A = FieldAccess;
   f_position_ = DeclareField({"position", L::kNode, 3, "m", A::kRead, "current node position"});
@@ -51,7 +52,7 @@ RigidTool::RigidTool(std::string name, const RigidToolSpec& spec, std::shared_pt
                            "sum of the contact forces on the tool this macro step"});
   f_offset_ = DeclareField(
       {"offset", L::kGlobal, 3, "m", A::kRead, "translation of the tool from its rest placement"});
-  offset_ = OffsetAt(0);
+  state_.offset = OffsetAt(0);
   Place();
 }
 
@@ -66,12 +67,14 @@ Vec3 RigidTool::OffsetAt(double t) const {
   return (1 - w) * p[k - 1].second + w * p[k].second;
 }
 
-void RigidTool::Place() { positions_ = domain().nodes.colwise() + (spec_.position + offset_); }
+void RigidTool::Place() {
+  positions_ = domain().nodes.colwise() + (spec_.position + state_.offset);
+}
 
 StepStatus RigidTool::DoStep(double t, double dt) {
   const Vec3 next = OffsetAt(t + dt);
-  velocity_ = (next - offset_) / dt;
-  offset_ = next;
+  state_.velocity = (next - state_.offset) / dt;
+  state_.offset = next;
   Place();
   return StepStatus::Ok();
 }
@@ -87,7 +90,7 @@ void RigidTool::DoReadField(FieldId id, Eigen::Ref<Eigen::MatrixXd> out) const {
   if (id == f_position_) {
     out = positions_;
   } else if (id == f_velocity_) {
-    out.colwise() = velocity_;
+    out.colwise() = state_.velocity;
   } else if (id == f_displacement_) {
     out = positions_ - domain().nodes;
   } else if (id == f_bposition_ || id == f_bdisplacement_) {
@@ -98,11 +101,11 @@ void RigidTool::DoReadField(FieldId id, Eigen::Ref<Eigen::MatrixXd> out) const {
                                            : Vec3(positions_.col(n) - domain().nodes.col(n));
     }
   } else if (id == f_bvelocity_) {
-    out.colwise() = velocity_;
+    out.colwise() = state_.velocity;
   } else if (id == f_force_) {
     out.col(0) = ContactForce();
   } else if (id == f_offset_) {
-    out.col(0) = offset_;
+    out.col(0) = state_.offset;
   }
 }
 

@@ -37,6 +37,19 @@ struct RigidToolSpec {
   Vec3 velocity = Vec3::Zero();  ///< m/s, when there is no path
 };
 
+/// What a rigid tool carries from one step to the next (a state value type; the rest is the
+/// scene's motion law). Copyable.
+struct RigidToolState {
+  Vec3 offset = Vec3::Zero();    ///< translation from the rest placement [m]
+  Vec3 velocity = Vec3::Zero();  ///< [m/s]
+
+  template <class Self, class V>
+  static void Fields(Self& s, V& v) {
+    v("offset", s.offset);
+    v("velocity", s.velocity);
+  }
+};
+
 /// Not copyable or movable (a SimObject).
 class RigidTool final : public SimObject, public RigidCollider {
  public:
@@ -46,15 +59,13 @@ class RigidTool final : public SimObject, public RigidCollider {
 
   [[nodiscard]] std::string_view type_name() const override { return "RigidTool"; }
   [[nodiscard]] const Points& domain_positions() const override { return positions_; }
-  void SaveObjectState(StateWriter& out) const override;
-  void RestoreObjectState(StateReader& in) override;
   [[nodiscard]] const RigidToolSpec& spec() const { return spec_; }
   /// True for sphere and capsule tools (contacts use the exact primitive).
   [[nodiscard]] bool is_primitive() const { return spec_.shape != RigidToolSpec::Shape::kMesh; }
   /// Current axis segment of a primitive tool (equal points for a sphere) [m].
-  [[nodiscard]] Vec3 axis_start() const { return spec_.position + offset_; }
+  [[nodiscard]] Vec3 axis_start() const { return spec_.position + state_.offset; }
   [[nodiscard]] Vec3 axis_end() const {
-    return spec_.position + offset_ + Vec3(0, 0, spec_.length);
+    return spec_.position + state_.offset + Vec3(0, 0, spec_.length);
   }
   /// RigidCollider: the capsule of a sphere or capsule tool (none for a mesh tool), and its
   /// velocity.
@@ -62,10 +73,10 @@ class RigidTool final : public SimObject, public RigidCollider {
     if (!is_primitive()) return std::nullopt;
     return Capsule{axis_start(), axis_end(), spec_.radius};
   }
-  [[nodiscard]] Vec3 RigidVelocity() const override { return velocity_; }
+  [[nodiscard]] Vec3 RigidVelocity() const override { return state_.velocity; }
   /// Current translation from the rest placement [m] and velocity [m/s].
-  [[nodiscard]] const Vec3& offset() const { return offset_; }
-  [[nodiscard]] const Vec3& velocity() const { return velocity_; }
+  [[nodiscard]] const Vec3& offset() const { return state_.offset; }
+  [[nodiscard]] const Vec3& velocity() const { return state_.velocity; }
   /// Sum of the boundary forces on the tool [N]: what contact exerts on it this macro step.
   [[nodiscard]] Vec3 ContactForce() const;
   /// The prescribed offset at time t.
@@ -73,14 +84,15 @@ class RigidTool final : public SimObject, public RigidCollider {
 
  protected:
   StepStatus DoStep(double t, double dt) override;
+  /// After a checkpoint or snapshot restore: places the nodes.
+  void StateRestored() override { Place(); }
   void DoReadField(FieldId id, Eigen::Ref<Eigen::MatrixXd> out) const override;
   void DoWriteField(FieldId id, const Eigen::Ref<const Eigen::MatrixXd>& in) override;
 
  private:
   void Place();
   RigidToolSpec spec_;
-  Vec3 offset_ = Vec3::Zero();
-  Vec3 velocity_ = Vec3::Zero();
+  RigidToolState state_;  // checkpoints and step retries (BindState)
   Points positions_;
   FieldId f_position_, f_velocity_, f_displacement_;
   FieldId f_bposition_, f_bvelocity_, f_bdisplacement_, f_force_, f_offset_;

@@ -39,7 +39,7 @@ void Connector::RestoreState(StateReader& in) {
 namespace {
 
 /// What Connector::TakeSnapshot copies: the fire count and the type's own state.
-class ConnectorSnapshot final : public ObjectState {
+class ConnectorSnapshot final : public TypedState<ConnectorSnapshot> {
  public:
   ConnectorSnapshot(const Connector* connector, std::unique_ptr<ObjectState> own)
       : connector(connector), own(std::move(own)) {}
@@ -54,14 +54,6 @@ class ConnectorSnapshot final : public ObjectState {
     const ConnectorSnapshot& o = Of(other);
     if (fire_count != o.fire_count) return "fire count";
     return own->FirstDifference(*o.own);
-  }
-  static const ConnectorSnapshot& Of(const ObjectState& box) {
-    const auto* typed = dynamic_cast<const ConnectorSnapshot*>(&box);
-    GIPSI_CHECK(typed != nullptr, "not a connector snapshot");
-    return *typed;
-  }
-  static ConnectorSnapshot& Of(ObjectState& box) {
-    return const_cast<ConnectorSnapshot&>(Of(static_cast<const ObjectState&>(box)));
   }
 
   const Connector* connector;

@@ -24,7 +24,8 @@ SimObject& Coordinator::AddObject(std::unique_ptr<SimObject> object, double dt) 
   for (const auto& slot : objects_)
     if (slot.object->name() == object->name())
       throw InputError(fmt::format("duplicate object name '{}'", object->name()));
-  objects_.push_back({std::move(object), dt, 1});
+  const auto* paced = dynamic_cast<const WallClockPaced*>(object.get());
+  objects_.push_back({std::move(object), dt, 1, 0.0, paced});
   return *objects_.back().object;
 }
 
@@ -107,6 +108,7 @@ void Coordinator::BeginMacroStep() {
 }
 
 void Coordinator::SetStopToken(StopToken token) {
+  stop_ = token;
   for (auto& slot : objects_) slot.object->SetStopToken(token);
 }
 
@@ -128,6 +130,8 @@ std::optional<ScheduleFailure> Coordinator::MacroStep(double t, std::int64_t mac
       const double dt = macro_dt / slot.substeps;
       const auto start = Clock::now();
       for (int k = 0; k < slot.substeps; ++k) {
+        if (slot.paced != nullptr)
+          WaitForWallClock(*slot.paced, slot.object->time(), slot.object->time() + dt, stop_);
         StepStatus status = slot.object->Step(dt);
         if (!status.ok()) {
           slot.seconds += std::chrono::duration<double>(Clock::now() - start).count();

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "gipsi/core/connector.h"
+#include "gipsi/core/pacing.h"
 #include "gipsi/core/sim_object.h"
 
 namespace gipsi {
@@ -56,13 +57,16 @@ class Coordinator {
   [[nodiscard]] double macro_dt() const { return macro_dt_; }
 
   /// Runs one macro step from time t: for each entry in order, sub-steps an object
-  /// `substeps` times or fires a due connector. Stops at the first failure. Never throws.
+  /// `substeps` times or fires a due connector. Stops at the first failure. Never throws. An
+  /// object that is WallClockPaced (gipsi/core/pacing.h) is never stepped past the wall clock:
+  /// the coordinator waits before its sub-step until the wall clock reaches the sub-step's end.
   /// `split` > 1 makes it a 1/split fraction of a macro step (every object's sub-step divided
   /// by split; connectors fire as in the full step): the kernel's retry after a failure.
   std::optional<ScheduleFailure> MacroStep(double t, std::int64_t macro_index, int split = 1);
   /// Forwards `BeginMacroStep` to every object.
   void BeginMacroStep();
-  /// Hands `token` to every object (SimObject::SetStopToken).
+  /// Hands `token` to every object (SimObject::SetStopToken); a stop request also ends a wait
+  /// for the wall clock.
   void SetStopToken(StopToken token);
 
   /// Snapshots of every object and connector (a CompositeState, gipsi/base/object_state.h):
@@ -94,6 +98,7 @@ class Coordinator {
     double dt = 0;
     int substeps = 1;
     double seconds = 0;
+    const WallClockPaced* paced = nullptr;  // the object, if it runs on the wall clock
   };
   struct ConnectorSlot {
     std::unique_ptr<Connector> connector;
@@ -117,6 +122,7 @@ class Coordinator {
   bool has_order_ = false;
   std::string order_where_;
   double macro_dt_ = 0;
+  StopToken stop_;
 };
 
 }  // namespace gipsi

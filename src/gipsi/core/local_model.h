@@ -2,7 +2,7 @@
 /// @file
 /// The local model an object provides for haptics (the GiPSi paper's multi-rate haptics):
 /// the model's data, its discretisation and the `LocalModelBuilder` interface an object type
-/// implements and registers (TypeRegistry::local_models, beside the type's own registration).
+/// implements and registers (`LocalModels(registry)`, beside the type's own registration).
 /// The haptic side that steps these models is gipsi/haptics/local_model.h.
 ///
 /// Local dynamic models for multi-rate haptics (Çavuşoğlu & Tendick, ICRA 2000): a low-order
@@ -34,9 +34,12 @@
 /// device's own damping above k h / 2).
 
 #include <cstdint>
+#include <functional>
+#include <memory>
 #include <vector>
 
 #include "gipsi/base/math.h"
+#include "gipsi/core/registry.h"
 
 namespace gipsi {
 
@@ -108,6 +111,22 @@ class LocalModelBuilder {
   virtual bool Build(Index vertex, const Vec3& normal, double anchor_force, double period,
                      LocalDynamicModel& out) = 0;
 };
+
+/// Builds the haptic local-model builder of an object of the type it is registered under;
+/// `rings` is the HapticCoupling's neighbourhood size (0-5), for builders that use one. May
+/// throw InputError (e.g. an object without a boundary).
+using LocalModelFactory =
+    std::function<std::unique_ptr<LocalModelBuilder>(SimObject& object, int rings)>;
+
+/// The haptic local models, keyed by the object type (SimObject::type_name()) they describe: a
+/// HapticCoupling can render any object whose type has one. A model type registers its own
+/// beside its object factory (plugins too).
+inline FactoryTable<LocalModelFactory>& LocalModels(TypeRegistry& registry) {
+  return registry.Table<LocalModelFactory>("haptic local model");
+}
+inline const FactoryTable<LocalModelFactory>& LocalModels(const TypeRegistry& registry) {
+  return registry.Table<LocalModelFactory>("haptic local model");
+}
 
 /// Per domain node of `object`: 1 if any axis of its boundary vertex is constrained (such nodes
 /// are held fixed in local models), else 0.

@@ -61,41 +61,27 @@ std::pair<SimObject*, FieldId> ConnectorBuildContext::ObjectField(std::string_vi
   }
 }
 
-template <class Factory>
-void FactoryTable<Factory>::Register(const std::string& name, Factory factory,
-                                     std::string description) {
-  GIPSI_CHECK(!name.empty() && factory, "empty {} registration", kind_);
-  GIPSI_CHECK(!Contains(name), "{} '{}' registered twice", kind_, name);
-  table_.emplace(name, Entry{std::move(factory), std::move(description)});
-}
-
-template <class Factory>
-const Factory& FactoryTable<Factory>::Get(std::string_view name, const JsonNode& where) const {
-  auto it = table_.find(name);
-  if (it != table_.end()) return it->second.factory;
-  std::vector<std::string> names;
+void FailUnknown(std::string_view kind, std::string_view name,
+                 const std::vector<std::string>& known, const JsonNode& where) {
   std::string list;
-  for (const auto& [n, e] : table_) {
-    names.push_back(n);
-    list += (list.empty() ? "" : ", ") + n;
-  }
+  for (const std::string& n : known) list += (list.empty() ? "" : ", ") + n;
+  if (list.empty()) list = "none";
   where.Fail(
-      fmt::format("unknown {} '{}'{}; known: {}", kind_, name, SuggestClosest(name, names), list));
+      fmt::format("unknown {} '{}'{}; known: {}", kind, name, SuggestClosest(name, known), list));
 }
 
-template <class Factory>
-std::vector<std::pair<std::string, std::string>> FactoryTable<Factory>::List() const {
-  std::vector<std::pair<std::string, std::string>> out;
-  for (const auto& [n, e] : table_) out.emplace_back(n, e.description);
+std::vector<std::string> TypeRegistry::TableKinds() const {
+  std::vector<std::string> out;
+  for (const auto& [kind, table] : tables_) out.push_back(kind);
   return out;
 }
 
-template class FactoryTable<ObjectFactory>;
-template class FactoryTable<ConnectorFactory>;
-template class FactoryTable<IntegratorFactory>;
-template class FactoryTable<MaterialFactory>;
-template class FactoryTable<CellModelFactory>;
-template class FactoryTable<LocalModelFactory>;
+std::vector<std::pair<std::string, std::string>> TypeRegistry::ListTable(
+    std::string_view kind) const {
+  auto it = tables_.find(kind);
+  GIPSI_CHECK(it != tables_.end(), "no {} table", kind);
+  return it->second.list();
+}
 
 std::unique_ptr<SimObject> TypeRegistry::CreateObject(const std::string& name,
                                                       const JsonNode& params,

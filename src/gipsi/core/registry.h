@@ -9,8 +9,10 @@
 #include <memory>
 #include <string>
 #include <string_view>
+#include <typeindex>
 #include <vector>
 
+#include "gipsi/base/error.h"
 #include "gipsi/base/json_node.h"
 #include "gipsi/core/connector.h"
 #include "gipsi/core/material.h"
@@ -21,15 +23,15 @@
 /// 2: checkpoint hooks; 3: haptic local models by type; 4: SimObject's stop token, local models
 /// in core; 5: cavities through the CavityWall capability, not a SimObject virtual; 6: snapshot
 /// hooks (NewObjectState, CopyObjectState, SetObjectState) on SimObject and Connector; 7:
-/// connector ports (Connector::UseField, …, RequireOrder; gipsi/core/port.h).
-#define GIPSI_PLUGIN_ABI_VERSION 7
+/// connector ports (Connector::UseField, …, RequireOrder; gipsi/core/port.h); 8: cell models
+/// and local models in tables a layer above declares (TypeRegistry::Table; CellModels,
+/// LocalModels).
+#define GIPSI_PLUGIN_ABI_VERSION 8
 
 namespace gipsi {
 
 class TypeRegistry;
 class Coordinator;
-class CellModel;
-class LocalModelBuilder;
 
 /// Looks up meshes declared in the scene by name (implemented by the scene loader).
 class MeshProvider {
@@ -89,27 +91,36 @@ using ConnectorFactory = std::function<std::unique_ptr<Connector>(const Connecto
 using IntegratorFactory = std::function<std::unique_ptr<ExplicitIntegrator>()>;
 /// Builds a material from its JSON object (the "law" key is already consumed).
 using MaterialFactory = std::function<std::shared_ptr<const Material>(const JsonNode&)>;
-/// Builds a cardiac cell model from its JSON object ({"model": name, ...parameters}; see
-/// gipsi/models/ep/cell_models.h); throws InputError naming the JSON path of a bad parameter.
-using CellModelFactory = std::function<std::shared_ptr<const CellModel>(const JsonNode& params)>;
-/// Builds the haptic local-model builder (gipsi/core/local_model.h) of an object of
-/// the type it is registered under; `rings` is the HapticCoupling's neighbourhood size (0-5),
-/// for builders that use one. May throw InputError (e.g. an object without a boundary).
-using LocalModelFactory =
-    std::function<std::unique_ptr<LocalModelBuilder>(SimObject& object, int rings)>;
-
 /// Factories by type name, for one kind of product. Not copyable; movable.
 template <class Factory>
 class FactoryTable {
  public:
   explicit FactoryTable(std::string kind) : kind_(std::move(kind)) {}
   /// Registers `factory` under `name`; aborts (programmer error) on a duplicate name.
-  void Register(const std::string& name, Factory factory, std::string description);
+  void Register(const std::string& name, Factory factory, std::string description) {
+    GIPSI_CHECK(!name.empty() && factory, "empty {} registration", kind_);
+    GIPSI_CHECK(!Contains(name), "{} '{}' registered twice", kind_, name);
+    table_.emplace(name, Entry{std::move(factory), std::move(description)});
+  }
   [[nodiscard]] bool Contains(std::string_view name) const { return table_.count(name) > 0; }
   /// The factory for `name`; throws InputError at `where` listing the known names.
-  [[nodiscard]] const Factory& Get(std::string_view name, const JsonNode& where) const;
+  [[nodiscard]] const Factory& Get(std::string_view name, const JsonNode& where) const {
+    auto it = table_.find(name);
+    if (it == table_.end()) FailUnknown(kind_, name, Names(), where);
+    return it->second.factory;
+  }
   /// (name, description) of every registered type, sorted by name.
-  [[nodiscard]] std::vector<std::pair<std::string, std::string>> List() const;
+  [[nodiscard]] std::vector<std::pair<std::string, std::string>> List() const {
+    std::vector<std::pair<std::string, std::string>> out;
+    for (const auto& [n, e] : table_) out.emplace_back(n, e.description);
+    return out;
+  }
+  /// The registered names, sorted.
+  [[nodiscard]] std::vector<std::string> Names() const {
+    std::vector<std::string> out;
+    for (const auto& [n, e] : table_) out.push_back(n);
+    return out;
+  }
 
  private:
   struct Entry {
@@ -119,6 +130,10 @@ class FactoryTable {
   std::string kind_;
   std::map<std::string, Entry, std::less<>> table_;
 };
+
+/// Throws InputError at `where`: "unknown KIND 'NAME' (did you mean …); known: …".
+[[noreturn]] void FailUnknown(std::string_view kind, std::string_view name,
+                              const std::vector<std::string>& known, const JsonNode& where);
 
 /// All factories. Create one, call `RegisterBuiltins`, optionally `LoadPlugin`, and pass it to
 /// the scene loader. Plugins stay loaded for the registry's lifetime and beyond (never unloaded,
@@ -133,10 +148,25 @@ class TypeRegistry {
   FactoryTable<ConnectorFactory> connectors{"connector type"};
   FactoryTable<IntegratorFactory> integrators{"integrator"};
   FactoryTable<MaterialFactory> materials{"material law"};
-  FactoryTable<CellModelFactory> cell_models{"cell model"};
-  /// Haptic local models, keyed by the object type (SimObject::type_name()) they describe: a
-  /// HapticCoupling can render any object whose type has one (plugins register their own).
-  FactoryTable<LocalModelFactory> local_models{"haptic local model"};
+
+  /// The table of another kind of product, which the layer that defines the product declares
+  /// (the kernel names no model concept): e.g. `CellModels(registry)` in
+  /// gipsi/models/ep/cell_models.h is `registry.Table<CellModelFactory>("cell model")`. The
+  /// table is created empty on first use; a kind is always used with the same factory type
+  /// (checked). Not thread-safe: register and look up while the scene is built.
+  template <class Factory>
+  [[nodiscard]] FactoryTable<Factory>& Table(const std::string& kind) {
+    return FindTable<Factory>(kind);
+  }
+  template <class Factory>
+  [[nodiscard]] const FactoryTable<Factory>& Table(const std::string& kind) const {
+    return FindTable<Factory>(kind);
+  }
+  /// The kinds of the tables created by Table, sorted.
+  [[nodiscard]] std::vector<std::string> TableKinds() const;
+  /// (name, description) of every product in the table of `kind` (one of TableKinds()).
+  [[nodiscard]] std::vector<std::pair<std::string, std::string>> ListTable(
+      std::string_view kind) const;
 
   /// Builds the object described by `params` (its "type" picks the factory).
   [[nodiscard]] std::unique_ptr<SimObject> CreateObject(const std::string& name,
@@ -170,7 +200,26 @@ class TypeRegistry {
   [[nodiscard]] const std::vector<std::string>& loaded_plugins() const { return plugins_; }
 
  private:
+  struct AnyTable {
+    std::type_index type;
+    std::shared_ptr<void> table;
+    std::function<std::vector<std::pair<std::string, std::string>>()> list;
+  };
+  template <class Factory>
+  FactoryTable<Factory>& FindTable(const std::string& kind) const {
+    auto it = tables_.find(kind);
+    if (it == tables_.end()) {
+      auto table = std::make_shared<FactoryTable<Factory>>(kind);
+      auto list = [t = table.get()] { return t->List(); };
+      it = tables_.emplace(kind, AnyTable{typeid(Factory), table, list}).first;
+    }
+    GIPSI_CHECK(it->second.type == std::type_index(typeid(Factory)),
+                "the {} table is used with two factory types", kind);
+    return *static_cast<FactoryTable<Factory>*>(it->second.table.get());
+  }
+
   std::vector<std::string> plugins_;
+  mutable std::map<std::string, AnyTable, std::less<>> tables_;
 };
 
 /// Registers the explicit integrators ("ExplicitEuler", "SymplecticEuler", "RK4").

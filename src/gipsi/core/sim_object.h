@@ -11,6 +11,8 @@
 #include <vector>
 
 #include "gipsi/base/math.h"
+#include "gipsi/base/object_state.h"
+#include "gipsi/base/state_value.h"
 #include "gipsi/base/stop_token.h"
 #include "gipsi/core/boundary_conditions.h"
 #include "gipsi/core/cavity_law.h"
@@ -21,10 +23,6 @@
 #include "gipsi/geometry/mesh.h"
 
 namespace gipsi {
-
-class ObjectState;
-class StateReader;
-class StateWriter;
 
 /// What an object is drawn with: a triangle surface whose vertices follow the domain through a
 /// mapping (barycentric embedding of a finer or coarser surface), or the boundary itself.
@@ -140,7 +138,8 @@ class SimObject {
   void RestoreState(StateReader& in);
   /// Everything of the subclass that influences the future (state, integrator history, event
   /// logs), and the solver caches a bitwise continuation needs (a kept factorisation). The
-  /// defaults throw InputError("object type X does not support checkpoints").
+  /// defaults write and read the state bound by BindState, and throw InputError("object type X
+  /// does not support checkpoints") for a type that bound none.
   virtual void SaveObjectState(StateWriter& out) const;
   virtual void RestoreObjectState(StateReader& in);
 
@@ -184,10 +183,26 @@ class SimObject {
                               const double* velocities, Eigen::Ref<Eigen::MatrixXd> out) const;
 
   virtual StepStatus DoStep(double t, double dt) = 0;
+
+  /// Declares the object's state value type (gipsi/base/state_value.h): `state`, a member whose
+  /// static `Fields` lists everything that evolves, is then what checkpoints save and restore
+  /// (WriteFields / ReadFields) and what step retries copy (a StateBox<S>), with no further
+  /// hook to write. Call once, from the constructor. After a restore, StateRestored() rebuilds
+  /// what derives from the state. A type that saves more than one value (a solver's kept
+  /// factorisation) overrides the hooks below instead.
+  template <class S>
+  void BindState(S& state) {
+    GIPSI_CHECK(state_binding_ == nullptr, "object '{}': BindState called twice", name_);
+    state_binding_ = std::make_unique<BoundState<S>>(state);
+  }
+  /// Called after the state bound by BindState was replaced (a checkpoint or a snapshot
+  /// restored): rebuild what derives from it. Default: nothing.
+  virtual void StateRestored() {}
+
   /// Hooks of the snapshots: a box for the type's state, copying into it, and restoring from
-  /// it (then rebuilding what derives from the state). The defaults serialise through
-  /// SaveObjectState / RestoreObjectState into a ByteState; a type with a state value type `S`
-  /// returns a StateBox<S> and copies values.
+  /// it (then rebuilding what derives from the state). The defaults copy the state bound by
+  /// BindState, else serialise through SaveObjectState / RestoreObjectState into a ByteState;
+  /// a type with its own state value type `S` returns a StateBox<S> and copies values.
   [[nodiscard]] virtual std::unique_ptr<ObjectState> NewObjectState() const;
   virtual void CopyObjectState(ObjectState& into) const;
   virtual void SetObjectState(const ObjectState& from);
@@ -197,7 +212,34 @@ class SimObject {
   virtual void DoWriteField(FieldId id, const Eigen::Ref<const Eigen::MatrixXd>& in) = 0;
 
  private:
+  /// The state bound by BindState, behind a type-free interface.
+  class StateBinding {
+   public:
+    virtual ~StateBinding() = default;
+    [[nodiscard]] virtual std::unique_ptr<ObjectState> New() const = 0;
+    virtual void Copy(ObjectState& into) const = 0;
+    virtual void Set(const ObjectState& from) = 0;
+    virtual void Write(StateWriter& out) const = 0;
+    virtual void Read(StateReader& in) = 0;
+  };
+  template <class S>
+  class BoundState final : public StateBinding {
+   public:
+    explicit BoundState(S& state) : state_(state) {}
+    [[nodiscard]] std::unique_ptr<ObjectState> New() const override {
+      return std::make_unique<StateBox<S>>(state_);
+    }
+    void Copy(ObjectState& into) const override { CopyFields(StateBox<S>::Of(into).value, state_); }
+    void Set(const ObjectState& from) override { CopyFields(state_, StateBox<S>::Of(from).value); }
+    void Write(StateWriter& out) const override { WriteFields(out, state_); }
+    void Read(StateReader& in) override { ReadFields(in, state_); }
+
+   private:
+    S& state_;
+  };
+
   std::string name_;
+  std::unique_ptr<StateBinding> state_binding_;
   std::shared_ptr<const Mesh> domain_;
   BoundarySurface boundary_;
   mutable DisplayGeometry display_;  // positions are a cache of the state

@@ -47,7 +47,7 @@ namespace {
 
 /// What SimObject::TakeSnapshot copies: the clock, the step count, the applied boundary
 /// conditions (only when their stamp changed) and the type's own state.
-class SimObjectSnapshot final : public ObjectState {
+class SimObjectSnapshot final : public TypedState<SimObjectSnapshot> {
  public:
   SimObjectSnapshot(const SimObject* object, std::unique_ptr<ObjectState> own)
       : object(object), own(std::move(own)) {}
@@ -67,14 +67,6 @@ class SimObjectSnapshot final : public ObjectState {
     std::string d = gipsi::FirstDifference(bcs, o.bcs);
     if (!d.empty()) return "boundary conditions: " + d;
     return own->FirstDifference(*o.own);
-  }
-  static const SimObjectSnapshot& Of(const ObjectState& box) {
-    const auto* typed = dynamic_cast<const SimObjectSnapshot*>(&box);
-    GIPSI_CHECK(typed != nullptr, "not an object snapshot");
-    return *typed;
-  }
-  static SimObjectSnapshot& Of(ObjectState& box) {
-    return const_cast<SimObjectSnapshot&>(Of(static_cast<const ObjectState&>(box)));
   }
 
   const SimObject* object;
@@ -111,10 +103,15 @@ void SimObject::RestoreSnapshot(const ObjectState& from) {
 }
 
 std::unique_ptr<ObjectState> SimObject::NewObjectState() const {
+  if (state_binding_) return state_binding_->New();
   return std::make_unique<ByteState>();
 }
 
 void SimObject::CopyObjectState(ObjectState& into) const {
+  if (state_binding_) {
+    state_binding_->Copy(into);
+    return;
+  }
   StateWriter out;
   out.BeginSection(type_name(), 1);
   SaveObjectState(out);
@@ -123,18 +120,32 @@ void SimObject::CopyObjectState(ObjectState& into) const {
 }
 
 void SimObject::SetObjectState(const ObjectState& from) {
+  if (state_binding_) {
+    state_binding_->Set(from);
+    StateRestored();
+    return;
+  }
   StateReader in(ByteState::Of(from).bytes, fmt::format("the snapshot of object '{}'", name_));
   in.BeginSection(type_name(), 1);
   RestoreObjectState(in);
   in.EndSection();
 }
 
-void SimObject::SaveObjectState(StateWriter& /*out*/) const {
+void SimObject::SaveObjectState(StateWriter& out) const {
+  if (state_binding_) {
+    state_binding_->Write(out);
+    return;
+  }
   throw InputError(
       fmt::format("object '{}': object type {} does not support checkpoints", name_, type_name()));
 }
 
-void SimObject::RestoreObjectState(StateReader& /*in*/) {
+void SimObject::RestoreObjectState(StateReader& in) {
+  if (state_binding_) {
+    state_binding_->Read(in);
+    StateRestored();
+    return;
+  }
   throw InputError(
       fmt::format("object '{}': object type {} does not support checkpoints", name_, type_name()));
 }

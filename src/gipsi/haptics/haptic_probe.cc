@@ -2,14 +2,13 @@
 
 #include <sched.h>
 
-#include <chrono>
 #include <cmath>
-#include <thread>
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
 #include "gipsi/base/error.h"
+#include "gipsi/core/local_model.h"
 #include "gipsi/haptics/igtl_surface_sender.h"
 
 namespace gipsi {
@@ -106,14 +105,13 @@ void HapticProbe::Attach(LatestValue<LocalDynamicModel>& models,
       std::make_unique<LocalModelTick>(*device_, spec_.workspace, models, &feedback, spec_.tick);
 }
 
-StepStatus HapticProbe::StepRealtime(double t, double dt) {
+StepStatus HapticProbe::StepRealtime() {
   if (!loop_running())
     return StepStatus::Failed(
         "the probe is real-time (\"realtime\") but its haptic loop is not running: run the scene "
         "with gipsi run or gipsi view (a program starts the loop with RealtimeHaptics)");
-  // Never ahead of the wall clock: the device, the models' age and the watchdog live on it.
-  const double ahead = (t + dt) - HapticTime(t);
-  if (ahead > 0) std::this_thread::sleep_for(std::chrono::duration<double>(ahead));
+  // Never ahead of the wall clock (the device, the models' age and the watchdog live on it):
+  // the coordinator waited for it before this step (WallClockPaced).
   if (samples_->Fetch()) {
     const Sample& s = samples_->front();
     force_ = s.force;
@@ -126,7 +124,7 @@ StepStatus HapticProbe::StepRealtime(double t, double dt) {
 }
 
 StepStatus HapticProbe::DoStep(double t, double dt) {
-  if (loop_) return StepRealtime(t, dt);
+  if (loop_) return StepRealtime();
   const int n = std::max(1, static_cast<int>(std::lround(dt * spec_.rate)));
   const double h = dt / n;
   for (int k = 1; k <= n; ++k) {
@@ -302,17 +300,14 @@ void RegisterHaptics(TypeRegistry& registry) {
         const std::int64_t rings = p.Int("rings", 1);
         if (rings < 0 || rings > 5) p.At("rings").Expected("an integer in [0, 5]");
         const std::string type(object.type_name());
-        if (!ctx.registry.local_models.Contains(type)) {
-          std::vector<std::string> known;
-          for (const auto& entry : ctx.registry.local_models.List()) known.push_back(entry.first);
+        if (!LocalModels(ctx.registry).Contains(type))
           p.At("object").Fail(fmt::format(
               "object '{}' is a {}, which has no haptic local model (types with one: {})",
-              object.name(), type, fmt::join(known, ", ")));
-        }
+              object.name(), type, fmt::join(LocalModels(ctx.registry).Names(), ", ")));
         try {
           return std::make_unique<HapticCoupling>(
               ctx.name,
-              ctx.registry.local_models.Get(type, p.At("object"))(object, static_cast<int>(rings)),
+              LocalModels(ctx.registry).Get(type, p.At("object"))(object, static_cast<int>(rings)),
               *probe, params);
         } catch (const InputError& e) {
           p.Fail(e.what());

@@ -31,10 +31,12 @@
 ///   "haptics": {"type": "HapticCoupling", "object": "liver", "device": "probe",
 ///               "capture_distance": 0.01, "rings": 1}
 
+#include <limits>
 #include <memory>
 #include <optional>
 
 #include "gipsi/core/connector.h"
+#include "gipsi/core/pacing.h"
 #include "gipsi/core/registry.h"
 #include "gipsi/core/sim_object.h"
 
@@ -62,7 +64,7 @@ struct HapticProbeSpec {
 };
 
 /// Not copyable or movable (a SimObject).
-class HapticProbe final : public SimObject {
+class HapticProbe final : public SimObject, public WallClockPaced {
  public:
   /// Throws InputError for an empty or non-increasing path, a rate outside (0, 10 kHz] or an
   /// OpenIGTLink device that cannot connect (IgtlDevice's constructor).
@@ -100,6 +102,11 @@ class HapticProbe final : public SimObject {
   /// probe; for a real-time one with its loop running, the simulation time the loop started at
   /// plus the wall-clock seconds since (models are stamped with it, so their age is real).
   [[nodiscard]] double HapticTime(double sim_time) const;
+  /// The haptic clock (HapticTime) while the real-time loop runs: the probe is never stepped
+  /// past it, the coordinator waits for it (gipsi/core/pacing.h). +infinity otherwise.
+  [[nodiscard]] double WallClockTime(double sim_time) const override {
+    return loop_running() ? HapticTime(sim_time) : std::numeric_limits<double>::infinity();
+  }
   /// The renderer the real-time loop ticks (null for a synchronous probe). Exposed so a test
   /// can tick it on its own thread while the loop is stopped (e.g. under an allocation guard).
   [[nodiscard]] HapticRenderer* loop_renderer();
@@ -124,7 +131,8 @@ class HapticProbe final : public SimObject {
     double model_force = 0;
     std::int64_t ticks = 0;
   };
-  StepStatus StepRealtime(double t, double dt);
+  /// The step of a real-time probe: reads the loop's newest sample.
+  StepStatus StepRealtime();
 
   HapticProbeSpec spec_;
   std::unique_ptr<HapticDevice> device_;
@@ -148,9 +156,9 @@ class HapticProbe final : public SimObject {
 /// Not copyable or movable (a Connector).
 class HapticCoupling final : public Connector {
  public:
-  /// Renders the local models `builder` makes of its object (see TypeRegistry::local_models):
-  /// attaches `probe` to the bridge and publishes a first model at the object's current state.
-  /// Throws InputError if the object has no boundary surface.
+  /// Renders the local models `builder` makes of its object (see LocalModels,
+  /// gipsi/core/local_model.h): attaches `probe` to the bridge and publishes a first model at the
+  /// object's current state. Throws InputError if the object has no boundary surface.
   HapticCoupling(std::string name, std::unique_ptr<LocalModelBuilder> builder, HapticProbe& probe,
                  const HapticBridgeParams& params);
   [[nodiscard]] std::string_view type_name() const override { return "HapticCoupling"; }

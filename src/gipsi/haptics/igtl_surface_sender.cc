@@ -30,12 +30,15 @@ IgtlSurfaceSender::IgtlSurfaceSender(std::string name, const SimObject& object, 
                                      double rate, std::string surface_name)
     : Connector(std::move(name)),
       object_(object),
+      field_(object.FindField("boundary_position")),
       device_(device),
       period_(1.0 / rate),
       surface_name_(std::move(surface_name)) {
   GIPSI_CHECK(rate > 0, "IgtlSurfaceSender: rate must be positive");
   if (object.boundary().num_vertices() == 0)
     throw InputError(fmt::format("object '{}' has no boundary surface", object.name()));
+  UseField("object", object, "boundary_position", FieldAccess::kRead, "m", 3);
+  positions_.resize(3, object.boundary().num_vertices());
 }
 
 StepStatus IgtlSurfaceSender::DoFire(double t) {
@@ -43,7 +46,7 @@ StepStatus IgtlSurfaceSender::DoFire(double t) {
   // firing rate sends at every firing.
   if (t + 1e-9 * period_ < next_) return StepStatus::Ok();
   next_ = next_ + period_ > t ? next_ + period_ : t + period_;
-  object_.boundary().Gather(object_.domain_positions(), positions_);
+  object_.ReadField(field_, positions_);
   device_.SendSurface(positions_, object_.boundary().triangles, surface_name_);
   ++queued_;
   return StepStatus::Ok();

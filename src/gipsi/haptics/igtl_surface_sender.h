@@ -27,8 +27,9 @@ IgtlDeviceParams ParseIgtlDevice(const JsonNode& node);
 class IgtlSurfaceSender final : public Connector {
  public:
   /// Sends `object`'s boundary surface through `device` as POLYDATA named `surface_name`, at
-  /// most `rate` [Hz of simulation time] (> 0) times per second. Throws InputError if the
-  /// object has no boundary surface.
+  /// most `rate` [Hz of simulation time] (> 0) times per second. Its port: it reads the
+  /// object's "boundary_position" field (3 by boundary vertices, m). Throws InputError if the
+  /// object has no boundary surface or no such field.
   IgtlSurfaceSender(std::string name, const SimObject& object, IgtlDevice& device, double rate,
                     std::string surface_name);
   [[nodiscard]] std::string_view type_name() const override { return "OpenIGTLinkSurface"; }
@@ -36,12 +37,13 @@ class IgtlSurfaceSender final : public Connector {
   [[nodiscard]] std::int64_t num_queued() const { return queued_; }
 
  protected:
-  /// Gathers the boundary positions and queues them when a send is due. Allocation-free after
+  /// Reads the boundary positions and queues them when a send is due. Allocation-free after
   /// the first firing on this side (the device copies into its own buffers).
   StepStatus DoFire(double t) override;
 
  private:
   const SimObject& object_;
+  FieldId field_;  // the object's boundary_position
   IgtlDevice& device_;
   double period_;
   std::string surface_name_;

@@ -43,7 +43,7 @@ TEST(CellModelRegistry, RegistersTheFiveBuiltInModels) {
   TypeRegistry registry;
   RegisterCellModels(registry);
   std::vector<std::string> names;
-  for (const auto& [name, description] : registry.cell_models.List()) {
+  for (const auto& [name, description] : CellModels(registry).List()) {
     names.push_back(name);
     EXPECT_FALSE(description.empty()) << name;
   }

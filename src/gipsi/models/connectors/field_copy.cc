@@ -120,28 +120,13 @@ void RegisterFieldCopy(TypeRegistry& registry) {
                                          : Mapping::kAuto;
         }
         // "scale": a number (dimensionless) or "VALUE UNIT".
-        double scale = 1.0;
-        std::string scale_units;
-        if (auto node = ctx.params.Find("scale")) {
-          if (node->is_number()) {
-            scale = node->AsNumber();
-          } else {
-            const std::string text = node->is_string() ? node->AsString() : std::string();
-            std::size_t end = 0;
-            try {
-              scale = std::stod(text, &end);
-            } catch (const std::exception&) {
-              end = 0;
-            }
-            const std::size_t unit = text.find_first_not_of(' ', end);
-            if (end == 0 || unit == std::string::npos || unit == end || !std::isfinite(scale))
-              node->Expected("a number, or a string \"VALUE UNIT\" (e.g. \"2 kPa/mV\")");
-            scale_units = text.substr(unit);
-          }
-        }
+        WrittenQuantity scale{1.0, {}};
+        if (auto node = ctx.params.Find("scale"))
+          scale = ReadWrittenQuantity(
+              *node, "a number, or a string \"VALUE UNIT\" (e.g. \"2 kPa/mV\")", "kPa/mV");
         try {
           return std::make_unique<FieldCopy>(ctx.name, *from, from_field, *to, to_field, mapping,
-                                             scale, scale_units);
+                                             scale.value, scale.unit);
         } catch (const InputError& e) {
           ctx.params.Fail(e.what());
         }

@@ -7,17 +7,17 @@
 namespace gipsi {
 
 void RegisterCellModels(TypeRegistry& registry) {
-  registry.cell_models.Register("AlievPanfilov", &AlievPanfilov::FromJson,
+  CellModels(registry).Register("AlievPanfilov", &AlievPanfilov::FromJson,
                                 "two-variable phenomenological ventricular model (1996)");
-  registry.cell_models.Register("MitchellSchaeffer", &MitchellSchaeffer::FromJson,
+  CellModels(registry).Register("MitchellSchaeffer", &MitchellSchaeffer::FromJson,
                                 "two-current phenomenological model with one gate (2003)");
-  registry.cell_models.Register(
+  CellModels(registry).Register(
       "FitzHughNagumo", [](const JsonNode& node) { return FitzHughNagumo::FromJson(node, true); },
       "cubic excitation with linear recovery (Rogers-McCulloch form)");
-  registry.cell_models.Register(
+  CellModels(registry).Register(
       "Nagumo", [](const JsonNode& node) { return FitzHughNagumo::FromJson(node, false); },
       "bistable cubic u' = k u (1 - u)(u - a), no recovery");
-  registry.cell_models.Register("TenTusscherPanfilov2006", &TenTusscherPanfilov2006::FromJson,
+  CellModels(registry).Register("TenTusscherPanfilov2006", &TenTusscherPanfilov2006::FromJson,
                                 "human ventricular ionic model, variants epi, endo, M (2006)");
 }
 
@@ -25,7 +25,7 @@ std::shared_ptr<const CellModel> CreateCellModel(const TypeRegistry& registry,
                                                  const JsonNode& node) {
   if (!node.is_object()) node.Expected("an object with a \"model\" key");
   const JsonNode name = node.At("model");
-  auto model = registry.cell_models.Get(name.AsString(), name)(node);
+  auto model = CellModels(registry).Get(name.AsString(), name)(node);
   GIPSI_CHECK(model != nullptr, "factory for '{}' returned null", name.AsString());
   return model;
 }

@@ -6,8 +6,9 @@
 ///   {"model": "TenTusscherPanfilov2006", "variant": "endo", "g_ks": 0.3}
 ///   {"model": "AlievPanfilov", "k": 8, "a": 0.15}
 ///
-/// Third parties add models with `registry.cell_models.Register(name, factory, description)`.
+/// Third parties add models with `CellModels(registry).Register(name, factory, description)`.
 
+#include <functional>
 #include <memory>
 
 #include "gipsi/base/json_node.h"
@@ -15,6 +16,18 @@
 #include "gipsi/models/ep/cell_model.h"
 
 namespace gipsi {
+
+/// Builds a cardiac cell model from its JSON object ({"model": name, ...parameters}); throws
+/// InputError naming the JSON path of a bad parameter.
+using CellModelFactory = std::function<std::shared_ptr<const CellModel>(const JsonNode& params)>;
+
+/// The cell models by name ("cell model" table of the registry).
+inline FactoryTable<CellModelFactory>& CellModels(TypeRegistry& registry) {
+  return registry.Table<CellModelFactory>("cell model");
+}
+inline const FactoryTable<CellModelFactory>& CellModels(const TypeRegistry& registry) {
+  return registry.Table<CellModelFactory>("cell model");
+}
 
 /// Registers "AlievPanfilov", "MitchellSchaeffer", "FitzHughNagumo", "Nagumo" and
 /// "TenTusscherPanfilov2006".

@@ -247,56 +247,97 @@ void FemSolid::FinishResidual(const VecX& d, VecX& r) {
   for (int dof : constrained_dofs_) r[dof] = 0;
 }
 
-bool FemSolid::CalcResidual(const VecX& d, VecX& r) {
+/// One load increment of a step as the nonlinear system r(d) = 0 that Newton solves, in the
+/// increment d = x − x_n. Everything the residual depends on is an argument or the object's
+/// state at the start of the increment: the load fraction `s` (the loads are interpolated
+/// between the previous step's, s = 0, and this step's, s = 1) and the constraint targets.
+/// What changes while Newton runs belongs to this solve only, and is here:
+/// - the force scale of the convergence test: the applied nodal loads at s, raised at the first
+///   residual Newton evaluates to the applied loads there, pressures included (a heart's only
+///   loads are its cavity pressure and its own active tension);
+/// - whether Rayleigh damping's K_n, the element tangent at the increment's first iterate, has
+///   been taken (from the first tangent Newton assembles, so it costs no extra assembly).
+class FemSolid::Increment final : public NonlinearSystem {
+ public:
+  Increment(FemSolid& solid, double s, double nodal_load_scale)
+      : solid_(solid),
+        s_(s),
+        force_scale_(nodal_load_scale),
+        damping_pending_(solid.params_.rayleigh_stiffness > 0) {}
+
+  bool CalcResidual(const VecX& d, VecX& r) override {
+    const bool ok = solid_.IncrementResidual(s_, d, r);
+    if (ok) TakeLoadScale();
+    return ok;
+  }
+  bool CalcResidualAndJacobian(const VecX& d, VecX& r, SparseMatrix& J) override {
+    const bool ok = solid_.IncrementResidualAndJacobian(s_, d, r, J, damping_pending_);
+    if (ok) {
+      TakeLoadScale();
+      damping_pending_ = false;
+    }
+    return ok;
+  }
+  [[nodiscard]] double force_scale() const override { return force_scale_; }
+  [[nodiscard]] double residual_floor() const override { return solid_.residual_floor_; }
+  [[nodiscard]] int num_low_rank_terms() const override { return solid_.num_low_rank_terms(); }
+  void LowRankTerm(int k, const VecX*& b, double& w) const override { solid_.LowRankTerm(k, b, w); }
+
+ private:
+  void TakeLoadScale() {
+    if (!scale_pending_) return;
+    scale_pending_ = false;
+    force_scale_ = std::max(force_scale_, solid_.AppliedLoadNorm());
+  }
+
+  FemSolid& solid_;
+  const double s_;
+  double force_scale_;
+  bool damping_pending_;
+  bool scale_pending_ = true;
+};
+
+bool FemSolid::IncrementResidual(double s, const VecX& d, VecX& r) {
   const auto start = Clock::now();
   work_ = state_.scheme.x() + d;
   bool ok = AssembleElements(work_.data(), f_int_, nullptr);
   if (ok) {
-    AssembleExternal(work_.data(), s_);
+    AssembleExternal(work_.data(), s);
     ok = AddCoupledCavityLoads(work_.data());
-    if (ok) {
-      TakeLoadScale();
-      FinishResidual(d, r);
-    }
+    if (ok) FinishResidual(d, r);
   }
   profile_.assembly_seconds += Seconds(start);
   return ok;
 }
 
-void FemSolid::TakeLoadScale() {
-  if (!load_scale_pending_) return;
-  load_scale_pending_ = false;
-  // The applied loads at the step's first iterate, pressures included (a heart's only loads
-  // are its cavity pressure and its own active tension), over the unconstrained unknowns.
+double FemSolid::AppliedLoadNorm() const {
   double sum = f_ext_.squaredNorm();
   for (int dof : constrained_dofs_) sum -= f_ext_[dof] * f_ext_[dof];
-  force_scale_ = std::max(force_scale_, std::sqrt(std::max(sum, 0.0)));
+  return std::sqrt(std::max(sum, 0.0));
 }
 
-bool FemSolid::CalcResidualAndJacobian(const VecX& d, VecX& r, SparseMatrix& J) {
+bool FemSolid::IncrementResidualAndJacobian(double s, const VecX& d, VecX& r, SparseMatrix& J,
+                                            bool damping_tangent) {
   const auto start = Clock::now();
   work_ = state_.scheme.x() + d;
   if (!AssembleElements(work_.data(), f_int_, J.valuePtr())) {
     profile_.assembly_seconds += Seconds(start);
     return false;
   }
-  AssembleExternal(work_.data(), s_);
+  AssembleExternal(work_.data(), s);
   if (!AddCoupledCavityLoads(work_.data())) {
     profile_.assembly_seconds += Seconds(start);
     return false;
   }
-  TakeLoadScale();
   double* jv = J.valuePtr();
   const Index nnz = J.nonZeros();
-  if (params_.rayleigh_stiffness > 0 && first_iteration_)
-    std::copy(jv, jv + nnz, damping_k_.valuePtr());
-  first_iteration_ = false;
+  if (damping_tangent) std::copy(jv, jv + nnz, damping_k_.valuePtr());
   // Symmetric part of the follower-load tangent: J −= sym(∂f_ext/∂x).
   const BoundarySurface& bnd = boundary();
   for (Index f = 0; f < bnd.num_triangles(); ++f) {
-    const double p = state_.pressure_prev[f] + s_ * (pressure_new_[f] - state_.pressure_prev[f]);
+    const double p = state_.pressure_prev[f] + s * (pressure_new_[f] - state_.pressure_prev[f]);
     const Vec3 t =
-        state_.traction_prev.col(f) + s_ * (traction_new_.col(f) - state_.traction_prev.col(f));
+        state_.traction_prev.col(f) + s * (traction_new_.col(f) - state_.traction_prev.col(f));
     if (p == 0 && t.squaredNorm() == 0) continue;
     AddFaceLoadTangent(f, work_.data(), p, t, jv);
   }
@@ -427,9 +468,8 @@ void FemSolid::GatherTargets() {
 void FemSolid::InitialAcceleration() {
   // Newmark needs a_0 from M a_0 = f_ext − f_int − C v_0 (lumped: nodal division; consistent:
   // solved with a direct factorisation of M, once).
-  s_ = 0;
   if (!AssembleElements(state_.scheme.x().data(), f_int_, nullptr)) return;
-  AssembleExternal(state_.scheme.x().data(), s_);
+  AssembleExternal(state_.scheme.x().data(), 0.0);
   VecX rhs = f_ext_ - f_int_;
   if (params_.rayleigh_mass > 0) {
     if (params_.lumped_mass) {
@@ -459,10 +499,8 @@ StepStatus FemSolid::Advance(double s0, double s1, double dt, int depth) {
   if (stop_token().stop_requested()) return StepStatus::Stopped();
   saved_scheme_ = state_.scheme;
   state_.scheme.Begin((s1 - s0) * dt);
-  s_ = s1;
   const bool predict = params_.predict_velocity && params_.scheme != ImplicitSchemeKind::kStatic;
   auto solve = [&](bool predicted) {
-    first_iteration_ = true;
     if (predicted)
       d_ = ((s1 - s0) * dt) * state_.scheme.v();
     else
@@ -474,11 +512,10 @@ StepStatus FemSolid::Advance(double s0, double s1, double dt, int depth) {
       else
         d_[dof] = state_.scheme.IncrementForVelocity(dof, target_[dof]);
     }
-    // The force scale for the convergence test: applied loads and the weight, raised to the
-    // loads at the first iterate (TakeLoadScale) once Newton evaluates it.
-    force_scale_ = (state_.f_nodal_prev + s1 * (f_nodal_new_ - state_.f_nodal_prev)).norm();
-    load_scale_pending_ = true;
-    state_.last_newton = newton_->Solve(*this, d_, jac_, stop_token());
+    Increment increment(*this, s1,
+                        (state_.f_nodal_prev + s1 * (f_nodal_new_ - state_.f_nodal_prev)).norm());
+    state_.last_newton = newton_->Solve(increment, d_, jac_, stop_token());
+    load_scale_ = increment.force_scale();
     if (state_.last_newton.switched_to_indefinite)  // once per run: the switch is for good
       Log().warn(
           "{}: t = {:.6g} s, load increment to {:.4g} % of the step: the tangent is not "

@@ -77,7 +77,7 @@ struct FemProfile {
 };
 
 /// Not copyable or movable (a SimObject).
-class FemSolid final : public SimObject, public CavityWall, private NonlinearSystem {
+class FemSolid final : public SimObject, public CavityWall {
  public:
   /// Throws InputError for a mesh without tets, inverted/degenerate tets, a missing material,
   /// or a non-positive density.
@@ -104,7 +104,7 @@ class FemSolid final : public SimObject, public CavityWall, private NonlinearSys
   /// The force scale [N] of the last increment's Newton convergence test: the norm of the
   /// applied loads (nodal, weight, surface and cavity pressures) at its first iterate, over the
   /// unconstrained unknowns; Newton converges at tolerance · max(‖r(d₀)‖, this).
-  [[nodiscard]] double load_scale() const { return force_scale_; }
+  [[nodiscard]] double load_scale() const { return load_scale_; }
   [[nodiscard]] std::vector<ProfileEntry> ProfileBreakdown() const override;
   /// Checkpoints: the state (FemState) and the Newton solver's warm start and kept
   /// factorisation, which a bitwise continuation needs.
@@ -151,13 +151,17 @@ class FemSolid final : public SimObject, public CavityWall, private NonlinearSys
   void DoWriteField(FieldId id, const Eigen::Ref<const Eigen::MatrixXd>& in) override;
 
  private:
-  // NonlinearSystem: residual of the current increment as a function of d = x − x_n.
-  bool CalcResidual(const VecX& d, VecX& r) override;
-  bool CalcResidualAndJacobian(const VecX& d, VecX& r, SparseMatrix& J) override;
-  [[nodiscard]] double force_scale() const override { return force_scale_; }
-  [[nodiscard]] double residual_floor() const override { return residual_floor_; }
-  [[nodiscard]] int num_low_rank_terms() const override;
-  void LowRankTerm(int k, const VecX*& b, double& w) const override;
+  /// One load increment as the nonlinear system Newton solves (fem_solid.cc).
+  class Increment;
+  // The increment's residual r(d) at load fraction s (0: the previous step's loads, 1: this
+  // step's) as a function of d = x − x_n; false if d is not admissible.
+  bool IncrementResidual(double s, const VecX& d, VecX& r);
+  // Its residual and tangent; if `damping_tangent`, the element tangent at d also becomes K_n
+  // of Rayleigh damping (the tangent at the increment's first iterate).
+  bool IncrementResidualAndJacobian(double s, const VecX& d, VecX& r, SparseMatrix& J,
+                                    bool damping_tangent);
+  [[nodiscard]] int num_low_rank_terms() const;
+  void LowRankTerm(int k, const VecX*& b, double& w) const;
 
   /// f_int (and K values if `k_values` is not null) at displacements u; marks invalid
   /// elements.
@@ -183,9 +187,9 @@ class FemSolid final : public SimObject, public CavityWall, private NonlinearSys
   /// Adds p ∂V/∂x of every coupled cavity at the current positions to f (every dof, the held
   /// ones too: for reaction forces).
   void AddCoupledCavityForces(VecX& f) const;
-  /// At the step's first residual: raises force_scale_ to the norm of the applied loads then
-  /// (nodal, surface and cavity pressures) over the free unknowns.
-  void TakeLoadScale();
+  /// The norm of the applied loads last assembled (f_ext_: nodal, surface and cavity
+  /// pressures) over the free unknowns.
+  [[nodiscard]] double AppliedLoadNorm() const;
   /// Back to the pressures at the start of the step (after a failed Newton solve).
   void RestoreCavityPressures();
   void InitialAcceleration();
@@ -203,19 +207,17 @@ class FemSolid final : public SimObject, public CavityWall, private NonlinearSys
   std::unique_ptr<NewtonSolver> newton_;
   FemProfile profile_;
 
-  // This step's loads (s = 1; the previous step's, s = 0, are state), interpolated at s_.
+  // This step's loads (s = 1; the previous step's, s = 0, are state), interpolated at the
+  // increment's load fraction.
   VecX f_nodal_new_;  // 3N: gravity + nodal forces + external_force
   VecX pressure_new_;
   Points traction_new_;
-  double s_ = 1;
   // Constraints: mask per dof, displacement target (absolute position) or velocity.
   std::vector<std::uint8_t> constraint_;  // 0 free, 1 displacement, 2 velocity
   VecX target_, x_begin_;
   std::vector<int> constrained_dofs_;
   std::vector<std::array<int, 3>> face_local_;  // local indices of face vertices in its tet
-  bool first_iteration_ = true;
-  double force_scale_ = 0;
-  bool load_scale_pending_ = false;  // the step's first residual sets force_scale_
+  double load_scale_ = 0;                       // of the last increment solved (a statistic)
 
   // Work buffers (3N unless noted).
   mutable VecX f_int_, f_ext_, work_, work2_;

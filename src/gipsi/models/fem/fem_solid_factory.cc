@@ -59,7 +59,7 @@ void ParseLoadStepping(const JsonNode& object, int& load_steps, int& max_bisecti
 }
 
 void RegisterFemSolid(TypeRegistry& registry) {
-  registry.local_models.Register(
+  LocalModels(registry).Register(
       "FemSolid",
       [](SimObject& object, int /*rings*/) -> std::unique_ptr<LocalModelBuilder> {
         return std::make_unique<FemCondensation>(dynamic_cast<FemSolid&>(object));

@@ -417,17 +417,33 @@ void MixedSolid::ApplyConstraints(VecX& r, double* jv) const {
   for (int dof : constrained_dofs_) jv[diag_index_[static_cast<std::size_t>(dof)]] = diag_scale_;
 }
 
-bool MixedSolid::CalcResidual(const VecX& z, VecX& r) {
-  if (!Assemble(z, s_, r, nullptr)) return false;
-  AssembleLoads(z, s_, r, nullptr);
-  ApplyConstraints(r, nullptr);
-  return r.allFinite();
-}
+/// One load increment as the nonlinear system r(z) = 0 that Newton solves: its inputs are its
+/// arguments, the load fraction s (loads, active tension and constraint targets interpolated
+/// between the step's start, 0, and end, 1) and the force scale of the convergence test (the
+/// applied loads at s).
+class MixedSolid::Increment final : public NonlinearSystem {
+ public:
+  Increment(const MixedSolid& solid, double s, double force_scale)
+      : solid_(solid), s_(s), force_scale_(force_scale) {}
+  bool CalcResidual(const VecX& z, VecX& r) override {
+    return solid_.IncrementResidual(s_, z, r, nullptr);
+  }
+  bool CalcResidualAndJacobian(const VecX& z, VecX& r, SparseMatrix& J) override {
+    return solid_.IncrementResidual(s_, z, r, J.valuePtr());
+  }
+  [[nodiscard]] double force_scale() const override { return force_scale_; }
+  [[nodiscard]] double residual_floor() const override { return solid_.residual_floor_; }
 
-bool MixedSolid::CalcResidualAndJacobian(const VecX& z, VecX& r, SparseMatrix& J) {
-  if (!Assemble(z, s_, r, J.valuePtr())) return false;
-  AssembleLoads(z, s_, r, J.valuePtr());
-  ApplyConstraints(r, J.valuePtr());
+ private:
+  const MixedSolid& solid_;
+  const double s_;
+  const double force_scale_;
+};
+
+bool MixedSolid::IncrementResidual(double s, const VecX& z, VecX& r, double* jv) const {
+  if (!Assemble(z, s, r, jv)) return false;
+  AssembleLoads(z, s, r, jv);
+  ApplyConstraints(r, jv);
   return r.allFinite();
 }
 
@@ -500,13 +516,12 @@ StepStatus MixedSolid::Advance(double s0, double s1, int depth) {
     const double sb = k == n ? s1 : s0 + (s1 - s0) * k / n;
     if (stop_token().stop_requested()) return StepStatus::Stopped();
     const VecX z_start = z_;
-    s_ = sb;
     SetTargets(z_, sb);
     VecX loads = VecX::Zero(z_.size());
     AssembleLoads(z_, sb, loads, nullptr);
     ApplyConstraints(loads, nullptr);
-    force_scale_ = loads.norm();
-    last_newton_ = newton_->Solve(*this, z_, jac_, stop_token());
+    Increment increment(*this, sb, loads.norm());
+    last_newton_ = newton_->Solve(increment, z_, jac_, stop_token());
     total_iterations_ += last_newton_.iterations;
     if (last_newton_.converged) continue;
     z_ = z_start;

@@ -80,7 +80,7 @@ struct MixedSolidParams {
 };
 
 /// Not copyable or movable (a SimObject).
-class MixedSolid final : public SimObject, private NonlinearSystem {
+class MixedSolid final : public SimObject {
  public:
   /// Throws InputError for a mesh without tets, inverted or degenerate tets, a missing law or
   /// one without a split volumetric term, or a zero fibre direction.
@@ -129,10 +129,11 @@ class MixedSolid final : public SimObject, private NonlinearSystem {
   void DoWriteField(FieldId id, const Eigen::Ref<const Eigen::MatrixXd>& in) override;
 
  private:
-  bool CalcResidual(const VecX& z, VecX& r) override;
-  bool CalcResidualAndJacobian(const VecX& z, VecX& r, SparseMatrix& J) override;
-  [[nodiscard]] double force_scale() const override { return force_scale_; }
-  [[nodiscard]] double residual_floor() const override { return residual_floor_; }
+  /// One load increment as the nonlinear system Newton solves (mixed_solid.cc).
+  class Increment;
+  /// The increment's residual r(z) at load fraction s (and J's values if `jv` is not null);
+  /// false if z is not admissible.
+  bool IncrementResidual(double s, const VecX& z, VecX& r, double* jv) const;
 
   /// Element terms of r (and J's values if `jv` is not null) at z and load fraction `load`
   /// (the active tension is ramped with the loads); false if an element is
@@ -181,8 +182,6 @@ class MixedSolid final : public SimObject, private NonlinearSystem {
   VecX pressure_prev_, pressure_new_;
   Points traction_prev_, traction_new_;
   bool have_prev_ = false;
-  double s_ = 1;
-  double force_scale_ = 0;
   mutable double residual_floor_ = 0;
   double diag_scale_ = 1;
   bool exact_load_tangent_ = false;  // the linear solver takes nonsymmetric matrices

@@ -154,7 +154,8 @@ void MassSpring::Finish() {
   SetUpCavities();
 }
 
-void MassSpring::CalcForces(double /*t*/, Eigen::Ref<const VecX> x, Eigen::Ref<VecX> f) const {
+void MassSpring::CalcForces(double /*t*/, Eigen::Ref<const VecX> x, Eigen::Ref<VecX> f,
+                            CoupledPressures coupled) const {
   const Index n = num_nodes();
   const auto q = x.head(3 * n);
   const auto v = x.tail(3 * n);
@@ -201,12 +202,17 @@ void MassSpring::CalcForces(double /*t*/, Eigen::Ref<const VecX> x, Eigen::Ref<V
     }
   }
   AddVolumeForces(q, f);
-  AddCavityForces(q, f, !coupled_predictor_);
+  AddCavityForces(q, f, coupled == CoupledPressures::kIncluded);
 }
 
 void MassSpring::CalcDerivative(double t, Eigen::Ref<const VecX> x, Eigen::Ref<VecX> xdot) const {
+  CalcDerivative(t, x, xdot, CoupledPressures::kIncluded);
+}
+
+void MassSpring::CalcDerivative(double t, Eigen::Ref<const VecX> x, Eigen::Ref<VecX> xdot,
+                                CoupledPressures coupled) const {
   const Index n = num_nodes();
-  CalcForces(t, x, force_);
+  CalcForces(t, x, force_, coupled);
   xdot.head(3 * n) = x.tail(3 * n);
   for (Index i = 0; i < n; ++i)
     xdot.segment<3>(3 * n + 3 * i) = force_.segment<3>(3 * i) / mass_[i];
@@ -271,18 +277,25 @@ StepStatus MassSpring::CheckState() const {
   return StepStatus::Ok();
 }
 
+struct MassSpring::StepOde {
+  const MassSpring& object;
+  CoupledPressures coupled;
+  [[nodiscard]] Index ode_size() const { return object.ode_size(); }
+  [[nodiscard]] Index ode_num_positions() const { return object.ode_num_positions(); }
+  void CalcDerivative(double t, Eigen::Ref<const VecX> x, Eigen::Ref<VecX> xdot) const {
+    object.CalcDerivative(t, x, xdot, coupled);
+  }
+};
+
 StepStatus MassSpring::DoStep(double t, double dt) {
   failure_detail_.clear();
   ApplyConstraints(dt);
   const bool coupled = std::any_of(cavities_.begin(), cavities_.end(),
                                    [](const Cavity& c) { return c.law != nullptr; });
-  if (coupled) {
-    // The step with p = 0 for the coupled cavities, then their pressures (mass_spring.h).
-    BeginCoupledStep();
-    coupled_predictor_ = true;
-  }
-  integrator_->Step(OdeView(*this), t, dt, state_.x);
-  coupled_predictor_ = false;
+  // With coupled cavities, the step with p = 0 for them, then their pressures (mass_spring.h).
+  if (coupled) BeginCoupledStep();
+  const StepOde ode{*this, coupled ? CoupledPressures::kLeftOut : CoupledPressures::kIncluded};
+  integrator_->Step(OdeView(ode), t, dt, state_.x);
   if (coupled && !SolveCoupledCavities(t, dt))
     return StepStatus::Failed("the cavity pressure could not be solved with the blood");
   const Index n = num_nodes();

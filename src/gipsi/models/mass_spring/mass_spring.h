@@ -64,6 +64,7 @@
 /// inside the blood's step (a law asked at a time the blood is not at fails the step with a
 /// diagnostic).
 
+#include <cstdint>
 #include <memory>
 #include <string>
 #include <vector>
@@ -206,8 +207,16 @@ class MassSpring final : public SimObject, public CavityWall {
   void DoWriteField(FieldId id, const Eigen::Ref<const Eigen::MatrixXd>& in) override;
 
  private:
+  /// Which cavity pressures a force evaluation includes: all, or all but the coupled ones (the
+  /// predictor of a step with coupled cavities, which solves their pressures after it).
+  enum class CoupledPressures : std::uint8_t { kIncluded, kLeftOut };
+  /// The ODE a step integrates: CalcDerivative with the coupled pressures included or not.
+  struct StepOde;
   /// Total force on every node (3N) at state x, without constraint handling.
-  void CalcForces(double t, Eigen::Ref<const VecX> x, Eigen::Ref<VecX> f) const;
+  void CalcForces(double t, Eigen::Ref<const VecX> x, Eigen::Ref<VecX> f,
+                  CoupledPressures coupled = CoupledPressures::kIncluded) const;
+  void CalcDerivative(double t, Eigen::Ref<const VecX> x, Eigen::Ref<VecX> xdot,
+                      CoupledPressures coupled) const;
   /// Applies the boundary conditions' kinematic constraints to x before a step.
   void ApplyConstraints(double dt);
   StepStatus CheckState() const;
@@ -259,8 +268,7 @@ class MassSpring final : public SimObject, public CavityWall {
     Points step_gradient;  // g at the start of the step, zero on held axes
   };
   std::vector<Cavity> cavities_;
-  bool symplectic_ = false;                 // the integrator is SymplecticEuler
-  mutable bool coupled_predictor_ = false;  // CalcForces leaves the coupled pressures out
+  bool symplectic_ = false;  // the integrator is SymplecticEuler
   std::string failure_detail_;
 };
 

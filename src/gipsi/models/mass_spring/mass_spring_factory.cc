@@ -38,7 +38,7 @@ void WarnInvertedTets(const Mesh& mesh, const std::string& where) {
 }  // namespace
 
 void RegisterMassSpring(TypeRegistry& registry) {
-  registry.local_models.Register(
+  LocalModels(registry).Register(
       "MassSpring",
       [](SimObject& object, int rings) -> std::unique_ptr<LocalModelBuilder> {
         return std::make_unique<MassSpringNeighbourhood>(dynamic_cast<MassSpring&>(object), rings);
