@@ -3,6 +3,8 @@
 /// `SimObject`: one physical process (or an aggregate of processes) with its three geometries,
 /// named fields, boundary conditions and a `Step`. The GiPSi simulation API.
 
+#include <concepts>
+#include <cstdint>
 #include <memory>
 #include <optional>
 #include <span>
@@ -188,8 +190,12 @@ class SimObject {
   /// static `Fields` lists everything that evolves, is then what checkpoints save and restore
   /// (WriteFields / ReadFields) and what step retries copy (a StateBox<S>), with no further
   /// hook to write. Call once, from the constructor. After a restore, StateRestored() rebuilds
-  /// what derives from the state. A type that saves more than one value (a solver's kept
-  /// factorisation) overrides the hooks below instead.
+  /// what derives from the state. A checkpoint read fails as a whole: the state is replaced only
+  /// once every field was read. If `S` declares `static constexpr std::string_view kTag` and
+  /// `std::uint32_t kVersion`, checkpoints wrap its fields in a section of that tag and version
+  /// (raise the version when the fields change, and an old checkpoint is refused by name). A
+  /// type that saves more than one value (a solver's kept factorisation) overrides the hooks
+  /// below instead.
   template <class S>
   void BindState(S& state) {
     GIPSI_CHECK(state_binding_ == nullptr, "object '{}': BindState called twice", name_);
@@ -224,6 +230,11 @@ class SimObject {
   };
   template <class S>
   class BoundState final : public StateBinding {
+    static constexpr bool kVersioned = requires {
+      { S::kTag } -> std::convertible_to<std::string_view>;
+      { S::kVersion } -> std::convertible_to<std::uint32_t>;
+    };
+
    public:
     explicit BoundState(S& state) : state_(state) {}
     [[nodiscard]] std::unique_ptr<ObjectState> New() const override {
@@ -231,8 +242,18 @@ class SimObject {
     }
     void Copy(ObjectState& into) const override { CopyFields(StateBox<S>::Of(into).value, state_); }
     void Set(const ObjectState& from) override { CopyFields(state_, StateBox<S>::Of(from).value); }
-    void Write(StateWriter& out) const override { WriteFields(out, state_); }
-    void Read(StateReader& in) override { ReadFields(in, state_); }
+    void Write(StateWriter& out) const override {
+      if constexpr (kVersioned) out.BeginSection(S::kTag, S::kVersion);
+      WriteFields(out, state_);
+      if constexpr (kVersioned) out.EndSection();
+    }
+    void Read(StateReader& in) override {
+      S read = state_;  // kFixed fields are checked against the current shapes
+      if constexpr (kVersioned) in.BeginSection(S::kTag, S::kVersion);
+      ReadFields(in, read);
+      if constexpr (kVersioned) in.EndSection();
+      CopyFields(state_, read);  // into the existing storage (kept capacities, references)
+    }
 
    private:
     S& state_;

@@ -56,8 +56,6 @@ void AdaptiveOde::Prepare(Index n, int num_events, const AdaptiveOdeOptions& opt
   atol_ = options.absolute_tolerances.size() == n ? options.absolute_tolerances
                                                   : VecX::Constant(n, options.absolute_tolerance);
   GIPSI_CHECK((atol_.array() > 0).all(), "absolute tolerances must be positive");
-  for (VecX& k : k_) k.setZero(n);
-  x_old_.setZero(n);
   x_new_.setZero(n);
   stage_.setZero(n);
   err_.setZero(n);
@@ -67,8 +65,15 @@ void AdaptiveOde::Prepare(Index n, int num_events, const AdaptiveOdeOptions& opt
   g_probe_.setZero(num_events);
   g_prev_.setZero(num_events);
   g_right_.setZero(num_events);
-  h_ = options.initial_step > 0 ? options.initial_step : 0;
-  have_step_ = false;
+  state_ = NewState();
+}
+
+AdaptiveOdeState AdaptiveOde::NewState() const {
+  AdaptiveOdeState state;
+  state.next_step = options_.initial_step > 0 ? options_.initial_step : 0;
+  state.x_old.setZero(n_);
+  for (VecX& k : state.k) k.setZero(n_);
+  return state;
 }
 
 double AdaptiveOde::ErrorNorm(const VecX& x, const VecX& x_new) const {
@@ -82,10 +87,11 @@ double AdaptiveOde::ErrorNorm(const VecX& x, const VecX& x_new) const {
   return std::sqrt(sum / static_cast<double>(n_));
 }
 
-double AdaptiveOde::InitialStep(const OdeView& system, double t, double t_end, const VecX& x) {
+double AdaptiveOde::InitialStep(AdaptiveOdeState& m, const OdeView& system, double t, double t_end,
+                                const VecX& x) {
   // Hairer, Nørsett & Wanner, Solving ODEs I, §II.4: balance the first Euler step's size
   // against the scale of x and of the change of f.
-  const VecX& f0 = k_[0];
+  const VecX& f0 = m.k[0];
   auto rms_scaled = [&](auto&& v) {
     double sum = 0;
     for (Index i = 0; i < n_; ++i) {
@@ -99,8 +105,8 @@ double AdaptiveOde::InitialStep(const OdeView& system, double t, double t_end, c
   double h0 = (d0 < 1e-5 || d1 < 1e-5) ? 1e-6 : 0.01 * d0 / d1;
   h0 = std::min({h0, t_end - t, options_.max_step});
   stage_.noalias() = x + h0 * f0;
-  system.CalcDerivative(t + h0, stage_, k_[1]);
-  err_.noalias() = k_[1] - f0;
+  system.CalcDerivative(t + h0, stage_, m.k[1]);
+  err_.noalias() = m.k[1] - f0;
   const double d2 = rms_scaled(err_) / h0;
   const double dm = std::max(d1, d2);
   const double h1 = dm <= 1e-15 ? std::max(1e-6, h0 * 1e-3) : std::pow(0.01 / dm, 1.0 / 5);
@@ -108,20 +114,21 @@ double AdaptiveOde::InitialStep(const OdeView& system, double t, double t_end, c
   return std::isfinite(h) && h > 0 ? h : h0;
 }
 
-void AdaptiveOde::DenseAt(double theta, Eigen::Ref<VecX> out) const {
+void AdaptiveOde::DenseAt(const AdaptiveOdeState& m, double theta, Eigen::Ref<VecX> out) {
   double w[7];
   for (int i = 0; i < 7; ++i)
     w[i] = theta * (kP[i][0] + theta * (kP[i][1] + theta * (kP[i][2] + theta * kP[i][3])));
-  out = x_old_;
-  for (int i = 0; i < 7; ++i)
-    if (w[i] != 0) out.noalias() += (h_old_ * w[i]) * k_[i];
+  out = m.x_old;
+  for (std::size_t i = 0; i < 7; ++i)
+    if (w[i] != 0) out.noalias() += (m.h_old * w[i]) * m.k[i];
 }
 
-void AdaptiveOde::Interpolate(double s, Eigen::Ref<VecX> out) const {
-  GIPSI_CHECK(have_step_, "Interpolate before any accepted step");
-  GIPSI_CHECK(out.size() == n_);
-  const double theta = h_old_ > 0 ? (s - t_old_) / h_old_ : 0.0;
-  DenseAt(std::clamp(theta, 0.0, 1.0), out);
+void AdaptiveOde::Interpolate(const AdaptiveOdeState& memory, double s,
+                              Eigen::Ref<VecX> out) const {
+  GIPSI_CHECK(memory.have_step, "Interpolate before any accepted step");
+  GIPSI_CHECK(out.size() == n_ && memory.x_old.size() == n_);
+  const double theta = memory.h_old > 0 ? (s - memory.t_old) / memory.h_old : 0.0;
+  DenseAt(memory, std::clamp(theta, 0.0, 1.0), out);
 }
 
 int AdaptiveOde::FirstPositive(const EventFunctions& events, double t, Eigen::Ref<const VecX> x) {
@@ -133,18 +140,18 @@ int AdaptiveOde::FirstPositive(const EventFunctions& events, double t, Eigen::Re
   return -1;
 }
 
-double AdaptiveOde::LocateRoot(const EventFunctions& events, int i, double a, double ga, double b,
-                               double gb) {
+double AdaptiveOde::LocateRoot(const AdaptiveOdeState& m, const EventFunctions& events, int i,
+                               double a, double ga, double b, double gb) {
   // Illinois variant of regula falsi, with a bisection every third iteration so that the
   // bracket [a, b] (g(a) ≤ 0 < g(b)) shrinks below the tolerance whatever the function's shape.
-  const double width_tolerance = options_.event_tolerance / h_old_;
+  const double width_tolerance = options_.event_tolerance / m.h_old;
   auto g = g_probe_.head(events.num_events());
   int side = 0;
   for (int iteration = 0; iteration < 200 && b - a > width_tolerance; ++iteration) {
     double c = (iteration % 3 == 2) ? 0.5 * (a + b) : b - gb * (b - a) / (gb - ga);
     if (!(c > a && c < b)) c = 0.5 * (a + b);
-    DenseAt(c, dense_);
-    events.Calc(t_old_ + c * h_old_, dense_, g);
+    DenseAt(m, c, dense_);
+    events.Calc(m.t_old + c * m.h_old, dense_, g);
     const double gc = g[i];
     if (gc > 0) {
       b = c;
@@ -161,10 +168,12 @@ double AdaptiveOde::LocateRoot(const EventFunctions& events, int i, double a, do
   return b;
 }
 
-AdaptiveOdeResult AdaptiveOde::Integrate(const OdeView& system, double& t, double t_end,
-                                         Eigen::Ref<VecX> x, const EventFunctions* events) {
-  GIPSI_CHECK(system.size() == n_ && x.size() == n_, "AdaptiveOde prepared for {}, got {}", n_,
-              system.size());
+AdaptiveOdeResult AdaptiveOde::Integrate(AdaptiveOdeState& mem, const OdeView& system, double& t,
+                                         double t_end, Eigen::Ref<VecX> x,
+                                         const EventFunctions* events) {
+  GIPSI_CHECK(system.size() == n_ && x.size() == n_ && mem.x_old.size() == n_,
+              "AdaptiveOde prepared for {}, got {} (a state of size {})", n_, system.size(),
+              mem.x_old.size());
   GIPSI_CHECK(events == nullptr || events->num_events() <= g_old_.size(),
               "more event functions than prepared");
   using Outcome = AdaptiveOdeResult::Outcome;
@@ -172,24 +181,25 @@ AdaptiveOdeResult AdaptiveOde::Integrate(const OdeView& system, double& t, doubl
   if (!(t_end > t)) return result;
   const int m = events ? events->num_events() : 0;
 
-  system.CalcDerivative(t, x, k_[0]);
+  system.CalcDerivative(t, x, mem.k[0]);
   ++result.evaluations;
-  if (!AllFinite(k_[0])) {
+  if (!AllFinite(mem.k[0])) {
     result.outcome = Outcome::kNonFinite;
     return result;
   }
   if (m > 0) events->Calc(t, x, g_old_.head(m));
-  if (!(h_ > 0)) {
+  if (!(mem.next_step > 0)) {
     x_new_ = x;  // InitialStep reads a plain vector
-    h_ = InitialStep(system, t, t_end, x_new_);
+    mem.next_step = InitialStep(mem, system, t, t_end, x_new_);
     ++result.evaluations;
   }
   bool rejected_last = false;
-  bool fsal_pending = false;  // k_[6] holds f at the new x; it becomes k_[0] at the next attempt
+  bool fsal_pending =
+      false;  // mem.k[6] holds f at the new x; it becomes mem.k[0] at the next attempt
   for (std::int64_t attempt = 0;; ++attempt) {
     if (fsal_pending) {
-      // Deferred so that k_ keeps the last accepted step's stages for Interpolate.
-      std::swap(k_[0], k_[6]);
+      // Deferred so that mem.k keeps the last accepted step's stages for Interpolate.
+      std::swap(mem.k[0], mem.k[6]);
       fsal_pending = false;
     }
     if (attempt >= options_.max_steps) {
@@ -197,7 +207,7 @@ AdaptiveOdeResult AdaptiveOde::Integrate(const OdeView& system, double& t, doubl
       return result;
     }
     const double remaining = t_end - t;
-    double h = std::min(h_, options_.max_step);
+    double h = std::min(mem.next_step, options_.max_step);
     const bool last = h >= remaining * (1 - 1e-12);
     if (last) h = remaining;
     if (!last && h < options_.min_step_factor * std::max(std::abs(t), 1.0)) {
@@ -205,31 +215,32 @@ AdaptiveOdeResult AdaptiveOde::Integrate(const OdeView& system, double& t, doubl
       return result;
     }
     // Stages.
-    stage_.noalias() = x + (h * kA21) * k_[0];
-    system.CalcDerivative(t + kC2 * h, stage_, k_[1]);
-    stage_.noalias() = x + h * (kA31 * k_[0] + kA32 * k_[1]);
-    system.CalcDerivative(t + kC3 * h, stage_, k_[2]);
-    stage_.noalias() = x + h * (kA41 * k_[0] + kA42 * k_[1] + kA43 * k_[2]);
-    system.CalcDerivative(t + kC4 * h, stage_, k_[3]);
-    stage_.noalias() = x + h * (kA51 * k_[0] + kA52 * k_[1] + kA53 * k_[2] + kA54 * k_[3]);
-    system.CalcDerivative(t + kC5 * h, stage_, k_[4]);
+    stage_.noalias() = x + (h * kA21) * mem.k[0];
+    system.CalcDerivative(t + kC2 * h, stage_, mem.k[1]);
+    stage_.noalias() = x + h * (kA31 * mem.k[0] + kA32 * mem.k[1]);
+    system.CalcDerivative(t + kC3 * h, stage_, mem.k[2]);
+    stage_.noalias() = x + h * (kA41 * mem.k[0] + kA42 * mem.k[1] + kA43 * mem.k[2]);
+    system.CalcDerivative(t + kC4 * h, stage_, mem.k[3]);
     stage_.noalias() =
-        x + h * (kA61 * k_[0] + kA62 * k_[1] + kA63 * k_[2] + kA64 * k_[3] + kA65 * k_[4]);
-    system.CalcDerivative(t + h, stage_, k_[5]);
-    x_new_.noalias() =
-        x + h * (kB1 * k_[0] + kB3 * k_[2] + kB4 * k_[3] + kB5 * k_[4] + kB6 * k_[5]);
+        x + h * (kA51 * mem.k[0] + kA52 * mem.k[1] + kA53 * mem.k[2] + kA54 * mem.k[3]);
+    system.CalcDerivative(t + kC5 * h, stage_, mem.k[4]);
+    stage_.noalias() = x + h * (kA61 * mem.k[0] + kA62 * mem.k[1] + kA63 * mem.k[2] +
+                                kA64 * mem.k[3] + kA65 * mem.k[4]);
+    system.CalcDerivative(t + h, stage_, mem.k[5]);
+    x_new_.noalias() = x + h * (kB1 * mem.k[0] + kB3 * mem.k[2] + kB4 * mem.k[3] + kB5 * mem.k[4] +
+                                kB6 * mem.k[5]);
     const double t_new = last ? t_end : t + h;
-    system.CalcDerivative(t_new, x_new_, k_[6]);
+    system.CalcDerivative(t_new, x_new_, mem.k[6]);
     result.evaluations += 6;
-    err_.noalias() =
-        h * (kE1 * k_[0] + kE3 * k_[2] + kE4 * k_[3] + kE5 * k_[4] + kE6 * k_[5] + kE7 * k_[6]);
+    err_.noalias() = h * (kE1 * mem.k[0] + kE3 * mem.k[2] + kE4 * mem.k[3] + kE5 * mem.k[4] +
+                          kE6 * mem.k[5] + kE7 * mem.k[6]);
     const double error = ErrorNorm(x, x_new_);
-    if (!std::isfinite(error) || !AllFinite(k_[6])) {
+    if (!std::isfinite(error) || !AllFinite(mem.k[6])) {
       // A too-large step on a stiff problem may overflow: retry much smaller.
       ++result.rejected;
-      h_ = 0.1 * h;
+      mem.next_step = 0.1 * h;
       rejected_last = true;
-      if (h_ < options_.min_step_factor * std::max(std::abs(t), 1.0)) {
+      if (mem.next_step < options_.min_step_factor * std::max(std::abs(t), 1.0)) {
         result.outcome = Outcome::kNonFinite;
         return result;
       }
@@ -237,20 +248,20 @@ AdaptiveOdeResult AdaptiveOde::Integrate(const OdeView& system, double& t, doubl
     }
     if (error > 1) {
       ++result.rejected;
-      h_ = h * std::max(0.2, 0.9 * std::pow(error, -0.2));
+      mem.next_step = h * std::max(0.2, 0.9 * std::pow(error, -0.2));
       rejected_last = true;
       continue;
     }
     // Accepted.
     ++result.accepted;
-    x_old_ = x;
-    t_old_ = t;
-    h_old_ = h;
-    have_step_ = true;
+    mem.x_old = x;
+    mem.t_old = t;
+    mem.h_old = h;
+    mem.have_step = true;
     double factor = error == 0 ? 5.0 : std::min(5.0, std::max(0.2, 0.9 * std::pow(error, -0.2)));
     if (rejected_last) factor = std::min(factor, 1.0);
     const double proposal = h * factor;
-    h_ = last ? std::max(h_, proposal) : proposal;
+    mem.next_step = last ? std::max(mem.next_step, proposal) : proposal;
     rejected_last = false;
 
     if (m > 0) {
@@ -267,7 +278,7 @@ AdaptiveOdeResult AdaptiveOde::Integrate(const OdeView& system, double& t, doubl
         if (k == samples) {
           g_here = g_new_.head(m);
         } else {
-          DenseAt(theta, dense_);
+          DenseAt(mem, theta, dense_);
           events->Calc(t + theta * h, dense_, g_here);
         }
         int first = -1;
@@ -279,13 +290,14 @@ AdaptiveOdeResult AdaptiveOde::Integrate(const OdeView& system, double& t, doubl
           g_right_.head(m) = g_here;
           for (int i = 0; i < m; ++i) {
             if (!(g_prev[i] <= 0 && g_right_[i] > 0)) continue;
-            const double root = LocateRoot(*events, i, theta_prev, g_prev[i], theta, g_right_[i]);
+            const double root =
+                LocateRoot(mem, *events, i, theta_prev, g_prev[i], theta, g_right_[i]);
             if (root < first_theta) {
               first_theta = root;
               first = i;
             }
           }
-          DenseAt(first_theta, x);
+          DenseAt(mem, first_theta, x);
           t = t + first_theta * h;
           result.outcome = Outcome::kEvent;
           result.event = first;

@@ -12,16 +12,16 @@
 /// component divided by atol_i + rtol·max(|x_i|, |x̃_i|), is at most 1; the next step is
 /// h·min(5, max(0.2, 0.9·err^(−1/5))) (no growth right after a rejection).
 
+#include <array>
 #include <cstdint>
 #include <limits>
+#include <string_view>
 
 #include "gipsi/base/math.h"
+#include "gipsi/base/state_value.h"
 #include "gipsi/numerics/ode.h"
 
 namespace gipsi {
-
-class StateReader;
-class StateWriter;
 
 /// Event functions for AdaptiveOde: `num_events()` values g_i(t, x); event i happens where g_i
 /// crosses zero upward (from ≤ 0 to > 0). A caller that wants a downward crossing negates its
@@ -69,9 +69,36 @@ struct AdaptiveOdeResult {
   }
 };
 
+/// What AdaptiveOde carries from one Integrate call to the next, as a state value type
+/// (gipsi/base/state_value.h): the step size the controller proposes next, and the last accepted
+/// step (start, length, initial value and stages), which is its dense output. Everything else
+/// in AdaptiveOde is work space, rewritten before it is read. A caller that integrates several
+/// trajectories with one AdaptiveOde (a trial integration beside the real one) keeps one state
+/// each and passes it to Integrate. Copyable.
+struct AdaptiveOdeState {
+  double next_step = 0;         ///< the controller's next step size; 0: choose one
+  bool have_step = false;       ///< a step was accepted: the dense output below is valid
+  double t_old = 0, h_old = 0;  ///< start and length of the last accepted step
+  VecX x_old;                   ///< x at its start
+  std::array<VecX, 7> k;        ///< its stages; k[6] = f at its end (first stage of the next)
+
+  template <class Self, class Visitor>
+  static void Fields(Self& s, Visitor& v) {
+    static constexpr std::array<std::string_view, 7> kStages = {"k1", "k2", "k3", "k4",
+                                                                "k5", "k6", "k7"};
+    v("next_step", s.next_step);
+    v("have_step", s.have_step);
+    v("t_old", s.t_old);
+    v("h_old", s.h_old);
+    v("x_old", s.x_old, Shape::kFixed);
+    for (std::size_t i = 0; i < kStages.size(); ++i) v(kStages[i], s.k[i], Shape::kFixed);
+  }
+};
+
 /// Dormand–Prince 5(4) with dense output and event location. Not copyable (work buffers);
 /// movable. Usage: `Prepare(n, m)` once; then `Integrate` as often as needed. The last step size
-/// is kept as the first guess of the next call. Integrate allocates nothing.
+/// is kept as the first guess of the next call (in the AdaptiveOdeState integrated: the
+/// object's own, or one the caller keeps). Integrate allocates nothing.
 class AdaptiveOde {
  public:
   AdaptiveOde() = default;
@@ -97,7 +124,18 @@ class AdaptiveOde {
   /// reported (see FirstPositive; hybrid callers keep every g_i ≤ 0 in their current mode).
   /// On failure `t` and `x` hold the last accepted state. Never throws.
   AdaptiveOdeResult Integrate(const OdeView& system, double& t, double t_end, Eigen::Ref<VecX> x,
+                              const EventFunctions* events = nullptr) {
+    return Integrate(state_, system, t, t_end, x, events);
+  }
+  /// The same, continuing from (and updating) the caller's `memory` instead of the object's own
+  /// state: `memory` must come from NewState() of an AdaptiveOde prepared for the same size.
+  AdaptiveOdeResult Integrate(AdaptiveOdeState& memory, const OdeView& system, double& t,
+                              double t_end, Eigen::Ref<VecX> x,
                               const EventFunctions* events = nullptr);
+  /// A fresh state sized for this integrator (no step taken, the options' initial step).
+  [[nodiscard]] AdaptiveOdeState NewState() const;
+  /// The object's own state (what the one-argument Integrate continues from).
+  [[nodiscard]] const AdaptiveOdeState& state() const { return state_; }
 
   /// The first i with g_i(t, x) > 0, or −1: an event pending at (t, x). Allocates nothing
   /// (after Prepare).
@@ -106,38 +144,37 @@ class AdaptiveOde {
   /// The dense output of the last accepted step at time `s` in [step_begin(), step_end()]
   /// (fourth order). After an event the step still covers its whole attempted length (the
   /// event time lies inside it). Precondition: a step has been accepted.
-  void Interpolate(double s, Eigen::Ref<VecX> out) const;
-  [[nodiscard]] double step_begin() const { return t_old_; }
-  [[nodiscard]] double step_end() const { return t_old_ + h_old_; }
+  void Interpolate(double s, Eigen::Ref<VecX> out) const { Interpolate(state_, s, out); }
+  /// The same for the last step recorded in `memory`.
+  void Interpolate(const AdaptiveOdeState& memory, double s, Eigen::Ref<VecX> out) const;
+  [[nodiscard]] double step_begin() const { return state_.t_old; }
+  [[nodiscard]] double step_end() const { return state_.t_old + state_.h_old; }
   /// The step size the controller proposes next (0 before the first step).
-  [[nodiscard]] double next_step() const { return h_; }
+  [[nodiscard]] double next_step() const { return state_.next_step; }
   /// Forgets the step-size guess (e.g. after a discontinuity in the model).
-  void ResetStepSize() { h_ = 0; }
+  void ResetStepSize() { state_.next_step = 0; }
   /// Sets the step-size guess (0: choose one): a second integrator started like this one
   /// repeats its steps exactly (trial integrations).
-  void SetStepSize(double h) { h_ = h; }
-  /// Checkpoints (gipsi/base/state.h; defined in circulation_state.cc).
-  void SaveState(StateWriter& out) const;
-  void RestoreState(StateReader& in);
+  void SetStepSize(double h) { state_.next_step = h; }
 
  private:
-  double InitialStep(const OdeView& system, double t, double t_end, const VecX& x);
+  double InitialStep(AdaptiveOdeState& m, const OdeView& system, double t, double t_end,
+                     const VecX& x);
   double ErrorNorm(const VecX& x, const VecX& x_new) const;
-  // Dense output at fraction θ of the last accepted step into `out`.
-  void DenseAt(double theta, Eigen::Ref<VecX> out) const;
+  // Dense output at fraction θ of the last accepted step in `m` into `out`.
+  static void DenseAt(const AdaptiveOdeState& m, double theta, Eigen::Ref<VecX> out);
   // Root of g_i between fractions a < b of the last step with g_i(a) ≤ 0 < g_i(b); returns the
   // fraction on the positive side.
-  double LocateRoot(const EventFunctions& events, int i, double a, double ga, double b, double gb);
+  double LocateRoot(const AdaptiveOdeState& m, const EventFunctions& events, int i, double a,
+                    double ga, double b, double gb);
 
   AdaptiveOdeOptions options_;
   VecX atol_;
-  VecX k_[7];
-  VecX x_old_, x_new_, stage_, err_;
+  AdaptiveOdeState state_;
+  // Work space, rewritten before it is read.
+  VecX x_new_, stage_, err_;
   VecX g_old_, g_new_, g_probe_, g_prev_, g_right_;
   VecX dense_;
-  double t_old_ = 0, h_old_ = 0;
-  double h_ = 0;
-  bool have_step_ = false;
   Index n_ = 0;
 };
 

@@ -24,8 +24,9 @@ double FlowWaveform::Evaluate(double t, double field_value) const {
   return 0;
 }
 
-Circuit::Circuit(std::vector<CompartmentSpec> compartments, std::vector<ConnectionSpec> connections)
-    : compartments_(std::move(compartments)), connections_(std::move(connections)) {
+Circuit::Circuit(std::vector<CompartmentSpec> compartments, std::vector<ConnectionSpec> connections,
+                 CircuitState& state)
+    : compartments_(std::move(compartments)), connections_(std::move(connections)), s_(state) {
   const int nc = num_compartments();
   GIPSI_CHECK(nc >= 1, "a circuit needs a compartment");
   for (const auto& c : compartments_) {
@@ -48,18 +49,18 @@ Circuit::Circuit(std::vector<CompartmentSpec> compartments, std::vector<Connecti
     flow_state_.push_back(c.inertial() ? size_++ : -1);
     if (c.kind == ConnectionSpec::Kind::kValve) valves_.push_back(i);
   }
-  states_.assign(valves_.size(), ValveState::kClosed);
-  cavity_volume_.assign(static_cast<std::size_t>(nc), 0.0);
-  cavity_rate_.assign(static_cast<std::size_t>(nc), 0.0);
-  cavity_time_.assign(static_cast<std::size_t>(nc), 0.0);
+  s_.valves.assign(valves_.size(), ValveState::kClosed);
+  s_.cavity_volume.assign(static_cast<std::size_t>(nc), 0.0);
+  s_.cavity_rate.assign(static_cast<std::size_t>(nc), 0.0);
+  s_.cavity_time.assign(static_cast<std::size_t>(nc), 0.0);
   for (int i = 0; i < nc; ++i)
-    cavity_volume_[static_cast<std::size_t>(i)] =
+    s_.cavity_volume[static_cast<std::size_t>(i)] =
         compartments_[static_cast<std::size_t>(i)].initial_cavity_volume;
-  chamber_pressure_.assign(static_cast<std::size_t>(nc), 0.0);
+  s_.chamber_pressure.assign(static_cast<std::size_t>(nc), 0.0);
   for (int i = 0; i < nc; ++i)
-    chamber_pressure_[static_cast<std::size_t>(i)] =
+    s_.chamber_pressure[static_cast<std::size_t>(i)] =
         compartments_[static_cast<std::size_t>(i)].initial_pressure;
-  source_value_.assign(connections_.size(), 0.0);
+  s_.source_value.assign(connections_.size(), 0.0);
   p_work_.setZero(nc);
   q_work_.setZero(num_connections());
 }
@@ -83,21 +84,21 @@ double Circuit::Elastance(int c, double t) const {
 
 double Circuit::CavityVolume(int c, double t) const {
   const auto i = static_cast<std::size_t>(c);
-  return cavity_volume_[i] + cavity_rate_[i] * (t - cavity_time_[i]);
+  return s_.cavity_volume[i] + s_.cavity_rate[i] * (t - s_.cavity_time[i]);
 }
 
 void Circuit::SetCavityVolume(int c, double volume, double t_written) {
   const auto i = static_cast<std::size_t>(c);
-  cavity_volume_[i] = volume;
-  cavity_time_[i] = t_written;
+  s_.cavity_volume[i] = volume;
+  s_.cavity_time[i] = t_written;
 }
 
 void Circuit::SetCavityVolumeRate(int c, double rate, double t_written) {
   const auto i = static_cast<std::size_t>(c);
   // Keep V_cav continuous at the time of writing: re-anchor the volume there.
-  cavity_volume_[i] = CavityVolume(c, t_written);
-  cavity_time_[i] = t_written;
-  cavity_rate_[i] = rate;
+  s_.cavity_volume[i] = CavityVolume(c, t_written);
+  s_.cavity_time[i] = t_written;
+  s_.cavity_rate[i] = rate;
 }
 
 void Circuit::CalcPressures(double t, Eigen::Ref<const VecX> x, Eigen::Ref<VecX> p) const {
@@ -114,7 +115,7 @@ void Circuit::CalcPressures(double t, Eigen::Ref<const VecX> x, Eigen::Ref<VecX>
             p[i] = (x[i] - CavityVolume(i, t)) / s.compliance;
             break;
           case CompartmentSpec::Drive::kPressure:
-            p[i] = chamber_pressure_[static_cast<std::size_t>(i)];
+            p[i] = s_.chamber_pressure[static_cast<std::size_t>(i)];
             break;
         }
         break;
@@ -135,9 +136,9 @@ void Circuit::CalcFlows(double t, Eigen::Ref<const VecX> x, Eigen::Ref<const Vec
     const auto& s = connections_[static_cast<std::size_t>(c)];
     bool open = true;
     if (s.kind == ConnectionSpec::Kind::kValve)
-      open = states_[static_cast<std::size_t>(valve++)] == ValveState::kOpen;
+      open = s_.valves[static_cast<std::size_t>(valve++)] == ValveState::kOpen;
     if (s.kind == ConnectionSpec::Kind::kSource) {
-      q[c] = s.source.Evaluate(t, source_value_[static_cast<std::size_t>(c)]);
+      q[c] = s.source.Evaluate(t, s_.source_value[static_cast<std::size_t>(c)]);
     } else if (!open) {
       q[c] = 0;
     } else if (flow_state(c) >= 0) {
@@ -160,7 +161,7 @@ void Circuit::CalcDerivative(double t, Eigen::Ref<const VecX> x, Eigen::Ref<VecX
     xdot[s.to] += q;
     bool open = true;
     if (s.kind == ConnectionSpec::Kind::kValve)
-      open = states_[static_cast<std::size_t>(valve++)] == ValveState::kOpen;
+      open = s_.valves[static_cast<std::size_t>(valve++)] == ValveState::kOpen;
     if (flow_state(c) >= 0)
       xdot[flow_state(c)] =
           open ? (p_work_[s.from] - p_work_[s.to] - s.resistance * q) / s.inertance : 0.0;
@@ -168,7 +169,7 @@ void Circuit::CalcDerivative(double t, Eigen::Ref<const VecX> x, Eigen::Ref<VecX
 }
 
 void Circuit::SwitchValve(int k, Eigen::Ref<VecX> x) {
-  auto& state = states_[static_cast<std::size_t>(k)];
+  auto& state = s_.valves[static_cast<std::size_t>(k)];
   state = NextValveState(state);
   const int c = valves_[static_cast<std::size_t>(k)];
   if (state == ValveState::kClosed && flow_state(c) >= 0) x[flow_state(c)] = 0;
@@ -180,7 +181,7 @@ void Circuit::InitialiseValves(double t, Eigen::Ref<VecX> x) {
     const auto& s = connections_[static_cast<std::size_t>(valves_[k])];
     const Index fs = flow_state(valves_[k]);
     const bool open = p_work_[s.from] > p_work_[s.to] || (fs >= 0 && x[fs] > 0);
-    states_[k] = open ? ValveState::kOpen : ValveState::kClosed;
+    s_.valves[k] = open ? ValveState::kOpen : ValveState::kClosed;
     if (!open && fs >= 0) x[fs] = 0;
   }
 }
@@ -196,7 +197,7 @@ void Circuit::Guards::Calc(double t, Eigen::Ref<const VecX> x, Eigen::Ref<VecX> 
     const Index fs = c.flow_state(conn);
     const double q = fs >= 0 ? x[fs] : 0.0;
     g[static_cast<Index>(k)] =
-        ValveGuard(c.states_[k], fs >= 0, c.p_work_[s.from] - c.p_work_[s.to], q);
+        ValveGuard(c.s_.valves[k], fs >= 0, c.p_work_[s.from] - c.p_work_[s.to], q);
   }
 }
 

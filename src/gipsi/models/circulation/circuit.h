@@ -22,14 +22,12 @@
 #include <vector>
 
 #include "gipsi/base/math.h"
+#include "gipsi/base/state_value.h"
 #include "gipsi/models/circulation/activation.h"
 #include "gipsi/models/circulation/valve.h"
 #include "gipsi/numerics/adaptive_ode.h"
 
 namespace gipsi {
-
-class StateReader;
-class StateWriter;
 
 /// A blood-holding compartment. Plain struct; copyable.
 struct CompartmentSpec {
@@ -76,15 +74,41 @@ struct ConnectionSpec {
   [[nodiscard]] bool inertial() const { return inertance > 0 && kind != Kind::kSource; }
 };
 
-/// The circuit: specs, valve states and external inputs, and its ODE. An OdeSystem. Not
-/// copyable or movable (its guards refer to it). CalcDerivative allocates nothing.
+/// The circuit's discrete state and its latest inputs, as a state value type
+/// (gipsi/base/state_value.h): every valve's state, and what connectors or events last wrote
+/// (cavity volumes with their rates and times, chamber pressures, source flows). All sized by
+/// the circuit. Copyable.
+struct CircuitState {
+  std::vector<ValveState> valves;  ///< per valve
+  /// Per compartment: the driving cavity's volume [m³], its rate [m³/s] and when they were
+  /// written [s]; the prescribed pressure of a pressure-driven chamber [Pa].
+  std::vector<double> cavity_volume, cavity_rate, cavity_time, chamber_pressure;
+  std::vector<double> source_value;  ///< per connection: a field-driven source's flow [m³/s]
+
+  template <class Self, class Visitor>
+  static void Fields(Self& s, Visitor& v) {
+    v("valves", s.valves, Shape::kFixed);
+    v("cavity_volume", s.cavity_volume, Shape::kFixed);
+    v("cavity_rate", s.cavity_rate, Shape::kFixed);
+    v("cavity_time", s.cavity_time, Shape::kFixed);
+    v("chamber_pressure", s.chamber_pressure, Shape::kFixed);
+    v("source_value", s.source_value, Shape::kFixed);
+  }
+};
+
+/// The circuit: specs and its ODE, reading and changing a CircuitState that lives elsewhere
+/// (in the Circulation's state). An OdeSystem. Not copyable or movable (its guards refer to it).
+/// CalcDerivative allocates nothing.
 class Circuit {
  public:
   Circuit(const Circuit&) = delete;
   Circuit& operator=(const Circuit&) = delete;
-  /// Preconditions (checked): indices in range, positive parameters where needed (the scene
-  /// factory reports bad input as InputError before this).
-  Circuit(std::vector<CompartmentSpec> compartments, std::vector<ConnectionSpec> connections);
+  /// Sizes `state` for these specs and sets it to the specs' initial inputs (valves closed
+  /// until InitialiseValves); `state` must outlive the circuit. Preconditions (checked): indices
+  /// in range, positive parameters where needed (the scene factory reports bad input as
+  /// InputError before this).
+  Circuit(std::vector<CompartmentSpec> compartments, std::vector<ConnectionSpec> connections,
+          CircuitState& state);
 
   [[nodiscard]] const std::vector<CompartmentSpec>& compartments() const { return compartments_; }
   [[nodiscard]] const std::vector<ConnectionSpec>& connections() const { return connections_; }
@@ -112,10 +136,12 @@ class Circuit {
   [[nodiscard]] double Elastance(int c, double t) const;
 
   // --- Valves (the hybrid part) ---
-  [[nodiscard]] ValveState valve_state(int k) const { return states_[static_cast<std::size_t>(k)]; }
+  [[nodiscard]] ValveState valve_state(int k) const {
+    return s_.valves[static_cast<std::size_t>(k)];
+  }
   /// Every valve's state (valve order), e.g. to undo a trial integration.
-  [[nodiscard]] const std::vector<ValveState>& valve_states() const { return states_; }
-  void SetValveStates(const std::vector<ValveState>& states) { states_ = states; }
+  [[nodiscard]] const std::vector<ValveState>& valve_states() const { return s_.valves; }
+  void SetValveStates(const std::vector<ValveState>& states) { s_.valves = states; }
   /// Switches valve k to its next state; a closing inertial valve's flow state is set to 0.
   void SwitchValve(int k, Eigen::Ref<VecX> x);
   /// Sets every valve's state from the pressures at (t, x) without events: open where the
@@ -130,18 +156,15 @@ class Circuit {
   void SetCavityVolumeRate(int c, double rate, double t_written);
   [[nodiscard]] double CavityVolume(int c, double t) const;
   [[nodiscard]] double CavityVolumeRate(int c) const {
-    return cavity_rate_[static_cast<std::size_t>(c)];
+    return s_.cavity_rate[static_cast<std::size_t>(c)];
   }
   /// Pressure-driven chamber c: p (held until written again).
-  void SetChamberPressure(int c, double p) { chamber_pressure_[static_cast<std::size_t>(c)] = p; }
+  void SetChamberPressure(int c, double p) { s_.chamber_pressure[static_cast<std::size_t>(c)] = p; }
   [[nodiscard]] double ChamberPressure(int c) const {
-    return chamber_pressure_[static_cast<std::size_t>(c)];
+    return s_.chamber_pressure[static_cast<std::size_t>(c)];
   }
   /// Field-driven source connection c.
-  void SetSourceFlow(int c, double q) { source_value_[static_cast<std::size_t>(c)] = q; }
-  /// Checkpoints (gipsi/base/state.h; defined in circulation_state.cc).
-  void SaveState(StateWriter& out) const;
-  void RestoreState(StateReader& in);
+  void SetSourceFlow(int c, double q) { s_.source_value[static_cast<std::size_t>(c)] = q; }
 
  private:
   class Guards final : public EventFunctions {
@@ -156,10 +179,7 @@ class Circuit {
   std::vector<ConnectionSpec> connections_;
   std::vector<int> valves_;
   std::vector<Index> flow_state_;
-  std::vector<ValveState> states_;                                 // per valve
-  std::vector<double> cavity_volume_, cavity_rate_, cavity_time_;  // per compartment
-  std::vector<double> chamber_pressure_;                           // per compartment
-  std::vector<double> source_value_;                               // per connection
+  CircuitState& s_;
   Index size_ = 0;
   Guards guards_{this};
   mutable VecX p_work_, q_work_;  // CalcDerivative/guards work space

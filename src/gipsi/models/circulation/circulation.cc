@@ -25,16 +25,19 @@ AdaptiveOdeOptions OdeOptions(const CirculationParams& p, const Circuit& circuit
 Circulation::Circulation(std::string name, CirculationParams params)
     : SimObject(std::move(name)),
       params_(std::move(params)),
-      circuit_(params_.compartments, params_.connections),
-      events_(params_.event_log_capacity) {
+      circuit_(params_.compartments, params_.connections, state_.circuit) {
   using L = FieldLocation;
   using A = FieldAccess;
-  x_ = circuit_.InitialState();
-  circuit_.InitialiseValves(0, x_);
+  state_.x = circuit_.InitialState();
+  circuit_.InitialiseValves(0, state_.x);
   ode_.Prepare(circuit_.ode_size(), static_cast<int>(circuit_.valves().size()),
                OdeOptions(params_, circuit_));
-  pressure_.setZero(circuit_.num_compartments());
-  flow_.setZero(circuit_.num_connections());
+  state_.ode = ode_.NewState();
+  trial_ode_ = ode_.NewState();
+  state_.pressure.setZero(circuit_.num_compartments());
+  state_.flow.setZero(circuit_.num_connections());
+  state_.events = Stamped<ValveEventLog>(ValveEventLog(params_.event_log_capacity));
+  BindState(state_);
 
   for (int c = 0; c < circuit_.num_compartments(); ++c) {
     const auto& s = circuit_.compartments()[static_cast<std::size_t>(c)];
@@ -135,34 +138,38 @@ const std::string& Circulation::valve_name(int k) const {
       .name;
 }
 
-double Circulation::total_volume() const { return x_.head(circuit_.num_compartments()).sum(); }
-
-void Circulation::UpdateOutputs(double t) {
-  circuit_.CalcPressures(t, x_, pressure_);
-  circuit_.CalcFlows(t, x_, pressure_, flow_);
+double Circulation::total_volume() const {
+  return state_.x.head(circuit_.num_compartments()).sum();
 }
 
-StepStatus Circulation::Integrate(AdaptiveOde& ode, double t, double dt, VecX& x, bool record) {
+void Circulation::UpdateOutputs(double t) {
+  circuit_.CalcPressures(t, state_.x, state_.pressure);
+  circuit_.CalcFlows(t, state_.x, state_.pressure, state_.flow);
+}
+
+StepStatus Circulation::Integrate(AdaptiveOdeState& memory, double t, double dt, VecX& x,
+                                  bool record) {
   const double t_end = t + dt;
   double now = t;
   const OdeView view(circuit_);
   int switches = 0;
   auto log_switch = [&](int k) {
     circuit_.SwitchValve(k, x);
-    if (record) events_.Record({now, k, circuit_.valve_state(k)});
+    if (record) state_.events.Write().Record({now, k, circuit_.valve_state(k)});
     return ++switches <= params_.max_events_per_step;
   };
   while (true) {
     // Transitions pending at the current point (after an external input changed a pressure,
     // or two valves switching at the same instant).
-    for (int k; (k = ode.FirstPositive(circuit_.guards(), now, x)) >= 0;)
+    for (int k; (k = ode_.FirstPositive(circuit_.guards(), now, x)) >= 0;)
       if (!log_switch(k))
         return StepStatus::Failed("valves switch without end within one step (chattering)", k, now);
-    const AdaptiveOdeResult result = ode.Integrate(view, now, t_end, x, &circuit_.guards());
+    const AdaptiveOdeResult result =
+        ode_.Integrate(memory, view, now, t_end, x, &circuit_.guards());
     if (record) {
-      accepted_ += result.accepted;
-      rejected_ += result.rejected;
-      evaluations_ += result.evaluations;
+      state_.accepted += result.accepted;
+      state_.rejected += result.rejected;
+      state_.evaluations += result.evaluations;
     }
     using Outcome = AdaptiveOdeResult::Outcome;
     if (result.outcome == Outcome::kEvent) {
@@ -186,14 +193,11 @@ bool Circulation::PredictChamberVolume(int c, double dt, double p, double& volum
   GIPSI_CHECK(c >= 0 && c < circuit_.num_compartments() &&
               circuit_.compartments()[static_cast<std::size_t>(c)].drive ==
                   CompartmentSpec::Drive::kPressure);
-  if (trial_x_.size() != x_.size())
-    trial_ode_.Prepare(circuit_.ode_size(), static_cast<int>(circuit_.valves().size()),
-                       OdeOptions(params_, circuit_));
-  trial_x_ = x_;
+  trial_x_ = state_.x;
   trial_valves_ = circuit_.valve_states();
   const double saved_pressure = circuit_.ChamberPressure(c);
   circuit_.SetChamberPressure(c, p);
-  trial_ode_.SetStepSize(ode_.next_step());
+  trial_ode_.next_step = state_.ode.next_step;
   const StepStatus status = Integrate(trial_ode_, time(), dt, trial_x_, false);
   circuit_.SetValveStates(trial_valves_);
   circuit_.SetChamberPressure(c, saved_pressure);
@@ -203,33 +207,33 @@ bool Circulation::PredictChamberVolume(int c, double dt, double p, double& volum
 
 void Circulation::SetVolume(int c, double volume) {
   GIPSI_CHECK(c >= 0 && c < circuit_.num_compartments());
-  x_[c] = volume;
-  circuit_.InitialiseValves(time(), x_);
+  state_.x[c] = volume;
+  circuit_.InitialiseValves(time(), state_.x);
   UpdateOutputs(time());
 }
 
 StepStatus Circulation::DoStep(double t, double dt) {
   failed_compartment_ = failed_connection_ = -1;
   const double t_end = t + dt;
-  if (StepStatus status = Integrate(ode_, t, dt, x_, true); !status.ok()) return status;
+  if (StepStatus status = Integrate(state_.ode, t, dt, state_.x, true); !status.ok()) return status;
   UpdateOutputs(t_end);
-  for (Index i = 0; i < x_.size(); ++i)
-    if (!std::isfinite(x_[i]))
-      return StepStatus::Diverged("circulation state became non-finite", i, x_[i]);
+  for (Index i = 0; i < state_.x.size(); ++i)
+    if (!std::isfinite(state_.x[i]))
+      return StepStatus::Diverged("circulation state became non-finite", i, state_.x[i]);
   // A non-finite input (e.g. a cavity volume) may leave the states finite while a pressure or
   // flow is not: report it rather than publish NaN.
-  for (Index i = 0; i < pressure_.size(); ++i) {
-    if (!std::isfinite(pressure_[i])) {
+  for (Index i = 0; i < state_.pressure.size(); ++i) {
+    if (!std::isfinite(state_.pressure[i])) {
       failed_compartment_ = static_cast<int>(i);
       return StepStatus::Diverged("compartment pressure is not finite (a non-finite input?)", i,
-                                  pressure_[i]);
+                                  state_.pressure[i]);
     }
   }
-  for (Index i = 0; i < flow_.size(); ++i) {
-    if (!std::isfinite(flow_[i])) {
+  for (Index i = 0; i < state_.flow.size(); ++i) {
+    if (!std::isfinite(state_.flow[i])) {
       failed_connection_ = static_cast<int>(i);
       return StepStatus::Diverged("connection flow is not finite (a non-finite input?)", i,
-                                  flow_[i]);
+                                  state_.flow[i]);
     }
   }
   if (params_.log_events) LogNewEvents();
@@ -248,25 +252,26 @@ std::string Circulation::failure_detail() const {
 
 std::vector<std::string> Circulation::DescribeValveEvents() const {
   std::vector<std::string> lines;
-  for (const ValveEvent& e : events_.Events())
+  for (const ValveEvent& e : state_.events.get().Events())
     lines.push_back(fmt::format("t = {:.6f} s: {} {}", e.time, valve_name(e.valve),
                                 e.state == ValveState::kOpen ? "opens" : "closes"));
   return lines;
 }
 
 void Circulation::LogNewEvents() {
-  if (events_.total() == logged_events_) return;
-  for (const ValveEvent& e : events_.EventsSince(logged_events_))
+  const ValveEventLog& events = state_.events.get();
+  if (events.total() == state_.logged_events) return;
+  for (const ValveEvent& e : events.EventsSince(state_.logged_events))
     Log().info("{}: t = {:.6f} s: valve {} {}", name(), e.time, valve_name(e.valve),
                e.state == ValveState::kOpen ? "opens" : "closes");
-  logged_events_ = events_.total();
+  state_.logged_events = events.total();
 }
 
 std::vector<SimObject::ProfileEntry> Circulation::ProfileBreakdown() const {
-  return {{"adaptive steps accepted", static_cast<double>(accepted_), ""},
-          {"adaptive steps rejected", static_cast<double>(rejected_), ""},
-          {"derivative evaluations", static_cast<double>(evaluations_), ""},
-          {"valve events", static_cast<double>(events_.total()), ""}};
+  return {{"adaptive steps accepted", static_cast<double>(state_.accepted), ""},
+          {"adaptive steps rejected", static_cast<double>(state_.rejected), ""},
+          {"derivative evaluations", static_cast<double>(state_.evaluations), ""},
+          {"valve events", static_cast<double>(state_.events.get().total()), ""}};
 }
 
 void Circulation::DoReadField(FieldId id, Eigen::Ref<Eigen::MatrixXd> out) const {
@@ -275,10 +280,10 @@ void Circulation::DoReadField(FieldId id, Eigen::Ref<Eigen::MatrixXd> out) const
   double value = 0;
   switch (f.quantity) {
     case Quantity::kPressure:
-      value = pressure_[i];
+      value = state_.pressure[i];
       break;
     case Quantity::kVolume:
-      value = x_[i];
+      value = state_.x[i];
       break;
     case Quantity::kElastance:
       value = circuit_.Elastance(i, time());
@@ -293,11 +298,12 @@ void Circulation::DoReadField(FieldId id, Eigen::Ref<Eigen::MatrixXd> out) const
       value = circuit_.ChamberPressure(i);
       break;
     case Quantity::kFlow:
-      value = flow_[i];
+      value = state_.flow[i];
       break;
     case Quantity::kPressureDrop: {
       const auto& s = circuit_.connections()[static_cast<std::size_t>(i)];
-      value = s.from >= 0 ? pressure_[s.from] - pressure_[s.to] : s.resistance * flow_[i];
+      value = s.from >= 0 ? state_.pressure[s.from] - state_.pressure[s.to]
+                          : s.resistance * state_.flow[i];
       break;
     }
     case Quantity::kValveOpen:
@@ -307,10 +313,10 @@ void Circulation::DoReadField(FieldId id, Eigen::Ref<Eigen::MatrixXd> out) const
       value = total_volume();
       break;
     case Quantity::kValveEvents:
-      value = static_cast<double>(events_.total());
+      value = static_cast<double>(state_.events.get().total());
       break;
     case Quantity::kSteps:
-      value = static_cast<double>(accepted_);
+      value = static_cast<double>(state_.accepted);
       break;
   }
   out(0, 0) = value;

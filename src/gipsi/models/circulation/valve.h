@@ -10,13 +10,11 @@
 /// A closed valve carries no flow at all (not a small leak): the circuit changes its equations.
 
 #include <cstdint>
+#include <string>
 #include <string_view>
 #include <vector>
 
 namespace gipsi {
-
-class StateReader;
-class StateWriter;
 
 /// The discrete state of a valve.
 enum class ValveState : std::uint8_t { kClosed, kOpen };
@@ -41,10 +39,19 @@ struct ValveEvent {
   double time = 0;  ///< [s]
   int valve = -1;
   ValveState state = ValveState::kClosed;
+
+  template <class Self, class Visitor>
+  static void Fields(Self& s, Visitor& v) {
+    v("time", s.time);
+    v("valve", s.valve);
+    v("state", s.state);
+  }
 };
 
-/// The record of valve transitions: a preallocated ring keeping the most recent `capacity`
-/// events, and the total count. Recording never allocates. Copyable and movable.
+/// The record of valve transitions: a ring keeping the most recent `capacity` events (its
+/// storage reserved up front, so recording never allocates), and the total count. A state
+/// value type (gipsi/base/state_value.h) whose fields are the kept events and the count: a copy
+/// moves only the events recorded, not the whole capacity. Copyable and movable.
 class ValveEventLog {
  public:
   explicit ValveEventLog(std::size_t capacity = 100000);
@@ -56,13 +63,21 @@ class ValveEventLog {
   [[nodiscard]] std::vector<ValveEvent> Events() const;
   /// The kept events with index ≥ `first` in the total numbering (for "what is new since").
   [[nodiscard]] std::vector<ValveEvent> EventsSince(std::int64_t first) const;
-  [[nodiscard]] std::size_t capacity() const { return ring_.size(); }
-  /// Checkpoints (gipsi/base/state.h; defined in circulation_state.cc).
-  void SaveState(StateWriter& out) const;
-  void RestoreState(StateReader& in);
+  [[nodiscard]] std::size_t capacity() const { return capacity_; }
+  /// Why a log read from a checkpoint cannot be this one's (more kept events than the
+  /// capacity, a count that disagrees with them, an unknown valve state or a valve index
+  /// outside [0, num_valves)); empty if it can.
+  [[nodiscard]] std::string Inconsistency(int num_valves) const;
+
+  template <class Self, class Visitor>
+  static void Fields(Self& s, Visitor& v) {
+    v("events", s.ring_);
+    v("total", s.total_);
+  }
 
  private:
-  std::vector<ValveEvent> ring_;
+  std::size_t capacity_;
+  std::vector<ValveEvent> ring_;  // min(total_, capacity_) events; event j at j % capacity_
   std::int64_t total_ = 0;
 };
 
