@@ -1,5 +1,6 @@
 #include "gipsi/models/mass_spring/mass_spring.h"
 
+#include <cmath>
 #include <random>
 
 #include <gtest/gtest.h>
@@ -15,7 +16,7 @@ std::shared_ptr<const Mesh> Box(int cells = 2) {
       MakeTetBox(Vec3::Zero(), Vec3(0.1, 0.1, 0.1), {cells, cells, cells}));
 }
 
-std::unique_ptr<ExplicitIntegrator> Make(const std::string& name) {
+std::unique_ptr<OdeIntegrator> Make(const std::string& name) {
   if (name == "ExplicitEuler") return std::make_unique<ExplicitEuler>();
   if (name == "RK4") return std::make_unique<RungeKutta4>();
   return std::make_unique<SymplecticEuler>();
@@ -212,6 +213,62 @@ TEST(MassSpring, ExponentialSpringSagsLessThanHookeUnderTheSameLoad) {
   const double strain = std::log1p(0.2 * 9.81 * 5 / (20 * 0.1)) / 5;
   EXPECT_NEAR(exponential, strain * 0.1, 1e-12);
   EXPECT_LT(exponential, hooke);
+}
+
+/// A chain of `n` springs (rest length 0.1 m, 100 N/m) hanging from a fixed top node, node
+/// masses 10 g, released unstretched.
+std::unique_ptr<MassSpring> HangingChain(int n, double drag,
+                                         std::unique_ptr<OdeIntegrator> integrator) {
+  Points nodes(3, n + 1);
+  for (int i = 0; i <= n; ++i) nodes.col(i) = Vec3(0, 0, -0.1 * i);
+  Eigen::Matrix2Xi springs(2, n);
+  for (int i = 0; i < n; ++i) springs.col(i) << i, i + 1;
+  MassSpringParams params;
+  params.stiffness = 100;
+  params.drag = drag;
+  auto chain = std::make_unique<MassSpring>("chain", nodes, springs, VecX::Constant(n + 1, 0.01),
+                                            params, std::move(integrator));
+  chain->boundary_conditions().Fix(0);
+  return chain;
+}
+
+TEST(MassSpring, BackwardEulerSettlesAHangingChainAtItsStaticSagBeyondTheExplicitLimit) {
+  // Spring i carries the n − i nodes below it: elongation m g (n − i) / k. Backward Euler's
+  // fixed point is f = 0, the static equilibrium; its slowest mode (ω ≈ 15/s) loses a factor
+  // 0.8 per step at Δt = 0.05 s, so after 400 steps only Newton's tolerance (1e-10 of the
+  // state) remains.
+  const int n = 10;
+  auto chain = HangingChain(n, 0.5, std::make_unique<BackwardEulerOde>());
+  const double dt = 0.05;
+  ASSERT_GT(dt, 5 * chain->stable_dt_estimate());
+  for (int k = 0; k < 400; ++k) ASSERT_TRUE(chain->Step(dt).ok()) << k << chain->failure_detail();
+  double z = 0;
+  for (int i = 0; i < n; ++i) {
+    z -= 0.1 + 0.01 * 9.81 * (n - i) / 100;
+    EXPECT_NEAR(chain->domain_positions()(2, i + 1), z, 1e-9) << "node " << i + 1;
+  }
+  // The explicit default (symplectic Euler) diverges at the same step.
+  auto explicit_chain = HangingChain(n, 0.5, std::make_unique<SymplecticEuler>());
+  bool diverged = false;
+  for (int k = 0; k < 400 && !diverged; ++k) diverged = !explicit_chain->Step(dt).ok();
+  EXPECT_TRUE(diverged);
+}
+
+TEST(MassSpring, BackwardEulerConvergesAtFirstOrderToAReferenceSolution) {
+  // Three springs released from rest for 0.2 s, undamped. Reference: RK4 at Δt = 1e-5 s
+  // (ω_max Δt ≈ 0.002, error ~1e-13). Backward Euler at ω_max Δt ≈ 0.09 and 0.045 is in its
+  // asymptotic regime: the error halves with the step (order 1 ± 0.1).
+  auto run = [](std::unique_ptr<OdeIntegrator> integrator, double dt) {
+    auto chain = HangingChain(3, 0, std::move(integrator));
+    const auto steps = std::lround(0.2 / dt);
+    for (long k = 0; k < steps; ++k) EXPECT_TRUE(chain->Step(dt).ok()) << chain->failure_detail();
+    return Points(chain->domain_positions());
+  };
+  const Points reference = run(std::make_unique<RungeKutta4>(), 1e-5);
+  const double e1 = (run(std::make_unique<BackwardEulerOde>(), 5e-4) - reference).norm();
+  const double e2 = (run(std::make_unique<BackwardEulerOde>(), 2.5e-4) - reference).norm();
+  EXPECT_NEAR(std::log2(e1 / e2), 1.0, 0.1) << e1 << " " << e2;
+  EXPECT_LT(e2, 1e-3);  // against a motion of ~3 cm amplitude
 }
 
 }  // namespace

@@ -1,7 +1,9 @@
 #include "gipsi/numerics/ode.h"
 
 #include <cmath>
+#include <limits>
 #include <numbers>
+#include <string>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -23,7 +25,7 @@ struct Oscillator {
 static_assert(OdeSystem<Oscillator>);
 
 /// |x(T) − exact| after integrating from q=1, v=0 with `steps` steps.
-double ErrorAtEnd(ExplicitIntegrator& integrator, int steps, double end = 1.0) {
+double ErrorAtEnd(OdeIntegrator& integrator, int steps, double end = 1.0) {
   Oscillator osc;
   VecX x(2);
   x << 1.0, 0.0;
@@ -36,7 +38,7 @@ double ErrorAtEnd(ExplicitIntegrator& integrator, int steps, double end = 1.0) {
 }
 
 /// Observed order from errors at dt and dt/2 over a sequence of refinements (last pair).
-double ObservedOrder(ExplicitIntegrator& integrator) {
+double ObservedOrder(OdeIntegrator& integrator) {
   const double e1 = ErrorAtEnd(integrator, 400);
   const double e2 = ErrorAtEnd(integrator, 800);
   return std::log2(e1 / e2);
@@ -129,6 +131,79 @@ TEST(SymplecticEulerDeathTest, RejectsSystemsWithoutPositions) {
   integrator.Prepare(1);
   VecX y = VecX::Ones(1);
   EXPECT_DEATH(integrator.Step(OdeView(decay), 0, 0.1, y), "mechanical system");
+}
+
+// --- BackwardEulerOde: implicit, through the same OdeSystem contract ---
+
+TEST(BackwardEulerOde, ConvergesAtFirstOrder) {
+  BackwardEulerOde integrator;
+  EXPECT_NEAR(ObservedOrder(integrator), 1.0, 0.05);
+}
+
+TEST(BackwardEulerOde, DampsTheOscillatorByItsClosedFormFactorFarBeyondTheExplicitLimit) {
+  // On x' = J x with J skew in the energy norm, backward Euler multiplies the energy by exactly
+  // 1 / (1 + ω²Δt²) per step. At ωΔt = 10 (explicit Euler would multiply it by 101) three steps
+  // leave 101⁻³. The Jacobian-vector products of a linear f are exact up to rounding
+  // (√ε relative, ~1e-8) and Newton iterates until its update is below 1e-10 of the state, so
+  // the factor holds to ~1e-9; 1e-7 leaves margin for three steps.
+  Oscillator osc;
+  BackwardEulerOde integrator;
+  integrator.Prepare(2);
+  VecX x(2);
+  x << 1.0, 0.0;
+  const double dt = 10 / osc.omega;
+  const double e0 = osc.Energy(x);
+  for (int k = 1; k <= 3; ++k) {
+    ASSERT_TRUE(integrator.Step(OdeView(osc), (k - 1) * dt, dt, x)) << integrator.failure();
+    const double expected = e0 * std::pow(1 + osc.omega * osc.omega * dt * dt, -k);
+    EXPECT_NEAR(osc.Energy(x), expected, 1e-7 * expected) << "step " << k;
+    EXPECT_LE(integrator.last_newton_iterations(), 3);
+  }
+}
+
+TEST(BackwardEulerOde, FollowsItsRecurrenceOnAStiffNonMechanicalEquation) {
+  // Prothero–Robinson y' = λ (y − cos t) − sin t with λ = −10⁴ and Δt = 0.01 (|λ|Δt = 100, a
+  // hundred times the explicit limit): the exact solution is cos t, and backward Euler's
+  // recurrence is y₊ = (y + Δt (−λ cos t₊ − sin t₊)) / (1 − λΔt), computed here directly.
+  struct ProtheroRobinson {
+    double lambda = -1e4;
+    Index ode_size() const { return 1; }
+    Index ode_num_positions() const { return 0; }
+    void CalcDerivative(double t, Eigen::Ref<const VecX> x, Eigen::Ref<VecX> xdot) const {
+      xdot[0] = lambda * (x[0] - std::cos(t)) - std::sin(t);
+    }
+  } system;
+  BackwardEulerOde integrator;
+  integrator.Prepare(1);
+  VecX y = VecX::Constant(1, 2.0);  // off the smooth solution: a fast transient first
+  double expected = 2.0;
+  const double dt = 0.01;
+  for (int k = 0; k < 100; ++k) {
+    const double t1 = (k + 1) * dt;
+    ASSERT_TRUE(integrator.Step(OdeView(system), k * dt, dt, y)) << integrator.failure();
+    expected =
+        (expected + dt * (-system.lambda * std::cos(t1) - std::sin(t1))) / (1 - system.lambda * dt);
+    EXPECT_NEAR(y[0], expected, 1e-9) << "step " << k;
+  }
+  // And it is on the smooth solution: |y − cos t| = O(Δt/|λ|) after the transient.
+  EXPECT_NEAR(y[0], std::cos(1.0), 1e-5);
+}
+
+TEST(BackwardEulerOde, AFailedSolveLeavesTheStateAndSaysWhy) {
+  // f is finite at the start but not beyond |x| > 1.5, where the predictor lands.
+  struct Blowup {
+    Index ode_size() const { return 1; }
+    Index ode_num_positions() const { return 0; }
+    void CalcDerivative(double, Eigen::Ref<const VecX> x, Eigen::Ref<VecX> xdot) const {
+      xdot[0] = std::abs(x[0]) > 1.5 ? std::numeric_limits<double>::quiet_NaN() : 10.0;
+    }
+  } system;
+  BackwardEulerOde integrator;
+  integrator.Prepare(1);
+  VecX y = VecX::Ones(1);
+  EXPECT_FALSE(integrator.Step(OdeView(system), 0, 0.1, y));
+  EXPECT_EQ(y[0], 1.0);
+  EXPECT_NE(integrator.failure().find("not finite"), std::string::npos) << integrator.failure();
 }
 
 }  // namespace

@@ -106,7 +106,7 @@ std::unique_ptr<Connector> TypeRegistry::CreateConnector(const std::string& name
   return connector;
 }
 
-std::unique_ptr<ExplicitIntegrator> TypeRegistry::CreateIntegrator(const JsonNode& where) const {
+std::unique_ptr<OdeIntegrator> TypeRegistry::CreateIntegrator(const JsonNode& where) const {
   return integrators.Get(where.AsString(), where)();
 }
 
@@ -130,6 +130,10 @@ void RegisterIntegrators(TypeRegistry& registry) {
       "semi-implicit Euler for mechanical systems, first order, energy stays bounded");
   registry.integrators.Register(
       "RK4", [] { return std::make_unique<RungeKutta4>(); }, "classic Runge-Kutta, fourth order");
+  registry.integrators.Register(
+      "BackwardEuler", [] { return std::make_unique<BackwardEulerOde>(); },
+      "implicit Euler, first order, no stability limit; Newton with matrix-free GMRES (the model "
+      "provides only its derivative)");
 }
 
 void TypeRegistry::LoadPlugin(const std::string& path) {

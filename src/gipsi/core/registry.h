@@ -26,7 +26,7 @@
 /// connector ports (Connector::UseField, …, RequireOrder; gipsi/core/port.h); 8: cell models
 /// and local models in tables a layer above declares (TypeRegistry::Table; CellModels,
 /// LocalModels).
-#define GIPSI_PLUGIN_ABI_VERSION 8
+#define GIPSI_PLUGIN_ABI_VERSION 9
 
 namespace gipsi {
 
@@ -88,7 +88,7 @@ struct ConnectorBuildContext {
 
 using ObjectFactory = std::function<std::unique_ptr<SimObject>(const ObjectBuildContext&)>;
 using ConnectorFactory = std::function<std::unique_ptr<Connector>(const ConnectorBuildContext&)>;
-using IntegratorFactory = std::function<std::unique_ptr<ExplicitIntegrator>()>;
+using IntegratorFactory = std::function<std::unique_ptr<OdeIntegrator>()>;
 /// Builds a material from its JSON object (the "law" key is already consumed).
 using MaterialFactory = std::function<std::shared_ptr<const Material>(const JsonNode&)>;
 /// Factories by type name, for one kind of product. Not copyable; movable.
@@ -178,7 +178,7 @@ class TypeRegistry {
                                                            const JsonNode& params,
                                                            const Coordinator& scope) const;
   /// The integrator named by the string at `where`.
-  [[nodiscard]] std::unique_ptr<ExplicitIntegrator> CreateIntegrator(const JsonNode& where) const;
+  [[nodiscard]] std::unique_ptr<OdeIntegrator> CreateIntegrator(const JsonNode& where) const;
 
   /// The material described by `node` ({"law": name, ...parameters}); throws InputError at the
   /// node unless the law exists and belongs to `family`.

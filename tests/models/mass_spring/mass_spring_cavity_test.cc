@@ -35,7 +35,7 @@ std::shared_ptr<const Mesh> Ventricle() {
 /// The mass-spring ventricle of the heart's "muscle_model": "mass_spring" (heart.cc), base held,
 /// rule-based fibres, the endocardium a cavity "lumen".
 std::unique_ptr<MassSpring> MassSpringVentricle(
-    std::unique_ptr<ExplicitIntegrator> integrator = std::make_unique<SymplecticEuler>()) {
+    std::unique_ptr<OdeIntegrator> integrator = std::make_unique<SymplecticEuler>()) {
   MassSpringParams params;
   params.stiffness = 11;
   params.law = std::make_shared<ExponentialSpring>(10);

@@ -35,8 +35,7 @@ Eigen::Matrix2Xi UniqueEdges(const Mesh& mesh) {
 }  // namespace
 
 MassSpring::MassSpring(std::string name, std::shared_ptr<const Mesh> domain,
-                       const MassSpringParams& params,
-                       std::unique_ptr<ExplicitIntegrator> integrator)
+                       const MassSpringParams& params, std::unique_ptr<OdeIntegrator> integrator)
     : SimObject(std::move(name)), params_(params), integrator_(std::move(integrator)) {
   GIPSI_CHECK(domain != nullptr && integrator_ != nullptr);
   const Mesh& mesh = *domain;
@@ -70,7 +69,7 @@ MassSpring::MassSpring(std::string name, std::shared_ptr<const Mesh> domain,
 
 MassSpring::MassSpring(std::string name, const Points& nodes, const Eigen::Matrix2Xi& springs,
                        const VecX& masses, const MassSpringParams& params,
-                       std::unique_ptr<ExplicitIntegrator> integrator)
+                       std::unique_ptr<OdeIntegrator> integrator)
     : SimObject(std::move(name)), params_(params), integrator_(std::move(integrator)) {
   GIPSI_CHECK(integrator_ != nullptr);
   const Index n = nodes.cols();
@@ -295,7 +294,10 @@ StepStatus MassSpring::DoStep(double t, double dt) {
   // With coupled cavities, the step with p = 0 for them, then their pressures (mass_spring.h).
   if (coupled) BeginCoupledStep();
   const StepOde ode{*this, coupled ? CoupledPressures::kLeftOut : CoupledPressures::kIncluded};
-  integrator_->Step(OdeView(ode), t, dt, state_.x);
+  if (!integrator_->Step(OdeView(ode), t, dt, state_.x)) {
+    failure_detail_ = fmt::format("{}: {}", integrator_->name(), integrator_->failure());
+    return StepStatus::Failed("the implicit integrator's solve failed (state left at the start)");
+  }
   if (coupled && !SolveCoupledCavities(t, dt))
     return StepStatus::Failed("the cavity pressure could not be solved with the blood");
   const Index n = num_nodes();

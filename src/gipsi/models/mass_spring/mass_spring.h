@@ -144,7 +144,7 @@ class MassSpring final : public SimObject, public CavityWall {
   /// lumped masses. Throws InputError if a node belongs to no element or a spring has zero rest
   /// length.
   MassSpring(std::string name, std::shared_ptr<const Mesh> domain, const MassSpringParams& params,
-             std::unique_ptr<ExplicitIntegrator> integrator);
+             std::unique_ptr<OdeIntegrator> integrator);
 
   /// A spring network without elements (a thread, a chain, a single spring): `nodes` 3 by N,
   /// `springs` 2 by S node pairs, `masses` N positive masses [kg]. Every node is a boundary
@@ -152,7 +152,7 @@ class MassSpring final : public SimObject, public CavityWall {
   /// `thickness` are unused. Throws InputError for bad indices, zero rest lengths or masses.
   MassSpring(std::string name, const Points& nodes, const Eigen::Matrix2Xi& springs,
              const VecX& masses, const MassSpringParams& params,
-             std::unique_ptr<ExplicitIntegrator> integrator);
+             std::unique_ptr<OdeIntegrator> integrator);
 
   [[nodiscard]] std::string_view type_name() const override { return "MassSpring"; }
   [[nodiscard]] const Points& domain_positions() const override { return positions_; }
@@ -173,6 +173,8 @@ class MassSpring final : public SimObject, public CavityWall {
   [[nodiscard]] const VecX& masses() const { return mass_; }
   [[nodiscard]] const VecX& rest_lengths() const { return rest_length_; }
   [[nodiscard]] const MassSpringParams& params() const { return params_; }
+  /// The integrator that steps [q; v] (any OdeIntegrator: explicit or implicit).
+  [[nodiscard]] const OdeIntegrator& integrator() const { return *integrator_; }
   /// Full state [q; v] (6N).
   [[nodiscard]] const MassSpringState& state() const { return state_; }
   /// Largest stable explicit time step estimate at rest, 2 / ω_max with ω_max² ≈ 4 max_i Σ k / m_i
@@ -246,7 +248,7 @@ class MassSpring final : public SimObject, public CavityWall {
 
   MassSpringParams params_;
   bool hooke_ = true;  // params_.law is HookeSpring (inlined in CalcForces)
-  std::unique_ptr<ExplicitIntegrator> integrator_;
+  std::unique_ptr<OdeIntegrator> integrator_;
   Eigen::Matrix2Xi springs_;
   VecX rest_length_;
   VecX mass_;
