@@ -151,11 +151,6 @@ class AdaptiveOde {
   [[nodiscard]] double step_end() const { return state_.t_old + state_.h_old; }
   /// The step size the controller proposes next (0 before the first step).
   [[nodiscard]] double next_step() const { return state_.next_step; }
-  /// Forgets the step-size guess (e.g. after a discontinuity in the model).
-  void ResetStepSize() { state_.next_step = 0; }
-  /// Sets the step-size guess (0: choose one): a second integrator started like this one
-  /// repeats its steps exactly (trial integrations).
-  void SetStepSize(double h) { state_.next_step = h; }
 
  private:
   double InitialStep(AdaptiveOdeState& m, const OdeView& system, double t, double t_end,
