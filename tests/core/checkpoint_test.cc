@@ -204,6 +204,10 @@ TEST(Resume, FemIsBitwiseIdentical) {
   ExpectBitwiseResume("cantilever.json", "fem", 0.05, 0.07, 0.12);
 }
 
+TEST(Resume, FemThroughTheOdeContractIsBitwiseIdentical) {
+  ExpectBitwiseResume("cantilever_explicit.json", "fem_ode", 0.05, 0.07, 0.12);
+}
+
 TEST(Resume, MonodomainIsBitwiseIdentical) {
   ExpectBitwiseResume("slab_ep_grid_0.5mm.json", "ep", 0.001, 0.0015, 0.003);
 }

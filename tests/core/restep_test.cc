@@ -137,6 +137,7 @@ TEST(Restep, FromOneSnapshotEveryBuiltInTypeIsBitwise) {
                {"block_drop.json", 0.15, 0.2},
                {"coupled_blocks.json", 0.02, 0.03},
                {"cantilever.json", 0.05, 0.08},
+               {"cantilever_explicit.json", 0.05, 0.08},
                {"land_beam.json", 0, 1},
                {"land_beam_p2.json", 0, 1},
                {"probe_indentation.json", 0.5, 0.6},
@@ -168,6 +169,11 @@ TEST(Restep, AggregateWithBoundaryCouplingIsBitwise) {
 }
 
 TEST(Restep, FemSolidDynamicIsBitwise) { ExpectRestepIsBitwise("cantilever.json", 0.05, 0.08); }
+
+TEST(Restep, FemSolidThroughTheOdeContractIsBitwise) {
+  // RK4 steps the solid (fem_solid_ode.cc): its [u; v] is packed from the state every step.
+  ExpectRestepIsBitwise("cantilever_explicit.json", 0.05, 0.08);
+}
 
 TEST(Restep, FemSolidQuasiStaticNewtonIsBitwise) {
   // The Land et al. Guccione beam (Static, 10 load steps, Newton with the natural monotonicity

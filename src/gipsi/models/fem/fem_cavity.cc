@@ -50,6 +50,12 @@ void FemSolid::AttachCavityLaw(std::string_view cavity, CavityLaw* law) {
   GIPSI_CHECK(law != nullptr);
   const std::size_t i =
       FindUncoupledCavity(name(), type_name(), params_.cavities, cavities_, cavity);
+  if (ode_integrator_)
+    throw InputError(fmt::format(
+        "object '{}' (FemSolid): cavity '{}' coupled to blood needs an implicit scheme "
+        "(\"integrator\": \"BackwardEuler\", \"BDF2\" or \"Newmark\"), which solves the pressure "
+        "with the wall; '{}' cannot",
+        name(), cavity, ode_integrator_->name()));
   cavities_[i].law = law;
   cavity_follower_tangent_ = newton_->linear_solver().AcceptIndefinite();
   if (!cavity_follower_tangent_)

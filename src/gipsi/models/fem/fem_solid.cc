@@ -570,6 +570,7 @@ StepStatus FemSolid::Advance(double s0, double s1, double dt, int depth) {
 }
 
 StepStatus FemSolid::DoStep(double t, double dt) {
+  if (ode_integrator_) return StepOde(t, dt);
   step_time_ = t;
   step_dt_ = dt;
   failed_cavity_ = -1;

@@ -19,7 +19,11 @@
 /// the step is then abandoned (the state of its start restored) and reported as stopped.
 /// Kinematic boundary conditions (displacement, velocity per axis on boundary vertices) are
 /// imposed exactly; reaction forces are readable as the boundary field "reaction_force".
-/// Units: SI (m, kg, s, N, Pa).
+/// Alternatively the solid is an OdeSystem (numerics/ode.h) and any OdeIntegrator steps it
+/// (explicit dynamics, fem_solid_ode.cc): y = [u; v], ẏ = [v; M_L⁻¹(f_ext − f_int − C v)] with
+/// the lumped mass, C = α M_L + β K(u) at the stage's state, loads interpolated linearly in time
+/// over the step, and constrained axes moving at their prescribed velocity (displacement targets
+/// reached exactly at the step's end). Units: SI (m, kg, s, N, Pa).
 
 #include <array>
 #include <chrono>
@@ -37,6 +41,7 @@
 #include "gipsi/models/wall_cavity.h"
 #include "gipsi/numerics/implicit_scheme.h"
 #include "gipsi/numerics/newton.h"
+#include "gipsi/numerics/ode.h"
 
 namespace gipsi {
 
@@ -82,6 +87,11 @@ class FemSolid final : public SimObject, public CavityWall {
   /// Throws InputError for a mesh without tets, inverted/degenerate tets, a missing material,
   /// or a non-positive density.
   FemSolid(std::string name, std::shared_ptr<const Mesh> domain, FemParams params);
+  /// Stepped by `integrator` through the OdeSystem contract instead of an implicit scheme
+  /// (params.scheme, newton, linear_solver, load_steps, max_bisections and predict_velocity are
+  /// then unused). Also throws InputError unless params.lumped_mass: the ODE needs M⁻¹.
+  FemSolid(std::string name, std::shared_ptr<const Mesh> domain, FemParams params,
+           std::unique_ptr<OdeIntegrator> integrator);
 
   [[nodiscard]] std::string_view type_name() const override { return "FemSolid"; }
   [[nodiscard]] const Points& domain_positions() const override { return positions_; }
@@ -112,6 +122,19 @@ class FemSolid final : public SimObject, public CavityWall {
   void RestoreObjectState(StateReader& in) override;
   /// The state that evolves (fem_state.h).
   [[nodiscard]] const FemState& state() const { return state_; }
+
+  /// The OdeSystem contract (y = [u; v], 6N; fem_solid_ode.cc). CalcDerivative evaluates the
+  /// loads at the fraction (t − t_n)/Δt of the step in progress (1 outside a step), and gives
+  /// constrained axes zero acceleration. An element outside its law's domain at a stage makes
+  /// the step fail after the integrator returns (the state is then left at the step's start).
+  [[nodiscard]] Index ode_size() const { return 6 * num_nodes(); }
+  [[nodiscard]] Index ode_num_positions() const { return 3 * num_nodes(); }
+  void CalcDerivative(double t, Eigen::Ref<const VecX> y, Eigen::Ref<VecX> ydot) const;
+  /// The integrator that steps the ODE, or null when an implicit scheme does.
+  [[nodiscard]] const OdeIntegrator* ode_integrator() const { return ode_integrator_.get(); }
+  /// Stability limit of explicit (central-difference-like) steps, 2/ω_max, with ω_max² bounded
+  /// by the largest Gershgorin row sum of M_L⁻¹ K at the rest shape [s]: conservative.
+  [[nodiscard]] double stable_dt_estimate() const;
 
   /// Internal forces f_int(x) (3N) for positions x (3N); false if an element is outside its
   /// law's domain. For tests and connectors.
@@ -176,6 +199,8 @@ class FemSolid final : public SimObject, public CavityWall {
   /// Reads the boundary conditions into the step's targets.
   void GatherTargets();
   StepStatus Advance(double s0, double s1, double dt, int depth);
+  /// A step through the OdeSystem contract (fem_solid_ode.cc).
+  StepStatus StepOde(double t, double dt);
   [[nodiscard]] MaterialPoint PointOf(Index e) const;
   /// J −= sym(∂f/∂x) of face f's follower pressure p and traction t at displacements u.
   void AddFaceLoadTangent(Index f, const double* u, double p, const Vec3& t, double* jv) const;
@@ -197,15 +222,21 @@ class FemSolid final : public SimObject, public CavityWall {
   FemParams params_;
   TetAssembly assembly_;
   const SolidMaterial* law_ = nullptr;
-  VecX lumped_mass_;        // per node
-  SparseMatrix mass_;       // consistent mass (pattern layout); empty values if lumped
-  SparseMatrix jac_;        // Newton matrix
-  SparseMatrix damping_k_;  // K_n for Rayleigh β
-  FemState state_;          // everything that evolves (fem_state.h)
+  VecX lumped_mass_;   // per node
+  SparseMatrix mass_;  // consistent mass (pattern layout); empty values if lumped
+  SparseMatrix jac_;   // Newton matrix
+  // K_n for Rayleigh β (implicit schemes); the stage tangent K(u) under an ODE integrator.
+  mutable SparseMatrix damping_k_;
+  FemState state_;  // everything that evolves (fem_state.h)
   ImplicitScheme saved_scheme_;
   ImplicitScheme begin_scheme_;  // at the start of the step (a stop abandons the step)
   std::unique_ptr<NewtonSolver> newton_;
   FemProfile profile_;
+  // Explicit dynamics through the ODE contract (null: the implicit scheme steps).
+  std::unique_ptr<OdeIntegrator> ode_integrator_;
+  VecX ode_y_;                        // 6N: [u; v] of the step in progress (work)
+  double ode_t0_ = 0, ode_dt_ = 0;    // the step in progress (dt 0: loads at s = 1)
+  mutable bool ode_invalid_ = false;  // a stage met an element outside its law's domain
 
   // This step's loads (s = 1; the previous step's, s = 0, are state), interpolated at the
   // increment's load fraction.

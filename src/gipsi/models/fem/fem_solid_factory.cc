@@ -1,9 +1,13 @@
 /// @file
 /// Scene-file factory of "FemSolid" (its keys are documented in docs/scene-format.md).
 
+#include <algorithm>
+
 #include <fmt/format.h>
 
 #include "gipsi/base/error.h"
+#include "gipsi/base/log.h"
+#include "gipsi/base/units.h"
 #include "gipsi/geometry/region_json.h"
 #include "gipsi/models/fem/fem_local_model.h"
 #include "gipsi/models/fem/fem_solid.h"
@@ -13,12 +17,25 @@
 namespace gipsi {
 namespace {
 
-ImplicitSchemeKind ParseScheme(const JsonNode& node) {
-  const std::string name = node.AsChoice({"Static", "BackwardEuler", "BDF2", "Newmark"});
-  if (name == "Static") return ImplicitSchemeKind::kStatic;
-  if (name == "BDF2") return ImplicitSchemeKind::kBdf2;
-  if (name == "Newmark") return ImplicitSchemeKind::kNewmark;
-  return ImplicitSchemeKind::kBackwardEuler;
+/// "integrator": one of FemSolid's implicit schemes (assembled tangent, Newton), or any other
+/// integrator of the registry (RK4, SymplecticEuler, …), which steps the solid through the
+/// OdeSystem contract (returned; the scheme is then unused).
+std::unique_ptr<OdeIntegrator> ParseIntegrator(const JsonNode& node, const TypeRegistry& registry,
+                                               ImplicitSchemeKind& scheme) {
+  const std::string name = node.AsString();
+  if (name == "Static") scheme = ImplicitSchemeKind::kStatic;
+  if (name == "BackwardEuler") scheme = ImplicitSchemeKind::kBackwardEuler;
+  if (name == "BDF2") scheme = ImplicitSchemeKind::kBdf2;
+  if (name == "Newmark") scheme = ImplicitSchemeKind::kNewmark;
+  if (name == "Static" || name == "BackwardEuler" || name == "BDF2" || name == "Newmark")
+    return nullptr;
+  if (!registry.integrators.Contains(name)) {
+    std::vector<std::string> known = {"BDF2", "BackwardEuler", "Newmark", "Static"};
+    for (const std::string& other : registry.integrators.Names())
+      if (std::find(known.begin(), known.end(), other) == known.end()) known.push_back(other);
+    FailUnknown("integrator", name, known, node);
+  }
+  return registry.CreateIntegrator(node);
 }
 
 }  // namespace
@@ -83,7 +100,21 @@ void RegisterFemSolid(TypeRegistry& registry) {
           params.rayleigh_stiffness = damping->NonNegative("stiffness", 0);
         }
         params.gravity = p.Vector3("gravity", params.gravity);
-        if (auto integrator = p.Find("integrator")) params.scheme = ParseScheme(*integrator);
+        std::unique_ptr<OdeIntegrator> ode;
+        if (auto integrator = p.Find("integrator"))
+          ode = ParseIntegrator(*integrator, ctx.registry, params.scheme);
+        if (ode) {
+          if (!p.Has("mass")) params.lumped_mass = true;  // explicit dynamics' usual mass
+          // Keys of the implicit schemes would silently do nothing: refuse them.
+          for (const char* key :
+               {"newmark", "newton", "linear_solver", "load_steps", "max_bisections", "predictor"})
+            if (auto unused = p.Find(key))
+              unused->Fail(fmt::format(
+                  "has no effect with integrator '{}' (explicit dynamics through the ODE "
+                  "contract); remove it, or choose an implicit scheme (\"BackwardEuler\", "
+                  "\"BDF2\", \"Newmark\", \"Static\")",
+                  ode->name()));
+        }
         if (auto newmark = p.Find("newmark")) {
           newmark->CheckKeys({"beta", "gamma"});
           params.newmark_beta = newmark->Positive("beta", params.newmark_beta);
@@ -118,18 +149,30 @@ void RegisterFemSolid(TypeRegistry& registry) {
                   params.material->law()));
         }
         if (auto cavities = p.Find("cavities")) params.cavities = ParseCavitySpecs(*cavities);
+        std::unique_ptr<FemSolid> solid;
         try {
           auto mesh = ctx.DomainMesh();
-          auto solid = std::make_unique<FemSolid>(ctx.name, mesh, std::move(params));
+          solid =
+              ode ? std::make_unique<FemSolid>(ctx.name, mesh, std::move(params), std::move(ode))
+                  : std::make_unique<FemSolid>(ctx.name, mesh, std::move(params));
           if (fibre_rule)
             solid->WriteField(solid->FindField("fibre"),
                               MakeTransmuralFibres(*mesh, *fibre_rule).fibre);
-          return solid;
         } catch (const InputError& e) {
           p.Fail(e.what());
         }
+        if (auto dt = p.Find("dt");
+            dt && solid->ode_integrator() && solid->ode_integrator()->is_explicit()) {
+          const double value = ReadPositiveQuantity(*dt, "s");
+          const double limit = solid->stable_dt_estimate();
+          if (value > limit)
+            Log().warn("{}: dt = {:.3g} s exceeds the estimated explicit stability limit {:.3g} s",
+                       dt->path(), value, limit);
+        }
+        return solid;
       },
-      "nonlinear solid mechanics on P1 tetrahedra with implicit time stepping");
+      "nonlinear solid mechanics on P1 tetrahedra with implicit time stepping, or explicit through "
+      "the ODE contract");
 }
 
 }  // namespace gipsi
