@@ -502,9 +502,8 @@ int Validate(const std::string& file, const std::vector<std::string>& plugins,
 }
 
 int Info(const std::string& file) {
-  gipsi::MeshFileIds ids;
-  gipsi::Mesh mesh = gipsi::ReadMesh(file, &ids);
-  std::cout << file << "\n" << gipsi::DescribeMesh(mesh, &ids);
+  gipsi::Mesh mesh = gipsi::ReadMesh(file);
+  std::cout << file << "\n" << gipsi::DescribeMesh(mesh);
   return 0;
 }
 

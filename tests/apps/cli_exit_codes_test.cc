@@ -328,9 +328,18 @@ TEST(GipsiInfo, NamesTetsByTheFilesOwnIds) {
   EXPECT_EQ(validate.code, 0) << validate.output;
   EXPECT_THAT(validate.output,
               HasSubstr("two.json: objects.tets: 1 of 2 tets of the domain are inverted "
-                        "(negative volume in node order 0-1-2-3; the first is tet 1, counting "
-                        "from 0): volume preservation would push them further inside out; fix "
-                        "the mesh's node order (`gipsi info` lists them)"));
+                        "(negative volume in node order 0-1-2-3; the first is tet 9 (Gmsh "
+                        "element tag)): volume preservation would push them further inside "
+                        "out; fix the mesh's node order (`gipsi info` lists them)"));
+  // A FemSolid refuses it, naming the tet as the file does (it used to say "elements 1").
+  std::ofstream(dir / "fem.json") << R"({"meshes": {"two": {"file": "two.msh"}},
+    "objects": {"tets": {"type": "FemSolid", "domain": "two", "dt": 0.001,
+      "material": {"law": "Linear", "youngs_modulus": 1e4, "poisson_ratio": 0.3}}},
+    "schedule": {"end": 1}})";
+  const Result fem = Gipsi("validate " + (dir / "fem.json").string());
+  EXPECT_NE(fem.code, 0) << fem.output;
+  EXPECT_THAT(fem.output, HasSubstr("1 tetrahedra are inverted or degenerate (non-positive rest "
+                                    "volume), e.g. tets 9 (Gmsh element tags)"));
   // A format without ids of its own says which ids it prints.
   std::ofstream(dir / "two.vtk")
       << "# vtk DataFile Version 3.0\ntwo\nASCII\nDATASET UNSTRUCTURED_GRID\nPOINTS 5 double\n"

@@ -36,6 +36,10 @@ const MeshGroup* Mesh::FindGroup(std::string_view name) const {
   return nullptr;
 }
 
+std::string Mesh::TetName(Index e) const {
+  return fmt::format("tet {} ({})", TetId(e), TetIdKind());
+}
+
 void Mesh::Validate(std::string_view source) const {
   if (!nodes.allFinite()) {
     for (Index i = 0; i < nodes.cols(); ++i)
@@ -44,6 +48,8 @@ void Mesh::Validate(std::string_view source) const {
   }
   CheckConnectivity(tets, num_nodes(), "tetrahedron", source);
   CheckConnectivity(triangles, num_nodes(), "triangle", source);
+  if (!tet_ids.empty() && static_cast<Index>(tet_ids.size()) != num_tets())
+    ThrowInputError(source, "", fmt::format("{} tet ids for {} tets", tet_ids.size(), num_tets()));
   std::set<std::string> names;
   for (const auto& g : groups) {
     if (!names.insert(g.name).second)

@@ -4,6 +4,7 @@
 /// object is built on: nodes, tetrahedra and/or triangles, and named groups (Gmsh physical
 /// groups, VTK/TetGen region markers). Shared between objects as `std::shared_ptr<const Mesh>`.
 
+#include <cstdint>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -27,16 +28,33 @@ struct Mesh {
   Tets tets = Tets(4, 0);                 ///< 4 by E node indices of each tetrahedron
   Triangles triangles = Triangles(3, 0);  ///< 3 by T node indices of each triangle
   std::vector<MeshGroup> groups;          ///< named groups, unique names
+  /// The mesh file's own id of each tet (Gmsh element tags), and what the ids are (singular,
+  /// e.g. "Gmsh element tag"); empty for generated meshes and formats without ids, whose tets
+  /// are named by their 0-based index. Messages name tets through TetName.
+  std::vector<std::int64_t> tet_ids;
+  std::string tet_id_kind;
 
   [[nodiscard]] Index num_nodes() const { return nodes.cols(); }
   [[nodiscard]] Index num_tets() const { return tets.cols(); }
   [[nodiscard]] Index num_triangles() const { return triangles.cols(); }
 
+  /// Tet e's id: its id in the mesh file, or e without file ids.
+  [[nodiscard]] std::int64_t TetId(Index e) const {
+    return tet_ids.empty() ? e : tet_ids[static_cast<std::size_t>(e)];
+  }
+  /// What TetId is, for messages: "Gmsh element tag" or "0-based index".
+  [[nodiscard]] std::string_view TetIdKind() const {
+    return tet_ids.empty() ? std::string_view("0-based index") : std::string_view(tet_id_kind);
+  }
+  /// Tet e as messages name it: "tet 813 (Gmsh element tag)" or "tet 12 (0-based index)".
+  [[nodiscard]] std::string TetName(Index e) const;
+
   /// The group called `name`, or nullptr.
   [[nodiscard]] const MeshGroup* FindGroup(std::string_view name) const;
 
   /// Throws InputError (naming `source`) unless: coordinates are finite, every index is in
-  /// range, no element repeats a node, every group refers to existing items.
+  /// range, no element repeats a node, every group refers to existing items, and tet_ids is
+  /// empty or has one id per tet.
   void Validate(std::string_view source) const;
 
   /// Drops nodes no element refers to (keeps all when there are no elements) and renumbers

@@ -26,12 +26,13 @@ std::string LowerExtension(const std::filesystem::path& path) {
 }
 
 /// The reader for `path`'s extension; Gmsh files also give their tet tags.
-Mesh ReadByExtension(const std::filesystem::path& path, MeshFileIds* ids) {
+Mesh ReadByExtension(const std::filesystem::path& path) {
   const std::string ext = LowerExtension(path);
   if (ext == ".msh") {
-    if (!ids) return ReadGmsh(path);
-    Mesh mesh = ReadGmsh(path, &ids->tets);
-    ids->kind = "Gmsh element tags";
+    std::vector<std::int64_t> tags;
+    Mesh mesh = ReadGmsh(path, &tags);
+    mesh.tet_ids = std::move(tags);
+    mesh.tet_id_kind = "Gmsh element tag";
     return mesh;
   }
   if (ext == ".node" || ext == ".ele" || ext == ".face") return ReadTetGen(path);
@@ -47,11 +48,8 @@ Mesh ReadByExtension(const std::filesystem::path& path, MeshFileIds* ids) {
 
 }  // namespace
 
-Mesh ReadMesh(const std::filesystem::path& path) { return ReadMesh(path, nullptr); }
-
-Mesh ReadMesh(const std::filesystem::path& path, MeshFileIds* ids) {
-  if (ids) *ids = MeshFileIds{{}, "0-based indices in file order"};
-  Mesh mesh = ReadByExtension(path, ids);
+Mesh ReadMesh(const std::filesystem::path& path) {
+  Mesh mesh = ReadByExtension(path);
   // Some formats (OBJ) skip lines they do not know, so a file of another format, or an empty
   // one, reads as a mesh without nodes: never what was meant.
   if (mesh.num_nodes() == 0)

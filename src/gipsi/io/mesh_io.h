@@ -19,24 +19,9 @@ namespace gipsi {
 ///  - `.obj`: Wavefront OBJ surface (`ReadObj`);
 ///  - `.stl`: STL surface, ASCII or binary, vertices welded with the default tolerance (`ReadStl`).
 /// Throws InputError for an unknown extension (listing the supported ones), a missing file or
-/// any format error (see each reader). The result has passed `Mesh::Validate`.
+/// any format error (see each reader). The result has passed `Mesh::Validate`. Gmsh files also
+/// give their element tags as `Mesh::tet_ids`, so messages name tets as the file does.
 Mesh ReadMesh(const std::filesystem::path& path);
-
-/// How a mesh file names its tets, for messages: `tets[e]` is the file's own id of tet e (Gmsh:
-/// its element tag), and `kind` says what the ids are. Plain struct.
-struct MeshFileIds {
-  std::vector<std::int64_t> tets;
-  std::string kind;  ///< e.g. "Gmsh element tags"; empty when the file has no ids of its own
-  /// Tet `e`'s id in the file, or `e` itself (the 0-based index in the mesh) without them.
-  [[nodiscard]] std::int64_t Tet(Index e) const {
-    return tets.empty() ? e : tets[static_cast<std::size_t>(e)];
-  }
-};
-
-/// ReadMesh, also filling `ids` with the file's own tet ids where the format has them (Gmsh
-/// element tags); for the other formats `ids->tets` stays empty and `ids->kind` says the ids
-/// are 0-based indices in file order.
-Mesh ReadMesh(const std::filesystem::path& path, MeshFileIds* ids);
 
 /// Writes `mesh`, choosing the writer by the (case-insensitive) extension of `path`:
 ///  - `.vtu`: tets and triangles as one unstructured grid (`WriteVtu`);

@@ -12,22 +12,20 @@ namespace gipsi {
 namespace {
 
 /// The first ten tets of `tets` by their file ids, and what kind of ids they are.
-std::string IdList(const std::vector<int>& tets, const MeshFileIds& ids) {
+std::string IdList(const std::vector<int>& tets, const Mesh& mesh) {
   std::string out;
   for (std::size_t i = 0; i < tets.size() && i < 10; ++i)
-    out += fmt::format("{}{}", i ? ", " : "", ids.Tet(tets[i]));
+    out += fmt::format("{}{}", i ? ", " : "", mesh.TetId(tets[i]));
   if (tets.size() > 10) out += fmt::format(", ... ({} more)", tets.size() - 10);
-  return out + " (" + ids.kind + ")";
+  return out + " (" +
+         (mesh.tet_ids.empty() ? std::string("0-based indices in file order")
+                               : mesh.tet_id_kind + "s") +
+         ")";
 }
 
 }  // namespace
 
-std::string DescribeMesh(const Mesh& mesh, const MeshFileIds* file_ids) {
-  const MeshFileIds ids = file_ids &&
-                                  static_cast<Index>(file_ids->tets.size()) == mesh.num_tets() &&
-                                  !file_ids->kind.empty()
-                              ? *file_ids
-                              : MeshFileIds{{}, "0-based indices in file order"};
+std::string DescribeMesh(const Mesh& mesh) {
   std::string out;
   out += fmt::format("nodes:           {}\n", mesh.num_nodes());
   out += fmt::format("tetrahedra:      {}\n", mesh.num_tets());
@@ -71,14 +69,14 @@ std::string DescribeMesh(const Mesh& mesh, const MeshFileIds* file_ids) {
     out += "quality:\n";
     out += fmt::format("  volume:         {:.6g} (element min {:.4g}, max {:.4g})\n",
                        q.total_volume, q.min_volume, q.max_volume);
-    out += fmt::format(
-        "  aspect ratio:   min {:.4g}, mean {:.4g}, max {:.4g} (tet {})\n", q.min_aspect,
-        q.mean_aspect, q.max_aspect,
-        q.worst_aspect_tet < 0 ? std::string("-") : fmt::format("{}", ids.Tet(q.worst_aspect_tet)));
+    out += fmt::format("  aspect ratio:   min {:.4g}, mean {:.4g}, max {:.4g} (tet {})\n",
+                       q.min_aspect, q.mean_aspect, q.max_aspect,
+                       q.worst_aspect_tet < 0 ? std::string("-")
+                                              : fmt::format("{}", mesh.TetId(q.worst_aspect_tet)));
     out += fmt::format("  inverted tets:  {}{}\n", q.inverted.size(),
-                       q.inverted.empty() ? "" : " — ids: " + IdList(q.inverted, ids));
+                       q.inverted.empty() ? "" : " — ids: " + IdList(q.inverted, mesh));
     out += fmt::format("  degenerate:     {}{}\n", q.degenerate.size(),
-                       q.degenerate.empty() ? "" : " — ids: " + IdList(q.degenerate, ids));
+                       q.degenerate.empty() ? "" : " — ids: " + IdList(q.degenerate, mesh));
   }
   return out;
 }

@@ -5,15 +5,14 @@
 #include <string>
 
 #include "gipsi/geometry/mesh.h"
-#include "gipsi/io/mesh_io.h"
 
 namespace gipsi {
 
 /// Counts (nodes, tets, triangles, boundary faces), named groups, bounding box, element quality
 /// (inverted and degenerate tets with their ids, aspect ratios, volume) and, for surfaces,
 /// whether they are closed and manifold.
-/// Tets are named by `ids` (the file's own ids, e.g. Gmsh element tags) when given, else by their
-/// 0-based index; the kind of id is stated.
-std::string DescribeMesh(const Mesh& mesh, const MeshFileIds* ids = nullptr);
+/// Tets are named by the file's own ids (Mesh::tet_ids, e.g. Gmsh element tags) when the mesh has
+/// them, else by their 0-based index; the kind of id is stated.
+std::string DescribeMesh(const Mesh& mesh);
 
 }  // namespace gipsi

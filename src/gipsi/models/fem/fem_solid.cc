@@ -553,13 +553,14 @@ StepStatus FemSolid::Advance(double s0, double s1, double dt, int depth) {
         "object stepped right after this one?)",
         params_.cavities[static_cast<std::size_t>(failed_cavity_)].name);
   if (state_.last_newton.inadmissible && first_invalid_ >= 0)
-    failure_detail_ +=
-        fmt::format("; element {} is outside its law's domain (det F <= 0?)", first_invalid_);
+    failure_detail_ += fmt::format("; {} is outside its law's domain (det F <= 0?)",
+                                   domain().TetName(first_invalid_));
   if (state_.last_newton.inadmissible && failed_cavity_ >= 0)
     return StepStatus::Failed("the blood coupled to a cavity could not answer; cavity",
                               failed_cavity_);
   if (state_.last_newton.inadmissible)
-    return StepStatus::Failed("no admissible state: an element inverted; element", first_invalid_);
+    return StepStatus::Failed("no admissible state: an element inverted; tet",
+                              domain().TetId(first_invalid_));
   if (state_.last_newton.linear_failure)
     return StepStatus::Failed(
         state_.last_newton.linear_failure_kind == LinearFailure::kNotConverged

@@ -84,10 +84,10 @@ StepStatus FemSolid::StepOde(double t, double dt) {
   ++profile_.steps;
   failure_detail_.clear();
   if (ode_invalid_) {
-    failure_detail_ = fmt::format("{}: element {} is outside its law's domain (det F <= 0?)",
-                                  ode_integrator_->name(), first_invalid_);
-    return StepStatus::Failed("an element inverted in a stage of the step; element",
-                              first_invalid_);
+    failure_detail_ = fmt::format("{}: {} is outside its law's domain (det F <= 0?)",
+                                  ode_integrator_->name(), domain().TetName(first_invalid_));
+    return StepStatus::Failed("an element inverted in a stage of the step; tet",
+                              domain().TetId(first_invalid_));
   }
   if (!solved) {
     failure_detail_ = fmt::format("{}: {}", ode_integrator_->name(), ode_integrator_->failure());

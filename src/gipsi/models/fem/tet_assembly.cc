@@ -36,11 +36,11 @@ TetAssembly::TetAssembly(const Mesh& mesh) : num_nodes_(mesh.num_nodes()), tets_
   if (!bad.empty()) {
     std::string list;
     for (std::size_t i = 0; i < std::min<std::size_t>(bad.size(), 10); ++i)
-      list += fmt::format("{}{}", i ? ", " : "", bad[i]);
+      list += fmt::format("{}{}", i ? ", " : "", mesh.TetId(bad[i]));
     throw InputError(fmt::format(
         "FEM domain: {} tetrahedra are inverted or degenerate (non-positive rest volume), "
-        "e.g. elements {}; fix the mesh orientation or quality",
-        bad.size(), list));
+        "e.g. tets {} ({}s); fix the mesh orientation or quality",
+        bad.size(), list, mesh.TetIdKind()));
   }
 
   // Node adjacency (sorted, including the node itself).

@@ -268,11 +268,6 @@ StepStatus MassSpring::CheckState() const {
           s, length / rest_length_[s]);
   }
   (void)n;
-  if (const Index e = FirstInvertedTet(); e >= 0)
-    return StepStatus::Diverged(
-        "a tet was inverted (volume <= 0; time step too large, or a load the volume term cannot "
-        "hold); tet",
-        e);
   return StepStatus::Ok();
 }
 
@@ -302,7 +297,16 @@ StepStatus MassSpring::DoStep(double t, double dt) {
     return StepStatus::Failed("the cavity pressure could not be solved with the blood");
   const Index n = num_nodes();
   positions_ = Eigen::Map<const Points>(state_.x.data(), 3, n);
-  return CheckState();
+  const StepStatus status = CheckState();
+  if (!status.ok()) return status;
+  if (const Index e = FirstInvertedTet(); e >= 0) {
+    failure_detail_ = domain().TetName(e) + " inverted";  // as the mesh file names it
+    return StepStatus::Diverged(
+        "a tet was inverted (volume <= 0; time step too large, or a load the volume term cannot "
+        "hold); tet",
+        domain().TetId(e));
+  }
+  return status;
 }
 
 double MassSpring::stable_dt_estimate() const {

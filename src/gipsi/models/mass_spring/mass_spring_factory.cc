@@ -30,9 +30,9 @@ void WarnInvertedTets(const Mesh& mesh, const std::string& where) {
   if (inverted > 0)
     Log().warn(
         "{}: {} of {} tets of the domain are inverted (negative volume in node order 0-1-2-3; "
-        "the first is tet {}, counting from 0): volume preservation would push them further "
-        "inside out; fix the mesh's node order (`gipsi info` lists them)",
-        where, inverted, mesh.num_tets(), first);
+        "the first is {}): volume preservation would push them further inside out; fix the "
+        "mesh's node order (`gipsi info` lists them)",
+        where, inverted, mesh.num_tets(), mesh.TetName(first));
 }
 
 }  // namespace
