@@ -25,8 +25,9 @@
 /// hooks (NewObjectState, CopyObjectState, SetObjectState) on SimObject and Connector; 7:
 /// connector ports (Connector::UseField, …, RequireOrder; gipsi/core/port.h); 8: cell models
 /// and local models in tables a layer above declares (TypeRegistry::Table; CellModels,
-/// LocalModels).
-#define GIPSI_PLUGIN_ABI_VERSION 9
+/// LocalModels); 9: OdeIntegrator (implicit integrators, Step returns bool); 10: SimObject's
+/// state cache hooks (SaveStateCache, RestoreStateCache, DropStateCache).
+#define GIPSI_PLUGIN_ABI_VERSION 10
 
 namespace gipsi {
 

@@ -194,8 +194,8 @@ class SimObject {
   /// once every field was read. If `S` declares `static constexpr std::string_view kTag` and
   /// `std::uint32_t kVersion`, checkpoints wrap its fields in a section of that tag and version
   /// (raise the version when the fields change, and an old checkpoint is refused by name). A
-  /// type that saves more than one value (a solver's kept factorisation) overrides the hooks
-  /// below instead.
+  /// solver cache that a bitwise continuation needs (a kept factorisation) goes beside it
+  /// through the three cache hooks below.
   template <class S>
   void BindState(S& state) {
     GIPSI_CHECK(state_binding_ == nullptr, "object '{}': BindState called twice", name_);
@@ -204,6 +204,15 @@ class SimObject {
   /// Called after the state bound by BindState was replaced (a checkpoint or a snapshot
   /// restored): rebuild what derives from it. Default: nothing.
   virtual void StateRestored() {}
+  /// Caches of the future that are not state but change the bits of what follows (a Newton
+  /// solver's warm start and kept factorisation), for a bound state (docs/architecture.md,
+  /// "State"): checkpoints write them after the state (SaveStateCache) and read them back
+  /// before the state is replaced (RestoreStateCache; a throw leaves the object untouched, so
+  /// read into temporaries or validate first); a snapshot restore drops them instead
+  /// (DropStateCache: the retry of a failed step recomputes them). Defaults: nothing.
+  virtual void SaveStateCache(StateWriter& /*out*/) const {}
+  virtual void RestoreStateCache(StateReader& /*in*/) {}
+  virtual void DropStateCache() {}
 
   /// Hooks of the snapshots: a box for the type's state, copying into it, and restoring from
   /// it (then rebuilding what derives from the state). The defaults copy the state bound by
@@ -225,8 +234,10 @@ class SimObject {
     [[nodiscard]] virtual std::unique_ptr<ObjectState> New() const = 0;
     virtual void Copy(ObjectState& into) const = 0;
     virtual void Set(const ObjectState& from) = 0;
-    virtual void Write(StateWriter& out) const = 0;
-    virtual void Read(StateReader& in) = 0;
+    /// Checkpoints: the state, then the owner's cache (SaveStateCache); reading both before
+    /// the state is replaced.
+    virtual void Write(StateWriter& out, const SimObject& owner) const = 0;
+    virtual void Read(StateReader& in, SimObject& owner) = 0;
   };
   template <class S>
   class BoundState final : public StateBinding {
@@ -242,16 +253,18 @@ class SimObject {
     }
     void Copy(ObjectState& into) const override { CopyFields(StateBox<S>::Of(into).value, state_); }
     void Set(const ObjectState& from) override { CopyFields(state_, StateBox<S>::Of(from).value); }
-    void Write(StateWriter& out) const override {
+    void Write(StateWriter& out, const SimObject& owner) const override {
       if constexpr (kVersioned) out.BeginSection(S::kTag, S::kVersion);
       WriteFields(out, state_);
       if constexpr (kVersioned) out.EndSection();
+      owner.SaveStateCache(out);
     }
-    void Read(StateReader& in) override {
+    void Read(StateReader& in, SimObject& owner) override {
       S read = state_;  // kFixed fields are checked against the current shapes
       if constexpr (kVersioned) in.BeginSection(S::kTag, S::kVersion);
       ReadFields(in, read);
       if constexpr (kVersioned) in.EndSection();
+      owner.RestoreStateCache(in);
       CopyFields(state_, read);  // into the existing storage (kept capacities, references)
     }
 

@@ -122,6 +122,7 @@ void SimObject::CopyObjectState(ObjectState& into) const {
 void SimObject::SetObjectState(const ObjectState& from) {
   if (state_binding_) {
     state_binding_->Set(from);
+    DropStateCache();
     StateRestored();
     return;
   }
@@ -133,7 +134,7 @@ void SimObject::SetObjectState(const ObjectState& from) {
 
 void SimObject::SaveObjectState(StateWriter& out) const {
   if (state_binding_) {
-    state_binding_->Write(out);
+    state_binding_->Write(out, *this);
     return;
   }
   throw InputError(
@@ -142,7 +143,7 @@ void SimObject::SaveObjectState(StateWriter& out) const {
 
 void SimObject::RestoreObjectState(StateReader& in) {
   if (state_binding_) {
-    state_binding_->Read(in);
+    state_binding_->Read(in, *this);
     StateRestored();
     return;
   }

@@ -84,6 +84,7 @@ EpTissue::EpTissue(std::string name, EpTissueParams params)
                               FieldAccess::kRead, "mass-weighted integral of V over the domain"});
   f_cg_ = DeclareField({"diffusion_iterations", FieldLocation::kGlobal, 1, "1", FieldAccess::kRead,
                         "linear-solver iterations of the last diffusion step"});
+  BindState(state_);
 }
 
 void EpTissue::InitTissue() {

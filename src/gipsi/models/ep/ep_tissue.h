@@ -20,6 +20,7 @@
 /// ms, V mV, D mm²/ms, currents µA/µF (= mV/ms). Fields report V in mV and times in ms.
 
 #include <chrono>
+#include <cstdint>
 #include <memory>
 #include <optional>
 #include <string>
@@ -102,6 +103,9 @@ struct EpTissueParams {
 /// The stimuli and clamps are functions of time, the cell models are immutable and the
 /// diffusion solve starts from the current voltage. Copyable.
 struct EpState {
+  static constexpr const char* kTag = "EpState";
+  static constexpr std::uint32_t kVersion = 1;
+
   CellStates cells;
   VecX activation_time;  ///< first activation [ms] per node, −1 where none
   VecX last_activation;  ///< latest activation [ms] per node, −1 where none
@@ -141,10 +145,7 @@ class EpTissue : public SimObject {
   /// Nodes driven by each stimulus / clamp (in declaration order).
   [[nodiscard]] const std::vector<std::vector<int>>& stimulus_nodes() const { return stim_nodes_; }
   [[nodiscard]] std::vector<ProfileEntry> ProfileBreakdown() const override;
-  /// Checkpoints: the state (EpState).
-  void SaveObjectState(StateWriter& out) const override;
-  void RestoreObjectState(StateReader& in) override;
-  /// The state that evolves.
+  /// The state that evolves, bound with BindState (checkpoints and snapshots).
   [[nodiscard]] const EpState& state() const { return state_; }
   [[nodiscard]] std::string failure_detail() const override { return failure_detail_; }
 
@@ -164,11 +165,10 @@ class EpTissue : public SimObject {
   [[nodiscard]] virtual Vec3 NodePositionMm(Index node) const;
 
   StepStatus DoStep(double t, double dt) override;
-  /// Snapshots copy EpState; the diffusion factorisation depends on the step size only and is
-  /// kept.
-  [[nodiscard]] std::unique_ptr<ObjectState> NewObjectState() const override;
-  void CopyObjectState(ObjectState& into) const override;
-  void SetObjectState(const ObjectState& from) override;
+  /// The diffusion factorisation depends on the step size only: a snapshot restore keeps it; a
+  /// checkpoint holds none, so its restore refactorises at the next step (the same factors).
+  void RestoreStateCache(StateReader& /*in*/) override { system_dt_ = -1; }
+  void StateRestored() override;
   void DoReadField(FieldId id, Eigen::Ref<Eigen::MatrixXd> out) const override;
   void DoWriteField(FieldId id, const Eigen::Ref<const Eigen::MatrixXd>& in) override;
 

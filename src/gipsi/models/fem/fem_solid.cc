@@ -116,6 +116,7 @@ FemSolid::FemSolid(std::string name, std::shared_ptr<const Mesh> domain, FemPara
            "pressure in the cavity, acting on its faces (follower load)"))
     cavities_.emplace_back(std::move(wall)).gradient = VecX::Zero(3 * n);
   state_.cavities.resize(cavities_.size());
+  BindState(state_);
 }
 
 MaterialPoint FemSolid::PointOf(Index e) const {

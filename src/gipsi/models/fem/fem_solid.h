@@ -116,11 +116,9 @@ class FemSolid final : public SimObject, public CavityWall {
   /// unconstrained unknowns; Newton converges at tolerance · max(‖r(d₀)‖, this).
   [[nodiscard]] double load_scale() const { return load_scale_; }
   [[nodiscard]] std::vector<ProfileEntry> ProfileBreakdown() const override;
-  /// Checkpoints: the state (FemState) and the Newton solver's warm start and kept
-  /// factorisation, which a bitwise continuation needs.
-  void SaveObjectState(StateWriter& out) const override;
-  void RestoreObjectState(StateReader& in) override;
-  /// The state that evolves (fem_state.h).
+  /// The state that evolves (fem_state.h), bound with BindState: checkpoints save it and the
+  /// Newton solver's warm start and kept factorisation (a bitwise continuation needs them);
+  /// a snapshot restore drops the latter (fem_solid_state.cc).
   [[nodiscard]] const FemState& state() const { return state_; }
 
   /// The OdeSystem contract (y = [u; v], 6N; fem_solid_ode.cc). CalcDerivative evaluates the
@@ -165,11 +163,10 @@ class FemSolid final : public SimObject, public CavityWall {
 
  protected:
   StepStatus DoStep(double t, double dt) override;
-  /// Snapshots copy FemState. Restoring one drops the Newton solver's warm start and kept
-  /// factorisation (they belong to the abandoned future; the next step factorises afresh).
-  [[nodiscard]] std::unique_ptr<ObjectState> NewObjectState() const override;
-  void CopyObjectState(ObjectState& into) const override;
-  void SetObjectState(const ObjectState& from) override;
+  void SaveStateCache(StateWriter& out) const override;
+  void RestoreStateCache(StateReader& in) override;
+  void DropStateCache() override;
+  void StateRestored() override { UpdatePositions(); }
   void DoReadField(FieldId id, Eigen::Ref<Eigen::MatrixXd> out) const override;
   void DoWriteField(FieldId id, const Eigen::Ref<const Eigen::MatrixXd>& in) override;
 

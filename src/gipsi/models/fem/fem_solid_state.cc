@@ -13,41 +13,15 @@
 /// resumed run must continue bitwise; a snapshot restore drops it (the retry of a failed step
 /// factorises afresh), which is the rule docs/architecture.md states.
 
-#include "gipsi/base/object_state.h"
 #include "gipsi/base/state.h"
 #include "gipsi/models/fem/fem_solid.h"
 
 namespace gipsi {
 
-void FemSolid::SaveObjectState(StateWriter& out) const {
-  out.BeginSection("FemState", 1);
-  WriteFields(out, state_);
-  out.EndSection();
-  newton_->SaveState(out, jac_);
-}
+void FemSolid::SaveStateCache(StateWriter& out) const { newton_->SaveState(out, jac_); }
 
-void FemSolid::RestoreObjectState(StateReader& in) {
-  FemState read = state_;  // all or nothing: the object is untouched if the read fails
-  in.BeginSection("FemState", 1);
-  ReadFields(in, read);
-  in.EndSection();
-  newton_->RestoreState(in, jac_);
-  state_ = std::move(read);
-  UpdatePositions();
-}
+void FemSolid::RestoreStateCache(StateReader& in) { newton_->RestoreState(in, jac_); }
 
-std::unique_ptr<ObjectState> FemSolid::NewObjectState() const {
-  return std::make_unique<StateBox<FemState>>(state_);
-}
-
-void FemSolid::CopyObjectState(ObjectState& into) const {
-  CopyFields(StateBox<FemState>::Of(into).value, state_);
-}
-
-void FemSolid::SetObjectState(const ObjectState& from) {
-  CopyFields(state_, StateBox<FemState>::Of(from).value);
-  newton_->ForgetHandOver();
-  UpdatePositions();
-}
+void FemSolid::DropStateCache() { newton_->ForgetHandOver(); }
 
 }  // namespace gipsi

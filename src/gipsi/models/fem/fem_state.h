@@ -6,6 +6,7 @@
 /// matrix and its kept factorisation, the damping matrix of the step) or work of the step in
 /// progress.
 
+#include <cstdint>
 #include <vector>
 
 #include "gipsi/base/math.h"
@@ -29,6 +30,9 @@ struct FemCavityState {
 
 /// Copyable. Shapes: N nodes, E elements, F boundary faces.
 struct FemState {
+  static constexpr const char* kTag = "FemState";
+  static constexpr std::uint32_t kVersion = 1;
+
   ImplicitScheme scheme;  ///< displacements u, velocities, accelerations and their history (3N)
   /// The previous step's loads (s = 0 of the load interpolation within a step).
   VecX f_nodal_prev;     ///< 3N: gravity + nodal forces + external_force

@@ -47,10 +47,10 @@ MixedSolid::MixedSolid(std::string name, std::shared_ptr<const Mesh> domain,
   if (params_.fibre.norm() == 0)
     throw InputError(fmt::format("object '{}': the fibre direction is zero", this->name()));
   mesh_ = ElevateToQuadratic(*domain);
-  axes_.assign(static_cast<std::size_t>(kQuad * mesh_.num_elements()),
-               MaterialAxes(params_.fibre, params_.sheet));
-  active_prev_ = VecX::Zero(mesh_.num_elements());
-  active_new_ = VecX::Zero(mesh_.num_elements());
+  state_.axes.Write().assign(static_cast<std::size_t>(kQuad * mesh_.num_elements()),
+                             MaterialAxes(params_.fibre, params_.sheet));
+  state_.active_prev = VecX::Zero(mesh_.num_elements());
+  state_.active_new = VecX::Zero(mesh_.num_elements());
   SetGeometry(domain, MakeBoundary(*domain));
 
   // Element geometry: volumes and P2 gradients at the quadrature points.
@@ -65,9 +65,9 @@ MixedSolid::MixedSolid(std::string name, std::shared_ptr<const Mesh> domain,
     const double det = dm.determinant();
     if (!(det > 0))
       throw InputError(
-          fmt::format("object '{}': element {} is degenerate or inverted (rest "
+          fmt::format("object '{}': {} is degenerate or inverted (rest "
                       "volume {:.3g} m³)",
-                      this->name(), e, det / 6));
+                      this->name(), domain->TetName(e), det / 6));
     volume_[e] = det / 6;
     const Mat3 inv = dm.inverse();
     Eigen::Matrix<double, 3, 4> gl;
@@ -87,10 +87,10 @@ MixedSolid::MixedSolid(std::string name, std::shared_ptr<const Mesh> domain,
   const TetQualityReport quality = CheckTetQuality(domain->nodes, domain->tets);
   if (quality.max_aspect > kSliverAspect)
     Log().warn(
-        "{}: tet {} has aspect ratio {:.3g} (1 for a regular tet): mixed P2-P1 elements can "
+        "{}: {} has aspect ratio {:.3g} (1 for a regular tet): mixed P2-P1 elements can "
         "collapse in such slivers under load; remesh (or refine) if a step fails there "
         "(docs/incompressible.md)",
-        this->name(), quality.worst_aspect_tet, quality.max_aspect);
+        this->name(), domain->TetName(quality.worst_aspect_tet), quality.max_aspect);
   double edge_sum = 0;
   for (Index k = 0; k < mesh_.edges.cols(); ++k)
     edge_sum += (mesh_.rest.col(mesh_.edges(0, k)) - mesh_.rest.col(mesh_.edges(1, k))).norm();
@@ -173,15 +173,15 @@ MixedSolid::MixedSolid(std::string name, std::shared_ptr<const Mesh> domain,
   constrained_.assign(static_cast<std::size_t>(nu), 0);
   target_prev_ = VecX::Zero(nu);
   target_new_ = VecX::Zero(nu);
-  force_prev_ = VecX::Zero(3 * nv);
+  state_.force_prev = VecX::Zero(3 * nv);
   force_new_ = VecX::Zero(3 * nv);
-  pressure_prev_ = VecX::Zero(bnd.num_triangles());
+  state_.pressure_prev = VecX::Zero(bnd.num_triangles());
   pressure_new_ = VecX::Zero(bnd.num_triangles());
-  traction_prev_ = Points::Zero(3, bnd.num_triangles());
+  state_.traction_prev = Points::Zero(3, bnd.num_triangles());
   traction_new_ = Points::Zero(3, bnd.num_triangles());
-  external_force_ = Points::Zero(3, nv);
-  z_ = VecX::Zero(n);
-  z_begin_ = z_;
+  state_.external_force.Write() = Points::Zero(3, nv);
+  state_.z = VecX::Zero(n);
+  z_begin_ = state_.z;
   vertex_positions_ = domain->nodes;
 
   auto linear = MakeLinearSolver(params_.linear_solver);
@@ -208,13 +208,14 @@ MixedSolid::MixedSolid(std::string name, std::shared_ptr<const Mesh> domain,
                             "incompressible)"});
   f_newton_ = DeclareField({"newton_iterations", L::kGlobal, 1, "1", A::kRead,
                             "Newton iterations of the last load increment"});
+  BindState(state_);
 }
 
 Points MixedSolid::NodeDisplacements() const {
-  return Eigen::Map<const Points>(z_.data(), 3, mesh_.num_nodes());
+  return Eigen::Map<const Points>(state_.z.data(), 3, mesh_.num_nodes());
 }
 
-VecX MixedSolid::Pressures() const { return pressure_scale_ * z_.tail(mesh_.num_vertices); }
+VecX MixedSolid::Pressures() const { return pressure_scale_ * state_.z.tail(mesh_.num_vertices); }
 
 Mat3 MixedSolid::DeformationGradient(Index e, int q, const VecX& z) const {
   const auto g = Eigen::Map<const Eigen::Matrix<double, 3, 10>>(
@@ -230,7 +231,7 @@ double MixedSolid::CurrentVolume() const {
   double v = 0;
   for (Index e = 0; e < mesh_.num_elements(); ++e)
     for (int q = 0; q < kQuad; ++q) {
-      const Mat3 F = DeformationGradient(e, q, z_);
+      const Mat3 F = DeformationGradient(e, q, state_.z);
       v += volume_[e] * rule.weights[static_cast<std::size_t>(q)] * F.determinant();
     }
   return v;
@@ -239,18 +240,18 @@ double MixedSolid::CurrentVolume() const {
 void MixedSolid::SetFibreAt(Index e, int q, const Vec3& fibre) {
   GIPSI_CHECK(e >= 0 && e < mesh_.num_elements() && q >= 0 && q < kQuad && fibre.norm() > 0,
               "MixedSolid::SetFibreAt({}, {}): no such point or a zero fibre", e, q);
-  Mat3& axes = axes_[static_cast<std::size_t>(kQuad * e + q)];
+  Mat3& axes = state_.axes.Write()[static_cast<std::size_t>(kQuad * e + q)];
   axes = MaterialAxes(fibre, axes.col(1));
 }
 
 const Mat3& MixedSolid::axes_at(Index e, int q) const {
-  return axes_[static_cast<std::size_t>(kQuad * e + q)];
+  return state_.axes.get()[static_cast<std::size_t>(kQuad * e + q)];
 }
 
 MaterialPoint MixedSolid::PointOf(Index e, int q, double load) const {
   MaterialPoint mp;
-  mp.axes = axes_[static_cast<std::size_t>(kQuad * e + q)];
-  mp.active_tension = (1 - load) * active_prev_[e] + load * active_new_[e];
+  mp.axes = state_.axes.get()[static_cast<std::size_t>(kQuad * e + q)];
+  mp.active_tension = (1 - load) * state_.active_prev[e] + load * state_.active_new[e];
   return mp;
 }
 
@@ -354,12 +355,12 @@ void MixedSolid::AssembleLoads(const VecX& z, double s, VecX& r, double* jv) con
   const Index nv = mesh_.num_vertices;
   for (Index v = 0; v < nv; ++v)
     r.segment<3>(3 * v) -=
-        (1 - s) * force_prev_.segment<3>(3 * v) + s * force_new_.segment<3>(3 * v);
+        (1 - s) * state_.force_prev.segment<3>(3 * v) + s * force_new_.segment<3>(3 * v);
   const TriangleQuadrature& rule = TriangleRuleDegree4();
   const BoundarySurface& bnd = boundary();
   for (Index f = 0; f < faces_.cols(); ++f) {
-    const double p = (1 - s) * pressure_prev_[f] + s * pressure_new_[f];
-    const Vec3 t = (1 - s) * traction_prev_.col(f) + s * traction_new_.col(f);
+    const double p = (1 - s) * state_.pressure_prev[f] + s * pressure_new_[f];
+    const Vec3 t = (1 - s) * state_.traction_prev.col(f) + s * traction_new_.col(f);
     if (p == 0 && t.isZero()) continue;
     Eigen::Matrix<double, 3, 6> x;
     for (int a = 0; a < 6; ++a)
@@ -461,7 +462,7 @@ Index MixedSolid::GatherLoads() {
   const BoundarySurface& bnd = boundary();
   const BoundaryConditions& bcs = boundary_conditions();
   const Index nv = mesh_.num_vertices;
-  for (Index v = 0; v < nv; ++v) force_new_.segment<3>(3 * v) = external_force_.col(v);
+  for (Index v = 0; v < nv; ++v) force_new_.segment<3>(3 * v) = state_.external_force.get().col(v);
   for (Index j = 0; j < bnd.num_vertices(); ++j)
     force_new_.segment<3>(3 * bnd.vertex_to_node[static_cast<std::size_t>(j)]) += bcs.force(j);
   for (Index f = 0; f < bnd.num_triangles(); ++f) {
@@ -497,10 +498,10 @@ Index MixedSolid::GatherLoads() {
   constrained_dofs_.clear();
   for (std::size_t d = 0; d < constrained_.size(); ++d)
     if (constrained_[d] != 0) constrained_dofs_.push_back(static_cast<int>(d));
-  if (!have_prev_) {
-    force_prev_.setZero();
-    pressure_prev_.setZero();
-    traction_prev_.setZero();
+  if (!state_.have_prev) {
+    state_.force_prev.setZero();
+    state_.pressure_prev.setZero();
+    state_.traction_prev.setZero();
   }
   return velocity_vertex;
 }
@@ -515,21 +516,21 @@ StepStatus MixedSolid::Advance(double s0, double s1, int depth) {
     const double sa = s0 + (s1 - s0) * (k - 1) / n;
     const double sb = k == n ? s1 : s0 + (s1 - s0) * k / n;
     if (stop_token().stop_requested()) return StepStatus::Stopped();
-    const VecX z_start = z_;
-    SetTargets(z_, sb);
-    VecX loads = VecX::Zero(z_.size());
-    AssembleLoads(z_, sb, loads, nullptr);
+    const VecX z_start = state_.z;
+    SetTargets(state_.z, sb);
+    VecX loads = VecX::Zero(state_.z.size());
+    AssembleLoads(state_.z, sb, loads, nullptr);
     ApplyConstraints(loads, nullptr);
     Increment increment(*this, sb, loads.norm());
-    last_newton_ = newton_->Solve(increment, z_, jac_, stop_token());
-    total_iterations_ += last_newton_.iterations;
-    if (last_newton_.converged) continue;
-    z_ = z_start;
-    if (last_newton_.interrupted) return StepStatus::Stopped();
+    state_.last_newton = newton_->Solve(increment, state_.z, jac_, stop_token());
+    state_.total_iterations += state_.last_newton.iterations;
+    if (state_.last_newton.converged) continue;
+    state_.z = z_start;
+    if (state_.last_newton.interrupted) return StepStatus::Stopped();
     if (depth >= params_.max_bisections) {
       failure_detail_ =
           fmt::format("load increment {:.6g} → {:.6g} of the step: {}{}", sa, sb,
-                      Describe(last_newton_, params_.newton, newton_->linear_solver().name()),
+                      Describe(state_.last_newton, params_.newton, newton_->linear_solver().name()),
                       MostCompressedElement());
       return StepStatus::Failed("Newton did not converge (bisections exhausted)");
     }
@@ -544,7 +545,7 @@ std::string MixedSolid::MostCompressedElement() const {
   Index worst = -1;
   for (Index e = 0; e < mesh_.num_elements(); ++e)
     for (int q = 0; q < kQuad; ++q) {
-      const Mat3 F = DeformationGradient(e, q, z_);
+      const Mat3 F = DeformationGradient(e, q, state_.z);
       if (const double j = F.determinant(); j < smallest) {
         smallest = j;
         worst = e;
@@ -554,9 +555,9 @@ std::string MixedSolid::MostCompressedElement() const {
   Vec3 centre = Vec3::Zero();
   for (int a = 0; a < 4; ++a) centre += 0.25 * mesh_.rest.col(mesh_.elements(a, worst));
   return fmt::format(
-      "; at the last converged load the smallest J at a quadrature point is {:.4g}, in tet {} "
+      "; at the last converged load the smallest J at a quadrature point is {:.4g}, in {} "
       "(centre {:.4g}, {:.4g}, {:.4g} m)",
-      smallest, worst, centre.x(), centre.y(), centre.z());
+      smallest, domain().TetName(worst), centre.x(), centre.y(), centre.z());
 }
 
 StepStatus MixedSolid::DoStep(double /*t*/, double /*dt*/) {
@@ -569,26 +570,26 @@ StepStatus MixedSolid::DoStep(double /*t*/, double /*dt*/) {
     return StepStatus::Failed("a prescribed velocity on a quasi-static object", v);
   }
   // Prescribed displacements ramp from where the constrained dofs are now.
-  for (int dof : constrained_dofs_) target_prev_[dof] = z_[dof];
-  z_begin_ = z_;
+  for (int dof : constrained_dofs_) target_prev_[dof] = state_.z[dof];
+  z_begin_ = state_.z;
   const StepStatus status = Advance(0, 1, 0);
   if (!status.ok()) {
-    z_ = z_begin_;
+    state_.z = z_begin_;
     UpdatePositions();
     return status;
   }
-  force_prev_ = force_new_;
-  active_prev_ = active_new_;
-  pressure_prev_ = pressure_new_;
-  traction_prev_ = traction_new_;
-  have_prev_ = true;
+  state_.force_prev = force_new_;
+  state_.active_prev = state_.active_new;
+  state_.pressure_prev = pressure_new_;
+  state_.traction_prev = traction_new_;
+  state_.have_prev = true;
   UpdatePositions();
   return StepStatus::Ok();
 }
 
 void MixedSolid::UpdatePositions() {
   const Index nv = mesh_.num_vertices;
-  vertex_positions_ = domain().nodes + Eigen::Map<const Points>(z_.data(), 3, nv);
+  vertex_positions_ = domain().nodes + Eigen::Map<const Points>(state_.z.data(), 3, nv);
 }
 
 void MixedSolid::DoReadField(FieldId id, Eigen::Ref<Eigen::MatrixXd> out) const {
@@ -605,12 +606,12 @@ void MixedSolid::DoReadField(FieldId id, Eigen::Ref<Eigen::MatrixXd> out) const 
   } else if (id == mech_.displacement) {
     out = vertex_positions_ - domain().nodes;
   } else if (id == mech_.external_force) {
-    out = external_force_;
+    out = state_.external_force.get();
   } else if (id == mech_.reaction_force) {
     // f_int − f_ext on the held axes of the vertices, at the current state and loads.
     out.setZero();
     VecX r;
-    if (!EvaluateUnconstrained(z_, 1.0, r, nullptr)) return;
+    if (!EvaluateUnconstrained(state_.z, 1.0, r, nullptr)) return;
     // An edge node is held where both its vertices are; its reaction goes half to each, so
     // the vertices carry the whole: for a uniform traction on a 6-node face the vertex nodes'
     // own share is zero (∫ N_vertex dA = 0) and the edge nodes' is all of it.
@@ -629,12 +630,12 @@ void MixedSolid::DoReadField(FieldId id, Eigen::Ref<Eigen::MatrixXd> out) const 
         if (bcs.kind(static_cast<Index>(j), a) != ConstraintKind::kFree)
           out(a, static_cast<Index>(j)) = r[3 * v2n[j] + a];
   } else if (id == f_pressure_) {
-    out = pressure_scale_ * z_.segment(nu, nv).transpose();
+    out = pressure_scale_ * state_.z.segment(nu, nv).transpose();
   } else if (id == f_jacobian_) {
     for (Index e = 0; e < mesh_.num_elements(); ++e) {
       double mean = 0;
       for (int q = 0; q < kQuad; ++q) {
-        const Mat3 F = DeformationGradient(e, q, z_);
+        const Mat3 F = DeformationGradient(e, q, state_.z);
         mean += F.determinant() / kQuad;
       }
       out(0, e) = mean;
@@ -642,21 +643,21 @@ void MixedSolid::DoReadField(FieldId id, Eigen::Ref<Eigen::MatrixXd> out) const 
   } else if (id == f_fibre_) {
     for (Index e = 0; e < mesh_.num_elements(); ++e) out.col(e) = axes_at(e, 0).col(0);
   } else if (id == f_active_) {
-    out = active_new_.transpose();
+    out = state_.active_new.transpose();
   } else if (id == f_volume_) {
     out(0, 0) = CurrentVolume();
   } else if (id == f_energy_) {
     double w = 0;
-    for (Index e = 0; e < mesh_.num_elements(); ++e) w += ElementEnergy(e, z_);
+    for (Index e = 0; e < mesh_.num_elements(); ++e) w += ElementEnergy(e, state_.z);
     out(0, 0) = w;
   } else if (id == f_newton_) {
-    out(0, 0) = last_newton_.iterations;
+    out(0, 0) = state_.last_newton.iterations;
   }
 }
 
 void MixedSolid::DoWriteField(FieldId id, const Eigen::Ref<const Eigen::MatrixXd>& in) {
   if (id == mech_.external_force) {
-    external_force_ = in;
+    state_.external_force.Write() = in;
   } else if (id == f_fibre_) {
     for (Index e = 0; e < mesh_.num_elements(); ++e) {
       const Vec3 fibre = in.col(e);
@@ -664,60 +665,18 @@ void MixedSolid::DoWriteField(FieldId id, const Eigen::Ref<const Eigen::MatrixXd
         for (int q = 0; q < kQuad; ++q) SetFibreAt(e, q, fibre);
     }
   } else if (id == f_active_) {
-    active_new_ = in.row(0).transpose();
+    state_.active_new = in.row(0).transpose();
   } else if (id == mech_.position) {
     // Vertices where written, edge nodes at the mean of their ends (straight edges).
     const Index nv = mesh_.num_vertices;
     const Points u = in - domain().nodes;
-    for (Index v = 0; v < nv; ++v) z_.segment<3>(3 * v) = u.col(v);
+    for (Index v = 0; v < nv; ++v) state_.z.segment<3>(3 * v) = u.col(v);
     for (Index k = 0; k < mesh_.edges.cols(); ++k)
-      z_.segment<3>(3 * (nv + k)) = 0.5 * (u.col(mesh_.edges(0, k)) + u.col(mesh_.edges(1, k)));
+      state_.z.segment<3>(3 * (nv + k)) =
+          0.5 * (u.col(mesh_.edges(0, k)) + u.col(mesh_.edges(1, k)));
     UpdatePositions();
   }
   // Velocity writes are ignored: the object is quasi-static.
-}
-
-void MixedSolid::SaveObjectState(StateWriter& out) const {
-  out.BeginSection("MixedSolid", 1);
-  out.WriteMatrix(z_);
-  out.WriteBool(have_prev_);
-  out.WriteMatrix(force_prev_);
-  out.WriteMatrix(pressure_prev_);
-  out.WriteMatrix(traction_prev_);
-  out.WriteMatrix(external_force_);
-  out.WriteMatrix(active_prev_);
-  out.WriteMatrix(active_new_);
-  Eigen::MatrixXd axes(9, static_cast<Index>(axes_.size()));
-  for (std::size_t i = 0; i < axes_.size(); ++i)
-    axes.col(static_cast<Index>(i)) = axes_[i].reshaped();
-  out.WriteMatrix(axes);
-  out.WriteInt(last_newton_.iterations);
-  out.WriteInt(total_iterations_);
-  newton_->SaveState(out, jac_);
-  out.EndSection();
-}
-
-void MixedSolid::RestoreObjectState(StateReader& in) {
-  in.BeginSection("MixedSolid", 1);
-  in.ReadMatrixExact(z_, "the unknowns");
-  have_prev_ = in.ReadBool();
-  in.ReadMatrixExact(force_prev_, "the previous nodal forces");
-  in.ReadMatrixExact(pressure_prev_, "the previous face pressures");
-  in.ReadMatrixExact(traction_prev_, "the previous face tractions");
-  in.ReadMatrixExact(external_force_, "the external force");
-  in.ReadMatrixExact(active_prev_, "the previous active tension");
-  in.ReadMatrixExact(active_new_, "the active tension");
-  Eigen::MatrixXd axes(9, static_cast<Index>(axes_.size()));
-  in.ReadMatrixExact(axes, "the material axes");
-  for (std::size_t i = 0; i < axes_.size(); ++i)
-    axes_[i] = axes.col(static_cast<Index>(i)).reshaped(3, 3);
-  last_newton_ = NewtonStats{};
-  last_newton_.iterations = static_cast<int>(in.ReadInt());
-  last_newton_.converged = true;
-  total_iterations_ = in.ReadInt();
-  newton_->RestoreState(in, jac_);
-  in.EndSection();
-  UpdatePositions();
 }
 
 }  // namespace gipsi

@@ -44,9 +44,12 @@
 /// an active tension along the fibre (MaterialPoint), ramped from the previous step's values
 /// with the loads.
 ///
+/// The state is MixedState (mixed_state.h). Checkpoints save it and the Newton solver's warm
+/// start and kept factorisation (a resumed run continues bitwise); a snapshot restore drops the
+/// latter (the retry factorises afresh), as for FemSolid.
+///
 /// Not yet: dynamics (mass, damping), cavities coupled to blood, quadratic (curved) output,
-/// collision and haptic local models, checkpoints of the factorisation (the state saved is
-/// displacements, pressures and the previous loads). Units: SI.
+/// collision and haptic local models. Units: SI.
 
 #include <memory>
 #include <string>
@@ -54,6 +57,7 @@
 
 #include "gipsi/core/registry.h"
 #include "gipsi/core/sim_object.h"
+#include "gipsi/models/fem/mixed_state.h"
 #include "gipsi/models/fem/quadratic_tets.h"
 #include "gipsi/models/fem/solid_material.h"
 #include "gipsi/numerics/newton.h"
@@ -99,9 +103,9 @@ class MixedSolid final : public SimObject {
   /// ∫ J dV over the body [m³] at the current state.
   [[nodiscard]] double CurrentVolume() const;
   /// Statistics of the last Newton solve.
-  [[nodiscard]] const NewtonStats& last_newton() const { return last_newton_; }
+  [[nodiscard]] const NewtonStats& last_newton() const { return state_.last_newton; }
   /// Total Newton iterations and factorisations over all steps (for benchmarks).
-  [[nodiscard]] std::int64_t total_newton_iterations() const { return total_iterations_; }
+  [[nodiscard]] std::int64_t total_newton_iterations() const { return state_.total_iterations; }
 
   /// The residual r(z) and, if `jacobian` is not null, the Jacobian at the unknowns z =
   /// (u node-major, p̃) for the loads at load fraction s of the current step, with no
@@ -118,13 +122,17 @@ class MixedSolid final : public SimObject {
   /// Material axes (columns fibre, sheet, normal) at quadrature point q of element e.
   [[nodiscard]] const Mat3& axes_at(Index e, int q) const;
   /// The current unknowns z.
-  [[nodiscard]] const VecX& unknowns() const { return z_; }
+  [[nodiscard]] const VecX& unknowns() const { return state_.z; }
 
-  void SaveObjectState(StateWriter& out) const override;
-  void RestoreObjectState(StateReader& in) override;
+  /// The state that evolves (mixed_state.h), bound with BindState.
+  [[nodiscard]] const MixedState& state() const { return state_; }
 
  protected:
   StepStatus DoStep(double t, double dt) override;
+  void SaveStateCache(StateWriter& out) const override;
+  void RestoreStateCache(StateReader& in) override;
+  void DropStateCache() override;
+  void StateRestored() override { UpdatePositions(); }
   void DoReadField(FieldId id, Eigen::Ref<Eigen::MatrixXd> out) const override;
   void DoWriteField(FieldId id, const Eigen::Ref<const Eigen::MatrixXd>& in) override;
 
@@ -161,10 +169,8 @@ class MixedSolid final : public SimObject {
   const SolidMaterial* law_ = nullptr;
   double kappa_ = 0;
   QuadraticTets mesh_;
-  std::vector<double> grad_;       // per element and quadrature point: 3 × 10 ∇N (column-major)
-  VecX volume_;                    // rest volume per element
-  std::vector<Mat3> axes_;         // per quadrature point (4 per tet): fibre, sheet, normal
-  VecX active_prev_, active_new_;  // per element active tension at s = 0 and s = 1 [Pa]
+  std::vector<double> grad_;  // per element and quadrature point: 3 × 10 ∇N (column-major)
+  VecX volume_;               // rest volume per element
   double pressure_scale_ = 1;
   // Boundary faces as 6-node triangles (P2 node ids).
   Eigen::Matrix<int, 6, Eigen::Dynamic> faces_;
@@ -178,19 +184,16 @@ class MixedSolid final : public SimObject {
   std::vector<int> constrained_dofs_;
   VecX target_prev_, target_new_;
   // Loads at s = 0 and s = 1.
-  VecX force_prev_, force_new_;  // 3 × vertices
-  VecX pressure_prev_, pressure_new_;
-  Points traction_prev_, traction_new_;
-  bool have_prev_ = false;
+  VecX force_new_;  // 3 × vertices (the previous step's, s = 0, are state)
+  VecX pressure_new_;
+  Points traction_new_;
   mutable double residual_floor_ = 0;
   double diag_scale_ = 1;
   bool exact_load_tangent_ = false;  // the linear solver takes nonsymmetric matrices
-  VecX z_, z_begin_;
+  MixedState state_;                 // everything that evolves (mixed_state.h)
+  VecX z_begin_;
   Points vertex_positions_;
-  Points external_force_;
   std::unique_ptr<NewtonSolver> newton_;
-  NewtonStats last_newton_;
-  std::int64_t total_iterations_ = 0;
   std::string failure_detail_;
   MechanicalFieldIds mech_;
   FieldId f_fibre_, f_active_, f_pressure_, f_jacobian_, f_volume_, f_energy_, f_newton_;
