@@ -40,6 +40,15 @@ std::string Mesh::TetName(Index e) const {
   return fmt::format("tet {} ({})", TetId(e), TetIdKind());
 }
 
+std::string Mesh::TetIdList(const std::vector<int>& tets) const {
+  std::string out;
+  for (std::size_t i = 0; i < tets.size() && i < 10; ++i)
+    out += fmt::format("{}{}", i ? ", " : "", TetId(tets[i]));
+  if (tets.size() > 10) out += fmt::format(", ... ({} more)", tets.size() - 10);
+  return fmt::format("{} ({})", out,
+                     tet_ids.empty() ? "0-based indices in file order" : tet_id_kind + "s");
+}
+
 void Mesh::Validate(std::string_view source) const {
   if (!nodes.allFinite()) {
     for (Index i = 0; i < nodes.cols(); ++i)

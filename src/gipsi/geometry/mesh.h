@@ -48,6 +48,9 @@ struct Mesh {
   }
   /// Tet e as messages name it: "tet 813 (Gmsh element tag)" or "tet 12 (0-based index)".
   [[nodiscard]] std::string TetName(Index e) const;
+  /// The ids of the first ten of `tets` and what they are, for messages: "9, 12 (Gmsh element
+  /// tags)", "3, 7, ... (5 more) (0-based indices in file order)".
+  [[nodiscard]] std::string TetIdList(const std::vector<int>& tets) const;
 
   /// The group called `name`, or nullptr.
   [[nodiscard]] const MeshGroup* FindGroup(std::string_view name) const;

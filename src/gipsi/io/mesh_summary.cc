@@ -9,21 +9,6 @@
 #include "gipsi/geometry/quality.h"
 
 namespace gipsi {
-namespace {
-
-/// The first ten tets of `tets` by their file ids, and what kind of ids they are.
-std::string IdList(const std::vector<int>& tets, const Mesh& mesh) {
-  std::string out;
-  for (std::size_t i = 0; i < tets.size() && i < 10; ++i)
-    out += fmt::format("{}{}", i ? ", " : "", mesh.TetId(tets[i]));
-  if (tets.size() > 10) out += fmt::format(", ... ({} more)", tets.size() - 10);
-  return out + " (" +
-         (mesh.tet_ids.empty() ? std::string("0-based indices in file order")
-                               : mesh.tet_id_kind + "s") +
-         ")";
-}
-
-}  // namespace
 
 std::string DescribeMesh(const Mesh& mesh) {
   std::string out;
@@ -74,9 +59,9 @@ std::string DescribeMesh(const Mesh& mesh) {
                        q.worst_aspect_tet < 0 ? std::string("-")
                                               : fmt::format("{}", mesh.TetId(q.worst_aspect_tet)));
     out += fmt::format("  inverted tets:  {}{}\n", q.inverted.size(),
-                       q.inverted.empty() ? "" : " — ids: " + IdList(q.inverted, mesh));
+                       q.inverted.empty() ? "" : " — ids: " + mesh.TetIdList(q.inverted));
     out += fmt::format("  degenerate:     {}{}\n", q.degenerate.size(),
-                       q.degenerate.empty() ? "" : " — ids: " + IdList(q.degenerate, mesh));
+                       q.degenerate.empty() ? "" : " — ids: " + mesh.TetIdList(q.degenerate));
   }
   return out;
 }

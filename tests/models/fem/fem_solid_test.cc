@@ -381,5 +381,28 @@ TEST(FemSolid, CavityPressureInflatesItsVolumeAsLame) {
   EXPECT_NEAR((value(0, 0) - v0) / expected, 1.0, 0.05);
 }
 
+TEST(FemSolid, InvertedRestTetsAreRefusedByTheirIds) {
+  // A generated mesh has no file ids: its tets are listed by 0-based index, and the message says
+  // so (it used to end in "(0-based indexs)"). With file ids the file's own are listed.
+  Mesh mesh = MakeTetBox(Vec3::Zero(), Vec3::Ones(), {1, 1, 1});
+  std::swap(mesh.tets(2, 3), mesh.tets(3, 3));
+  FemParams params =
+      AccurateParams(R"({"law": "Linear", "youngs_modulus": 1e4, "poisson_ratio": 0.3})",
+                     ImplicitSchemeKind::kBackwardEuler);
+  auto build = [&](const Mesh& m) {
+    try {
+      FemSolid fem("cube", std::make_shared<const Mesh>(m), params);
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("(no error)");
+  };
+  EXPECT_THAT(build(mesh), HasSubstr("1 tetrahedra are inverted or degenerate (non-positive rest "
+                                     "volume), e.g. tets 3 (0-based indices in file order)"));
+  for (Index e = 0; e < mesh.num_tets(); ++e) mesh.tet_ids.push_back(101 + e);
+  mesh.tet_id_kind = "Gmsh element tag";
+  EXPECT_THAT(build(mesh), HasSubstr("e.g. tets 104 (Gmsh element tags)"));
+}
+
 }  // namespace
 }  // namespace gipsi

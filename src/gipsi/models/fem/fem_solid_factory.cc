@@ -23,14 +23,16 @@ namespace {
 std::unique_ptr<OdeIntegrator> ParseIntegrator(const JsonNode& node, const TypeRegistry& registry,
                                                ImplicitSchemeKind& scheme) {
   const std::string name = node.AsString();
-  if (name == "Static") scheme = ImplicitSchemeKind::kStatic;
-  if (name == "BackwardEuler") scheme = ImplicitSchemeKind::kBackwardEuler;
-  if (name == "BDF2") scheme = ImplicitSchemeKind::kBdf2;
-  if (name == "Newmark") scheme = ImplicitSchemeKind::kNewmark;
-  if (name == "Static" || name == "BackwardEuler" || name == "BDF2" || name == "Newmark")
-    return nullptr;
+  std::vector<std::string> known;
+  for (ImplicitSchemeKind kind : {ImplicitSchemeKind::kStatic, ImplicitSchemeKind::kBackwardEuler,
+                                  ImplicitSchemeKind::kBdf2, ImplicitSchemeKind::kNewmark}) {
+    if (name == ToString(kind)) {
+      scheme = kind;
+      return nullptr;
+    }
+    known.emplace_back(ToString(kind));
+  }
   if (!registry.integrators.Contains(name)) {
-    std::vector<std::string> known = {"BDF2", "BackwardEuler", "Newmark", "Static"};
     for (const std::string& other : registry.integrators.Names())
       if (std::find(known.begin(), known.end(), other) == known.end()) known.push_back(other);
     FailUnknown("integrator", name, known, node);

@@ -15,7 +15,7 @@ TetAssembly::TetAssembly(const Mesh& mesh) : num_nodes_(mesh.num_nodes()), tets_
   if (ne == 0) throw InputError("FEM domain has no tetrahedra");
   grad_.resize(static_cast<std::size_t>(12 * ne));
   volume_.resize(ne);
-  std::vector<Index> bad;
+  std::vector<int> bad;
   for (Index e = 0; e < ne; ++e) {
     Mat3 dm;
     for (int c = 0; c < 3; ++c)
@@ -25,7 +25,7 @@ TetAssembly::TetAssembly(const Mesh& mesh) : num_nodes_(mesh.num_nodes()), tets_
     // Relative test: a sliver whose volume is round-off compared with its edges is degenerate.
     const double scale = dm.colwise().norm().prod();
     if (!(det > 1e-12 * scale)) {
-      bad.push_back(e);
+      bad.push_back(static_cast<int>(e));
       continue;
     }
     const Mat3 inv = dm.inverse();
@@ -33,15 +33,11 @@ TetAssembly::TetAssembly(const Mesh& mesh) : num_nodes_(mesh.num_nodes()), tets_
     for (int a = 0; a < 3; ++a) g.col(a + 1) = inv.row(a).transpose();
     g.col(0) = -(g.col(1) + g.col(2) + g.col(3));
   }
-  if (!bad.empty()) {
-    std::string list;
-    for (std::size_t i = 0; i < std::min<std::size_t>(bad.size(), 10); ++i)
-      list += fmt::format("{}{}", i ? ", " : "", mesh.TetId(bad[i]));
+  if (!bad.empty())
     throw InputError(fmt::format(
         "FEM domain: {} tetrahedra are inverted or degenerate (non-positive rest volume), "
-        "e.g. tets {} ({}s); fix the mesh orientation or quality",
-        bad.size(), list, mesh.TetIdKind()));
-  }
+        "e.g. tets {}; fix the mesh orientation or quality",
+        bad.size(), mesh.TetIdList(bad)));
 
   // Node adjacency (sorted, including the node itself).
   std::vector<std::vector<int>> nbrs(static_cast<std::size_t>(num_nodes_));
