@@ -32,7 +32,9 @@
 #include "gipsi/base/file_io.h"
 #include "gipsi/base/log.h"
 #include "gipsi/base/state.h"
+#include "gipsi/base/version.h"
 #include "gipsi/core/aggregate.h"
+#include "gipsi/core/registry.h"
 #include "gipsi/haptics/realtime_haptics.h"
 #include "gipsi/io/builtins.h"
 #include "gipsi/io/mesh_io.h"
@@ -193,7 +195,7 @@ class BuildProgress {
 gipsi::Scene Load(const std::string& file, const std::vector<std::string>& plugins,
                   gipsi::TypeRegistry& registry, const gipsi::SceneLimits& limits, bool quiet) {
   gipsi::RegisterBuiltins(registry);
-  for (const auto& plugin : plugins) registry.LoadPlugin(plugin);
+  for (const auto& plugin : plugins) registry.LoadPlugin(gipsi::ResolvePlugin(plugin, "."));
   BuildProgress progress(quiet);
   return gipsi::LoadScene(file, registry, limits, progress.Callback());
 }
@@ -510,7 +512,7 @@ int Info(const std::string& file) {
 int Types(const std::vector<std::string>& plugins) {
   gipsi::TypeRegistry registry;
   gipsi::RegisterBuiltins(registry);
-  for (const auto& plugin : plugins) registry.LoadPlugin(plugin);
+  for (const auto& plugin : plugins) registry.LoadPlugin(gipsi::ResolvePlugin(plugin, "."));
   auto print = [](const char* title, const auto& list) {
     std::cout << title << ":\n";
     for (const auto& [name, description] : list)
@@ -557,7 +559,7 @@ nlohmann::ordered_json CellSpec(const CellOptions& options) {
 int Cell(CellOptions options, const std::vector<std::string>& plugins) {
   gipsi::TypeRegistry registry;
   gipsi::RegisterBuiltins(registry);
-  for (const auto& plugin : plugins) registry.LoadPlugin(plugin);
+  for (const auto& plugin : plugins) registry.LoadPlugin(gipsi::ResolvePlugin(plugin, "."));
   const nlohmann::ordered_json spec = CellSpec(options);
   auto model = gipsi::CreateCellModel(registry, gipsi::JsonNode(spec, "command line", "cell"));
   gipsi::PacingProtocol& protocol = options.protocol;
@@ -617,7 +619,8 @@ int Cell(CellOptions options, const std::vector<std::string>& plugins) {
 
 int main(int argc, char** argv) {
   CLI::App app{"GiPSi: an open-architecture framework for organ-level and surgical simulation"};
-  app.set_version_flag("--version", "gipsi 0.1.0");
+  app.set_version_flag("--version", "gipsi " GIPSI_VERSION_STRING " (plugin interface " +
+                                        std::to_string(GIPSI_PLUGIN_ABI_VERSION) + ")");
   app.require_subcommand(1);
   std::string scene_file, out_dir, mesh_file;
   double until = 0;

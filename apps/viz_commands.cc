@@ -238,7 +238,7 @@ int VizCommands::Snapshot() {
 
   TypeRegistry registry;
   RegisterBuiltins(registry);
-  for (const auto& plugin : plugins_) registry.LoadPlugin(plugin);
+  for (const auto& plugin : plugins_) registry.LoadPlugin(ResolvePlugin(plugin, "."));
   Scene scene = LoadScene(scene_, registry);
   // Every object as the scene's "display" keys say, with the command line's choices on top;
   // checked before anything runs.

@@ -44,6 +44,11 @@ cmake --build --preset release
 ctest --preset release
 stage_done release
 
+# The installed package, used by an outside project (find_package(gipsi); docs/install.md).
+echo "== package"
+bash scripts/consumer-test.sh build/release
+stage_done package
+
 if [ "${1:-}" = "--full" ]; then
   # The slowest pure-physics tests (convergence studies on refined meshes and long
   # integrations, 3.5-12 s each in the release build); the release stage runs them, and their

@@ -19,6 +19,8 @@
 #include <gtest/gtest.h>
 
 #include "apps/cli_test_util.h"
+#include "gipsi/base/version.h"
+#include "gipsi/core/registry.h"
 #include "test_paths.h"
 
 extern char** environ;
@@ -46,6 +48,13 @@ fs::path AFile(const fs::path& dir) {
 fs::path WriteCsv(const fs::path& dir) {
   std::ofstream(dir / "t.csv") << "time,a\n0,1\n1,2\n2,0\n";
   return dir / "t.csv";
+}
+
+TEST(GipsiExitCodes, VersionNamesThePackageAndPluginInterfaceVersions) {
+  const Result r = Gipsi("--version");
+  EXPECT_EQ(r.code, 0) << r.output;
+  EXPECT_EQ(r.output, "gipsi " GIPSI_VERSION_STRING " (plugin interface " +
+                          std::to_string(GIPSI_PLUGIN_ABI_VERSION) + ")\n");
 }
 
 TEST(GipsiExitCodes, BadCommandLineExits2ForEverySubcommand) {

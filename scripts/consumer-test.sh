@@ -1,0 +1,74 @@
+#!/usr/bin/env bash
+# The installed package as an outside user gets it: installs a build (default build/release)
+# into a fresh temporary prefix, copies tests/consumer/ away from the source tree, configures it
+# with find_package(gipsi) against that prefix alone, builds it and runs its checks; then runs the
+# installed `gipsi` with the installed example plugin. Fails if the consumer's build refers to
+# the source or build tree. Run by scripts/test.sh after the release tests (about 40 s).
+#   bash scripts/consumer-test.sh [BUILD_DIR]
+set -euo pipefail
+cd "$(dirname "$0")/.."
+source_dir=$PWD
+build_dir=$(realpath "${1:-build/release}")
+work=$(mktemp -d "${TMPDIR:-/tmp}/gipsi-consumer.XXXXXX")
+trap 'rm -rf "$work"' EXIT
+
+cmake --install "$build_dir" --prefix "$work/prefix" > "$work/install.log"
+echo "installed into a temporary prefix: $(grep -c 'Installing:' "$work/install.log") files"
+cp -r tests/consumer "$work/src"
+cmake -S "$work/src" -B "$work/build" -G Ninja -DCMAKE_BUILD_TYPE=Release \
+  -DCMAKE_PREFIX_PATH="$work/prefix" -DCMAKE_FIND_USE_PACKAGE_REGISTRY=OFF > "$work/configure.log"
+grep -q "^gipsi_DIR:PATH=$work/prefix/" "$work/build/CMakeCache.txt" ||
+  { echo "consumer-test: gipsi was not found in the fresh prefix" >&2; grep gipsi_DIR "$work/build/CMakeCache.txt" >&2; exit 1; }
+cmake --build "$work/build"
+
+# The consumer must have seen only the installed package.
+for tree in "$source_dir" "$build_dir"; do
+  if grep -q "$tree" "$work/build/compile_commands.json" "$work/build/build.ninja"; then
+    echo "consumer-test: the consumer's build refers to $tree:" >&2
+    grep -o "[^ ]*$tree[^ ]*" "$work/build/compile_commands.json" "$work/build/build.ninja" | head >&2
+    exit 1
+  fi
+done
+if ldd "$work/build/thermal_consumer" | grep -q "$build_dir"; then
+  echo "consumer-test: thermal_consumer loads libraries from the build tree" >&2; exit 1
+fi
+
+"$work/build/thermal_consumer" "$work"
+"$work/prefix/bin/gipsi" --version
+
+# The CMake snippet of docs/install.md as a user copies it, with a main of their own; then the
+# same with COMPONENTS viz, and with a component that does not exist (must fail, naming it).
+project_dir="$work/my_project"
+mkdir -p "$project_dir"
+awk '/^```cmake$/{f=1; next} /^```$/{f=0} f' docs/install.md > "$project_dir/CMakeLists.txt"
+cat > "$project_dir/main.cc" <<'CC'
+#include <cstdio>
+
+#include "gipsi/base/version.h"
+#include "gipsi/core/registry.h"
+#include "gipsi/io/builtins.h"
+
+int main() {
+  gipsi::TypeRegistry registry;
+  gipsi::RegisterBuiltins(registry);
+  std::printf("docs/install.md snippet: gipsi %s, %zu object types\n", GIPSI_VERSION_STRING,
+              registry.objects.Names().size());
+}
+CC
+configure() { cmake -S "$project_dir" -B "$project_dir/build" -G Ninja -DCMAKE_PREFIX_PATH="$work/prefix"; }
+configure > /dev/null
+cmake --build "$project_dir/build" > /dev/null
+"$project_dir/build/my_simulation"
+sed -i 's/find_package(gipsi 0.1 REQUIRED)/find_package(gipsi 0.1 REQUIRED COMPONENTS viz)/;
+        s/PRIVATE gipsi::gipsi)/PRIVATE gipsi::gipsi gipsi::viz)/' "$project_dir/CMakeLists.txt"
+configure > /dev/null
+cmake --build "$project_dir/build" > /dev/null
+"$project_dir/build/my_simulation" > /dev/null
+sed -i 's/COMPONENTS viz)/COMPONENTS viz python)/' "$project_dir/CMakeLists.txt"
+if configure > "$work/bad_component.log" 2>&1 || ! grep -q "no component 'python'" "$work/bad_component.log"; then
+  echo "consumer-test: an unknown component was not refused by name:" >&2
+  cat "$work/bad_component.log" >&2; exit 1
+fi
+"$work/prefix/bin/gipsi" types --plugin gipsi_example_plugin | grep -q "Oscillator" ||
+  { echo "consumer-test: the installed gipsi did not load the installed example plugin" >&2; exit 1; }
+echo "consumer-test: passed"
