@@ -71,4 +71,24 @@ if configure > "$work/bad_component.log" 2>&1 || ! grep -q "no component 'python
 fi
 "$work/prefix/bin/gipsi" types --plugin gipsi_example_plugin | grep -q "Oscillator" ||
   { echo "consumer-test: the installed gipsi did not load the installed example plugin" >&2; exit 1; }
+# The installed Python module, from the prefix alone (when the build has it).
+module=$(find "$work/prefix" -name 'gipsi.cpython-*.so' | head -1)
+if [ -n "$module" ]; then
+  python=$(sed -n 's/^_Python3_EXECUTABLE:INTERNAL=//p' "$build_dir/CMakeCache.txt")
+  PYTHONPATH=$(dirname "$module") "${python:-/usr/bin/python3}" - "$work/prefix" <<'PY'
+import sys
+import gipsi
+assert gipsi.__file__.startswith(sys.argv[1]), f"gipsi imported from {gipsi.__file__}"
+scene = {"gipsi": 1, "units": "SI",
+         "meshes": {"m": {"generate": "sheet", "origin": [0, 0, 0], "u": [0.1, 0, 0],
+                          "v": [0, 0.1, 0], "cells": [2, 2]}},
+         "objects": {"sheet": {"type": "MassSpring", "domain": "m", "density": 1000,
+                               "thickness": 0.001, "stiffness": 20, "dt": 0.001}},
+         "schedule": {"end": 0.01, "dt": 0.001}}
+sim = gipsi.Simulation.from_dict(scene)
+assert sim.run()["outcome"] == "completed"
+assert sim.object("sheet").positions.shape == (9, 3)
+print(f"installed Python module: gipsi {gipsi.__version__} from the prefix")
+PY
+fi
 echo "consumer-test: passed"

@@ -25,6 +25,7 @@ packages=(
   clang-14 libclang-rt-14-dev libomp-14-dev  # libFuzzer targets (scripts/fuzz.sh)
   libopenigtlink-dev     # OpenIGTLink 1.11: the networked haptic device (tracker, 3D Slicer)
   libfcl-dev             # FCL 0.7: the collision benchmark's baseline (bench/collision_bench.cc)
+  pybind11-dev python3-dev python3-numpy  # the gipsi Python module (python/)
   clang-format clang-tidy
 )
 

@@ -1,0 +1,495 @@
+/// @file
+/// The `gipsi` Python module (pybind11): scenes loaded from files or dicts, stepped and run from
+/// Python, objects' positions as NumPy views without a copy, fields read into and written from
+/// NumPy arrays (with the checks a connector's ports get), probes recorded in memory as dicts of
+/// arrays, checkpoints to bytes and files, and mesh files as arrays. See docs/python.md.
+
+#include <pybind11/functional.h>
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+#include <pybind11/stl/filesystem.h>
+
+#include <cmath>
+#include <filesystem>
+#include <map>
+#include <memory>
+#include <optional>
+#include <regex>
+#include <string>
+#include <vector>
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+#include <nlohmann/json.hpp>
+
+#include "gipsi/base/error.h"
+#include "gipsi/base/state.h"
+#include "gipsi/base/version.h"
+#include "gipsi/core/kernel.h"
+#include "gipsi/core/registry.h"
+#include "gipsi/core/sim_object.h"
+#include "gipsi/io/builtins.h"
+#include "gipsi/io/mesh_io.h"
+#include "gipsi/io/outputs.h"
+#include "gipsi/io/probes.h"
+#include "gipsi/io/scene.h"
+
+namespace py = pybind11;
+
+namespace gipsi::python {
+namespace {
+
+/// The parts of an InputError message "FILE: LOCATION: WHAT" (error.h builds them so; empty
+/// parts are left out there). LOCATION is a JSON path ("objects.sheet.density", "probes[2]") or
+/// a line ("line 12"); a part is taken as such only if it looks like one.
+struct ErrorParts {
+  std::string file, path, what;
+};
+
+ErrorParts SplitMessage(const std::string& message) {
+  static const std::regex file_like(R"([^\s:]+\.[A-Za-z0-9]+)");
+  static const std::regex location_like(
+      R"([A-Za-z_][\w\-]*(\[\d+\])*(\.[\w\-]+(\[\d+\])*)*|line \d+(, column \d+)?)");
+  ErrorParts parts{"", "", message};
+  std::string rest = message;
+  if (auto colon = rest.find(": ");
+      colon != std::string::npos && std::regex_match(rest.substr(0, colon), file_like)) {
+    parts.file = rest.substr(0, colon);
+    rest = rest.substr(colon + 2);
+    if (auto next = rest.find(": ");
+        next != std::string::npos && std::regex_match(rest.substr(0, next), location_like)) {
+      parts.path = rest.substr(0, next);
+      rest = rest.substr(next + 2);
+    } else if (rest.starts_with("(document root): ")) {
+      rest = rest.substr(17);
+    }
+    parts.what = rest;
+  }
+  return parts;
+}
+
+/// Records the scene's point and region probes in memory at their sampling interval (line
+/// probes are written to files only, by `write_outputs`). Saved in checkpoints: the next sample
+/// time and the number of rows of every probe.
+class MemoryProbes final : public Observer {
+ public:
+  explicit MemoryProbes(std::vector<Probe> probes) : probes_(std::move(probes)) {
+    for (const Probe& p : probes_) {
+      Table table;
+      if (!p.is_line()) {
+        const std::string header = p.Header();
+        std::size_t start = 0;
+        while (start <= header.size()) {
+          const std::size_t comma = std::min(header.find(',', start), header.size());
+          table.columns.push_back(header.substr(start, comma - start));
+          start = comma + 1;
+        }
+        table.values.resize(table.columns.size());
+      }
+      tables_.push_back(std::move(table));
+    }
+  }
+
+  void Observe(const Kernel& kernel, double t) override {
+    const double tolerance = 1e-9 * kernel.macro_dt();
+    for (std::size_t i = 0; i < probes_.size(); ++i) {
+      Table& table = tables_[i];
+      if (probes_[i].is_line() || t + tolerance < table.next) continue;
+      probes_[i].Sample(row_);
+      table.values[0].push_back(t);
+      for (std::size_t c = 0; c < row_.size() && c + 1 < table.values.size(); ++c)
+        table.values[c + 1].push_back(row_[c]);
+      table.next = probes_[i].every > 0 ? t + probes_[i].every : t;
+    }
+  }
+  void SaveState(StateWriter& out) override {
+    out.BeginSection("PythonProbes", 1);
+    out.WriteInt(static_cast<std::int64_t>(tables_.size()));
+    for (const Table& table : tables_) {
+      out.WriteDouble(table.next);
+      out.WriteInt(table.values.empty() ? 0 : static_cast<std::int64_t>(table.values[0].size()));
+    }
+    out.EndSection();
+  }
+  void RestoreState(StateReader& in) override {
+    in.BeginSection("PythonProbes", 1);
+    const std::int64_t n = in.ReadInt();
+    if (n != static_cast<std::int64_t>(tables_.size()))
+      throw InputError(fmt::format("the checkpoint has {} probes recorded in memory, this scene {}",
+                                   n, tables_.size()));
+    pending_.clear();
+    for (std::int64_t i = 0; i < n; ++i) {
+      const double next = in.ReadDouble();
+      pending_.emplace_back(next, in.ReadInt());
+    }
+    in.EndSection();
+  }
+  // Rows after the checkpoint's are dropped (a restore within this simulation goes back in
+  // time); rows before it that a fresh simulation never recorded stay missing.
+  void CommitRestore() override {
+    for (std::size_t i = 0; i < tables_.size(); ++i) {
+      tables_[i].next = pending_[i].first;
+      for (auto& column : tables_[i].values)
+        if (static_cast<std::int64_t>(column.size()) > pending_[i].second)
+          column.resize(static_cast<std::size_t>(pending_[i].second));
+    }
+  }
+
+  /// Every probe's columns as NumPy arrays (copies), by probe name.
+  [[nodiscard]] py::dict ToDict() const {
+    py::dict result;
+    for (std::size_t i = 0; i < probes_.size(); ++i) {
+      if (probes_[i].is_line()) continue;
+      py::dict columns;
+      for (std::size_t c = 0; c < tables_[i].columns.size(); ++c) {
+        const auto& v = tables_[i].values[c];
+        columns[py::str(tables_[i].columns[c])] =
+            py::array_t<double>(static_cast<py::ssize_t>(v.size()), v.data());
+      }
+      result[py::str(probes_[i].name)] = columns;
+    }
+    return result;
+  }
+
+ private:
+  struct Table {
+    std::vector<std::string> columns;
+    std::vector<std::vector<double>> values;
+    double next = -INFINITY;
+  };
+  std::vector<Probe> probes_;
+  std::vector<Table> tables_;
+  std::vector<double> row_;
+  std::vector<std::pair<double, std::int64_t>> pending_;
+};
+
+/// A loaded scene with its registry (which must outlive the objects its plugins built).
+class Simulation {
+ public:
+  static std::shared_ptr<Simulation> FromFile(const std::filesystem::path& file,
+                                              const std::vector<std::string>& plugins) {
+    auto sim = std::shared_ptr<Simulation>(new Simulation(plugins, file.parent_path()));
+    sim->scene_ = LoadScene(file, *sim->registry_);
+    sim->Attach();
+    return sim;
+  }
+  static std::shared_ptr<Simulation> FromDict(const py::dict& scene, const std::string& name,
+                                              const std::filesystem::path& base_dir,
+                                              const std::vector<std::string>& plugins) {
+    const std::string text = py::module_::import("json").attr("dumps")(scene).cast<std::string>();
+    auto sim = std::shared_ptr<Simulation>(new Simulation(plugins, base_dir));
+    sim->scene_ = LoadSceneFromString(text, name, base_dir, *sim->registry_);
+    sim->Attach();
+    return sim;
+  }
+
+  Kernel& kernel() { return *scene_.kernel; }
+  const Scene& scene() const { return scene_; }
+  double end_time() const { return scene_.end_time; }
+  py::dict probes() const { return probes_->ToDict(); }
+
+  /// Runs to `until` (default: the scene's end). `callback(t)` is called after every macro
+  /// step (with the GIL); returning False stops the run there; an exception stops it and is
+  /// raised. Ctrl+C stops it too (KeyboardInterrupt).
+  py::dict Run(std::optional<double> until, const py::object& callback) {
+    const double end = until.value_or(scene_.end_time);
+    if (!std::isfinite(end))
+      throw py::value_error(fmt::format("until must be finite, got {}", end));
+    std::optional<py::error_already_set> error;
+    Kernel& k = kernel();
+    ProgressFn progress = [&](double t, double) {
+      py::gil_scoped_acquire gil;
+      if (error) return;
+      try {
+        if (PyErr_CheckSignals() != 0) throw py::error_already_set();
+        if (!callback.is_none() && callback(t).is(py::bool_(false))) k.RequestStop();
+      } catch (py::error_already_set& e) {
+        error.emplace(std::move(e));
+        k.RequestStop();
+      }
+    };
+    RunResult result;
+    {
+      py::gil_scoped_release release;
+      result = k.Run(end, progress);
+    }
+    if (error) throw std::move(*error);
+    static const char* outcomes[] = {"completed", "diverged", "stopped", "output_failed"};
+    py::dict out;
+    out["outcome"] = outcomes[static_cast<int>(result.outcome)];
+    out["diagnostic"] = result.diagnostic;
+    out["start_time"] = result.start_time;
+    out["end_time"] = result.end_time;
+    out["wall_seconds"] = result.wall_seconds;
+    out["macro_steps"] = result.macro_steps;
+    return out;
+  }
+
+  py::bytes Save() {
+    StateWriter out;
+    kernel().SaveState(out);
+    return py::bytes(out.bytes());
+  }
+  void Restore(const py::bytes& bytes) {
+    StateReader in(std::string(bytes), "checkpoint bytes");
+    kernel().RestoreState(in);
+  }
+
+  /// Attaches the scene's file outputs (VTU/PVD series, probe CSVs) under `directory` (default:
+  /// the scene's outputs.directory).
+  void WriteOutputs(const std::optional<std::filesystem::path>& directory) {
+    AttachOutputs(scene_, directory.value_or(scene_.output_directory));
+  }
+
+ private:
+  Simulation(const std::vector<std::string>& plugins, const std::filesystem::path& base_dir)
+      : registry_(std::make_unique<TypeRegistry>()) {
+    RegisterBuiltins(*registry_);
+    for (const auto& plugin : plugins) registry_->LoadPlugin(ResolvePlugin(plugin, base_dir));
+  }
+  void Attach() {
+    auto probes = std::make_unique<MemoryProbes>(scene_.probes);
+    probes_ = probes.get();
+    scene_.kernel->AddObserver(std::move(probes));
+  }
+
+  std::unique_ptr<TypeRegistry> registry_;
+  Scene scene_;
+  MemoryProbes* probes_ = nullptr;
+};
+
+/// An object of a simulation (keeps the simulation alive).
+struct ObjectHandle {
+  std::shared_ptr<Simulation> sim;
+  SimObject* object;
+};
+
+const char* AccessName(FieldAccess a) {
+  return a == FieldAccess::kRead ? "read" : a == FieldAccess::kWrite ? "write" : "read_write";
+}
+
+py::dict FieldDict(const SimObject& o, FieldId id) {
+  const FieldInfo& f = o.field_info(id);
+  py::dict d;
+  d["location"] = std::string(ToString(f.location));
+  d["components"] = f.components;
+  d["count"] = o.FieldCount(id);
+  d["units"] = f.units;
+  d["access"] = AccessName(f.access);
+  d["description"] = f.description;
+  return d;
+}
+
+FieldId FindFieldOrRaise(const SimObject& o, const std::string& name) {
+  if (auto id = o.TryFindField(name)) return *id;
+  std::string known;
+  for (const FieldInfo& f : o.fields()) known += (known.empty() ? "" : ", ") + f.name;
+  throw py::key_error(fmt::format("object '{}' ({}) has no field '{}'; its fields: {}", o.name(),
+                                  o.type_name(), name, known));
+}
+
+/// The field as a new (count, components) array: one copy, straight from the object.
+py::array_t<double> ReadField(const ObjectHandle& h, const std::string& name) {
+  const SimObject& o = *h.object;
+  const FieldId id = FindFieldOrRaise(o, name);
+  const FieldInfo& f = o.field_info(id);
+  if (!f.readable())
+    throw py::value_error(fmt::format("field '{}' of '{}' is write-only", name, o.name()));
+  const Index count = o.FieldCount(id);
+  py::array_t<double> out(
+      {static_cast<py::ssize_t>(count), static_cast<py::ssize_t>(f.components)});
+  Eigen::Map<Eigen::MatrixXd> view(out.mutable_data(), f.components, count);
+  o.ReadField(id, view);
+  return out;
+}
+
+/// Writes a field with the checks a connector's port gets: writable, the shape (count,
+/// components) (a global field also takes (components,)), finite values.
+void WriteField(ObjectHandle& h, const std::string& name,
+                const py::array_t<double, py::array::c_style | py::array::forcecast>& values) {
+  SimObject& o = *h.object;
+  const FieldId id = FindFieldOrRaise(o, name);
+  const FieldInfo& f = o.field_info(id);
+  if (!f.writable())
+    throw py::value_error(
+        fmt::format("field '{}' of '{}' is read-only ({})", name, o.name(), f.description));
+  const Index count = o.FieldCount(id);
+  const bool global_vector = count == 1 && values.ndim() == 1 && values.shape(0) == f.components;
+  const bool full =
+      values.ndim() == 2 && values.shape(0) == count && values.shape(1) == f.components;
+  if (!global_vector && !full) {
+    std::vector<py::ssize_t> shape(values.shape(), values.shape() + values.ndim());
+    throw py::value_error(
+        fmt::format("field '{}' of '{}' takes an array of shape ({}, {}), got ({})", name, o.name(),
+                    count, f.components, fmt::join(shape, ", ")));
+  }
+  for (py::ssize_t i = 0; i < values.size(); ++i)
+    if (!std::isfinite(values.data()[i]))
+      throw py::value_error(fmt::format("field '{}' of '{}': value {} is not finite ({})", name,
+                                        o.name(), i, values.data()[i]));
+  Eigen::Map<const Eigen::MatrixXd> in(values.data(), f.components, count);
+  o.WriteField(id, in);
+}
+
+/// A read-only (rows, cols) view of column-major Eigen data that keeps `owner` alive.
+template <class Scalar>
+py::array View(const Scalar* data, Index cols, Index rows_per_col, py::object owner) {
+  py::array a(py::dtype::of<Scalar>(),
+              {static_cast<py::ssize_t>(cols), static_cast<py::ssize_t>(rows_per_col)},
+              {static_cast<py::ssize_t>(rows_per_col * sizeof(Scalar)),
+               static_cast<py::ssize_t>(sizeof(Scalar))},
+              data, owner);
+  py::detail::array_proxy(a.ptr())->flags &= ~py::detail::npy_api::NPY_ARRAY_WRITEABLE_;
+  return a;
+}
+
+py::dict MeshDict(const Mesh& mesh) {
+  py::dict d;
+  d["nodes"] = py::array_t<double>({mesh.num_nodes(), Index{3}}, mesh.nodes.data());
+  d["tets"] = py::array_t<int>({mesh.num_tets(), Index{4}}, mesh.tets.data());
+  d["triangles"] = py::array_t<int>({mesh.num_triangles(), Index{3}}, mesh.triangles.data());
+  py::dict groups;
+  for (const MeshGroup& g : mesh.groups)
+    groups[py::str(g.name)] =
+        py::array_t<int>(static_cast<py::ssize_t>(g.items.size()), g.items.data());
+  d["groups"] = groups;
+  return d;
+}
+
+}  // namespace
+}  // namespace gipsi::python
+
+PYBIND11_MODULE(gipsi, m) {
+  using namespace gipsi;
+  using namespace gipsi::python;
+  m.doc() = "GiPSi: an open-architecture framework for organ-level and surgical simulation";
+  m.attr("__version__") = GIPSI_VERSION_STRING;
+  m.attr("plugin_interface") = GIPSI_PLUGIN_ABI_VERSION;
+
+  static py::exception<InputError> input_error(m, "InputError", PyExc_ValueError);
+  input_error.doc() =
+      "Bad input (scene, mesh, plugin, checkpoint). Attributes: file, path (the JSON path or "
+      "line, '' if none), what (the rest of the message).";
+  py::register_exception_translator([](std::exception_ptr p) {
+    try {
+      if (p) std::rethrow_exception(p);
+    } catch (const InputError& e) {
+      const ErrorParts parts = SplitMessage(e.what());
+      py::object error = py::handle(input_error.ptr())(e.what());
+      error.attr("file") = parts.file;
+      error.attr("path") = parts.path;
+      error.attr("what") = parts.what;
+      PyErr_SetObject(input_error.ptr(), error.ptr());
+    }
+  });
+
+  py::class_<ObjectHandle>(m, "Object", "An object of a simulation (a view; keeps it alive).")
+      .def_property_readonly("name", [](const ObjectHandle& h) { return h.object->name(); })
+      .def_property_readonly(
+          "type", [](const ObjectHandle& h) { return std::string(h.object->type_name()); })
+      .def_property_readonly(
+          "fields",
+          [](const ObjectHandle& h) {
+            py::dict d;
+            for (std::size_t i = 0; i < h.object->fields().size(); ++i) {
+              const FieldId id = h.object->FindField(h.object->fields()[i].name);
+              d[py::str(h.object->fields()[i].name)] = FieldDict(*h.object, id);
+            }
+            return d;
+          },
+          "Every declared field: location, components, count, units, access, description.")
+      .def_property_readonly(
+          "positions",
+          [](py::object self) {
+            const auto& h = self.cast<const ObjectHandle&>();
+            const Points& x = h.object->domain_positions();
+            return View(x.data(), x.cols(), 3, self);
+          },
+          "Current domain node positions, (nodes, 3): a read-only view of the object's state "
+          "(no copy), valid while the object lives; it follows the simulation as it runs.")
+      .def_property_readonly(
+          "rest_positions",
+          [](py::object self) {
+            const auto& h = self.cast<const ObjectHandle&>();
+            const Points& x = h.object->domain().nodes;
+            return View(x.data(), x.cols(), 3, self);
+          },
+          "Rest domain node positions, (nodes, 3), a read-only view.")
+      .def_property_readonly(
+          "tets",
+          [](py::object self) {
+            const auto& h = self.cast<const ObjectHandle&>();
+            const Tets& t = h.object->domain().tets;
+            return View(t.data(), t.cols(), 4, self);
+          },
+          "Domain tetrahedra, (tets, 4) node indices, a read-only view.")
+      .def("field", &ReadField, py::arg("name"),
+           "The field as a new (count, components) array, in its declared units.")
+      .def("set_field", &WriteField, py::arg("name"), py::arg("values"),
+           "Writes a writable field (shape (count, components); (components,) for a global "
+           "field); checked like a connector's port: access, shape and finite values.");
+
+  py::class_<Simulation, std::shared_ptr<Simulation>>(m, "Simulation",
+                                                      "A loaded scene, ready to run.")
+      .def_static("from_file", &Simulation::FromFile, py::arg("file"),
+                  py::arg("plugins") = std::vector<std::string>{},
+                  "Loads a scene file (JSON), with the same checks as `gipsi run`.")
+      .def_static("from_dict", &Simulation::FromDict, py::arg("scene"),
+                  py::arg("name") = "scene.json", py::arg("base_dir") = ".",
+                  py::arg("plugins") = std::vector<std::string>{},
+                  "Loads a scene from a dict (the JSON scene format); `name` is used in messages "
+                  "and `base_dir` resolves relative mesh and plugin paths.")
+      .def_property_readonly("time", [](Simulation& s) { return s.kernel().time(); })
+      .def_property_readonly("end_time", &Simulation::end_time)
+      .def_property_readonly("macro_dt", [](Simulation& s) { return s.kernel().macro_dt(); })
+      .def_property_readonly("macro_steps", [](Simulation& s) { return s.kernel().macro_steps(); })
+      .def_property_readonly(
+          "objects",
+          [](std::shared_ptr<Simulation> s) {
+            py::dict d;
+            for (const auto& [path, object] : s->kernel().ObjectPaths())
+              d[py::str(path)] = ObjectHandle{s, object};
+            return d;
+          },
+          "Every object and aggregate part by its full dotted name.")
+      .def(
+          "object",
+          [](std::shared_ptr<Simulation> s, const std::string& name) {
+            return ObjectHandle{s, &s->kernel().FindObject(name)};
+          },
+          py::arg("name"), "The object called `name` (as in scenes and probes).")
+      .def(
+          "step",
+          [](Simulation& s) {
+            return s.Run(s.kernel().time() + s.kernel().macro_dt(), py::none());
+          },
+          "Runs one macro step; returns the run's outcome as a dict.")
+      .def("run", &Simulation::Run, py::arg("until") = py::none(), py::arg("callback") = py::none(),
+           "Runs to `until` (default: the scene's end). callback(t) runs after every macro "
+           "step; returning False stops the run. Returns a dict: outcome ('completed', "
+           "'diverged', 'stopped', 'output_failed'), diagnostic, start_time, end_time, "
+           "wall_seconds, macro_steps.")
+      .def_property_readonly("probes", &Simulation::probes,
+                             "The scene's point and region probes recorded so far: {probe: "
+                             "{'time': array, column: array, ...}}.")
+      .def("save", &Simulation::Save, "The complete state as bytes (a checkpoint).")
+      .def("restore", &Simulation::Restore, py::arg("state"),
+           "Restores bytes from save() of the same scene.")
+      .def(
+          "save_file",
+          [](Simulation& s, const std::filesystem::path& f) { s.kernel().WriteCheckpoint(f); },
+          py::arg("file"), "Writes a checkpoint file (atomic, checksummed; as gipsi run's).")
+      .def(
+          "restore_file",
+          [](Simulation& s, const std::filesystem::path& f) { s.kernel().ReadCheckpoint(f); },
+          py::arg("file"), "Restores a checkpoint file of the same scene.")
+      .def("write_outputs", &Simulation::WriteOutputs, py::arg("directory") = py::none(),
+           "Writes the scene's VTU/PVD series and probe CSVs while it runs, as gipsi run does.");
+
+  m.def(
+      "read_mesh", [](const std::filesystem::path& file) { return MeshDict(ReadMesh(file)); },
+      py::arg("file"),
+      "Reads a mesh file (.msh, .vtu, .vtk, .obj, ...) as a dict of arrays: nodes (N, 3), tets "
+      "(E, 4), triangles (T, 3), groups {name: item indices}.");
+}

@@ -1,0 +1,239 @@
+"""The gipsi Python module (python/gipsi_module.cc; docs/python.md), run by ctest as
+Python.Module with PYTHONPATH pointing at the build tree's module.
+
+Physics checks have exact answers: a free sheet under gravity falls as -g t^2 / 2 (RK4 is exact
+for a constant acceleration, and unstretched springs exert no force), and a force written into
+every node changes the total momentum by N f t (spring forces cancel in the sum).
+"""
+import contextlib
+import io
+import os
+import re
+import tempfile
+import unittest
+
+import numpy as np
+
+import gipsi
+
+SOURCE_DIR = os.environ.get("GIPSI_SOURCE_DIR", os.path.join(os.path.dirname(__file__), "..", ".."))
+G = 9.81
+
+
+def sheet_scene(gravity=(0.0, 0.0, -G), end=0.2, integrator="RK4"):
+    """A free 10 x 10 cm mass-spring sheet (no pins, no damping, no drag), as a dict."""
+    return {
+        "gipsi": 1,
+        "units": "SI",
+        "meshes": {"sheet": {"generate": "sheet", "origin": [0, 0, 0], "u": [0.1, 0, 0],
+                             "v": [0, 0.1, 0], "cells": [4, 4]}},
+        "objects": {"sheet": {"type": "MassSpring", "domain": "sheet", "density": 1000,
+                              "thickness": 0.001, "stiffness": 20, "damping": 0, "drag": 0,
+                              "gravity": list(gravity), "integrator": integrator, "dt": 0.001}},
+        "schedule": {"end": end, "dt": 0.01},
+        "probes": {"energy": {"object": "sheet", "fields": ["kinetic_energy"], "every": 0.02}},
+    }
+
+
+class Module(unittest.TestCase):
+    def test_names_its_version_and_plugin_interface(self):
+        self.assertRegex(gipsi.__version__, r"^\d+\.\d+\.\d+$")
+        self.assertGreaterEqual(gipsi.plugin_interface, 10)
+
+
+class Running(unittest.TestCase):
+    def test_a_free_sheet_falls_as_minus_g_t_squared_over_two(self):
+        sim = gipsi.Simulation.from_dict(sheet_scene())
+        sheet = sim.object("sheet")
+        x = sheet.positions  # a view: it follows the state as the simulation runs
+        z0 = x[:, 2].copy()
+        result = sim.run(until=0.1)
+        self.assertEqual(result["outcome"], "completed")
+        self.assertEqual(sim.macro_steps, 10)
+        t = sim.time
+        self.assertAlmostEqual(t, 0.1, delta=1e-12)
+        # Rounding only: 100 RK4 steps of a 5 m/s^2-scale motion.
+        np.testing.assert_allclose(x[:, 2], z0 - G * t * t / 2, rtol=0, atol=1e-12)
+        np.testing.assert_array_equal(x[:, :2], sheet.rest_positions[:, :2])
+
+    def test_positions_are_a_read_only_view_without_a_copy(self):
+        sim = gipsi.Simulation.from_dict(sheet_scene())
+        sheet = sim.object("sheet")
+        x = sheet.positions
+        self.assertFalse(x.flags.writeable)
+        self.assertEqual(x.shape, (25, 3))
+        before = x.copy()
+        sim.step()
+        self.assertFalse(np.array_equal(before, x))  # the same array now shows the new state
+        self.assertTrue(np.shares_memory(x, sheet.positions))
+        with self.assertRaises(ValueError):
+            x[0, 0] = 1.0
+        del sim  # the view keeps the simulation alive
+        self.assertTrue(np.all(np.isfinite(x)))
+
+    def test_fields_read_in_their_declared_shape(self):
+        sim = gipsi.Simulation.from_dict(sheet_scene())
+        sheet = sim.object("sheet")
+        sim.run(until=0.05)
+        info = sheet.fields["displacement"]
+        self.assertEqual((info["location"], info["components"], info["count"], info["units"]),
+                         ("node", 3, 25, "m"))
+        np.testing.assert_array_equal(sheet.field("displacement"),
+                                      sheet.positions - sheet.rest_positions)
+        self.assertEqual(sheet.field("kinetic_energy").shape, (1, 1))
+
+    def test_a_written_force_changes_the_momentum_by_n_f_t(self):
+        sim = gipsi.Simulation.from_dict(sheet_scene(gravity=(0, 0, 0)))
+        sheet = sim.object("sheet")
+        f = np.array([0.0, 0.002, 0.001])
+        force = np.tile(f, (25, 1))
+        for _ in range(10):  # a coupling load lasts one macro step: set it before each
+            sheet.set_field("external_force", force)
+            sim.step()
+        momentum = sheet.field("momentum")[0]
+        np.testing.assert_allclose(momentum, 25 * f * sim.time, rtol=1e-12, atol=1e-17)
+
+    def test_writes_are_checked_like_a_connectors_port(self):
+        sim = gipsi.Simulation.from_dict(sheet_scene())
+        sheet = sim.object("sheet")
+        with self.assertRaisesRegex(ValueError, r"read-only"):
+            sheet.set_field("displacement", np.zeros((25, 3)))
+        with self.assertRaisesRegex(ValueError, r"shape \(25, 3\), got \(24, 3\)"):
+            sheet.set_field("external_force", np.zeros((24, 3)))
+        bad = np.zeros((25, 3))
+        bad[7, 1] = np.nan
+        with self.assertRaisesRegex(ValueError, r"value 22 is not finite"):
+            sheet.set_field("external_force", bad)
+        with self.assertRaisesRegex(KeyError, r"no field 'pressure'.*external_force"):
+            sheet.field("pressure")
+
+    def test_a_callback_can_stop_the_run_and_its_exceptions_propagate(self):
+        sim = gipsi.Simulation.from_dict(sheet_scene())
+        seen = []
+        result = sim.run(callback=lambda t: seen.append(t) or t < 0.05 - 1e-9)
+        self.assertEqual(result["outcome"], "stopped")
+        self.assertAlmostEqual(sim.time, 0.05, delta=1e-12)
+        self.assertEqual(len(seen), 5)
+
+        def fail(t):
+            raise RuntimeError("from the callback")
+
+        with self.assertRaisesRegex(RuntimeError, "from the callback"):
+            sim.run(callback=fail)
+        self.assertAlmostEqual(sim.time, 0.06, delta=1e-12)  # stopped after that step
+
+
+class Checkpoints(unittest.TestCase):
+    def test_restoring_bytes_repeats_the_run_bitwise_with_its_probes(self):
+        sim = gipsi.Simulation.from_dict(sheet_scene(integrator="SymplecticEuler"))
+        sim.run(until=0.1)
+        state = sim.save()
+        self.assertIsInstance(state, bytes)
+        sim.run(until=0.2)
+        first = sim.object("sheet").positions.copy()
+        first_probe = sim.probes["energy"]
+        sim.restore(state)
+        self.assertAlmostEqual(sim.time, 0.1, delta=1e-12)
+        self.assertEqual(len(sim.probes["energy"]["time"]), 6)  # 0, 0.02, ..., 0.1
+        sim.run(until=0.2)
+        np.testing.assert_array_equal(sim.object("sheet").positions, first)
+        for column, values in first_probe.items():
+            np.testing.assert_array_equal(sim.probes["energy"][column], values)
+
+    def test_a_checkpoint_file_resumes_in_a_fresh_simulation(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            path = os.path.join(tmp, "sheet.ckpt")
+            sim = gipsi.Simulation.from_dict(sheet_scene())
+            sim.run(until=0.1)
+            sim.save_file(path)
+            sim.run(until=0.2)
+            fresh = gipsi.Simulation.from_dict(sheet_scene())
+            fresh.restore_file(path)
+            fresh.run(until=0.2)
+            np.testing.assert_array_equal(fresh.object("sheet").positions,
+                                          sim.object("sheet").positions)
+
+    def test_bytes_of_another_scene_are_refused(self):
+        sim = gipsi.Simulation.from_dict(sheet_scene())
+        other = sheet_scene()
+        other["meshes"]["sheet"]["cells"] = [5, 5]
+        with self.assertRaisesRegex(gipsi.InputError, "checkpoint bytes"):
+            gipsi.Simulation.from_dict(other).restore(sim.save())
+
+
+class Errors(unittest.TestCase):
+    def test_a_bad_value_raises_input_error_with_its_json_path(self):
+        scene = sheet_scene()
+        scene["objects"]["sheet"]["density"] = -1
+        with self.assertRaises(gipsi.InputError) as raised:
+            gipsi.Simulation.from_dict(scene, name="my_scene.json")
+        e = raised.exception
+        self.assertIsInstance(e, ValueError)
+        self.assertEqual(e.file, "my_scene.json")
+        self.assertEqual(e.path, "objects.sheet.density")
+        self.assertIn("positive", e.what)
+
+    def test_a_missing_top_level_key_names_the_document_root(self):
+        with self.assertRaises(gipsi.InputError) as raised:
+            gipsi.Simulation.from_dict({"gipsi": 1, "objects": {}})
+        self.assertEqual(raised.exception.path, "")
+        self.assertIn("missing required key 'schedule'", raised.exception.what)
+
+    def test_an_unknown_object_raises_input_error_listing_the_objects(self):
+        sim = gipsi.Simulation.from_dict(sheet_scene())
+        with self.assertRaisesRegex(gipsi.InputError, "sheet"):
+            sim.object("sheeet")
+
+
+class Meshes(unittest.TestCase):
+    def test_read_mesh_gives_the_arrays_a_scene_builds_from_the_file(self):
+        path = os.path.join(SOURCE_DIR, "scenes", "meshes", "liver.msh")
+        mesh = gipsi.read_mesh(path)
+        self.assertEqual(mesh["nodes"].shape[1], 3)
+        self.assertEqual(mesh["tets"].shape[1], 4)
+        self.assertGreater(len(mesh["tets"]), 100)
+        scene = {"gipsi": 1, "units": "SI", "meshes": {"liver": {"file": path}},
+                 "objects": {"liver": {"type": "MassSpring", "domain": "liver", "density": 1000,
+                                       "stiffness": 100, "dt": 0.001}},
+                 "schedule": {"end": 0.01, "dt": 0.001}}
+        liver = gipsi.Simulation.from_dict(scene).object("liver")
+        np.testing.assert_array_equal(liver.rest_positions, mesh["nodes"])
+        np.testing.assert_array_equal(liver.tets, mesh["tets"])
+
+    def test_a_missing_mesh_file_raises_input_error_naming_it(self):
+        with self.assertRaisesRegex(gipsi.InputError, "no_such.msh"):
+            gipsi.read_mesh("no_such.msh")
+
+
+class Outputs(unittest.TestCase):
+    def test_write_outputs_writes_the_series_gipsi_run_writes(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            sim = gipsi.Simulation.from_dict(sheet_scene(end=0.05))
+            sim.write_outputs(tmp)
+            self.assertEqual(sim.run()["outcome"], "completed")
+            self.assertTrue(os.path.exists(os.path.join(tmp, "sheet.pvd")))
+            self.assertTrue(os.path.exists(os.path.join(tmp, "probes", "energy.csv")))
+
+
+class DocsSnippets(unittest.TestCase):
+    def test_every_python_snippet_of_docs_python_md_runs(self):
+        with open(os.path.join(SOURCE_DIR, "docs", "python.md"), encoding="utf-8") as f:
+            text = f.read()
+        snippets = re.findall(r"```python\n(.*?)```", text, re.S)
+        self.assertGreaterEqual(len(snippets), 5)
+        cwd = os.getcwd()
+        with tempfile.TemporaryDirectory() as tmp:
+            # The snippets name files relative to the checkout; they write beside them.
+            os.symlink(os.path.join(SOURCE_DIR, "scenes"), os.path.join(tmp, "scenes"))
+            os.chdir(tmp)
+            try:
+                for snippet in snippets:
+                    with self.subTest(snippet=snippet.splitlines()[0]):
+                        with contextlib.redirect_stdout(io.StringIO()):
+                            exec(compile(snippet, "docs/python.md", "exec"), {})
+            finally:
+                os.chdir(cwd)
+
+
+if __name__ == "__main__":
+    unittest.main()
