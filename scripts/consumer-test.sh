@@ -1,23 +1,42 @@
 #!/usr/bin/env bash
-# The installed package as an outside user gets it: installs a build (default build/release)
-# into a fresh temporary prefix, copies tests/consumer/ away from the source tree, configures it
-# with find_package(gipsi) against that prefix alone, builds it and runs its checks; then runs the
-# installed `gipsi` with the installed example plugin. Fails if the consumer's build refers to
-# the source or build tree. Run by scripts/test.sh after the release tests (about 40 s).
-#   bash scripts/consumer-test.sh [BUILD_DIR]
+# The installed package as an outside user gets it. Installs a build (default build/release)
+# into a fresh temporary prefix, or with --deb builds the Debian package (CPack), checks that
+# apt can resolve its dependencies (a simulation: nothing is installed) and unpacks it into a
+# temporary folder. Then copies tests/consumer/ away from the source tree, configures it with
+# find_package(gipsi) against that prefix alone, builds it and runs its checks; builds the
+# docs/install.md snippet; runs the installed `gipsi` with the installed example plugin and
+# imports the installed Python module. Fails if the consumer's build refers to the source or
+# build tree. Run by scripts/test.sh after the release tests (about 40 s each way).
+#   bash scripts/consumer-test.sh [--deb] [BUILD_DIR]
 set -euo pipefail
 cd "$(dirname "$0")/.."
 source_dir=$PWD
+deb=false
+if [ "${1:-}" = "--deb" ]; then deb=true; shift; fi
 build_dir=$(realpath "${1:-build/release}")
 work=$(mktemp -d "${TMPDIR:-/tmp}/gipsi-consumer.XXXXXX")
 trap 'rm -rf "$work"' EXIT
 
-cmake --install "$build_dir" --prefix "$work/prefix" > "$work/install.log"
-echo "installed into a temporary prefix: $(grep -c 'Installing:' "$work/install.log") files"
+if $deb; then
+  (cd "$build_dir" && cpack -G DEB -B "$work/deb" > "$work/cpack.log") ||
+    { cat "$work/cpack.log" >&2; exit 1; }
+  package=$(ls "$work"/deb/gipsi_*.deb)
+  echo "built $(basename "$package") ($(du -k "$package" | cut -f1) kB)"
+  dpkg-deb --field "$package" Depends
+  # Every dependency must resolve from the machine's apt sources (simulated; installs nothing).
+  apt-get install --simulate --no-install-recommends "$package" > "$work/apt.log" 2>&1 ||
+    { echo "consumer-test: apt cannot install $(basename "$package"):" >&2; cat "$work/apt.log" >&2; exit 1; }
+  dpkg-deb --extract "$package" "$work/root"
+  prefix="$work/root/usr"
+else
+  cmake --install "$build_dir" --prefix "$work/prefix" > "$work/install.log"
+  echo "installed into a temporary prefix: $(grep -c 'Installing:' "$work/install.log") files"
+  prefix="$work/prefix"
+fi
 cp -r tests/consumer "$work/src"
 cmake -S "$work/src" -B "$work/build" -G Ninja -DCMAKE_BUILD_TYPE=Release \
-  -DCMAKE_PREFIX_PATH="$work/prefix" -DCMAKE_FIND_USE_PACKAGE_REGISTRY=OFF > "$work/configure.log"
-grep -q "^gipsi_DIR:PATH=$work/prefix/" "$work/build/CMakeCache.txt" ||
+  -DCMAKE_PREFIX_PATH="$prefix" -DCMAKE_FIND_USE_PACKAGE_REGISTRY=OFF > "$work/configure.log"
+grep -q "^gipsi_DIR:PATH=$prefix/" "$work/build/CMakeCache.txt" ||
   { echo "consumer-test: gipsi was not found in the fresh prefix" >&2; grep gipsi_DIR "$work/build/CMakeCache.txt" >&2; exit 1; }
 cmake --build "$work/build"
 
@@ -34,7 +53,11 @@ if ldd "$work/build/thermal_consumer" | grep -q "$build_dir"; then
 fi
 
 "$work/build/thermal_consumer" "$work"
-"$work/prefix/bin/gipsi" --version
+"$prefix/bin/gipsi" --version
+# The installed tool runs a scene and draws its plot (PLplot's driver is loaded at run time).
+"$prefix/bin/gipsi" run scenes/slab_ep_0.5mm.json --until 0.005 --out "$work/slab" -q
+[ -s "$work/slab/activation_diagonal.png" ] ||
+  { echo "consumer-test: the installed gipsi wrote no plot" >&2; exit 1; }
 
 # The CMake snippet of docs/install.md as a user copies it, with a main of their own; then the
 # same with COMPONENTS viz, and with a component that does not exist (must fail, naming it).
@@ -55,7 +78,7 @@ int main() {
               registry.objects.Names().size());
 }
 CC
-configure() { cmake -S "$project_dir" -B "$project_dir/build" -G Ninja -DCMAKE_PREFIX_PATH="$work/prefix"; }
+configure() { cmake -S "$project_dir" -B "$project_dir/build" -G Ninja -DCMAKE_PREFIX_PATH="$prefix"; }
 configure > /dev/null
 cmake --build "$project_dir/build" > /dev/null
 "$project_dir/build/my_simulation"
@@ -69,13 +92,13 @@ if configure > "$work/bad_component.log" 2>&1 || ! grep -q "no component 'python
   echo "consumer-test: an unknown component was not refused by name:" >&2
   cat "$work/bad_component.log" >&2; exit 1
 fi
-"$work/prefix/bin/gipsi" types --plugin gipsi_example_plugin | grep -q "Oscillator" ||
+"$prefix/bin/gipsi" types --plugin gipsi_example_plugin | grep -q "Oscillator" ||
   { echo "consumer-test: the installed gipsi did not load the installed example plugin" >&2; exit 1; }
 # The installed Python module, from the prefix alone (when the build has it).
-module=$(find "$work/prefix" -name 'gipsi.cpython-*.so' | head -1)
+module=$(find "$prefix" -name 'gipsi.cpython-*.so' | head -1)
 if [ -n "$module" ]; then
   python=$(sed -n 's/^_Python3_EXECUTABLE:INTERNAL=//p' "$build_dir/CMakeCache.txt")
-  PYTHONPATH=$(dirname "$module") "${python:-/usr/bin/python3}" - "$work/prefix" <<'PY'
+  PYTHONPATH=$(dirname "$module") "${python:-/usr/bin/python3}" - "$prefix" <<'PY'
 import sys
 import gipsi
 assert gipsi.__file__.startswith(sys.argv[1]), f"gipsi imported from {gipsi.__file__}"

@@ -47,6 +47,7 @@ stage_done release
 # The installed package, used by an outside project (find_package(gipsi); docs/install.md).
 echo "== package"
 bash scripts/consumer-test.sh build/release
+bash scripts/consumer-test.sh --deb build/release
 stage_done package
 
 if [ "${1:-}" = "--full" ]; then
