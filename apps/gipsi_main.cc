@@ -28,6 +28,7 @@
 #include <CLI/CLI.hpp>
 
 #include "cli_checks.h"
+#include "gipsi/base/build_info.h"
 #include "gipsi/base/error.h"
 #include "gipsi/base/file_io.h"
 #include "gipsi/base/log.h"
@@ -518,6 +519,7 @@ int Types(const std::vector<std::string>& plugins) {
     for (const auto& [name, description] : list)
       std::cout << fmt::format("  {:<18} {}\n", name, description);
   };
+  std::cout << "build: gipsi " GIPSI_VERSION_STRING ", " << gipsi::BuildFeatureSummary() << "\n";
   print("objects", registry.objects.List());
   print("connectors", registry.connectors.List());
   print("integrators", registry.integrators.List());
@@ -620,7 +622,8 @@ int Cell(CellOptions options, const std::vector<std::string>& plugins) {
 int main(int argc, char** argv) {
   CLI::App app{"GiPSi: an open-architecture framework for organ-level and surgical simulation"};
   app.set_version_flag("--version", "gipsi " GIPSI_VERSION_STRING " (plugin interface " +
-                                        std::to_string(GIPSI_PLUGIN_ABI_VERSION) + ")");
+                                        std::to_string(GIPSI_PLUGIN_ABI_VERSION) + "; " +
+                                        gipsi::BuildFeatureSummary() + ")");
   app.require_subcommand(1);
   std::string scene_file, out_dir, mesh_file;
   double until = 0;

@@ -48,6 +48,8 @@ stage_done release
 echo "== package"
 bash scripts/consumer-test.sh build/release
 bash scripts/consumer-test.sh --deb build/release
+# The core without Gmsh and OpenIGTLink (the same flags otherwise: ccache serves it).
+bash scripts/minimal-test.sh
 stage_done package
 
 if [ "${1:-}" = "--full" ]; then

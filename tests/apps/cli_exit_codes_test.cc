@@ -50,11 +50,11 @@ fs::path WriteCsv(const fs::path& dir) {
   return dir / "t.csv";
 }
 
-TEST(GipsiExitCodes, VersionNamesThePackageAndPluginInterfaceVersions) {
+TEST(GipsiExitCodes, VersionNamesThePackageAndPluginInterfaceVersionsAndTheOptionalParts) {
   const Result r = Gipsi("--version");
   EXPECT_EQ(r.code, 0) << r.output;
   EXPECT_EQ(r.output, "gipsi " GIPSI_VERSION_STRING " (plugin interface " +
-                          std::to_string(GIPSI_PLUGIN_ABI_VERSION) + ")\n");
+                          std::to_string(GIPSI_PLUGIN_ABI_VERSION) + "; with Gmsh, OpenIGTLink)\n");
 }
 
 TEST(GipsiExitCodes, BadCommandLineExits2ForEverySubcommand) {

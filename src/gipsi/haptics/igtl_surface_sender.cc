@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include "gipsi/base/build_info.h"
 #include "gipsi/base/error.h"
 
 namespace gipsi {
@@ -11,6 +12,8 @@ IgtlDeviceParams ParseIgtlDevice(const JsonNode& node) {
   node.CheckKeys(
       {"type", "host", "port", "name", "length_unit", "connect_timeout", "reconnect_interval"});
   (void)node.At("type").AsChoice({"OpenIGTLink", "Mouse"});
+  if (!GetBuildFeatures().openigtlink)
+    node.Fail(MissingFeature("an OpenIGTLink device", "OpenIGTLink", "GIPSI_WITH_OPENIGTLINK"));
   IgtlDeviceParams p;
   p.host = node.String("host", p.host);
   if (p.host.empty()) node.At("host").Expected("a host name or address");
