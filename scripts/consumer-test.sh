@@ -94,6 +94,23 @@ if configure > "$work/bad_component.log" 2>&1 || ! grep -q "no component 'python
 fi
 "$prefix/bin/gipsi" types --plugin gipsi_example_plugin | grep -q "Oscillator" ||
   { echo "consumer-test: the installed gipsi did not load the installed example plugin" >&2; exit 1; }
+# docs/plugins.md, "From an empty folder": the example plugin built as an outside project
+# against the prefix, listed by the installed tool and run in the oscillator scene.
+plugin_dir="$work/my_plugin"
+mkdir -p "$plugin_dir"
+awk '/^## From an empty folder/{s=1} s && /^```cmake$/{f=1; next} f && /^```$/{exit} f' \
+  docs/plugins.md > "$plugin_dir/CMakeLists.txt"
+cp plugins/example/example_plugin.cc "$plugin_dir/my_plugin.cc"
+cmake -S "$plugin_dir" -B "$plugin_dir/build" -G Ninja -DCMAKE_PREFIX_PATH="$prefix" > /dev/null
+cmake --build "$plugin_dir/build" > /dev/null
+"$prefix/bin/gipsi" types --plugin "$plugin_dir/build/my_plugin.so" | grep -q "Oscillator" ||
+  { echo "consumer-test: the outside plugin's types are not listed" >&2; exit 1; }
+sed "s|\"gipsi_example_plugin\"|\"$plugin_dir/build/my_plugin.so\"|" scenes/plugin_oscillator.json \
+  > "$work/oscillator.json"
+"$prefix/bin/gipsi" run "$work/oscillator.json" --until 0.05 --out "$work/oscillator" -q ||
+  { echo "consumer-test: the oscillator scene did not run with the outside plugin" >&2; exit 1; }
+echo "outside plugin: built from docs/plugins.md and run"
+
 # The installed Python module, from the prefix alone (when the build has it).
 module=$(find "$prefix" -name 'gipsi.cpython-*.so' | head -1)
 if [ -n "$module" ]; then

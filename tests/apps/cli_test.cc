@@ -313,6 +313,20 @@ TEST(GipsiPlugins, APluginConnectorsPortsAreCheckedWhenTheSceneLoads) {
   EXPECT_THAT(right.output, HasSubstr("sets the boundary conditions of curtain (to)"));
 }
 
+TEST(GipsiPlugins, TwoPluginsRegisteringOneTypeNameAreRefusedNotAborted) {
+  // The same plugin from two files (an installed one and a copy built elsewhere): the second
+  // would register Oscillator and Follow again.
+  const std::string plugin = std::string(GIPSI_BINARY_DIR) + "/plugins/gipsi_example_plugin.so";
+  const fs::path copy = TempDir("plugin_twice") / "copy_of_example.so";
+  fs::copy_file(plugin, copy);
+  const Result r = Gipsi("types --plugin " + plugin + " --plugin " + copy.string());
+  EXPECT_EQ(r.code, 1) << r.output;
+  EXPECT_THAT(r.output, HasSubstr(copy.string() +
+                                  ": the plugin registers object type 'Oscillator', connector "
+                                  "type 'Follow', already registered by GiPSi or an earlier "
+                                  "plugin (the same plugin loaded from two files?)"));
+}
+
 TEST(GipsiPlugins, NotAPluginIsAClearError) {
   Result r = Gipsi("types --plugin " + std::string(GIPSI_BINARY_DIR) + "/bin/gipsi");
   EXPECT_EQ(r.code, 1);

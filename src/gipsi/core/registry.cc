@@ -6,6 +6,7 @@
 #include <filesystem>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include "gipsi/base/error.h"
 #include "gipsi/core/coordinator.h"
@@ -156,6 +157,36 @@ void TypeRegistry::LoadPlugin(const std::string& path) {
     ThrowInputError(path, "",
                     fmt::format("plugin built for plugin ABI {}, this GiPSi has {}", version(),
                                 GIPSI_PLUGIN_ABI_VERSION));
+  // A name registered twice aborts in FactoryTable::Register (a programmer error among the
+  // built-ins); from a plugin it is bad input, e.g. two copies of one plugin. Register into an
+  // empty registry first and refuse a plugin whose names are taken, before it changes this one.
+  TypeRegistry scratch;
+  registrar(scratch);
+  std::vector<std::string> taken;
+  auto collect = [&](std::string_view kind, const std::vector<std::string>& ours,
+                     const std::vector<std::string>& theirs) {
+    for (const auto& name : theirs)
+      if (std::find(ours.begin(), ours.end(), name) != ours.end())
+        taken.push_back(fmt::format("{} '{}'", kind, name));
+  };
+  auto names = [](const std::vector<std::pair<std::string, std::string>>& list) {
+    std::vector<std::string> out;
+    for (const auto& [name, description] : list) out.push_back(name);
+    return out;
+  };
+  collect("object type", objects.Names(), scratch.objects.Names());
+  collect("connector type", connectors.Names(), scratch.connectors.Names());
+  collect("integrator", integrators.Names(), scratch.integrators.Names());
+  collect("material law", materials.Names(), scratch.materials.Names());
+  const std::vector<std::string> kinds = TableKinds();
+  for (const auto& kind : scratch.TableKinds())
+    if (std::find(kinds.begin(), kinds.end(), kind) != kinds.end())
+      collect(kind, names(ListTable(kind)), names(scratch.ListTable(kind)));
+  if (!taken.empty())
+    ThrowInputError(path, "",
+                    fmt::format("the plugin registers {}, already registered by GiPSi or an "
+                                "earlier plugin (the same plugin loaded from two files?)",
+                                fmt::join(taken, ", ")));
   registrar(*this);
   plugins_.push_back(canonical);
 }
