@@ -24,6 +24,7 @@
 #include <nlohmann/json.hpp>
 
 #include "gipsi/base/error.h"
+#include "gipsi/base/json_node.h"
 #include "gipsi/base/state.h"
 #include "gipsi/base/version.h"
 #include "gipsi/core/kernel.h"
@@ -67,6 +68,20 @@ ErrorParts SplitMessage(const std::string& message) {
     parts.what = rest;
   }
   return parts;
+}
+
+/// `value` (a dict) as JSON text: NumPy arrays and scalars become lists and numbers; NaN and
+/// infinities are refused (ValueError), anything else not JSON is a TypeError naming its type.
+std::string ToJsonText(const py::handle& value) {
+  py::cpp_function to_json([](const py::object& v) -> py::object {
+    if (py::hasattr(v, "tolist")) return v.attr("tolist")();
+    throw py::type_error(
+        fmt::format("a {} is not JSON (expected numbers, strings, lists, dicts, NumPy arrays)",
+                    py::str(py::type::of(v).attr("__name__")).cast<std::string>()));
+  });
+  return py::module_::import("json")
+      .attr("dumps")(value, py::arg("default") = to_json, py::arg("allow_nan") = false)
+      .cast<std::string>();
 }
 
 /// Records the scene's point and region probes in memory at their sampling interval (line
@@ -177,7 +192,9 @@ class Simulation {
   static std::shared_ptr<Simulation> FromDict(const py::dict& scene, const std::string& name,
                                               const std::filesystem::path& base_dir,
                                               const std::vector<std::string>& plugins) {
-    const std::string text = py::module_::import("json").attr("dumps")(scene).cast<std::string>();
+    // NumPy arrays and scalars (e.g. a mesh's "nodes" and "tets") go in as JSON arrays and
+    // numbers; NaN and infinities are refused here (ValueError) as the JSON reader would.
+    const std::string text = ToJsonText(scene);
     auto sim = std::shared_ptr<Simulation>(new Simulation(plugins, base_dir));
     sim->scene_ = LoadSceneFromString(text, name, base_dir, *sim->registry_);
     sim->Attach();
@@ -214,6 +231,11 @@ class Simulation {
       py::gil_scoped_release release;
       result = k.Run(end, progress);
     }
+    if (event_error_) {
+      py::error_already_set e = std::move(*event_error_);
+      event_error_.reset();
+      throw e;
+    }
     if (error) throw std::move(*error);
     static const char* outcomes[] = {"completed", "diverged", "stopped", "output_failed"};
     py::dict out;
@@ -223,6 +245,39 @@ class Simulation {
     out["end_time"] = result.end_time;
     out["wall_seconds"] = result.wall_seconds;
     out["macro_steps"] = result.macro_steps;
+    return out;
+  }
+
+  /// Schedules `action(sim)` at simulated time `time` (with the GIL), as a scene's events: it
+  /// runs at the start of the first macro step at or after `time`. An exception it raises stops
+  /// the run and is raised by run().
+  void Schedule(const std::shared_ptr<Simulation>& self, double time, py::function action,
+                const std::string& description) {
+    if (!std::isfinite(time))
+      throw py::value_error(fmt::format("an event's time must be finite, got {}", time));
+    // The kernel holds the action beyond this call; it refers to the simulation weakly, so
+    // the simulation can still be freed.
+    std::weak_ptr<Simulation> weak = self;
+    auto held = std::make_shared<py::function>(std::move(action));
+    kernel().ScheduleEvent({time, description, [weak, held](Kernel&) {
+                              py::gil_scoped_acquire gil;
+                              auto sim = weak.lock();
+                              if (!sim) return;
+                              try {
+                                (*held)(sim);
+                              } catch (py::error_already_set& e) {
+                                const std::string what = e.what();
+                                sim->event_error_.emplace(std::move(e));
+                                throw std::runtime_error(
+                                    what);  // stops the run: "event at t = ... failed"
+                              }
+                            }});
+  }
+
+  py::list FiredEvents() {
+    py::list out;
+    for (const auto& [t, description] : kernel().fired_events())
+      out.append(py::make_tuple(t, description));
     return out;
   }
 
@@ -256,6 +311,7 @@ class Simulation {
 
   std::unique_ptr<TypeRegistry> registry_;
   Scene scene_;
+  std::optional<py::error_already_set> event_error_;  // raised by the Run it stopped
   MemoryProbes* probes_ = nullptr;
 };
 
@@ -470,6 +526,19 @@ PYBIND11_MODULE(gipsi, m) {
            "step; returning False stops the run. Returns a dict: outcome ('completed', "
            "'diverged', 'stopped', 'output_failed'), diagnostic, start_time, end_time, "
            "wall_seconds, macro_steps.")
+      .def(
+          "schedule",
+          [](const std::shared_ptr<Simulation>& s, double time, py::function action,
+             const std::string& description) {
+            s->Schedule(s, time, std::move(action), description);
+          },
+          py::arg("time"), py::arg("action"), py::arg("description") = "Python event",
+          "Schedules action(sim) at simulated time `time` [s], like a scene's events: it runs "
+          "at the start of the first macro step at or after it. An exception it raises stops "
+          "the run and is raised by run()/step().")
+      .def_property_readonly("fired_events", &Simulation::FiredEvents,
+                             "The events fired so far (the scene's and schedule()'s): a list of "
+                             "(time, description).")
       .def_property_readonly("probes", &Simulation::probes,
                              "The scene's point and region probes recorded so far: {probe: "
                              "{'time': array, column: array, ...}}.")
@@ -484,9 +553,42 @@ PYBIND11_MODULE(gipsi, m) {
           "restore_file",
           [](Simulation& s, const std::filesystem::path& f) { s.kernel().ReadCheckpoint(f); },
           py::arg("file"), "Restores a checkpoint file of the same scene.")
+      .def(
+          "mesh",
+          [](const Simulation& s, const std::string& name) {
+            const auto& meshes = s.scene().meshes;
+            auto it = meshes.find(name);
+            if (it == meshes.end()) {
+              std::string known;
+              for (const auto& [n, mesh] : meshes) known += (known.empty() ? "" : ", ") + n;
+              throw py::key_error(fmt::format("the scene has no mesh '{}'; its meshes: {}", name,
+                                              known.empty() ? "none" : known));
+            }
+            return MeshDict(*it->second);
+          },
+          py::arg("name"),
+          "The scene's mesh called `name` (its \"meshes\" entry, as built) as a dict of arrays, "
+          "like read_mesh's.")
       .def("write_outputs", &Simulation::WriteOutputs, py::arg("directory") = py::none(),
            "Writes the scene's VTU/PVD series and probe CSVs while it runs, as gipsi run does.");
 
+  m.def(
+      "write_mesh",
+      [](const std::filesystem::path& file, const py::dict& mesh) {
+        for (const auto& [key, value] : mesh) {
+          const std::string k = py::str(key).cast<std::string>();
+          if (k != "nodes" && k != "tets" && k != "triangles")
+            throw py::key_error(
+                fmt::format("write_mesh: unknown key '{}' (expected nodes, tets, triangles)", k));
+        }
+        // Through the scene loader's checks of a mesh given by its nodes.
+        JsonDocument doc = JsonDocument::Parse(ToJsonText(mesh), file.string());
+        WriteMesh(file, BuildMesh(doc.root(), "."));
+      },
+      py::arg("file"), py::arg("mesh"),
+      "Writes {'nodes': (N, 3), 'tets': (E, 4) and/or 'triangles': (T, 3)} to a mesh file: "
+      ".vtu (tets and triangles), .obj or .stl (triangles); the arrays are checked as a "
+      "scene's inline mesh (InputError with the path of a bad value).");
   m.def(
       "read_mesh", [](const std::filesystem::path& file) { return MeshDict(ReadMesh(file)); },
       py::arg("file"),

@@ -3,6 +3,7 @@
 #include <filesystem>
 #include <fstream>
 
+#include <fmt/format.h>
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
@@ -210,6 +211,65 @@ TEST(Scene, ProbeNamesCannotLeaveTheOutputDirectory) {
                                R"(": {"object": "cube", "fields": ["kinetic_energy"]}})";
     EXPECT_THAT(LoadError(SceneText("", probes)), HasSubstr("must be a plain file name")) << name;
   }
+}
+
+/// The box of SceneText written out in the scene: its nodes (%.17g round-trips exactly) and
+/// tets as JSON arrays.
+std::string InlineBox(const Mesh& box) {
+  std::string nodes, tets;
+  for (Index i = 0; i < box.num_nodes(); ++i)
+    nodes += fmt::format("{}[{:.17g}, {:.17g}, {:.17g}]", i ? ", " : "", box.nodes(0, i),
+                         box.nodes(1, i), box.nodes(2, i));
+  for (Index e = 0; e < box.num_tets(); ++e)
+    tets += fmt::format("{}[{}, {}, {}, {}]", e ? ", " : "", box.tets(0, e), box.tets(1, e),
+                        box.tets(2, e), box.tets(3, e));
+  return fmt::format(R"({{"nodes": [{}], "tets": [{}]}})", nodes, tets);
+}
+
+TEST(Scene, AMeshGivenByItsNodesAndTetsRunsAsTheSameMeshGenerated) {
+  Scene generated = Load(SceneText());
+  const Mesh& box = *generated.meshes.at("box");
+  std::string text = SceneText();
+  const std::size_t start = text.find("{\"generate\": \"box\"");
+  text.replace(start, text.find('}', start) + 1 - start, InlineBox(box));
+  // The fixed boundary condition selects the generated box's group "zmax"; the inline mesh has
+  // no groups, so select the same face by a box region.
+  text.replace(text.find(R"({"group": "zmax"})"), std::string(R"({"group": "zmax"})").size(),
+               R"({"box": {"min": [-1, -1, 0.0999], "max": [1, 1, 1]}})");
+  Scene inline_scene = Load(text);
+  const Mesh& mesh = *inline_scene.meshes.at("box");
+  EXPECT_EQ(mesh.nodes, box.nodes);
+  EXPECT_EQ(mesh.tets, box.tets);
+  ASSERT_TRUE(generated.kernel->Run(0.005).ok());
+  ASSERT_TRUE(inline_scene.kernel->Run(0.005).ok());
+  EXPECT_EQ(inline_scene.kernel->FindObject("cube").domain_positions(),
+            generated.kernel->FindObject("cube").domain_positions());
+}
+
+TEST(SceneErrors, AMeshGivenByItsNodesNamesTheBadValueByItsPath) {
+  auto scene = [](const std::string& mesh) {
+    return R"({"meshes": {"m": )" + mesh + R"(},
+      "objects": {"o": {"type": "MassSpring", "domain": "m", "dt": 0.001}},
+      "schedule": {"end": 1}})";
+  };
+  const std::string nodes = R"("nodes": [[0,0,0], [1,0,0], [0,1,0], [0,0,1]])";
+  EXPECT_THAT(LoadError(scene("{" + nodes + R"(, "tets": [[0,1,2,3], [0,1,2,4]]})")),
+              HasSubstr("meshes.m.tets[1][3]: expected a node index in [0, 3] (0-based), got 4"));
+  EXPECT_THAT(LoadError(scene("{" + nodes + R"(, "tets": [[0,1,2]]})")),
+              HasSubstr("meshes.m.tets[0]: expected 4 node indices"));
+  EXPECT_THAT(LoadError(scene("{" + nodes + R"(, "triangles": [[0,1,-1]]})")),
+              HasSubstr("meshes.m.triangles[0][2]: expected a node index in [0, 3]"));
+  EXPECT_THAT(LoadError(scene(R"({"nodes": [[0,0,0], [1,0], [0,1,0]], "triangles": [[0,1,2]]})")),
+              HasSubstr("meshes.m.nodes[1]: expected"));
+  EXPECT_THAT(LoadError(scene("{" + nodes + "}")),
+              HasSubstr("meshes.m: a mesh given by its 'nodes' needs 'tets' or 'triangles' too"));
+  EXPECT_THAT(
+      LoadError(scene(R"({"nodes": [], "tets": []})")),
+      HasSubstr("meshes.m.nodes: expected a non-empty array of [x, y, z] node coordinates"));
+  EXPECT_THAT(LoadError(scene(R"({"file": "a.msh", "tets": [[0,1,2,3]]})")),
+              HasSubstr("meshes.m.tets: only a mesh given by its 'nodes' takes this key"));
+  EXPECT_THAT(LoadError(scene("{" + nodes + R"(, "tets": [[0,1,2,3]], "file": "a.msh"})")),
+              HasSubstr("meshes.m: expected exactly one of 'file', 'generate', 'nodes'"));
 }
 
 }  // namespace

@@ -123,6 +123,30 @@ class Running(unittest.TestCase):
         self.assertAlmostEqual(sim.time, 0.06, delta=1e-12)  # stopped after that step
 
 
+    def test_a_scheduled_python_event_fires_once_at_its_time(self):
+        sim = gipsi.Simulation.from_dict(sheet_scene(gravity=(0, 0, 0)))
+        times = []
+        sim.schedule(0.05, lambda s: times.append(s.time), "note the time")
+        sim.run(until=0.1)
+        self.assertEqual(len(times), 1)
+        self.assertAlmostEqual(times[0], 0.05, delta=1e-12)
+        self.assertEqual(len(sim.fired_events), 1)
+        self.assertAlmostEqual(sim.fired_events[0][0], 0.05, delta=1e-12)
+        self.assertEqual(sim.fired_events[0][1], "note the time")
+
+    def test_an_event_that_raises_stops_the_run_and_the_exception_propagates(self):
+        sim = gipsi.Simulation.from_dict(sheet_scene())
+
+        def fail(s):
+            raise KeyError("from the event")
+
+        sim.schedule(0.03, fail)
+        with self.assertRaisesRegex(KeyError, "from the event"):
+            sim.run()
+        self.assertAlmostEqual(sim.time, 0.03, delta=1e-12)  # the step it was due in not taken
+        self.assertEqual(sim.run(until=0.05)["outcome"], "completed")  # it fired once
+
+
 class Checkpoints(unittest.TestCase):
     def test_restoring_bytes_repeats_the_run_bitwise_with_its_probes(self):
         sim = gipsi.Simulation.from_dict(sheet_scene(integrator="SymplecticEuler"))
@@ -199,6 +223,49 @@ class Meshes(unittest.TestCase):
         liver = gipsi.Simulation.from_dict(scene).object("liver")
         np.testing.assert_array_equal(liver.rest_positions, mesh["nodes"])
         np.testing.assert_array_equal(liver.tets, mesh["tets"])
+
+    def test_write_mesh_then_read_mesh_gives_the_arrays_back(self):
+        nodes = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1.5]], dtype=float)
+        tets = np.array([[0, 1, 2, 3]])
+        with tempfile.TemporaryDirectory() as tmp:
+            path = os.path.join(tmp, "tet.vtu")
+            gipsi.write_mesh(path, {"nodes": nodes, "tets": tets})
+            mesh = gipsi.read_mesh(path)
+        np.testing.assert_array_equal(mesh["nodes"], nodes)
+        np.testing.assert_array_equal(mesh["tets"], tets)
+
+    def test_write_mesh_checks_the_arrays_as_a_scene_does(self):
+        nodes = np.zeros((4, 3))
+        with tempfile.TemporaryDirectory() as tmp:
+            path = os.path.join(tmp, "bad.vtu")
+            with self.assertRaises(gipsi.InputError) as raised:
+                gipsi.write_mesh(path, {"nodes": nodes, "tets": np.array([[0, 1, 2, 4]])})
+            self.assertEqual(raised.exception.file, path)
+            self.assertEqual(raised.exception.path, "tets[0][3]")
+            with self.assertRaisesRegex(KeyError, "unknown key 'tet'"):
+                gipsi.write_mesh(path, {"nodes": nodes, "tet": np.array([[0, 1, 2, 3]])})
+            self.assertFalse(os.path.exists(path))
+
+    def test_a_mesh_given_as_numpy_arrays_falls_as_the_generated_one(self):
+        generated = gipsi.Simulation.from_dict(sheet_scene())
+        mesh = generated.mesh("sheet")
+        self.assertEqual(mesh["nodes"].shape, (25, 3))
+        self.assertEqual(mesh["triangles"].shape, (32, 3))
+        scene = sheet_scene()
+        scene["meshes"]["sheet"] = {"nodes": mesh["nodes"], "triangles": mesh["triangles"]}
+        built = gipsi.Simulation.from_dict(scene)
+        generated.run(until=0.05)
+        built.run(until=0.05)
+        np.testing.assert_array_equal(built.object("sheet").positions,
+                                      generated.object("sheet").positions)
+
+    def test_nan_in_a_numpy_mesh_is_refused(self):
+        scene = sheet_scene()
+        nodes = np.zeros((3, 3))
+        nodes[1, 2] = np.nan
+        scene["meshes"]["sheet"] = {"nodes": nodes, "triangles": np.array([[0, 1, 2]])}
+        with self.assertRaisesRegex(ValueError, "JSON"):
+            gipsi.Simulation.from_dict(scene)
 
     def test_a_missing_mesh_file_raises_input_error_naming_it(self):
         with self.assertRaisesRegex(gipsi.InputError, "no_such.msh"):

@@ -249,15 +249,64 @@ std::string ResolvePlugin(const std::string& entry, const std::filesystem::path&
   return (base_dir / file).string();  // LoadPlugin reports it missing, with this path
 }
 
+namespace {
+
+/// Connectivity given in the scene (`key`: an array of `k` node indices per cell) into `out`
+/// (k by cells); every index checked against `num_nodes` at its JSON path.
+template <class Conn>
+void ReadConnectivity(const JsonNode& node, std::string_view key, Index num_nodes, Conn& out) {
+  constexpr int k = Conn::RowsAtCompileTime;
+  const auto list = node.Find(key);
+  if (!list) return;
+  if (!list->is_array()) list->Expected(fmt::format("an array of [{} node indices]", k));
+  out.resize(k, static_cast<Index>(list->size()));
+  for (std::size_t e = 0; e < list->size(); ++e) {
+    const JsonNode cell = list->Item(e);
+    if (!cell.is_array() || cell.size() != k) cell.Expected(fmt::format("{} node indices", k));
+    for (int a = 0; a < k; ++a) {
+      const JsonNode id = cell.Item(static_cast<std::size_t>(a));
+      const std::int64_t i = id.AsInt();
+      if (i < 0 || i >= num_nodes)
+        id.Expected(fmt::format("a node index in [0, {}] (0-based)", num_nodes - 1));
+      out(a, static_cast<Index>(e)) = static_cast<int>(i);
+    }
+  }
+}
+
+/// A mesh written in the scene: "nodes" ([x, y, z] each) with "tets" and/or "triangles".
+Mesh InlineMesh(const JsonNode& node) {
+  const JsonNode nodes = node.At("nodes");
+  if (!nodes.is_array() || nodes.size() == 0)
+    nodes.Expected("a non-empty array of [x, y, z] node coordinates");
+  if (!node.Has("tets") && !node.Has("triangles"))
+    node.Fail("a mesh given by its 'nodes' needs 'tets' or 'triangles' too");
+  Mesh mesh;
+  mesh.nodes.resize(3, static_cast<Index>(nodes.size()));
+  for (std::size_t i = 0; i < nodes.size(); ++i)
+    mesh.nodes.col(static_cast<Index>(i)) = nodes.Item(i).AsVec3();
+  ReadConnectivity(node, "tets", mesh.num_nodes(), mesh.tets);
+  ReadConnectivity(node, "triangles", mesh.num_nodes(), mesh.triangles);
+  mesh.Validate(node.file() + ": " + node.path());
+  return mesh;
+}
+
+}  // namespace
+
 Mesh BuildMesh(const JsonNode& node, const std::filesystem::path& base_dir) {
   node.CheckKeys({"file",         "generate", "scale",         "translate", "min",
                   "max",          "cells",    "origin",        "u",         "v",
                   "endo",         "epi",      "base_z",        "size",      "inner_radius",
-                  "outer_radius", "height",   "tets_per_cell", "surface",   "description"});
+                  "outer_radius", "height",   "tets_per_cell", "surface",   "description",
+                  "nodes",        "tets",     "triangles"});
   Mesh mesh;
-  if (node.Has("file") == node.Has("generate"))
-    node.Fail("expected exactly one of 'file', 'generate'");
-  if (auto file = node.Find("file")) {
+  if (int(node.Has("file")) + int(node.Has("generate")) + int(node.Has("nodes")) != 1)
+    node.Fail("expected exactly one of 'file', 'generate', 'nodes'");
+  if (!node.Has("nodes"))
+    for (const char* key : {"tets", "triangles"})
+      if (node.Has(key)) node.At(key).Fail("only a mesh given by its 'nodes' takes this key");
+  if (node.Has("nodes")) {
+    mesh = InlineMesh(node);
+  } else if (auto file = node.Find("file")) {
     std::filesystem::path path = file->AsString();
     if (path.is_relative()) path = base_dir / path;
     try {
