@@ -17,6 +17,7 @@
 #include <optional>
 #include <regex>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include <fmt/format.h>
@@ -209,7 +210,25 @@ class Simulation {
   /// Runs to `until` (default: the scene's end). `callback(t)` is called after every macro
   /// step (with the GIL); returning False stops the run there; an exception stops it and is
   /// raised. Ctrl+C stops it too (KeyboardInterrupt).
+  /// Refuses `what` while a run is going on, from any thread: the kernel is mid-step (a
+  /// callback or an event may not run, restore or schedule).
+  void CheckIdle(const char* what) const {
+    if (running_)
+      throw std::runtime_error(fmt::format(
+          "{}: the simulation is running (called from a callback or an event, or another "
+          "thread); wait for run() to return",
+          what));
+  }
+  /// Refuses `what` from another thread while a run is going on (a callback or an event of the
+  /// running thread may read and write fields and save between macro steps).
+  void CheckSameThread(const char* what) const {
+    if (running_ && *running_ != std::this_thread::get_id())
+      throw std::runtime_error(fmt::format(
+          "{}: the simulation is running on another thread; wait for run() to return", what));
+  }
+
   py::dict Run(std::optional<double> until, const py::object& callback) {
+    CheckIdle("run");
     const double end = until.value_or(scene_.end_time);
     if (!std::isfinite(end))
       throw py::value_error(fmt::format("until must be finite, got {}", end));
@@ -228,6 +247,8 @@ class Simulation {
     };
     RunResult result;
     {
+      running_ = std::this_thread::get_id();
+      const std::shared_ptr<void> not_running(nullptr, [this](void*) { running_.reset(); });
       py::gil_scoped_release release;
       result = k.Run(end, progress);
     }
@@ -253,6 +274,7 @@ class Simulation {
   /// the run and is raised by run().
   void Schedule(const std::shared_ptr<Simulation>& self, double time, py::function action,
                 const std::string& description) {
+    CheckIdle("schedule");  // the kernel's event list may not change while it fires events
     if (!std::isfinite(time))
       throw py::value_error(fmt::format("an event's time must be finite, got {}", time));
     // The kernel holds the action beyond this call; it refers to the simulation weakly, so
@@ -282,11 +304,13 @@ class Simulation {
   }
 
   py::bytes Save() {
+    CheckSameThread("save");
     StateWriter out;
     kernel().SaveState(out);
     return py::bytes(out.bytes());
   }
   void Restore(const py::bytes& bytes) {
+    CheckIdle("restore");
     StateReader in(std::string(bytes), "checkpoint bytes");
     kernel().RestoreState(in);
   }
@@ -294,6 +318,7 @@ class Simulation {
   /// Attaches the scene's file outputs (VTU/PVD series, probe CSVs) under `directory` (default:
   /// the scene's outputs.directory).
   void WriteOutputs(const std::optional<std::filesystem::path>& directory) {
+    CheckIdle("write_outputs");
     AttachOutputs(scene_, directory.value_or(scene_.output_directory));
   }
 
@@ -312,6 +337,7 @@ class Simulation {
   std::unique_ptr<TypeRegistry> registry_;
   Scene scene_;
   std::optional<py::error_already_set> event_error_;  // raised by the Run it stopped
+  std::optional<std::thread::id> running_;            // the thread in Run, while it runs
   MemoryProbes* probes_ = nullptr;
 };
 
@@ -347,6 +373,7 @@ FieldId FindFieldOrRaise(const SimObject& o, const std::string& name) {
 
 /// The field as a new (count, components) array: one copy, straight from the object.
 py::array_t<double> ReadField(const ObjectHandle& h, const std::string& name) {
+  h.sim->CheckSameThread("field");
   const SimObject& o = *h.object;
   const FieldId id = FindFieldOrRaise(o, name);
   const FieldInfo& f = o.field_info(id);
@@ -364,6 +391,7 @@ py::array_t<double> ReadField(const ObjectHandle& h, const std::string& name) {
 /// components) (a global field also takes (components,)), finite values.
 void WriteField(ObjectHandle& h, const std::string& name,
                 const py::array_t<double, py::array::c_style | py::array::forcecast>& values) {
+  h.sim->CheckSameThread("set_field");
   SimObject& o = *h.object;
   const FieldId id = FindFieldOrRaise(o, name);
   const FieldInfo& f = o.field_info(id);
@@ -547,11 +575,17 @@ PYBIND11_MODULE(gipsi, m) {
            "Restores bytes from save() of the same scene.")
       .def(
           "save_file",
-          [](Simulation& s, const std::filesystem::path& f) { s.kernel().WriteCheckpoint(f); },
+          [](Simulation& s, const std::filesystem::path& f) {
+            s.CheckSameThread("save_file");
+            s.kernel().WriteCheckpoint(f);
+          },
           py::arg("file"), "Writes a checkpoint file (atomic, checksummed; as gipsi run's).")
       .def(
           "restore_file",
-          [](Simulation& s, const std::filesystem::path& f) { s.kernel().ReadCheckpoint(f); },
+          [](Simulation& s, const std::filesystem::path& f) {
+            s.CheckIdle("restore_file");
+            s.kernel().ReadCheckpoint(f);
+          },
           py::arg("file"), "Restores a checkpoint file of the same scene.")
       .def(
           "mesh",

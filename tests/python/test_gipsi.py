@@ -10,6 +10,7 @@ import io
 import os
 import re
 import tempfile
+import threading
 import unittest
 
 import numpy as np
@@ -145,6 +146,50 @@ class Running(unittest.TestCase):
             sim.run()
         self.assertAlmostEqual(sim.time, 0.03, delta=1e-12)  # the step it was due in not taken
         self.assertEqual(sim.run(until=0.05)["outcome"], "completed")  # it fired once
+
+
+    def test_a_callback_may_read_and_write_fields_but_not_run_or_restore(self):
+        sim = gipsi.Simulation.from_dict(sheet_scene())
+        state = sim.save()
+        sheet = sim.object("sheet")
+        energies = []
+
+        def callback(t):
+            energies.append(sheet.field("kinetic_energy")[0, 0])
+            sheet.set_field("external_force", np.zeros((25, 3)))
+            sim.save()
+            if t > 0.025:
+                sim.step()
+
+        with self.assertRaisesRegex(RuntimeError, "run: the simulation is running"):
+            sim.run(callback=callback)
+        self.assertEqual(len(energies), 3)
+        for forbidden in (lambda: sim.restore(state), lambda: sim.schedule(1, print)):
+            with self.assertRaisesRegex(RuntimeError, "the simulation is running"):
+                sim.run(callback=lambda t: forbidden())
+
+    def test_another_thread_may_not_touch_fields_while_it_runs(self):
+        sim = gipsi.Simulation.from_dict(sheet_scene())
+        sheet = sim.object("sheet")
+        started, checked = threading.Event(), threading.Event()
+        outcome = []
+
+        def callback(t):
+            started.set()
+            checked.wait(timeout=60)
+            return False
+
+        worker = threading.Thread(target=lambda: outcome.append(sim.run(callback=callback)))
+        worker.start()
+        self.assertTrue(started.wait(timeout=60))
+        with self.assertRaisesRegex(RuntimeError, "running on another thread"):
+            sheet.field("displacement")
+        with self.assertRaisesRegex(RuntimeError, "running on another thread"):
+            sheet.set_field("external_force", np.zeros((25, 3)))
+        checked.set()
+        worker.join()
+        self.assertEqual(outcome[0]["outcome"], "stopped")
+        self.assertEqual(sheet.field("displacement").shape, (25, 3))  # fine once it returned
 
 
 class Checkpoints(unittest.TestCase):
