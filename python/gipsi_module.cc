@@ -180,6 +180,152 @@ class MemoryProbes final : public Observer {
   std::vector<std::pair<double, std::int64_t>> pending_;
 };
 
+/// A Python exception in one line, "Type: message" (pybind11's what() adds the traceback).
+std::string OneLine(const py::error_already_set& e) {
+  std::string what = e.what();
+  if (auto end = what.find('\n'); end != std::string::npos) what.resize(end);
+  return what;
+}
+
+/// An object type written in Python (gipsi.register_object): a class whose instances declare
+/// `fields` ({name: {"units", "access", "components", "description"}}, global fields) and
+/// implement step(t, dt), read(name) and write(name, values); get_state()/set_state(bytes) make
+/// it checkpointable (and so retry-able). Every call holds the GIL.
+class PythonObject final : public SimObject {
+ public:
+  PythonObject(std::string name, std::string type, py::object impl)
+      : SimObject(std::move(name)), type_(std::move(type)), impl_(std::move(impl)) {
+    SetGeometry(std::make_shared<const Mesh>(), BoundarySurface{});
+    if (!py::hasattr(impl_, "fields") || !py::isinstance<py::dict>(impl_.attr("fields")))
+      throw InputError("its 'fields' attribute must be a dict {name: {units, access, ...}}");
+    for (const auto& [key, spec_handle] : impl_.attr("fields").cast<py::dict>()) {
+      FieldInfo info;
+      info.name = py::str(key).cast<std::string>();
+      info.location = FieldLocation::kGlobal;
+      const py::dict spec = py::reinterpret_borrow<py::object>(spec_handle).cast<py::dict>();
+      info.units = spec.contains("units") ? py::str(spec["units"]).cast<std::string>() : "1";
+      const std::string access =
+          spec.contains("access") ? py::str(spec["access"]).cast<std::string>() : "read";
+      if (access != "read" && access != "write" && access != "read_write")
+        throw InputError(fmt::format("field '{}': access '{}' is not read, write or read_write",
+                                     info.name, access));
+      info.access = access == "read"    ? FieldAccess::kRead
+                    : access == "write" ? FieldAccess::kWrite
+                                        : FieldAccess::kReadWrite;
+      info.components = spec.contains("components") ? spec["components"].cast<int>() : 1;
+      if (info.components != 1 && info.components != 3 && info.components != 9)
+        throw InputError(fmt::format("field '{}': {} components (expected 1, 3 or 9)", info.name,
+                                     info.components));
+      info.description =
+          spec.contains("description") ? py::str(spec["description"]).cast<std::string>() : "";
+      DeclareField(std::move(info));
+    }
+  }
+  ~PythonObject() override {
+    py::gil_scoped_acquire gil;
+    impl_ = py::object();
+  }
+  std::string_view type_name() const override { return type_; }
+  const Points& domain_positions() const override { return no_positions_; }
+  std::string failure_detail() const override { return detail_; }
+
+  void SaveObjectState(StateWriter& out) const override {
+    py::gil_scoped_acquire gil;
+    if (!py::hasattr(impl_, "get_state")) SimObject::SaveObjectState(out);  // refuses
+    out.BeginSection("PythonObject", 1);
+    out.WriteString(Call("get_state").cast<std::string>());
+    out.EndSection();
+  }
+  void RestoreObjectState(StateReader& in) override {
+    py::gil_scoped_acquire gil;
+    if (!py::hasattr(impl_, "set_state")) SimObject::RestoreObjectState(in);  // refuses
+    in.BeginSection("PythonObject", 1);
+    const std::string state = in.ReadString();
+    in.EndSection();
+    Call("set_state", py::bytes(state));
+  }
+
+ protected:
+  StepStatus DoStep(double t, double dt) override {
+    py::gil_scoped_acquire gil;
+    try {
+      if (impl_.attr("step")(t, dt).is(py::bool_(false))) {
+        detail_ = "step() returned False";
+        return StepStatus::Failed("the Python object's step failed");
+      }
+    } catch (py::error_already_set& e) {
+      detail_ = fmt::format("step() raised {}", OneLine(e));
+      return StepStatus::Failed("the Python object's step raised");
+    }
+    return StepStatus::Ok();
+  }
+  void DoReadField(FieldId id, Eigen::Ref<Eigen::MatrixXd> out) const override {
+    py::gil_scoped_acquire gil;
+    const std::string& name = field_info(id).name;
+    const auto values =
+        py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(Call("read", name));
+    if (!values || values.size() != out.size())
+      throw std::runtime_error(fmt::format("{} '{}': read('{}') returned {} values, expected {}",
+                                           type_, this->name(), name, values ? values.size() : 0,
+                                           out.size()));
+    std::copy(values.data(), values.data() + values.size(), out.data());
+  }
+  void DoWriteField(FieldId id, const Eigen::Ref<const Eigen::MatrixXd>& in) override {
+    py::gil_scoped_acquire gil;
+    py::array_t<double> values(static_cast<py::ssize_t>(in.size()));
+    std::copy(in.data(), in.data() + in.size(), values.mutable_data());
+    Call("write", field_info(id).name, values);
+  }
+
+ private:
+  /// impl.name(args...), a Python exception becoming a C++ one with the object named.
+  template <class... Args>
+  py::object Call(const char* method, Args&&... args) const {
+    try {
+      return impl_.attr(method)(std::forward<Args>(args)...);
+    } catch (py::error_already_set& e) {
+      throw std::runtime_error(
+          fmt::format("{} '{}': {}() raised {}", type_, name(), method, OneLine(e)));
+    }
+  }
+
+  std::string type_;
+  py::object impl_;
+  std::string detail_;
+  Points no_positions_ = Points(3, 0);
+};
+
+/// Adds the object types registered from Python (the module's `_object_types`) to `registry`.
+void RegisterPythonTypes(TypeRegistry& registry) {
+  const py::dict types = py::module_::import("gipsi").attr("_object_types");
+  for (const auto& [key, entry] : types) {
+    const std::string type = py::str(key).cast<std::string>();
+    const py::tuple t = py::reinterpret_borrow<py::object>(entry).cast<py::tuple>();
+    auto factory = std::make_shared<py::object>(t[0]);
+    registry.objects.Register(
+        type,
+        [type, factory](const ObjectBuildContext& ctx) -> std::unique_ptr<SimObject> {
+          py::gil_scoped_acquire gil;
+          const py::object params =
+              py::module_::import("json").attr("loads")(ctx.params.raw().dump());
+          py::object impl;
+          try {
+            impl = (*factory)(ctx.name, params);
+          } catch (py::error_already_set& e) {
+            ctx.params.Fail(fmt::format("{}: {}", type, OneLine(e)));
+          }
+          try {
+            return std::make_unique<PythonObject>(ctx.name, type, impl);
+          } catch (py::error_already_set& e) {
+            ctx.params.Fail(fmt::format("{}: its fields: {}", type, OneLine(e)));
+          } catch (const std::exception& e) {  // InputError, or a field spec of the wrong type
+            ctx.params.Fail(fmt::format("{}: {}", type, e.what()));
+          }
+        },
+        t[1].cast<std::string>());
+  }
+}
+
 /// A loaded scene with its registry (which must outlive the objects its plugins built).
 class Simulation {
  public:
@@ -326,6 +472,7 @@ class Simulation {
   Simulation(const std::vector<std::string>& plugins, const std::filesystem::path& base_dir)
       : registry_(std::make_unique<TypeRegistry>()) {
     RegisterBuiltins(*registry_);
+    RegisterPythonTypes(*registry_);
     for (const auto& plugin : plugins) registry_->LoadPlugin(ResolvePlugin(plugin, base_dir));
   }
   void Attach() {
@@ -606,6 +753,25 @@ PYBIND11_MODULE(gipsi, m) {
       .def("write_outputs", &Simulation::WriteOutputs, py::arg("directory") = py::none(),
            "Writes the scene's VTU/PVD series and probe CSVs while it runs, as gipsi run does.");
 
+  m.attr("_object_types") = py::dict();
+  m.def(
+      "register_object",
+      [](const std::string& type, const py::object& factory, const std::string& description) {
+        if (!PyCallable_Check(factory.ptr()))
+          throw py::type_error("register_object: the factory must be callable (name, params)");
+        TypeRegistry builtins;
+        RegisterBuiltins(builtins);
+        if (builtins.objects.Contains(type))
+          throw py::value_error(
+              fmt::format("register_object: '{}' is a built-in object type", type));
+        py::dict types = py::module_::import("gipsi").attr("_object_types");
+        types[py::str(type)] = py::make_tuple(factory, "(Python) " + description);
+      },
+      py::arg("type"), py::arg("factory"), py::arg("description") = "",
+      "Registers an object type written in Python for the simulations loaded after it: "
+      "factory(name, params) returns an object with `fields` and step/read/write (see "
+      "docs/python.md). Registering a name again replaces it; a built-in name is refused when a "
+      "scene is loaded.");
   m.def(
       "write_mesh",
       [](const std::filesystem::path& file, const py::dict& mesh) {

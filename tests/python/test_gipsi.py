@@ -327,6 +327,147 @@ class Outputs(unittest.TestCase):
             self.assertTrue(os.path.exists(os.path.join(tmp, "probes", "energy.csv")))
 
 
+class Decay:
+    """dx/dt = -k x, stepped in closed form; reads its input u (added to x once per step)."""
+
+    fields = {"x": {"units": "1", "access": "read", "description": "the decaying value"},
+              "u": {"units": "1", "access": "write", "description": "a kick added per step"}}
+
+    def __init__(self, name, params):
+        if params.get("rate", 1.0) <= 0:
+            raise ValueError("rate must be positive")
+        self.k = params.get("rate", 1.0)
+        self.x = params.get("start", 1.0)
+        self.u = 0.0
+
+    def step(self, t, dt):
+        self.x = self.x * np.exp(-self.k * dt) + self.u
+        self.u = 0.0
+
+    def read(self, name):
+        return [self.x]
+
+    def write(self, name, values):
+        self.u = float(values[0])
+
+    def get_state(self):
+        return np.array([self.x, self.u]).tobytes()
+
+    def set_state(self, state):
+        self.x, self.u = np.frombuffer(state)
+
+
+def decay_scene(**extra):
+    scene = {"gipsi": 1, "units": "SI",
+             "objects": {"a": {"type": "Decay", "rate": 2.0, "dt": 0.01},
+                         "b": {"type": "Decay", "rate": 1.0, "start": 0.0, "dt": 0.01}},
+             "schedule": {"end": 1.0, "dt": 0.01},
+             "probes": {"a": {"object": "a", "fields": ["x"], "every": 0.1}}}
+    scene.update(extra)
+    return scene
+
+
+class PythonObjects(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        gipsi.register_object("Decay", Decay, "dx/dt = -k x")
+
+    def test_a_python_object_steps_in_the_kernel_and_is_probed(self):
+        sim = gipsi.Simulation.from_dict(decay_scene())
+        self.assertEqual(sim.object("a").type, "Decay")
+        self.assertEqual(sim.object("a").fields["u"]["access"], "write")
+        sim.run()
+        probe = sim.probes["a"]
+        np.testing.assert_allclose(probe["x"], np.exp(-2.0 * probe["time"]), rtol=1e-12)
+
+    def test_a_builtin_connector_couples_two_python_objects(self):
+        scene = decay_scene(connectors={"kick": {"type": "FieldCopy", "from": "a.x", "to": "b.u"}})
+        sim = gipsi.Simulation.from_dict(scene)
+        sim.run(until=0.05)
+        # b gets a's value at the start of each step: b_n+1 = b_n e^(-dt) + a_n, a_n = e^(-2 n dt).
+        dt, b = 0.01, 0.0
+        for n in range(5):
+            b = b * np.exp(-dt) + np.exp(-2.0 * n * dt)
+        self.assertAlmostEqual(sim.object("b").field("x")[0, 0], b, delta=1e-14)
+
+    def test_a_python_object_resumes_bitwise_from_its_state(self):
+        sim = gipsi.Simulation.from_dict(decay_scene())
+        sim.run(until=0.3)
+        state = sim.save()
+        sim.run(until=0.7)
+        x = sim.object("a").field("x")
+        sim.restore(state)
+        sim.run(until=0.7)
+        np.testing.assert_array_equal(sim.object("a").field("x"), x)
+
+    def test_a_failing_python_step_stops_the_run_with_its_reason(self):
+        class Broken(Decay):
+            def step(self, t, dt):
+                raise ZeroDivisionError("a bug in step")
+
+        gipsi.register_object("Broken", Broken)
+        scene = decay_scene()
+        scene["objects"]["a"]["type"] = "Broken"
+        result = gipsi.Simulation.from_dict(scene).run()
+        self.assertEqual(result["outcome"], "diverged")
+        self.assertIn("ZeroDivisionError: a bug in step", result["diagnostic"])
+
+        class Refusing(Decay):
+            def step(self, t, dt):
+                return t < 0.05 - 1e-9  # False from t = 0.05 on: the step failed
+
+        gipsi.register_object("Refusing", Refusing)
+        scene["objects"]["a"]["type"] = "Refusing"
+        sim = gipsi.Simulation.from_dict(scene)
+        result = sim.run()
+        self.assertEqual(result["outcome"], "diverged")
+        self.assertIn("step() returned False", result["diagnostic"])
+        self.assertAlmostEqual(sim.time, 0.05, delta=1e-12)
+
+    def test_a_step_that_fails_at_full_size_is_retried_in_halves(self):
+        class Picky(Decay):
+            def step(self, t, dt):
+                if dt > 0.006:  # only halved steps succeed
+                    return False
+                super().step(t, dt)
+
+        gipsi.register_object("Picky", Picky)
+        scene = decay_scene()
+        scene["objects"]["a"]["type"] = "Picky"
+        scene["schedule"]["on_failure"] = {"retry": {"max_halvings": 1}}
+        sim = gipsi.Simulation.from_dict(scene)
+        self.assertEqual(sim.run(until=0.1)["outcome"], "completed")
+        # Halved steps of the closed form compose exactly: x = e^(-2 t), to rounding.
+        self.assertAlmostEqual(sim.object("a").field("x")[0, 0], np.exp(-0.2), delta=1e-14)
+
+    def test_bad_parameters_and_declarations_are_refused_at_the_objects_path(self):
+        scene = decay_scene()
+        scene["objects"]["a"]["rate"] = -1
+        with self.assertRaises(gipsi.InputError) as raised:
+            gipsi.Simulation.from_dict(scene)
+        self.assertEqual(raised.exception.path, "objects.a")
+        self.assertIn("rate must be positive", raised.exception.what)
+
+        class NoFields:
+            def __init__(self, name, params):
+                pass
+
+        gipsi.register_object("NoFields", NoFields)
+        scene = decay_scene()
+        scene["objects"]["a"]["type"] = "NoFields"
+        with self.assertRaisesRegex(gipsi.InputError, "objects.a: NoFields: its 'fields'"):
+            gipsi.Simulation.from_dict(scene)
+        class BadComponents(Decay):
+            fields = {"x": {"components": "three"}}
+
+        gipsi.register_object("BadComponents", BadComponents)
+        scene["objects"]["a"]["type"] = "BadComponents"
+        with self.assertRaisesRegex(gipsi.InputError, "objects.a: BadComponents: "):
+            gipsi.Simulation.from_dict(scene)
+        with self.assertRaisesRegex(ValueError, "'MassSpring' is a built-in object type"):
+            gipsi.register_object("MassSpring", Decay)
+
+
 class DocsSnippets(unittest.TestCase):
     def test_every_python_snippet_of_docs_python_md_runs(self):
         with open(os.path.join(SOURCE_DIR, "docs", "python.md"), encoding="utf-8") as f:
