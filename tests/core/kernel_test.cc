@@ -5,7 +5,9 @@
 
 #include "core/test_objects.h"
 #include "gipsi/base/error.h"
+#include "gipsi/base/state.h"
 #include "gipsi/core/aggregate.h"
+#include "gipsi/core/connector.h"
 #include "gipsi/models/connectors/field_copy.h"
 
 namespace gipsi {
@@ -110,6 +112,48 @@ TEST(Kernel, DivergingObjectStopsRunWithDiagnosticAndKeepsOutputs) {
   // The observer saw t = 0 and t = 1 ms, and was finished (files flushed).
   EXPECT_EQ(times.size(), 2u);
   EXPECT_TRUE(finished);
+}
+
+/// A connector that breaks Connector's never-throw contract (as a plugin's or a Python
+/// object's field read can).
+class ThrowingConnector final : public Connector {
+ public:
+  ThrowingConnector() : Connector("thrower") {}
+  std::string_view type_name() const override { return "Throwing"; }
+  void SaveConnectorState(StateWriter&) const override {}
+  void RestoreConnectorState(StateReader&) override {}
+
+ protected:
+  StepStatus DoFire(double t) override {
+    if (t > 2.5e-3) throw std::runtime_error("read('x') returned 2 values, expected 1");
+    return StepStatus::Ok();
+  }
+};
+
+TEST(Kernel, AnExceptionInAMacroStepStopsTheRunNamingTheStepAndTheReason) {
+  Kernel kernel;
+  kernel.coordinator().AddObject(std::make_unique<CountingObject>("a"), 1e-3);
+  kernel.coordinator().AddConnector(std::make_unique<ThrowingConnector>());
+  kernel.Initialize();
+  const RunResult result = kernel.Run(0.01);
+  EXPECT_EQ(result.outcome, RunResult::Outcome::kStopped);
+  EXPECT_EQ(result.diagnostic,
+            "the macro step at t = 0.003 s could not be done: read('x') returned 2 values, "
+            "expected 1");
+  EXPECT_EQ(kernel.macro_steps(), 3);
+}
+
+TEST(Kernel, ARetryPolicyOverAnObjectWithoutCheckpointsSaysSo) {
+  Kernel kernel;
+  kernel.coordinator().AddObject(std::make_unique<CountingObject>("a"), 1e-3);
+  kernel.SetFailurePolicy(FailurePolicy{.max_halvings = 2});
+  kernel.Initialize();
+  const RunResult result = kernel.Run(0.01);
+  EXPECT_EQ(result.outcome, RunResult::Outcome::kStopped);
+  EXPECT_THAT(result.diagnostic,
+              HasSubstr("the macro step at t = 0 s could not be done: the failure policy needs "
+                        "checkpoints: "));
+  EXPECT_THAT(result.diagnostic, HasSubstr("does not support checkpoints"));
 }
 
 TEST(Kernel, ConnectorFiresEveryNMacroSteps) {

@@ -440,6 +440,20 @@ class PythonObjects(unittest.TestCase):
         # Halved steps of the closed form compose exactly: x = e^(-2 t), to rounding.
         self.assertAlmostEqual(sim.object("a").field("x")[0, 0], np.exp(-0.2), delta=1e-14)
 
+    def test_a_read_of_the_wrong_size_through_a_connector_stops_the_run_saying_so(self):
+        class Chatty(Decay):
+            def read(self, name):
+                return [self.x, self.x]
+
+        gipsi.register_object("Chatty", Chatty)
+        scene = decay_scene(connectors={"kick": {"type": "FieldCopy", "from": "a.x", "to": "b.u"}})
+        scene["objects"]["a"]["type"] = "Chatty"
+        del scene["probes"]  # a probe's read would fail first, as an output ("output_failed")
+        result = gipsi.Simulation.from_dict(scene).run()
+        self.assertEqual(result["outcome"], "stopped")
+        self.assertIn("the macro step at t = 0 s could not be done: Chatty 'a': read('x') "
+                      "returned 2 values, expected 1", result["diagnostic"])
+
     def test_bad_parameters_and_declarations_are_refused_at_the_objects_path(self):
         scene = decay_scene()
         scene["objects"]["a"]["rate"] = -1

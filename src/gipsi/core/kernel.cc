@@ -154,9 +154,12 @@ RunResult Kernel::Run(double end_time, const ProgressFn& progress) {
     std::optional<ScheduleFailure> failure;
     try {
       failure = StepWithPolicy(t, retry_note);
-    } catch (const std::exception& e) {  // a state that cannot be saved for roll-back
-      return finish(RunResult::Outcome::kStopped,
-                    fmt::format("the failure policy needs checkpoints: {}", e.what()));
+    } catch (const std::exception& e) {
+      // A state that cannot be saved for roll-back (StepWithPolicy says so), or a step or
+      // connector that broke its never-throw contract (a plugin's, a Python object's field).
+      return finish(
+          RunResult::Outcome::kStopped,
+          fmt::format("the macro step at t = {:.6g} s could not be done: {}", t, e.what()));
     }
     if (failure && failure->status.code == StepStatus::Code::kStopped) {
       // A stop request reached inside a step (StopToken): the object abandoned it. Objects

@@ -140,10 +140,14 @@ void Kernel::ReadCheckpoint(const std::filesystem::path& file) {
 std::optional<ScheduleFailure> Kernel::StepWithPolicy(double t, std::string& retry_note) {
   coordinator_.BeginMacroStep();
   if (policy_.max_halvings <= 0) return coordinator_.MacroStep(t, macro_index_);
-  if (rollback_)
-    coordinator_.TakeSnapshot(*rollback_);
-  else
-    rollback_ = coordinator_.NewSnapshot();
+  try {
+    if (rollback_)
+      coordinator_.TakeSnapshot(*rollback_);
+    else
+      rollback_ = coordinator_.NewSnapshot();
+  } catch (const InputError& e) {
+    throw InputError(fmt::format("the failure policy needs checkpoints: {}", e.what()));
+  }
   auto restore = [&] { coordinator_.RestoreSnapshot(*rollback_); };
   std::optional<ScheduleFailure> failure = coordinator_.MacroStep(t, macro_index_);
   auto stopped = [&] { return failure && failure->status.code == StepStatus::Code::kStopped; };
