@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 
 #include "gipsi/base/error.h"
+#include "gipsi/base/state.h"
 #include "gipsi/io/builtins.h"
 #include "gipsi/io/scene.h"
 #include "gipsi/models/circulation/circulation.h"
@@ -97,6 +98,58 @@ TEST(Windkessel, ConstantInflowMatchesClosedForm) {
     worst = std::max(worst, std::abs(wk.pressure(arteries) - exact));
   }
   EXPECT_LT(worst, 1e-8 * 100 * kMmHg) << worst;
+}
+
+// A written resistance acts from the next step: after R_p is doubled at t1 = 1.5 s, the
+// pressure relaxes from P(t1) toward P_v + 2 R_p Q with τ' = 2 R_p C (the closed form above
+// with the new R). It is state: a checkpoint taken after the write continues bitwise in a fresh
+// scene. Same tolerance reasoning as above.
+TEST(Windkessel, AWrittenResistanceActsAndIsCheckpointed) {
+  SceneHolder holder(WindkesselScene(R"("100 mL/s")"));
+  Circulation& wk = holder.Object("wk");
+  const int arteries = wk.FindCompartment("arteries");
+  const FieldId r = wk.FindField("peripheral_resistance");
+  EXPECT_EQ(wk.field_info(r).units, "Pa*s/m3");
+  Eigen::MatrixXd value(1, 1);
+  wk.ReadField(r, value);
+  EXPECT_DOUBLE_EQ(value(0, 0), kRp);  // the scene's "1 mmHg*s/mL", converted
+  for (int k = 1; k <= 1500; ++k) ASSERT_TRUE(wk.Step(1e-3).ok());
+  const double t1 = wk.time(), p1 = wk.pressure(arteries), q = 100 * kMl;
+  value(0, 0) = 2 * kRp;
+  wk.WriteField(r, value);
+  StateWriter saved;
+  wk.SaveState(saved);
+  double worst = 0;
+  for (int k = 1; k <= 1500; ++k) {
+    ASSERT_TRUE(wk.Step(1e-3).ok());
+    const double target = kPv + 2 * kRp * q;
+    const double exact = target + (p1 - target) * std::exp(-(wk.time() - t1) / (2 * kRp * kC));
+    worst = std::max(worst, std::abs(wk.pressure(arteries) - exact));
+  }
+  EXPECT_LT(worst, 1e-8 * 100 * kMmHg) << worst;
+
+  SceneHolder fresh(WindkesselScene(R"("100 mL/s")"));
+  Circulation& again = fresh.Object("wk");
+  StateReader in(saved.bytes(), "saved");
+  again.RestoreState(in);
+  again.ReadField(r, value);
+  EXPECT_EQ(value(0, 0), 2 * kRp);
+  for (int k = 1; k <= 1500; ++k) ASSERT_TRUE(again.Step(1e-3).ok());
+  EXPECT_EQ(again.pressure(arteries), wk.pressure(arteries));
+}
+
+// A resistance written as 0 (the connection has no inertance) fails the next step, naming the
+// connection, instead of publishing an infinite flow.
+TEST(Windkessel, AnUnusableWrittenResistanceFailsTheStepNamingTheConnection) {
+  SceneHolder holder(WindkesselScene(R"("100 mL/s")"));
+  Circulation& wk = holder.Object("wk");
+  Eigen::MatrixXd zero = Eigen::MatrixXd::Zero(1, 1);
+  wk.WriteField(wk.FindField("peripheral_resistance"), zero);
+  const StepStatus status = wk.Step(1e-3);
+  EXPECT_FALSE(status.ok());
+  EXPECT_THAT(status.what, HasSubstr("resistance"));
+  EXPECT_EQ(wk.failure_detail(), "connection 'peripheral'");
+  EXPECT_FALSE(wk.TryFindField("inflow_resistance").has_value());  // a source's R is not an input
 }
 
 // A chamber with both valves closed keeps its volume exactly (its derivative is 0), so its

@@ -61,8 +61,20 @@ Circuit::Circuit(std::vector<CompartmentSpec> compartments, std::vector<Connecti
     s_.chamber_pressure[static_cast<std::size_t>(i)] =
         compartments_[static_cast<std::size_t>(i)].initial_pressure;
   s_.source_value.assign(connections_.size(), 0.0);
+  s_.resistance.clear();
+  for (const auto& c : connections_) s_.resistance.push_back(c.resistance);
   p_work_.setZero(nc);
   q_work_.setZero(num_connections());
+}
+
+int Circuit::ResistanceProblem() const {
+  for (int c = 0; c < num_connections(); ++c) {
+    if (connections_[static_cast<std::size_t>(c)].kind == ConnectionSpec::Kind::kSource) continue;
+    const double r = s_.resistance[static_cast<std::size_t>(c)];
+    const bool inertial = connections_[static_cast<std::size_t>(c)].inertance > 0;
+    if (!std::isfinite(r) || r < 0 || (r == 0 && !inertial)) return c;
+  }
+  return -1;
 }
 
 VecX Circuit::InitialState() const {
@@ -144,7 +156,7 @@ void Circuit::CalcFlows(double t, Eigen::Ref<const VecX> x, Eigen::Ref<const Vec
     } else if (flow_state(c) >= 0) {
       q[c] = x[flow_state(c)];
     } else {
-      q[c] = (p[s.from] - p[s.to]) / s.resistance;
+      q[c] = (p[s.from] - p[s.to]) / s_.resistance[static_cast<std::size_t>(c)];
     }
   }
 }
@@ -164,7 +176,10 @@ void Circuit::CalcDerivative(double t, Eigen::Ref<const VecX> x, Eigen::Ref<VecX
       open = s_.valves[static_cast<std::size_t>(valve++)] == ValveState::kOpen;
     if (flow_state(c) >= 0)
       xdot[flow_state(c)] =
-          open ? (p_work_[s.from] - p_work_[s.to] - s.resistance * q) / s.inertance : 0.0;
+          open
+              ? (p_work_[s.from] - p_work_[s.to] - s_.resistance[static_cast<std::size_t>(c)] * q) /
+                    s.inertance
+              : 0.0;
   }
 }
 

@@ -84,6 +84,8 @@ struct CircuitState {
   /// written [s]; the prescribed pressure of a pressure-driven chamber [Pa].
   std::vector<double> cavity_volume, cavity_rate, cavity_time, chamber_pressure;
   std::vector<double> source_value;  ///< per connection: a field-driven source's flow [m³/s]
+  /// Per connection: R [Pa·s/m³], the spec's until written (`<name>_resistance`).
+  std::vector<double> resistance;
 
   template <class Self, class Visitor>
   static void Fields(Self& s, Visitor& v) {
@@ -93,6 +95,7 @@ struct CircuitState {
     v("cavity_time", s.cavity_time, Shape::kFixed);
     v("chamber_pressure", s.chamber_pressure, Shape::kFixed);
     v("source_value", s.source_value, Shape::kFixed);
+    v("resistance", s.resistance, Shape::kFixed);
   }
 };
 
@@ -165,6 +168,15 @@ class Circuit {
   }
   /// Field-driven source connection c.
   void SetSourceFlow(int c, double q) { s_.source_value[static_cast<std::size_t>(c)] = q; }
+  /// Connection c's resistance R [Pa·s/m³] (the spec's until set). Any value may be set; the
+  /// owner checks it before stepping (ResistanceProblem).
+  void SetResistance(int c, double r) { s_.resistance[static_cast<std::size_t>(c)] = r; }
+  [[nodiscard]] double resistance(int c) const {
+    return s_.resistance[static_cast<std::size_t>(c)];
+  }
+  /// The first connection (not a source) whose resistance cannot be used (R ≤ 0 where it has
+  /// no inertance, R < 0 otherwise, or not finite), or −1.
+  [[nodiscard]] int ResistanceProblem() const;
 
  private:
   class Guards final : public EventFunctions {

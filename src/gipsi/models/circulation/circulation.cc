@@ -72,6 +72,11 @@ Circulation::Circulation(std::string name, CirculationParams params)
     Declare({s.name + "_pressure_drop", L::kGlobal, 1, "Pa", A::kRead,
              "p_from - p_to (a source: R q, the pressure it works against above 'to')"},
             Quantity::kPressureDrop, c);
+    if (s.kind != ConnectionSpec::Kind::kSource)
+      Declare({s.name + "_resistance", L::kGlobal, 1, "Pa*s/m3", A::kReadWrite,
+               "resistance R (input: the scene's value until written; > 0, or >= 0 with an "
+               "inertance)"},
+              Quantity::kResistance, c);
   }
   for (std::size_t k = 0; k < circuit_.valves().size(); ++k)
     Declare({valve_name(static_cast<int>(k)) + "_open", L::kGlobal, 1, "1", A::kRead,
@@ -214,6 +219,13 @@ void Circulation::SetVolume(int c, double volume) {
 
 StepStatus Circulation::DoStep(double t, double dt) {
   failed_compartment_ = failed_connection_ = -1;
+  if (const int c = circuit_.ResistanceProblem(); c >= 0) {
+    failed_connection_ = c;
+    return StepStatus::Failed(
+        "a written resistance is not usable (it must be finite and > 0, or >= 0 with an "
+        "inertance)",
+        c, circuit_.resistance(c));
+  }
   const double t_end = t + dt;
   if (StepStatus status = Integrate(state_.ode, t, dt, state_.x, true); !status.ok()) return status;
   UpdateOutputs(t_end);
@@ -306,6 +318,9 @@ void Circulation::DoReadField(FieldId id, Eigen::Ref<Eigen::MatrixXd> out) const
                           : s.resistance * state_.flow[i];
       break;
     }
+    case Quantity::kResistance:
+      value = circuit_.resistance(i);
+      break;
     case Quantity::kValveOpen:
       value = circuit_.valve_state(i) == ValveState::kOpen ? 1.0 : 0.0;
       break;
@@ -337,6 +352,9 @@ void Circulation::DoWriteField(FieldId id, const Eigen::Ref<const Eigen::MatrixX
       break;
     case Quantity::kPressureInput:
       circuit_.SetChamberPressure(f.index, value);
+      break;
+    case Quantity::kResistance:
+      circuit_.SetResistance(f.index, value);
       break;
     default:
       GIPSI_CHECK(false, "field is not writable");

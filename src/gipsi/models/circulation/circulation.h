@@ -44,7 +44,7 @@ struct CirculationParams {
 /// probes read the same values before the first step after a restore. Copyable.
 struct CirculationState {
   static constexpr std::string_view kTag = "CirculationState";
-  static constexpr std::uint32_t kVersion = 1;
+  static constexpr std::uint32_t kVersion = 2;  // 2: writable resistances (circuit.resistance)
 
   VecX x;                ///< the ODE state [volumes…, inertial flows…]
   VecX pressure, flow;   ///< per compartment [Pa] and per connection [m³/s], at the object's time
@@ -135,6 +135,7 @@ class Circulation final : public SimObject, public LumpedChambers {
     // connections
     kFlow,
     kPressureDrop,
+    kResistance,
     kValveOpen,
     // global
     kTotalVolume,
