@@ -622,7 +622,7 @@ int Cell(CellOptions options, const std::vector<std::string>& plugins) {
 int main(int argc, char** argv) {
   CLI::App app{"GiPSi: an open-architecture framework for organ-level and surgical simulation"};
   app.set_version_flag("--version", "gipsi " GIPSI_VERSION_STRING " (plugin interface " +
-                                        std::to_string(GIPSI_PLUGIN_ABI_VERSION) + "; " +
+                                        std::to_string(GIPSI_PLUGIN_INTERFACE) + "; " +
                                         gipsi::BuildFeatureSummary() + ")");
   app.require_subcommand(1);
   std::string scene_file, out_dir, mesh_file;

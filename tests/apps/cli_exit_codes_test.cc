@@ -54,7 +54,7 @@ TEST(GipsiExitCodes, VersionNamesThePackageAndPluginInterfaceVersionsAndTheOptio
   const Result r = Gipsi("--version");
   EXPECT_EQ(r.code, 0) << r.output;
   EXPECT_EQ(r.output, "gipsi " GIPSI_VERSION_STRING " (plugin interface " +
-                          std::to_string(GIPSI_PLUGIN_ABI_VERSION) + "; with Gmsh, OpenIGTLink)\n");
+                          std::to_string(GIPSI_PLUGIN_INTERFACE) + "; with Gmsh, OpenIGTLink)\n");
 }
 
 TEST(GipsiExitCodes, BadCommandLineExits2ForEverySubcommand) {

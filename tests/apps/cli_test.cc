@@ -6,11 +6,13 @@
 #include <fstream>
 #include <sstream>
 
+#include <fmt/format.h>
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
 #include "apps/cli_test_util.h"
+#include "gipsi/core/registry.h"
 
 #include "gipsi/io/vtu_reader.h"
 #include "test_paths.h"
@@ -325,6 +327,23 @@ TEST(GipsiPlugins, TwoPluginsRegisteringOneTypeNameAreRefusedNotAborted) {
                                   ": the plugin registers object type 'Oscillator', connector "
                                   "type 'Follow', already registered by GiPSi or an earlier "
                                   "plugin (the same plugin loaded from two files?)"));
+}
+
+TEST(GipsiPlugins, APluginOfAnotherReleaseLineOrInterfaceIsRefusedNamingBoth) {
+  const std::string dir = std::string(GIPSI_BINARY_DIR) + "/tests/plugins/";
+  const std::string here =
+      fmt::format("this is gipsi {}.{} with plugin interface {}", GIPSI_VERSION_MAJOR,
+                  GIPSI_VERSION_MINOR, GIPSI_PLUGIN_INTERFACE);
+  Result next = Gipsi("types --plugin " + dir + "gipsi_test_next_minor_plugin.so");
+  EXPECT_EQ(next.code, 1) << next.output;
+  EXPECT_THAT(next.output,
+              HasSubstr(fmt::format("plugin built for gipsi {}.{} with plugin interface {}, {}",
+                                    GIPSI_VERSION_MAJOR, GIPSI_VERSION_MINOR + 1,
+                                    GIPSI_PLUGIN_INTERFACE, here)));
+  Result legacy = Gipsi("types --plugin " + dir + "gipsi_test_legacy_plugin.so");
+  EXPECT_EQ(legacy.code, 1) << legacy.output;
+  EXPECT_THAT(legacy.output,
+              HasSubstr("plugin built for plugin interface 10 (an older gipsi), " + here));
 }
 
 TEST(GipsiPlugins, NotAPluginIsAClearError) {

@@ -39,8 +39,7 @@ StepStatus AggregateObject::DoStep(double t, double dt) {
   // A kernel retrying a failed macro step asks for a fraction of the aggregate's step.
   const int split = std::max(1, static_cast<int>(std::lround(parts_.macro_dt() / dt)));
   if (auto failure = parts_.MacroStep(t, step_count(), split)) {
-    SimObject* part = failure->is_connector ? nullptr : parts_.FindObject(failure->who);
-    std::string inner = part ? part->failure_detail() : std::string();
+    const std::string& inner = failure->detail;
     failure_detail_ = std::string(failure->is_connector ? "connector '" : "part '") +
                       std::string(failure->who) + "'" + (inner.empty() ? "" : ", " + inner);
     return failure->status;

@@ -43,6 +43,9 @@ class Connector {
     return DoFire(t);
   }
   [[nodiscard]] std::int64_t fire_count() const { return fire_count_; }
+  /// What the last failed Fire adds to its status (e.g. an exception's message from a connector
+  /// written in Python), quoted in the run's diagnostic; empty by default.
+  [[nodiscard]] virtual std::string failure_detail() const { return {}; }
   /// What it uses of the objects it couples, and its constraints on the order, as declared by
   /// its constructor (checked by Coordinator::Prepare, listed by `gipsi validate`).
   [[nodiscard]] std::span<const PortUse> ports() const { return ports_; }

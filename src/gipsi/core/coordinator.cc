@@ -124,7 +124,9 @@ std::optional<ScheduleFailure> Coordinator::MacroStep(double t, std::int64_t mac
       const auto start = Clock::now();
       StepStatus status = slot.connector->Fire(t);
       slot.seconds += std::chrono::duration<double>(Clock::now() - start).count();
-      if (!status.ok()) return ScheduleFailure{status, slot.connector->name(), true, t};
+      if (!status.ok())
+        return ScheduleFailure{status, slot.connector->name(), true, t,
+                               slot.connector->failure_detail()};
     } else {
       ObjectSlot& slot = objects_[entry.index];
       const double dt = macro_dt / slot.substeps;
@@ -135,7 +137,8 @@ std::optional<ScheduleFailure> Coordinator::MacroStep(double t, std::int64_t mac
         StepStatus status = slot.object->Step(dt);
         if (!status.ok()) {
           slot.seconds += std::chrono::duration<double>(Clock::now() - start).count();
-          return ScheduleFailure{status, slot.object->name(), false, t + k * dt};
+          return ScheduleFailure{status, slot.object->name(), false, t + k * dt,
+                                 slot.object->failure_detail()};
         }
       }
       slot.seconds += std::chrono::duration<double>(Clock::now() - start).count();

@@ -23,7 +23,8 @@ struct ScheduleFailure {
   StepStatus status;
   std::string_view who;
   bool is_connector = false;
-  double time = 0;  ///< simulated time at the start of the failing sub-step
+  double time = 0;     ///< simulated time at the start of the failing sub-step
+  std::string detail;  ///< the object's or connector's failure_detail()
 };
 
 /// Owns objects and connectors and runs them in order. Not copyable; movable.

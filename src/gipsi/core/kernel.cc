@@ -173,10 +173,7 @@ RunResult Kernel::Run(double end_time, const ProgressFn& progress) {
                       t, checkpoint_every_ > 0 ? "; no checkpoint was written at the stop" : ""));
     }
     if (failure) {
-      std::string detail;
-      if (!failure->is_connector)
-        if (SimObject* object = coordinator_.FindObject(failure->who))
-          detail = object->failure_detail();
+      const std::string& detail = failure->detail;
       std::string where =
           failure->status.item >= 0
               ? fmt::format(" (item {}, value {:.6g})", failure->status.item, failure->status.value)

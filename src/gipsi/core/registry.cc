@@ -137,6 +137,18 @@ void RegisterIntegrators(TypeRegistry& registry) {
       "provides only its derivative)");
 }
 
+namespace {
+
+/// A plugin's ABI number in words (GIPSI_PLUGIN_ABI_VERSION's encoding; numbers below 1000 are
+/// the bare interface numbers of releases before the package version was part of it).
+std::string DescribeAbi(int v) {
+  if (v < 1000) return fmt::format("plugin interface {} (an older gipsi)", v);
+  return fmt::format("gipsi {}.{} with plugin interface {}", v / 1000000, v / 1000 % 1000,
+                     v % 1000);
+}
+
+}  // namespace
+
 void TypeRegistry::LoadPlugin(const std::string& path) {
   std::error_code ec;
   std::string canonical = std::filesystem::weakly_canonical(path, ec).string();
@@ -153,10 +165,12 @@ void TypeRegistry::LoadPlugin(const std::string& path) {
     ThrowInputError(path, "",
                     "not a GiPSi plugin: it must export gipsi_plugin_abi_version() and "
                     "gipsi_register_plugin(gipsi::TypeRegistry&)");
-  if (version() != GIPSI_PLUGIN_ABI_VERSION)
+  if (const int v = version(); v != GIPSI_PLUGIN_ABI_VERSION)
     ThrowInputError(path, "",
-                    fmt::format("plugin built for plugin ABI {}, this GiPSi has {}", version(),
-                                GIPSI_PLUGIN_ABI_VERSION));
+                    fmt::format("plugin built for {}, this is gipsi {}.{} with plugin interface "
+                                "{}; rebuild the plugin against this gipsi",
+                                DescribeAbi(v), GIPSI_VERSION_MAJOR, GIPSI_VERSION_MINOR,
+                                GIPSI_PLUGIN_INTERFACE));
   // A name registered twice aborts in FactoryTable::Register (a programmer error among the
   // built-ins); from a plugin it is bad input, e.g. two copies of one plugin. Register into an
   // empty registry first and refuse a plugin whose names are taken, before it changes this one.

@@ -14,20 +14,28 @@
 
 #include "gipsi/base/error.h"
 #include "gipsi/base/json_node.h"
+#include "gipsi/base/version.h"
 #include "gipsi/core/connector.h"
 #include "gipsi/core/material.h"
 #include "gipsi/core/sim_object.h"
 #include "gipsi/numerics/ode.h"
 
-/// Version of the plugin interface; a plugin built against another version is refused.
+/// Version of the plugin interface (the C++ classes and hooks a plugin builds on).
 /// 2: checkpoint hooks; 3: haptic local models by type; 4: SimObject's stop token, local models
 /// in core; 5: cavities through the CavityWall capability, not a SimObject virtual; 6: snapshot
 /// hooks (NewObjectState, CopyObjectState, SetObjectState) on SimObject and Connector; 7:
 /// connector ports (Connector::UseField, …, RequireOrder; gipsi/core/port.h); 8: cell models
 /// and local models in tables a layer above declares (TypeRegistry::Table; CellModels,
 /// LocalModels); 9: OdeIntegrator (implicit integrators, Step returns bool); 10: SimObject's
-/// state cache hooks (SaveStateCache, RestoreStateCache, DropStateCache).
-#define GIPSI_PLUGIN_ABI_VERSION 10
+/// state cache hooks (SaveStateCache, RestoreStateCache, DropStateCache); 11:
+/// Connector::failure_detail, and the ABI version tied to the package version.
+#define GIPSI_PLUGIN_INTERFACE 11
+/// What a plugin's gipsi_plugin_abi_version() returns and the loader requires: the package's
+/// major and minor version with the plugin interface, MAJOR·10⁶ + MINOR·10³ + INTERFACE. A
+/// plugin thus loads only into the release line it was built against (0.1.x, as the CMake
+/// package's SameMinorVersion and the libraries' SOVERSION) with the same interface.
+#define GIPSI_PLUGIN_ABI_VERSION \
+  (GIPSI_VERSION_MAJOR * 1000000 + GIPSI_VERSION_MINOR * 1000 + GIPSI_PLUGIN_INTERFACE)
 
 namespace gipsi {
 
