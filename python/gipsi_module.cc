@@ -4,6 +4,7 @@
 /// NumPy arrays (with the checks a connector's ports get), probes recorded in memory as dicts of
 /// arrays, checkpoints to bytes and files, and mesh files as arrays. See docs/python.md.
 
+#include <pybind11/eval.h>
 #include <pybind11/functional.h>
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
@@ -28,7 +29,9 @@
 #include "gipsi/base/json_node.h"
 #include "gipsi/base/state.h"
 #include "gipsi/base/version.h"
+#include "gipsi/core/coordinator.h"
 #include "gipsi/core/kernel.h"
+#include "gipsi/core/port.h"
 #include "gipsi/core/registry.h"
 #include "gipsi/core/sim_object.h"
 #include "gipsi/io/builtins.h"
@@ -36,6 +39,8 @@
 #include "gipsi/io/outputs.h"
 #include "gipsi/io/probes.h"
 #include "gipsi/io/scene.h"
+#include "gipsi/models/ep/cell_models.h"
+#include "gipsi/models/ep/single_cell.h"
 
 namespace py = pybind11;
 
@@ -226,6 +231,8 @@ class PythonObject final : public SimObject {
     impl_ = py::object();
   }
   std::string_view type_name() const override { return type_; }
+  /// The Python instance the factory returned.
+  [[nodiscard]] const py::object& impl() const { return impl_; }
   const Points& domain_positions() const override { return no_positions_; }
   std::string failure_detail() const override { return detail_; }
 
@@ -295,6 +302,175 @@ class PythonObject final : public SimObject {
   Points no_positions_ = Points(3, 0);
 };
 
+/// A connector type written in Python (gipsi.register_connector): an instance declares `ports`
+/// ({key: {"access", "units", "components"}}, each key a parameter naming "object.field") and
+/// `parameters` (its other keys), and implements fire(t, values) → {key: array} for the ports
+/// it writes; get_state()/set_state(bytes) make it checkpointable. The ports are declared to
+/// the kernel like a built-in connector's (units, access and components checked before the
+/// first step), and Fire reads and writes them with the checks of Object.set_field. Every call
+/// holds the GIL; a Python exception fails the macro step with the exception quoted.
+class PythonConnector final : public Connector {
+ public:
+  PythonConnector(const ConnectorBuildContext& ctx, std::string type, py::object impl)
+      : Connector(ctx.name), type_(std::move(type)), impl_(std::move(impl)) {
+    if (!py::hasattr(impl_, "ports") || !py::isinstance<py::dict>(impl_.attr("ports")))
+      ctx.params.Fail(fmt::format(
+          "{}: its 'ports' attribute must be a dict {{key: {{access, units, components}}}}",
+          type_));
+    if (!py::hasattr(impl_, "fire"))
+      ctx.params.Fail(fmt::format("{}: it has no fire(t, values) method", type_));
+    std::vector<std::string> keys;
+    for (const auto& [key_handle, spec_handle] : impl_.attr("ports").cast<py::dict>()) {
+      Port port;
+      port.key = py::str(key_handle).cast<std::string>();
+      const py::dict spec = py::reinterpret_borrow<py::object>(spec_handle).cast<py::dict>();
+      const std::string access =
+          spec.contains("access") ? py::str(spec["access"]).cast<std::string>() : "read";
+      if (access != "read" && access != "write" && access != "read_write")
+        ctx.params.Fail(fmt::format("{}: port '{}': access '{}' is not read, write or read_write",
+                                    type_, port.key, access));
+      port.access = access == "read"    ? FieldAccess::kRead
+                    : access == "write" ? FieldAccess::kWrite
+                                        : FieldAccess::kReadWrite;
+      const std::string units =
+          spec.contains("units") ? py::str(spec["units"]).cast<std::string>() : "";
+      const int components = spec.contains("components") ? spec["components"].cast<int>() : 0;
+      if (!ctx.params.Has(port.key))
+        ctx.params.Fail(fmt::format("{} needs \"{}\": \"object.field\" (a port it {})", type_,
+                                    port.key, access == "read" ? "reads" : "writes"));
+      auto [object, field] = ctx.ObjectField(port.key);
+      port.object = object;
+      port.field = field;
+      port.count = object->FieldCount(field);
+      port.components = object->field_info(field).components;
+      port.buffer.resize(port.components, port.count);
+      UseField(port.key, *object, object->field_info(field).name, port.access, units, components);
+      keys.push_back(port.key);
+      ports_.push_back(std::move(port));
+    }
+    if (py::hasattr(impl_, "parameters"))
+      for (const auto& k : impl_.attr("parameters")) keys.push_back(py::str(k).cast<std::string>());
+    for (const auto& [key, value] : ctx.params.raw().items())
+      if (key != "type" && key != "every" && key != "description" &&
+          std::find(keys.begin(), keys.end(), key) == keys.end())
+        ctx.params.At(key).Fail(fmt::format(
+            "{} has no parameter '{}' (its ports: {}; its other parameters, from its "
+            "'parameters' attribute: {})",
+            type_, key, fmt::join(keys.begin(), keys.begin() + std::ssize(ports_), ", "),
+            fmt::join(keys.begin() + std::ssize(ports_), keys.end(), ", ")));
+  }
+  ~PythonConnector() override {
+    py::gil_scoped_acquire gil;
+    impl_ = py::object();
+  }
+  std::string_view type_name() const override { return type_; }
+  std::string failure_detail() const override { return detail_; }
+  /// The Python instance the factory returned.
+  [[nodiscard]] const py::object& impl() const { return impl_; }
+
+  void SaveConnectorState(StateWriter& out) const override {
+    py::gil_scoped_acquire gil;
+    if (!py::hasattr(impl_, "get_state")) Connector::SaveConnectorState(out);  // refuses
+    out.BeginSection("PythonConnector", 1);
+    out.WriteString(Call("get_state").cast<std::string>());
+    out.EndSection();
+  }
+  void RestoreConnectorState(StateReader& in) override {
+    py::gil_scoped_acquire gil;
+    if (!py::hasattr(impl_, "set_state")) Connector::RestoreConnectorState(in);  // refuses
+    in.BeginSection("PythonConnector", 1);
+    const std::string state = in.ReadString();
+    in.EndSection();
+    Call("set_state", py::bytes(state));
+  }
+
+ protected:
+  StepStatus DoFire(double t) override {
+    py::gil_scoped_acquire gil;
+    detail_.clear();
+    try {
+      py::dict values;
+      for (Port& p : ports_) {
+        if (p.access == FieldAccess::kWrite) continue;
+        p.object->ReadField(p.field, p.buffer);
+        py::array_t<double> a(
+            {static_cast<py::ssize_t>(p.count), static_cast<py::ssize_t>(p.components)});
+        std::copy(p.buffer.data(), p.buffer.data() + p.buffer.size(), a.mutable_data());
+        values[py::str(p.key)] = a;
+      }
+      const py::object result = impl_.attr("fire")(t, values);
+      if (result.is_none()) return StepStatus::Ok();
+      if (!py::isinstance<py::dict>(result)) {
+        detail_ = fmt::format("fire() returned a {}, expected a dict {{port: values}} or None",
+                              py::str(py::type::of(result).attr("__name__")).cast<std::string>());
+        return StepStatus::Failed("the Python connector's fire() returned something else");
+      }
+      // Check every written port first, so a bad one writes nothing.
+      std::vector<std::pair<Port*, py::array_t<double>>> writes;
+      for (const auto& [key_handle, value] : result.cast<py::dict>()) {
+        const std::string key = py::str(key_handle).cast<std::string>();
+        Port* port = nullptr;
+        for (Port& p : ports_)
+          if (p.key == key) port = &p;
+        if (port == nullptr || port->access == FieldAccess::kRead) {
+          detail_ = fmt::format("fire() returned '{}', which is not a port it writes", key);
+          return StepStatus::Failed("the Python connector wrote an undeclared port");
+        }
+        auto a = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(value);
+        if (!a || a.size() != port->buffer.size()) {
+          detail_ = fmt::format("fire() returned {} values for '{}' ({}), expected {} by {}",
+                                a ? a.size() : 0, key, port->object->field_info(port->field).name,
+                                port->count, port->components);
+          return StepStatus::Failed("the Python connector wrote a field with the wrong shape");
+        }
+        for (py::ssize_t i = 0; i < a.size(); ++i)
+          if (!std::isfinite(a.data()[i])) {
+            detail_ = fmt::format("fire() returned a non-finite value for '{}' at {}: {}", key, i,
+                                  a.data()[i]);
+            return StepStatus::Failed("the Python connector wrote a non-finite value");
+          }
+        writes.emplace_back(port, std::move(a));
+      }
+      for (auto& [port, a] : writes) {
+        std::copy(a.data(), a.data() + a.size(), port->buffer.data());
+        port->object->WriteField(port->field, port->buffer);
+      }
+    } catch (py::error_already_set& e) {
+      detail_ = fmt::format("fire() raised {}", OneLine(e));
+      return StepStatus::Failed("the Python connector's fire() raised");
+    } catch (const std::exception& e) {  // a Python object's read or write failing
+      detail_ = e.what();
+      return StepStatus::Failed("the Python connector's field access failed");
+    }
+    return StepStatus::Ok();
+  }
+
+ private:
+  struct Port {
+    std::string key;
+    SimObject* object = nullptr;
+    FieldId field;
+    FieldAccess access = FieldAccess::kRead;
+    Index count = 0;
+    int components = 0;
+    Eigen::MatrixXd buffer;
+  };
+  template <class... Args>
+  py::object Call(const char* method, Args&&... args) const {
+    try {
+      return impl_.attr(method)(std::forward<Args>(args)...);
+    } catch (py::error_already_set& e) {
+      throw std::runtime_error(
+          fmt::format("{} '{}': {}() raised {}", type_, name(), method, OneLine(e)));
+    }
+  }
+
+  std::string type_;
+  py::object impl_;
+  std::vector<Port> ports_;
+  std::string detail_;
+};
+
 /// Adds the object types registered from Python (the module's `_object_types`) to `registry`.
 void RegisterPythonTypes(TypeRegistry& registry) {
   const py::dict types = py::module_::import("gipsi").attr("_object_types");
@@ -319,6 +495,35 @@ void RegisterPythonTypes(TypeRegistry& registry) {
           } catch (py::error_already_set& e) {
             ctx.params.Fail(fmt::format("{}: its fields: {}", type, OneLine(e)));
           } catch (const std::exception& e) {  // InputError, or a field spec of the wrong type
+            ctx.params.Fail(fmt::format("{}: {}", type, e.what()));
+          }
+        },
+        t[1].cast<std::string>());
+  }
+  const py::dict connector_types = py::module_::import("gipsi").attr("_connector_types");
+  for (const auto& [key, entry] : connector_types) {
+    const std::string type = py::str(key).cast<std::string>();
+    const py::tuple t = py::reinterpret_borrow<py::object>(entry).cast<py::tuple>();
+    auto factory = std::make_shared<py::object>(t[0]);
+    registry.connectors.Register(
+        type,
+        [type, factory](const ConnectorBuildContext& ctx) -> std::unique_ptr<Connector> {
+          py::gil_scoped_acquire gil;
+          const py::object params =
+              py::module_::import("json").attr("loads")(ctx.params.raw().dump());
+          py::object impl;
+          try {
+            impl = (*factory)(ctx.name, params);
+          } catch (py::error_already_set& e) {
+            ctx.params.Fail(fmt::format("{}: {}", type, OneLine(e)));
+          }
+          try {
+            return std::make_unique<PythonConnector>(ctx, type, impl);
+          } catch (const InputError&) {
+            throw;  // from ctx: already names the scene, the path and the problem
+          } catch (py::error_already_set& e) {
+            ctx.params.Fail(fmt::format("{}: its ports: {}", type, OneLine(e)));
+          } catch (const std::exception& e) {
             ctx.params.Fail(fmt::format("{}: {}", type, e.what()));
           }
         },
@@ -494,8 +699,34 @@ struct ObjectHandle {
   SimObject* object;
 };
 
+/// A connector of a simulation (keeps the simulation alive).
+struct ConnectorHandle {
+  std::shared_ptr<Simulation> sim;
+  Connector* connector;
+};
+
 const char* AccessName(FieldAccess a) {
   return a == FieldAccess::kRead ? "read" : a == FieldAccess::kWrite ? "write" : "read_write";
+}
+
+py::list PortList(const Connector& c) {
+  py::list out;
+  for (const PortUse& p : c.ports()) {
+    py::dict d;
+    d["key"] = p.key;
+    d["object"] = p.object ? p.object->name() : std::string();
+    d["kind"] = p.kind == PortUse::Kind::kField                ? "field"
+                : p.kind == PortUse::Kind::kBoundaryConditions ? "boundary_conditions"
+                                                               : "capability";
+    d["name"] = p.name;
+    if (p.kind == PortUse::Kind::kField) {
+      d["access"] = AccessName(p.access);
+      d["units"] = p.units;
+      d["components"] = p.components;
+    }
+    out.append(d);
+  }
+  return out;
 }
 
 py::dict FieldDict(const SimObject& o, FieldId id) {
@@ -596,7 +827,7 @@ PYBIND11_MODULE(gipsi, m) {
   using namespace gipsi::python;
   m.doc() = "GiPSi: an open-architecture framework for organ-level and surgical simulation";
   m.attr("__version__") = GIPSI_VERSION_STRING;
-  m.attr("plugin_interface") = GIPSI_PLUGIN_ABI_VERSION;
+  m.attr("plugin_interface") = GIPSI_PLUGIN_INTERFACE;
 
   static py::exception<InputError> input_error(m, "InputError", PyExc_ValueError);
   input_error.doc() =
@@ -655,11 +886,39 @@ PYBIND11_MODULE(gipsi, m) {
             return View(t.data(), t.cols(), 4, self);
           },
           "Domain tetrahedra, (tets, 4) node indices, a read-only view.")
+      .def_property_readonly(
+          "impl",
+          [](const ObjectHandle& h) -> py::object {
+            if (auto* p = dynamic_cast<PythonObject*>(h.object)) return p->impl();
+            return py::none();
+          },
+          "For an object type written in Python, the instance its factory returned; else None.")
       .def("field", &ReadField, py::arg("name"),
            "The field as a new (count, components) array, in its declared units.")
       .def("set_field", &WriteField, py::arg("name"), py::arg("values"),
            "Writes a writable field (shape (count, components); (components,) for a global "
            "field); checked like a connector's port: access, shape and finite values.");
+
+  py::class_<ConnectorHandle>(m, "Connector",
+                              "A connector of a simulation (a view; keeps it alive).")
+      .def_property_readonly("name", [](const ConnectorHandle& h) { return h.connector->name(); })
+      .def_property_readonly(
+          "type", [](const ConnectorHandle& h) { return std::string(h.connector->type_name()); })
+      .def_property_readonly(
+          "fire_count", [](const ConnectorHandle& h) { return h.connector->fire_count(); },
+          "How often it has fired (restored by checkpoints).")
+      .def_property_readonly(
+          "ports", [](const ConnectorHandle& h) { return PortList(*h.connector); },
+          "What it declared it uses: a list of dicts (key, object, kind, name, and for fields "
+          "access, units, components), as `gipsi validate` lists them.")
+      .def_property_readonly(
+          "impl",
+          [](const ConnectorHandle& h) -> py::object {
+            if (auto* p = dynamic_cast<PythonConnector*>(h.connector)) return p->impl();
+            return py::none();
+          },
+          "For a connector type written in Python, the instance its factory returned (its "
+          "attributes are as fire() left them); else None.");
 
   py::class_<Simulation, std::shared_ptr<Simulation>>(m, "Simulation",
                                                       "A loaded scene, ready to run.")
@@ -690,6 +949,29 @@ PYBIND11_MODULE(gipsi, m) {
             return ObjectHandle{s, &s->kernel().FindObject(name)};
           },
           py::arg("name"), "The object called `name` (as in scenes and probes).")
+      .def_property_readonly(
+          "connectors",
+          [](std::shared_ptr<Simulation> s) {
+            py::dict d;
+            Coordinator& c = s->kernel().coordinator();
+            for (std::size_t i = 0; i < c.num_connectors(); ++i)
+              d[py::str(c.connector(i).name())] = ConnectorHandle{s, &c.connector(i)};
+            return d;
+          },
+          "The scene's connectors by name (an aggregate's own are inside it).")
+      .def(
+          "connector",
+          [](std::shared_ptr<Simulation> s, const std::string& name) {
+            Coordinator& c = s->kernel().coordinator();
+            std::string known;
+            for (std::size_t i = 0; i < c.num_connectors(); ++i) {
+              if (c.connector(i).name() == name) return ConnectorHandle{s, &c.connector(i)};
+              known += (known.empty() ? "" : ", ") + c.connector(i).name();
+            }
+            throw py::key_error(fmt::format("the scene has no connector '{}'; its connectors: {}",
+                                            name, known.empty() ? "none" : known));
+          },
+          py::arg("name"), "The scene's connector called `name`.")
       .def(
           "step",
           [](Simulation& s) {
@@ -772,6 +1054,139 @@ PYBIND11_MODULE(gipsi, m) {
       "factory(name, params) returns an object with `fields` and step/read/write (see "
       "docs/python.md). Registering a name again replaces it; a built-in name is refused when a "
       "scene is loaded.");
+  m.attr("_connector_types") = py::dict();
+  m.def(
+      "register_connector",
+      [](const std::string& type, const py::object& factory, const std::string& description) {
+        if (!PyCallable_Check(factory.ptr()))
+          throw py::type_error("register_connector: the factory must be callable (name, params)");
+        TypeRegistry builtins;
+        RegisterBuiltins(builtins);
+        if (builtins.connectors.Contains(type))
+          throw py::value_error(
+              fmt::format("register_connector: '{}' is a built-in connector type", type));
+        py::dict types = py::module_::import("gipsi").attr("_connector_types");
+        types[py::str(type)] = py::make_tuple(factory, "(Python) " + description);
+      },
+      py::arg("type"), py::arg("factory"), py::arg("description") = "",
+      "Registers a connector type written in Python for the simulations loaded after it: "
+      "factory(name, params) returns an object with `ports`, `parameters` and fire(t, values) "
+      "(e.g. a gipsi.ConnectorBase subclass; see docs/python.md). Registering a name again "
+      "replaces it.");
+  // Base classes that document the protocols (any object with these attributes will do).
+  py::exec(R"py(
+class ConnectorBase:
+    """Base of connectors written in Python (gipsi.register_connector(type, cls)).
+
+    Built as cls(name, params) from the scene's connector entry (params: its JSON as a dict).
+    ports: {key: {"access": "read" | "write" | "read_write", "units": "Pa", "components": 1}};
+        each key is a parameter naming "object.field"; units and components ('' and 0: any)
+        are checked against the field before the first step, like a built-in's ports.
+    parameters: the other keys it accepts (any other key is refused with its JSON path).
+    fire(t, values): called at the connector's place in the order; values holds a
+        (count, components) array per readable port; returns {key: array} for the ports it
+        writes (or None). An exception stops the run with it quoted.
+    get_state() -> bytes, set_state(bytes): what outlives a fire, for checkpoints and retries
+        (without them, a scene with this connector cannot be checkpointed).
+    """
+    ports = {}
+    parameters = ()
+
+    def __init__(self, name, params):
+        self.name = name
+        self.params = params
+
+    def fire(self, t, values):
+        raise NotImplementedError("a gipsi.ConnectorBase must implement fire(t, values)")
+
+
+class ObjectBase:
+    """Base of object types written in Python (gipsi.register_object(type, cls)).
+
+    Built as cls(name, params). fields: {name: {"units", "access", "components",
+    "description"}} (global fields); step(t, dt) advances (returning False or raising fails
+    the step); read(name) -> values; write(name, values); get_state()/set_state(bytes) for
+    checkpoints and retries.
+    """
+    fields = {}
+
+    def __init__(self, name, params):
+        self.name = name
+        self.params = params
+
+    def step(self, t, dt):
+        raise NotImplementedError("a gipsi.ObjectBase must implement step(t, dt)")
+
+    def read(self, name):
+        raise NotImplementedError("a gipsi.ObjectBase must implement read(name)")
+
+    def write(self, name, values):
+        raise NotImplementedError("a gipsi.ObjectBase must implement write(name, values)")
+)py",
+           m.attr("__dict__"));
+  m.def(
+      "pace_cell",
+      [](const py::dict& cell, double bcl, std::int64_t beats, double dt,
+         std::optional<double> stimulus_amplitude, std::optional<double> stimulus_duration,
+         std::int64_t record_every, double apd_percent,
+         std::optional<py::array_t<double, py::array::c_style | py::array::forcecast>> initial,
+         const std::vector<std::string>& plugins) {
+        TypeRegistry registry;
+        RegisterBuiltins(registry);
+        for (const auto& plugin : plugins) registry.LoadPlugin(ResolvePlugin(plugin, "."));
+        const JsonDocument doc = JsonDocument::Parse(ToJsonText(cell), "pace_cell");
+        const auto model =
+            CreateCellModel(registry, JsonNode(doc.root().raw(), "pace_cell", "cell"));
+        PacingProtocol protocol;
+        protocol.bcl = bcl;
+        protocol.beats = beats;
+        protocol.dt = dt;
+        protocol.stim_amplitude = stimulus_amplitude.value_or(model->default_stimulus().amplitude);
+        protocol.stim_duration = stimulus_duration.value_or(model->default_stimulus().duration);
+        protocol.record_every = record_every;
+        protocol.apd_percent = apd_percent;
+        std::vector<double> start;
+        if (initial) start.assign(initial->data(), initial->data() + initial->size());
+        SingleCellResult r;
+        {
+          py::gil_scoped_release release;  // pure C++: sweeps in threads run in parallel
+          r = PaceSingleCell(*model, protocol, start);
+        }
+        auto array = [](const std::vector<double>& v) {
+          return py::array_t<double>(static_cast<py::ssize_t>(v.size()), v.data());
+        };
+        auto column = [&](double BeatMetrics::*member) {
+          std::vector<double> v;
+          for (const BeatMetrics& b : r.beats) v.push_back(b.*member);
+          return array(v);
+        };
+        py::dict beats_out;
+        beats_out["start"] = column(&BeatMetrics::start);
+        beats_out["rest"] = column(&BeatMetrics::rest);
+        beats_out["peak"] = column(&BeatMetrics::peak);
+        beats_out["dvdt_max"] = column(&BeatMetrics::dvdt_max);
+        beats_out["activation"] = column(&BeatMetrics::activation);
+        beats_out["apd"] = column(&BeatMetrics::apd);
+        py::dict out;
+        out["model"] = std::string(model->type_name());
+        out["variant"] = std::string(model->variant());
+        out["time"] = array(r.time);
+        out["voltage"] = array(r.voltage);
+        out["beats"] = beats_out;
+        out["final_state"] = array(r.final_state);
+        return out;
+      },
+      py::arg("cell"), py::kw_only(), py::arg("bcl") = 1000.0, py::arg("beats") = 1,
+      py::arg("dt") = 0.01, py::arg("stimulus_amplitude") = py::none(),
+      py::arg("stimulus_duration") = py::none(), py::arg("record_every") = 10,
+      py::arg("apd_percent") = 90.0, py::arg("initial") = py::none(),
+      py::arg("plugins") = std::vector<std::string>{},
+      "Paces one cell, as `gipsi cell`: cell = {'model': NAME, 'variant': ..., parameter: "
+      "value} (the scene's cell model JSON). Times in ms, V in mV, stimulus in uA/uF (default: "
+      "the model's). Returns {'model', 'variant', 'time', 'voltage' (every record_every-th "
+      "step), 'beats': {'start', 'rest', 'peak', 'dvdt_max', 'activation', 'apd'} (one value "
+      "per beat, APD at apd_percent % repolarisation; NaN where undefined), 'final_state'}. "
+      "Releases the GIL while it runs.");
   m.def(
       "write_mesh",
       [](const std::filesystem::path& file, const py::dict& mesh) {

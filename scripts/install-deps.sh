@@ -26,6 +26,7 @@ packages=(
   libopenigtlink-dev     # OpenIGTLink 1.11: the networked haptic device (tracker, 3D Slicer)
   libfcl-dev             # FCL 0.7: the collision benchmark's baseline (bench/collision_bench.cc)
   pybind11-dev python3-dev python3-numpy  # the gipsi Python module (python/)
+  python3-pytest python3-matplotlib  # its tests, and the plots of examples/python/
   clang-format clang-tidy
 )
 

@@ -39,7 +39,7 @@ def sheet_scene(gravity=(0.0, 0.0, -G), end=0.2, integrator="RK4"):
 class Module(unittest.TestCase):
     def test_names_its_version_and_plugin_interface(self):
         self.assertRegex(gipsi.__version__, r"^\d+\.\d+\.\d+$")
-        self.assertGreaterEqual(gipsi.plugin_interface, 10)
+        self.assertGreaterEqual(gipsi.plugin_interface, 11)
 
 
 class Running(unittest.TestCase):
@@ -480,6 +480,189 @@ class PythonObjects(unittest.TestCase):
             gipsi.Simulation.from_dict(scene)
         with self.assertRaisesRegex(ValueError, "'MassSpring' is a built-in object type"):
             gipsi.register_object("MassSpring", Decay)
+
+
+MMHG = 133.322387415  # Pa
+ML = 1e-6  # m^3
+
+
+def windkessel_scene(**extra):
+    """A Windkessel: 100 mL/s into arteries (C 1.5 mL/mmHg, from 80 mmHg) draining through R_p
+    (1 mmHg s/mL) into a 5 mmHg venous reservoir. P(t) = P_v + R Q + (P_0 - P_v - R Q) e^(-t/RC)
+    while R is held."""
+    scene = {
+        "gipsi": 1, "units": "SI",
+        "objects": {"wk": {
+            "type": "Circulation", "dt": "1 ms", "log_events": False,
+            "tolerance": {"relative": 1e-10, "absolute": "1e-9 mL"},
+            "compartments": {
+                "arteries": {"type": "compliance", "compliance": "1.5 mL/mmHg",
+                             "pressure": "80 mmHg"},
+                "veins": {"type": "reservoir", "pressure": "5 mmHg"}},
+            "connections": {
+                "inflow": {"type": "source", "to": "arteries", "flow": "100 mL/s"},
+                "peripheral": {"type": "resistor", "from": "arteries", "to": "veins",
+                               "resistance": "1 mmHg*s/mL"}}}},
+        "schedule": {"end": 3.0, "dt": 0.01},
+        "probes": {"p": {"object": "wk", "fields": ["arteries_pressure"], "every": 0.01}},
+    }
+    scene.update(extra)
+    return scene
+
+
+class Constrictor(gipsi.ConnectorBase):
+    """Holds the resistance it writes at `factor` times the one it reads."""
+    ports = {"resistance": {"access": "read_write", "units": "Pa*s/m3"}}
+    parameters = ("factor",)
+
+    def __init__(self, name, params):
+        super().__init__(name, params)
+        self.r0 = None
+
+    def fire(self, t, values):
+        if self.r0 is None:
+            self.r0 = values["resistance"][0, 0]
+        return {"resistance": [self.r0 * self.params["factor"]]}
+
+    def get_state(self):
+        return np.array([np.nan if self.r0 is None else self.r0]).tobytes()
+
+    def set_state(self, state):
+        r0 = np.frombuffer(state)[0]
+        self.r0 = None if np.isnan(r0) else r0
+
+
+class PressureControl(gipsi.ConnectorBase):
+    """Integral control of a pressure through a resistance: every fire,
+    R <- R (target / p)^gain. At a steady state p = target."""
+    ports = {"pressure": {"access": "read", "units": "Pa", "components": 1},
+             "resistance": {"access": "read_write", "units": "Pa*s/m3"}}
+    parameters = ("target", "gain")
+
+    def fire(self, t, values):
+        p, r = values["pressure"][0, 0], values["resistance"][0, 0]
+        return {"resistance": np.array([r * (self.params["target"] / p) ** self.params["gain"]])}
+
+
+def controlled_windkessel(connector):
+    return windkessel_scene(connectors={"ctl": connector})
+
+
+class PythonConnectors(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        gipsi.register_connector("Constrictor", Constrictor, "R <- factor R0")
+        gipsi.register_connector("PressureControl", PressureControl, "integral control")
+
+    def test_a_python_connector_changes_the_result_as_the_closed_form_predicts(self):
+        sim = gipsi.Simulation.from_dict(controlled_windkessel(
+            {"type": "Constrictor", "resistance": "wk.peripheral_resistance", "factor": 2.0}))
+        r0 = sim.object("wk").field("peripheral_resistance")[0, 0]
+        self.assertAlmostEqual(r0, MMHG / ML, delta=1e-9 * r0)
+        self.assertEqual(sim.run()["outcome"], "completed")
+        self.assertEqual(sim.object("wk").field("peripheral_resistance")[0, 0], 2 * r0)
+        # The connector fires before the circulation steps, so R = 2 R0 from t = 0. The
+        # integrator's tolerance (1e-10) bounds the error far below 1e-6 of the pressure.
+        t, p = sim.probes["p"]["time"], sim.probes["p"]["arteries_pressure"]
+        q, c, pv, p0, r = 100 * ML, 1.5 * ML / MMHG, 5 * MMHG, 80 * MMHG, 2 * r0
+        exact = pv + r * q + (p0 - pv - r * q) * np.exp(-t / (r * c))
+        np.testing.assert_allclose(p, exact, rtol=1e-6)
+
+    def test_a_python_feedback_holds_the_pressure_at_its_target(self):
+        target = 110 * MMHG
+        scene = controlled_windkessel({"type": "PressureControl", "target": target, "gain": 0.05,
+                                       "pressure": "wk.arteries_pressure",
+                                       "resistance": "wk.peripheral_resistance"})
+        scene["schedule"]["end"] = 40.0
+        sim = gipsi.Simulation.from_dict(scene)
+        self.assertEqual(sim.run()["outcome"], "completed")
+        # The only steady state: p = target with R Q = target - P_v.
+        wk = sim.object("wk")
+        self.assertAlmostEqual(wk.field("arteries_pressure")[0, 0], target, delta=1e-3 * target)
+        r_star = (target - 5 * MMHG) / (100 * ML)
+        self.assertAlmostEqual(wk.field("peripheral_resistance")[0, 0], r_star,
+                               delta=1e-3 * r_star)
+
+    def test_a_python_connector_resumes_bitwise_from_its_state(self):
+        sim = gipsi.Simulation.from_dict(controlled_windkessel(
+            {"type": "Constrictor", "resistance": "wk.peripheral_resistance", "factor": 1.5}))
+        sim.run(until=0.5)
+        state = sim.save()
+        sim.run(until=1.0)
+        p = sim.object("wk").field("arteries_pressure")
+        fresh = gipsi.Simulation.from_dict(controlled_windkessel(
+            {"type": "Constrictor", "resistance": "wk.peripheral_resistance", "factor": 1.5}))
+        fresh.restore(state)
+        fresh.run(until=1.0)
+        np.testing.assert_array_equal(fresh.object("wk").field("arteries_pressure"), p)
+
+    def test_ports_are_checked_when_the_scene_loads(self):
+        def refused(connector):
+            with self.assertRaises(gipsi.InputError) as raised:
+                gipsi.Simulation.from_dict(controlled_windkessel(connector))
+            return raised.exception
+
+        good = {"type": "PressureControl", "target": 1e4, "gain": 0.1,
+                "pressure": "wk.arteries_pressure", "resistance": "wk.peripheral_resistance"}
+        e = refused(dict(good, pressure="wk.arteries_volume"))  # m3, not Pa
+        self.assertEqual(e.path, "connectors.ctl")
+        self.assertIn("reads field 'arteries_volume' of 'wk' (Circulation) at its 'pressure' key",
+                      e.what)
+        e = refused(dict(good, resistance="wk.arteries_pressure"))  # read-only, and Pa
+        self.assertIn("arteries_pressure", e.what)
+        e = refused(dict(good, resistance="wk.peripheral_resistanse"))
+        self.assertEqual(e.path, "connectors.ctl.resistance")
+        self.assertIn("peripheral_resistance", e.what)  # the closest name is suggested
+        e = refused({k: v for k, v in good.items() if k != "pressure"})
+        self.assertIn("PressureControl needs \"pressure\": \"object.field\"", e.what)
+        e = refused(dict(good, gian=0.1))
+        self.assertEqual(e.path, "connectors.ctl.gian")
+        self.assertIn("PressureControl has no parameter 'gian'", e.what)
+        with self.assertRaisesRegex(ValueError, "'FieldCopy' is a built-in connector type"):
+            gipsi.register_connector("FieldCopy", Constrictor)
+
+    def test_a_failing_fire_stops_the_run_with_its_reason_and_writes_nothing(self):
+        class Wrong(gipsi.ConnectorBase):
+            ports = {"resistance": {"access": "read_write"},
+                     "pressure": {"access": "read"}}
+
+            def fire(self, t, values):
+                if t >= 0.1 - 1e-9:
+                    return {"resistance": [1e8], "pressure": [1.0]}
+                return None
+
+        gipsi.register_connector("Wrong", Wrong)
+        sim = gipsi.Simulation.from_dict(controlled_windkessel(
+            {"type": "Wrong", "pressure": "wk.arteries_pressure",
+             "resistance": "wk.peripheral_resistance"}))
+        r0 = sim.object("wk").field("peripheral_resistance")[0, 0]
+        result = sim.run()
+        self.assertEqual(result["outcome"], "diverged")
+        self.assertIn("connector 'ctl' (fire() returned 'pressure', which is not a port it "
+                      "writes) failed at t = 0.1 s", result["diagnostic"])
+        self.assertEqual(sim.object("wk").field("peripheral_resistance")[0, 0], r0)
+        self.assertAlmostEqual(sim.time, 0.1, delta=1e-12)
+        self.assertEqual(len(sim.probes["p"]["time"]), 11)  # t = 0 .. 0.1 kept
+
+        class Raising(Wrong):
+            def fire(self, t, values):
+                return {"resistance": [float(values["pressure"][0, 0]) / 0.0]}
+
+        gipsi.register_connector("Raising", Raising)
+        scene = controlled_windkessel({"type": "Raising", "pressure": "wk.arteries_pressure",
+                                       "resistance": "wk.peripheral_resistance"})
+        result = gipsi.Simulation.from_dict(scene).run()
+        self.assertIn("fire() raised ZeroDivisionError", result["diagnostic"])
+
+        class NotFinite(Wrong):
+            def fire(self, t, values):
+                return {"resistance": np.array([np.nan])}
+
+        gipsi.register_connector("NotFinite", NotFinite)
+        scene["connectors"]["ctl"]["type"] = "NotFinite"
+        result = gipsi.Simulation.from_dict(scene).run()
+        self.assertIn("fire() returned a non-finite value for 'resistance' at 0: nan",
+                      result["diagnostic"])
 
 
 class DocsSnippets(unittest.TestCase):
