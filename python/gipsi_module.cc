@@ -11,6 +11,7 @@
 #include <pybind11/stl.h>
 #include <pybind11/stl/filesystem.h>
 
+#include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <map>
@@ -580,12 +581,26 @@ class Simulation {
 
   py::dict Run(std::optional<double> until, const py::object& callback) {
     CheckIdle("run");
+    if (const std::string& broken = kernel().broken(); !broken.empty())
+      throw std::runtime_error(fmt::format(
+          "the simulation cannot go on from t = {:.6g} s: {}; restore() a state saved before "
+          "(or restore_file() a checkpoint) to continue",
+          kernel().time(), broken));
     const double end = until.value_or(scene_.end_time);
     if (!std::isfinite(end))
       throw py::value_error(fmt::format("until must be finite, got {}", end));
     std::optional<py::error_already_set> error;
     Kernel& k = kernel();
+    // Without a callback the GIL is taken back only every 0.1 s of wall time (to see Ctrl+C),
+    // so another Python thread that holds it does not delay every macro step.
+    using Clock = std::chrono::steady_clock;
+    auto last_check = Clock::now();
     ProgressFn progress = [&](double t, double) {
+      if (callback.is_none()) {
+        const auto now = Clock::now();
+        if (now - last_check < std::chrono::milliseconds(100)) return;
+        last_check = now;
+      }
       py::gil_scoped_acquire gil;
       if (error) return;
       try {
@@ -738,6 +753,7 @@ py::dict FieldDict(const SimObject& o, FieldId id) {
   d["units"] = f.units;
   d["access"] = AccessName(f.access);
   d["description"] = f.description;
+  d["view"] = o.FieldMemory(id) != nullptr;
   return d;
 }
 
@@ -782,9 +798,10 @@ void WriteField(ObjectHandle& h, const std::string& name,
       values.ndim() == 2 && values.shape(0) == count && values.shape(1) == f.components;
   if (!global_vector && !full) {
     std::vector<py::ssize_t> shape(values.shape(), values.shape() + values.ndim());
-    throw py::value_error(
-        fmt::format("field '{}' of '{}' takes an array of shape ({}, {}), got ({})", name, o.name(),
-                    count, f.components, fmt::join(shape, ", ")));
+    throw py::value_error(fmt::format(
+        "field '{}' of '{}' takes an array of shape ({}, {}) in [{}], got ({}); nothing was "
+        "written",
+        name, o.name(), count, f.components, f.units, fmt::join(shape, ", ")));
   }
   for (py::ssize_t i = 0; i < values.size(); ++i)
     if (!std::isfinite(values.data()[i]))
@@ -893,6 +910,30 @@ PYBIND11_MODULE(gipsi, m) {
             return py::none();
           },
           "For an object type written in Python, the instance its factory returned; else None.")
+      .def(
+          "view",
+          [](py::object self, const std::string& name) {
+            const auto& h = self.cast<const ObjectHandle&>();
+            const SimObject& o = *h.object;
+            const FieldId id = FindFieldOrRaise(o, name);
+            const double* memory = o.FieldMemory(id);
+            if (memory == nullptr)
+              throw py::value_error(
+                  fmt::format("field '{}' of '{}' is computed on request, not stored: read it with "
+                              "field('{}') (a copy); fields with views: {}",
+                              name, o.name(), name, [&] {
+                                std::string with;
+                                for (const FieldInfo& f : o.fields())
+                                  if (o.FieldMemory(o.FindField(f.name)) != nullptr)
+                                    with += (with.empty() ? "" : ", ") + f.name;
+                                return with.empty() ? std::string("none") : with;
+                              }()));
+            return View(memory, o.FieldCount(id), o.field_info(id).components, self);
+          },
+          py::arg("name"),
+          "A stored field as a read-only (count, components) view of the object's memory, no "
+          "copy: it follows the simulation as it runs (fields()[name]['view'] says which "
+          "fields are stored). Write with set_field.")
       .def("field", &ReadField, py::arg("name"),
            "The field as a new (count, components) array, in its declared units.")
       .def("set_field", &WriteField, py::arg("name"), py::arg("values"),

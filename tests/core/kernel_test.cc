@@ -156,6 +156,111 @@ TEST(Kernel, ARetryPolicyOverAnObjectWithoutCheckpointsSaysSo) {
   EXPECT_THAT(result.diagnostic, HasSubstr("does not support checkpoints"));
 }
 
+struct TickState {
+  std::int64_t ticks = 0;
+  template <class Self, class Visitor>
+  static void Fields(Self& s, Visitor& v) {
+    v("ticks", s.ticks);
+  }
+};
+
+/// Counts its steps in a checkpointable state; fails its `fail_at`-th step once, after
+/// counting it (a failure that leaves the object changed, as a diverged Newton solve does).
+class Ticker final : public SimObject {
+ public:
+  explicit Ticker(std::string name, std::int64_t fail_at = -1)
+      : SimObject(std::move(name)), fail_at_(fail_at) {
+    BindState(state_);
+  }
+  std::string_view type_name() const override { return "Ticker"; }
+  const Points& domain_positions() const override { return positions_; }
+  std::int64_t ticks() const { return state_.ticks; }
+
+ protected:
+  StepStatus DoStep(double, double) override {
+    if (++state_.ticks == fail_at_ && !failed_) {
+      failed_ = true;
+      return StepStatus::Failed("test failure");
+    }
+    return StepStatus::Ok();
+  }
+  void DoReadField(FieldId, Eigen::Ref<Eigen::MatrixXd>) const override {}
+  void DoWriteField(FieldId, const Eigen::Ref<const Eigen::MatrixXd>&) override {}
+
+ private:
+  TickState state_;
+  std::int64_t fail_at_;
+  bool failed_ = false;
+  Points positions_ = Points(3, 0);
+};
+
+TEST(Kernel, AfterAStepFailedPartWayItRefusesToGoOnUntilACheckpointIsRestored) {
+  Kernel kernel;
+  auto& a =
+      static_cast<Ticker&>(kernel.coordinator().AddObject(std::make_unique<Ticker>("a"), 1e-3));
+  auto& b =
+      static_cast<Ticker&>(kernel.coordinator().AddObject(std::make_unique<Ticker>("b", 3), 1e-3));
+  kernel.Initialize();
+  StateWriter start;
+  kernel.SaveState(start);
+  RunResult result = kernel.Run(0.01);
+  ASSERT_EQ(result.outcome, RunResult::Outcome::kDiverged);
+  // In the macro step at t = 2 ms, a stepped (3 ticks) and b failed its 3rd: the objects
+  // disagree, so stepping on would step a twice.
+  EXPECT_EQ(a.ticks(), 3);
+  EXPECT_EQ(kernel.broken(), "object 'b' failed inside the macro step at t = 0.002 s");
+  result = kernel.Run(0.01);
+  EXPECT_EQ(result.outcome, RunResult::Outcome::kStopped);
+  EXPECT_EQ(result.diagnostic,
+            "the simulation cannot go on from t = 0.002 s: object 'b' failed inside the macro "
+            "step at t = 0.002 s; restore a checkpoint to continue");
+  EXPECT_EQ(a.ticks(), 3);  // nothing stepped
+  StateReader in(start.bytes(), "start");
+  kernel.RestoreState(in);
+  EXPECT_EQ(kernel.broken(), "");
+  result = kernel.Run(0.01);
+  EXPECT_EQ(result.outcome, RunResult::Outcome::kCompleted) << result.diagnostic;
+  EXPECT_EQ(a.ticks(), 10);
+  EXPECT_EQ(b.ticks(), 10);
+}
+
+TEST(Kernel, WithTheRetryPolicyAFailedStepIsRolledBackAndTheRunMayGoOn) {
+  Kernel kernel;
+  auto& a =
+      static_cast<Ticker&>(kernel.coordinator().AddObject(std::make_unique<Ticker>("a"), 1e-3));
+  kernel.coordinator().AddObject(std::make_unique<Ticker>("b", 3), 1e-3);
+  kernel.SetFailurePolicy(FailurePolicy{.max_halvings = 1});
+  kernel.Initialize();
+  // b fails once; the halved retry succeeds, so the run completes.
+  EXPECT_EQ(kernel.Run(0.01).outcome, RunResult::Outcome::kCompleted);
+  EXPECT_EQ(kernel.broken(), "");
+  EXPECT_EQ(kernel.retried_steps(), 1);
+  EXPECT_EQ(a.ticks(), 11);  // 2 + 2 halves + 7
+}
+
+TEST(Kernel, ACheckpointRefusedBeforeTheObjectsLeavesTheSimulationAsItWas) {
+  Kernel other;
+  other.coordinator().AddObject(std::make_unique<Ticker>("a"), 1e-3);
+  other.ScheduleEvent({0.5, "an event this scene lacks", [](Kernel&) {}});
+  other.Initialize();
+  other.Run(0.004);
+  StateWriter saved;
+  other.SaveState(saved);
+
+  Kernel kernel;
+  auto& a =
+      static_cast<Ticker&>(kernel.coordinator().AddObject(std::make_unique<Ticker>("a"), 1e-3));
+  kernel.Initialize();
+  kernel.Run(0.002);
+  StateReader in(saved.bytes(), "other");
+  EXPECT_THROW(kernel.RestoreState(in), InputError);
+  EXPECT_EQ(kernel.time(), 0.002);
+  EXPECT_EQ(a.ticks(), 2);
+  EXPECT_EQ(kernel.broken(), "");
+  EXPECT_EQ(kernel.Run(0.005).outcome, RunResult::Outcome::kCompleted);
+  EXPECT_EQ(a.ticks(), 5);
+}
+
 TEST(Kernel, ConnectorFiresEveryNMacroSteps) {
   Kernel kernel;
   auto& a = kernel.coordinator().AddObject(std::make_unique<CountingObject>("a"), 1e-3);

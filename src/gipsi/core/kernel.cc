@@ -113,6 +113,16 @@ RunResult Kernel::Run(double end_time, const ProgressFn& progress) {
   const auto last_step =
       static_cast<std::int64_t>(std::ceil((end_time - start_time_) / macro_dt_ - 1e-9));
 
+  if (!broken_.empty()) {
+    result.outcome = RunResult::Outcome::kStopped;
+    result.diagnostic = fmt::format(
+        "the simulation cannot go on from t = {:.6g} s: {}; restore a checkpoint to continue",
+        time(), broken_);
+    result.end_time = time();
+    return result;
+  }
+  // The failure policy's roll-back (when active) leaves every object at the macro step's start.
+  const bool rolls_back = policy_.max_halvings > 0;
   auto finish = [&](RunResult::Outcome outcome, std::string diagnostic) {
     for (auto& observer : observers_) {
       try {
@@ -147,6 +157,7 @@ RunResult Kernel::Run(double end_time, const ProgressFn& progress) {
     try {
       FireDueEvents(t);
     } catch (const std::exception& e) {
+      // Every object is still at t (what the event changed before failing is the event's).
       return finish(RunResult::Outcome::kStopped,
                     fmt::format("event at t = {:.6g} s failed: {}", t, e.what()));
     }
@@ -157,10 +168,16 @@ RunResult Kernel::Run(double end_time, const ProgressFn& progress) {
     } catch (const std::exception& e) {
       // A state that cannot be saved for roll-back (StepWithPolicy says so), or a step or
       // connector that broke its never-throw contract (a plugin's, a Python object's field).
+      broken_ = fmt::format("the macro step at t = {:.6g} s was left part-way by an exception", t);
       return finish(
           RunResult::Outcome::kStopped,
           fmt::format("the macro step at t = {:.6g} s could not be done: {}", t, e.what()));
     }
+    if (failure && !rolls_back)
+      broken_ =
+          fmt::format("{} '{}' {} inside the macro step at t = {:.6g} s",
+                      failure->is_connector ? "connector" : "object", failure->who,
+                      failure->status.code == StepStatus::Code::kStopped ? "stopped" : "failed", t);
     if (failure && failure->status.code == StepStatus::Code::kStopped) {
       // A stop request reached inside a step (StopToken): the object abandoned it. Objects
       // before it in the order may have advanced, so no checkpoint is written at this stop

@@ -126,6 +126,12 @@ class Kernel {
   /// Runs until `end_time` (rounded to a whole number of macro steps). Never throws for a
   /// numerical failure: the outcome and diagnostic say what happened.
   RunResult Run(double end_time, const ProgressFn& progress = {});
+  /// Why the simulation cannot go on from its state, or empty. A run that ends inside a macro
+  /// step without the failure policy's roll-back (an object or connector failed, a step was
+  /// abandoned at a stop request, an exception inside the step) leaves some objects advanced
+  /// and others not; so does a checkpoint restored only in part. Run then refuses to step
+  /// (outcome stopped, saying so) until a checkpoint is restored.
+  [[nodiscard]] const std::string& broken() const { return broken_; }
   /// Asks `Run` to stop after its current macro step, also when asked before it (thread- and
   /// signal-safe). Objects that poll their stop token (SimObject::stop_token; FemSolid between
   /// load steps and Newton iterations) abandon their step instead: the run then ends inside the
@@ -170,6 +176,7 @@ class Kernel {
   double start_time_ = 0;
   std::int64_t macro_index_ = 0;
   bool started_ = false;
+  std::string broken_;  // see broken()
   FailurePolicy policy_;
   std::int64_t retried_ = 0;
   // The whole simulation at the start of the current macro step (retry policy): one snapshot,

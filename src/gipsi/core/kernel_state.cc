@@ -93,33 +93,48 @@ void Kernel::RestoreState(StateReader& in) {
   if (macro_dt != macro_dt_)
     in.Fail(
         fmt::format("the checkpoint's macro step is {} s, this scene's {} s", macro_dt, macro_dt_));
-  start_time_ = in.ReadDouble();
-  macro_index_ = in.ReadInt();
-  started_ = in.ReadBool();
+  // The kernel's own fields are read into locals and set only once everything was read: a
+  // checkpoint refused before the objects leaves the simulation as it was.
+  const double start_time = in.ReadDouble();
+  const std::int64_t macro_index = in.ReadInt();
+  const bool started = in.ReadBool();
   const std::int64_t events = in.ReadInt();
   if (events != static_cast<std::int64_t>(events_.size()))
     in.Fail(fmt::format("the checkpoint has {} scheduled events, this scene {}", events,
                         events_.size()));
-  next_event_ = static_cast<std::size_t>(in.ReadInt());
-  if (next_event_ > events_.size()) in.Fail("corrupted event queue position");
-  fired_.clear();
+  const auto next_event = static_cast<std::size_t>(in.ReadInt());
+  if (next_event > events_.size()) in.Fail("corrupted event queue position");
+  std::vector<std::pair<double, std::string>> fired_events;
   const std::int64_t fired = in.ReadInt();
   if (fired < 0 || fired > events) in.Fail("corrupted list of fired events");
   for (std::int64_t i = 0; i < fired; ++i) {
     const double t = in.ReadDouble();
-    fired_.emplace_back(t, in.ReadString());
+    fired_events.emplace_back(t, in.ReadString());
   }
-  retried_ = in.ReadInt();
-  RestoreSimulation(coordinator_, in);
-  const std::int64_t observers = in.ReadInt();
-  if (observers != static_cast<std::int64_t>(observers_.size()))
-    in.Fail(
-        fmt::format("the checkpoint has {} outputs, this run {} (were the same outputs "
-                    "enabled?)",
-                    observers, observers_.size()));
-  for (auto& observer : observers_) observer->RestoreState(in);
-  in.EndSection();
-  if (!in.at_end()) in.Fail("unexpected data after the kernel state");
+  const std::int64_t retried = in.ReadInt();
+  try {
+    RestoreSimulation(coordinator_, in);
+    const std::int64_t observers = in.ReadInt();
+    if (observers != static_cast<std::int64_t>(observers_.size()))
+      in.Fail(
+          fmt::format("the checkpoint has {} outputs, this run {} (were the same outputs "
+                      "enabled?)",
+                      observers, observers_.size()));
+    for (auto& observer : observers_) observer->RestoreState(in);
+    in.EndSection();
+    if (!in.at_end()) in.Fail("unexpected data after the kernel state");
+  } catch (const std::exception& e) {
+    // Some objects may hold the checkpoint's state and others not.
+    broken_ = fmt::format("a checkpoint was restored only in part ({})", e.what());
+    throw;
+  }
+  start_time_ = start_time;
+  macro_index_ = macro_index;
+  started_ = started;
+  next_event_ = next_event;
+  fired_ = std::move(fired_events);
+  retried_ = retried;
+  broken_.clear();
   for (auto& observer : observers_) observer->CommitRestore();
 }
 

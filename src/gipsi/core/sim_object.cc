@@ -166,6 +166,10 @@ void SimObject::ReadField(FieldId id, Eigen::Ref<Eigen::MatrixXd> out) const {
   DoReadField(id, out);
 }
 
+const double* SimObject::FieldMemory(FieldId id) const {
+  return field_info(id).readable() ? DoFieldMemory(id) : nullptr;
+}
+
 void SimObject::WriteField(FieldId id, const Eigen::Ref<const Eigen::MatrixXd>& in) {
   const FieldInfo& info = field_info(id);
   GIPSI_CHECK(info.writable(), "field '{}' of '{}' is read-only", info.name, name_);

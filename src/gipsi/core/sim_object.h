@@ -106,6 +106,12 @@ class SimObject {
   void ReadField(FieldId id, Eigen::Ref<Eigen::MatrixXd> out) const;
   /// Sets the field from `in` (components by count). Preconditions as ReadField, for writing.
   void WriteField(FieldId id, const Eigen::Ref<const Eigen::MatrixXd>& in);
+  /// Where a readable field's values are stored, if they are rather than computed on request:
+  /// components × count doubles, column-major (ReadField's layout), equal to what ReadField
+  /// gives. The address holds while the object lives (steps, retries and checkpoint restores
+  /// copy into it), so a view of it (the Python module's) follows the simulation without a
+  /// copy. nullptr for a computed field. Read-only: writes go through WriteField.
+  [[nodiscard]] const double* FieldMemory(FieldId id) const;
 
   // --- Simulation ---
   /// Advances by `dt` > 0 from time(). Never throws; reports trouble in the status.
@@ -224,6 +230,8 @@ class SimObject {
   /// Hook of SetStopToken (an aggregate forwards the token to its parts). Default: nothing.
   virtual void DoSetStopToken(StopToken /*token*/) {}
   virtual void DoReadField(FieldId id, Eigen::Ref<Eigen::MatrixXd> out) const = 0;
+  /// Hook of FieldMemory (readable fields only); default nullptr: every field computed.
+  [[nodiscard]] virtual const double* DoFieldMemory(FieldId /*id*/) const { return nullptr; }
   virtual void DoWriteField(FieldId id, const Eigen::Ref<const Eigen::MatrixXd>& in) = 0;
 
  private:

@@ -111,8 +111,10 @@ void ImplicitScheme::Commit(const VecX& d) {
   VecX& v_new = v_hat_;  // reuse buffers: v̂ ← c_v d + v̂, â ← c_a d + â
   v_new += c_v_ * d;
   a_hat_ += c_a_ * d;
-  v_.swap(v_new);
-  a_.swap(a_hat_);
+  // Copied, not swapped: v and a stay at their addresses (the state's velocity is viewed
+  // without a copy from Python); two vector copies are negligible against a step.
+  v_ = v_new;
+  a_ = a_hat_;
   x_ += d;
   dx_prev_ = d;
   dt_prev_ = dt_;

@@ -307,6 +307,15 @@ std::vector<SimObject::ProfileEntry> EpTissue::ProfileBreakdown() const {
           {"diffusion solver iterations", static_cast<double>(profile_.cg_iterations), ""}};
 }
 
+const double* EpTissue::DoFieldMemory(FieldId id) const {
+  for (std::size_t k = 0; k < state_fields_.size(); ++k)
+    if (id == state_fields_[k]) return state_.cells.var(static_cast<int>(k));
+  if (id == f_activation_) return state_.activation_time.data();
+  if (id == f_last_activation_) return state_.last_activation.data();
+  if (id == f_apd_) return state_.apd.data();
+  return nullptr;
+}
+
 void EpTissue::DoReadField(FieldId id, Eigen::Ref<Eigen::MatrixXd> out) const {
   for (std::size_t k = 0; k < state_fields_.size(); ++k) {
     if (id != state_fields_[k]) continue;

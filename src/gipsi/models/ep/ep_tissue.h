@@ -170,6 +170,7 @@ class EpTissue : public SimObject {
   void RestoreStateCache(StateReader& /*in*/) override { system_dt_ = -1; }
   void StateRestored() override;
   void DoReadField(FieldId id, Eigen::Ref<Eigen::MatrixXd> out) const override;
+  [[nodiscard]] const double* DoFieldMemory(FieldId id) const override;
   void DoWriteField(FieldId id, const Eigen::Ref<const Eigen::MatrixXd>& in) override;
 
   EpTissueParams params_;

@@ -667,6 +667,13 @@ Mat3 FemSolid::CauchyStress(Index e) const {
   return P * F.transpose() / j;
 }
 
+const double* FemSolid::DoFieldMemory(FieldId id) const {
+  if (id == mech_.position) return positions_.data();
+  if (id == mech_.velocity) return v().data();
+  if (id == mech_.external_force) return state_.external_force.get().data();
+  return nullptr;
+}
+
 void FemSolid::DoReadField(FieldId id, Eigen::Ref<Eigen::MatrixXd> out) const {
   const Index n = num_nodes();
   const auto& v2n = boundary().vertex_to_node;

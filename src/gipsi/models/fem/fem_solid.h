@@ -168,6 +168,7 @@ class FemSolid final : public SimObject, public CavityWall {
   void DropStateCache() override;
   void StateRestored() override { UpdatePositions(); }
   void DoReadField(FieldId id, Eigen::Ref<Eigen::MatrixXd> out) const override;
+  [[nodiscard]] const double* DoFieldMemory(FieldId id) const override;
   void DoWriteField(FieldId id, const Eigen::Ref<const Eigen::MatrixXd>& in) override;
 
  private:

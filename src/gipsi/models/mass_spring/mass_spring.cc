@@ -358,6 +358,13 @@ Vec3 MassSpring::Momentum() const {
   return p;
 }
 
+const double* MassSpring::DoFieldMemory(FieldId id) const {
+  if (id == mech_.position) return positions_.data();
+  if (id == mech_.velocity) return state_.x.data() + 3 * num_nodes();
+  if (id == mech_.external_force) return state_.external_force.data();
+  return nullptr;
+}
+
 void MassSpring::DoReadField(FieldId id, Eigen::Ref<Eigen::MatrixXd> out) const {
   const Index n = num_nodes();
   const auto& v2n = boundary().vertex_to_node;

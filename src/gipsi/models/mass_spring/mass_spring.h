@@ -206,6 +206,7 @@ class MassSpring final : public SimObject, public CavityWall {
   void SetObjectState(const ObjectState& from) override;
   StepStatus DoStep(double t, double dt) override;
   void DoReadField(FieldId id, Eigen::Ref<Eigen::MatrixXd> out) const override;
+  [[nodiscard]] const double* DoFieldMemory(FieldId id) const override;
   void DoWriteField(FieldId id, const Eigen::Ref<const Eigen::MatrixXd>& in) override;
 
  private:

@@ -23,7 +23,7 @@ void MassSpring::RestoreObjectState(StateReader& in) {
   ReadFields(in, read);
   in.EndSection();
   const bool fibres_changed = read.fibres.get() != state_.fibres.get();
-  state_ = std::move(read);
+  CopyFields(state_, read);  // into the existing storage: views of it stay valid
   UpdateDerived(fibres_changed);
 }
 
