@@ -7,7 +7,9 @@
 
 #include <string>
 
-namespace gipsi {
+#include "gipsi/base/export.h"
+
+namespace GIPSI_EXPORT gipsi {
 
 /// The optional parts of this build. Plain struct.
 struct BuildFeatures {

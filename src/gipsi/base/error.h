@@ -13,7 +13,9 @@
 
 #include <fmt/format.h>
 
-namespace gipsi {
+#include "gipsi/base/export.h"
+
+namespace GIPSI_EXPORT gipsi {
 
 /// Bad user input: a malformed file, an unknown type name, an out-of-range parameter.
 /// The message is complete and meant for the user, e.g.

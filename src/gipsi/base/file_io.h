@@ -10,7 +10,9 @@
 #include <string>
 #include <string_view>
 
-namespace gipsi {
+#include "gipsi/base/export.h"
+
+namespace GIPSI_EXPORT gipsi {
 
 /// Writing an output failed. The message names the file and the system's reason (errno text),
 /// e.g. `out/sheet/sheet_000003.vtu: cannot write: No space left on device`. Copyable.

@@ -16,9 +16,10 @@
 
 #include <nlohmann/json.hpp>
 
+#include "gipsi/base/export.h"
 #include "gipsi/base/math.h"
 
-namespace gipsi {
+namespace GIPSI_EXPORT gipsi {
 
 /// A read-only view of one value inside a JSON document, with its file name and JSON path.
 /// Object members keep their order in the file (declaration order matters for schedules).

@@ -12,7 +12,9 @@
 #include <atomic>
 #include <cstdint>
 
-namespace gipsi {
+#include "gipsi/base/export.h"
+
+namespace GIPSI_EXPORT gipsi {
 
 /// Not copyable or movable (the two threads hold references).
 template <class T>

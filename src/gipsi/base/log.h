@@ -5,7 +5,9 @@
 
 #include <spdlog/spdlog.h>
 
-namespace gipsi {
+#include "gipsi/base/export.h"
+
+namespace GIPSI_EXPORT gipsi {
 
 /// The framework's logger (stderr, colour when a terminal).
 spdlog::logger& Log();

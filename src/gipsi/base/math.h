@@ -6,7 +6,9 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>  // cross products everywhere
 
-namespace gipsi {
+#include "gipsi/base/export.h"
+
+namespace GIPSI_EXPORT gipsi {
 
 using Index = Eigen::Index;
 using Vec3 = Eigen::Vector3d;

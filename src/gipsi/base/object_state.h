@@ -17,9 +17,10 @@
 #include <vector>
 
 #include "gipsi/base/error.h"
+#include "gipsi/base/export.h"
 #include "gipsi/base/state_value.h"
 
-namespace gipsi {
+namespace GIPSI_EXPORT gipsi {
 
 /// Base of the snapshot boxes. Not copyable (copy through Assign, which keeps the storage).
 class ObjectState {

@@ -21,9 +21,10 @@
 #include <type_traits>
 #include <vector>
 
+#include "gipsi/base/export.h"
 #include "gipsi/base/math.h"
 
-namespace gipsi {
+namespace GIPSI_EXPORT gipsi {
 
 /// Appends typed entries to a byte buffer. Copyable and movable.
 class StateWriter {

@@ -39,10 +39,11 @@
 
 #include <fmt/format.h>
 
+#include "gipsi/base/export.h"
 #include "gipsi/base/math.h"
 #include "gipsi/base/state.h"
 
-namespace gipsi {
+namespace GIPSI_EXPORT gipsi {
 
 /// How a field may change between a state and its serialised copy.
 enum class Shape : std::uint8_t {

@@ -7,7 +7,9 @@
 
 #include <atomic>
 
-namespace gipsi {
+#include "gipsi/base/export.h"
+
+namespace GIPSI_EXPORT gipsi {
 
 /// Trivially copyable; does not own the flag, which must outlive every copy (the kernel's).
 /// A default-constructed token never requests a stop.

@@ -6,7 +6,9 @@
 #include <cstdint>
 #include <functional>
 
-namespace gipsi {
+#include "gipsi/base/export.h"
+
+namespace GIPSI_EXPORT gipsi {
 
 /// A typed index. `Tag` is any (incomplete) type that distinguishes one kind of id from another.
 /// Trivially copyable; default-constructed ids are invalid (-1).

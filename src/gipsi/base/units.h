@@ -10,9 +10,10 @@
 #include <string>
 #include <string_view>
 
+#include "gipsi/base/export.h"
 #include "gipsi/base/json_node.h"
 
-namespace gipsi {
+namespace GIPSI_EXPORT gipsi {
 
 /// The value of `node` in the SI unit `si_unit` (a UDUNITS-2 expression such as "S/m",
 /// "F/m^2", "1/m", "s", "A/m^3", "V"). Throws InputError naming the JSON path for anything that

@@ -17,9 +17,10 @@
 #include <emmintrin.h>
 #endif
 
+#include "gipsi/base/export.h"
 #include "gipsi/base/math.h"
 
-namespace gipsi {
+namespace GIPSI_EXPORT gipsi {
 
 /// A box, min and max corners. Plain struct.
 struct Box3 {

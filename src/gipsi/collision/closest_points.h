@@ -5,9 +5,10 @@
 /// segments are handled). Algorithms after Ericson, "Real-Time Collision Detection" (2005),
 /// §5.1.5 (Voronoi regions of a triangle) and §5.1.9 (segment–segment).
 
+#include "gipsi/base/export.h"
 #include "gipsi/base/math.h"
 
-namespace gipsi {
+namespace GIPSI_EXPORT gipsi {
 
 /// Which feature of a triangle holds the closest point.
 enum class TriangleFeature : std::uint8_t {

@@ -7,10 +7,11 @@
 #include <cstdint>
 #include <vector>
 
+#include "gipsi/base/export.h"
 #include "gipsi/base/math.h"
 #include "gipsi/collision/aabb_tree.h"
 
-namespace gipsi {
+namespace GIPSI_EXPORT gipsi {
 
 /// Not copyable (holds a tree over its own triangles); movable.
 class CollisionSurface {

@@ -25,13 +25,14 @@
 #include <memory>
 #include <vector>
 
+#include "gipsi/base/export.h"
 #include "gipsi/collision/collision_surface.h"
 #include "gipsi/collision/penalty.h"
 #include "gipsi/collision/proximity.h"
 #include "gipsi/core/connector.h"
 #include "gipsi/core/registry.h"
 
-namespace gipsi {
+namespace GIPSI_EXPORT gipsi {
 
 /// Options besides the contact material. Plain struct with defaults.
 struct ContactOptions {

@@ -12,9 +12,10 @@
 /// which friction is regularised (viscous), which keeps the explicit exchange smooth.
 /// The damping term never pulls (f_n is clamped at zero).
 
+#include "gipsi/base/export.h"
 #include "gipsi/base/math.h"
 
-namespace gipsi {
+namespace GIPSI_EXPORT gipsi {
 
 /// Contact parameters. Plain struct with defaults.
 struct ContactMaterial {

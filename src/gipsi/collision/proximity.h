@@ -19,10 +19,11 @@
 
 #include <vector>
 
+#include "gipsi/base/export.h"
 #include "gipsi/base/math.h"
 #include "gipsi/collision/collision_surface.h"
 
-namespace gipsi {
+namespace GIPSI_EXPORT gipsi {
 
 /// A vertex of one surface near a triangle of another (or the same) surface. Plain struct.
 struct VertexTriangleContact {

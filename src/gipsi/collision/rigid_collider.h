@@ -9,9 +9,10 @@
 
 #include <optional>
 
+#include "gipsi/base/export.h"
 #include "gipsi/base/math.h"
 
-namespace gipsi {
+namespace GIPSI_EXPORT gipsi {
 
 /// A capsule: the points within `radius` of the segment [start, end] [m]. Plain struct.
 struct Capsule {

@@ -16,11 +16,12 @@
 #include <optional>
 #include <vector>
 
+#include "gipsi/base/export.h"
 #include "gipsi/collision/rigid_collider.h"
 #include "gipsi/core/registry.h"
 #include "gipsi/core/sim_object.h"
 
-namespace gipsi {
+namespace GIPSI_EXPORT gipsi {
 
 /// Shape and motion of a tool. Plain struct with defaults.
 struct RigidToolSpec {

@@ -2,9 +2,10 @@
 /// @file
 /// Triangle surfaces of tool primitives.
 
+#include "gipsi/base/export.h"
 #include "gipsi/geometry/mesh.h"
 
-namespace gipsi {
+namespace GIPSI_EXPORT gipsi {
 
 /// A closed, outward-oriented triangle surface of a capsule: the points within `radius` of the
 /// segment from the origin to (0, 0, length) (a sphere when length is 0). `segments` (>= 3)

@@ -8,11 +8,12 @@
 #include <memory>
 #include <vector>
 
+#include "gipsi/base/export.h"
 #include "gipsi/core/coordinator.h"
 #include "gipsi/core/registry.h"
 #include "gipsi/core/sim_object.h"
 
-namespace gipsi {
+namespace GIPSI_EXPORT gipsi {
 
 /// Not copyable or movable.
 class AggregateObject : public SimObject {

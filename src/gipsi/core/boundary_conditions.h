@@ -13,10 +13,11 @@
 #include <cstdint>
 #include <vector>
 
+#include "gipsi/base/export.h"
 #include "gipsi/base/math.h"
 #include "gipsi/base/state_value.h"
 
-namespace gipsi {
+namespace GIPSI_EXPORT gipsi {
 
 /// Bit mask of constrained axes: 1 = x, 2 = y, 4 = z.
 using AxisMask = std::uint8_t;

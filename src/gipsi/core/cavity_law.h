@@ -13,7 +13,9 @@
 #include <string_view>
 #include <vector>
 
-namespace gipsi {
+#include "gipsi/base/export.h"
+
+namespace GIPSI_EXPORT gipsi {
 
 class SimObject;
 

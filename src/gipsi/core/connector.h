@@ -10,10 +10,11 @@
 #include <string_view>
 #include <vector>
 
+#include "gipsi/base/export.h"
 #include "gipsi/core/port.h"
 #include "gipsi/core/step_status.h"
 
-namespace gipsi {
+namespace GIPSI_EXPORT gipsi {
 
 class ObjectState;
 class SimObject;

@@ -11,11 +11,12 @@
 #include <string_view>
 #include <vector>
 
+#include "gipsi/base/export.h"
 #include "gipsi/core/connector.h"
 #include "gipsi/core/pacing.h"
 #include "gipsi/core/sim_object.h"
 
-namespace gipsi {
+namespace GIPSI_EXPORT gipsi {
 
 /// Where a macro step stopped, if it did not complete. `who` names the object or connector
 /// (points into its name; valid while the coordinator lives).

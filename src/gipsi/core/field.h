@@ -8,9 +8,10 @@
 #include <string>
 #include <string_view>
 
+#include "gipsi/base/export.h"
 #include "gipsi/base/strong_id.h"
 
-namespace gipsi {
+namespace GIPSI_EXPORT gipsi {
 
 /// Where a field's items live; the item count follows from the object's geometries.
 enum class FieldLocation {

@@ -15,10 +15,11 @@
 #include <string>
 #include <vector>
 
+#include "gipsi/base/export.h"
 #include "gipsi/base/object_state.h"
 #include "gipsi/core/coordinator.h"
 
-namespace gipsi {
+namespace GIPSI_EXPORT gipsi {
 
 class Kernel;
 class StateReader;

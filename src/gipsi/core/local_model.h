@@ -38,10 +38,11 @@
 #include <memory>
 #include <vector>
 
+#include "gipsi/base/export.h"
 #include "gipsi/base/math.h"
 #include "gipsi/core/registry.h"
 
-namespace gipsi {
+namespace GIPSI_EXPORT gipsi {
 
 class SimObject;
 

@@ -6,7 +6,9 @@
 
 #include <string_view>
 
-namespace gipsi {
+#include "gipsi/base/export.h"
+
+namespace GIPSI_EXPORT gipsi {
 
 /// Base of every constitutive law. Immutable after construction (shared by all elements).
 class Material {

@@ -7,9 +7,10 @@
 /// `Coordinator::MacroStep`): an object does not sleep in its own step, and a stop request ends
 /// the wait at once.
 
+#include "gipsi/base/export.h"
 #include "gipsi/base/stop_token.h"
 
-namespace gipsi {
+namespace GIPSI_EXPORT gipsi {
 
 /// The capability of an object paced by the wall clock.
 class WallClockPaced {

@@ -13,9 +13,10 @@
 #include <string>
 
 #include "gipsi/base/error.h"
+#include "gipsi/base/export.h"
 #include "gipsi/core/field.h"
 
-namespace gipsi {
+namespace GIPSI_EXPORT gipsi {
 
 class SimObject;
 

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "gipsi/base/error.h"
+#include "gipsi/base/export.h"
 #include "gipsi/base/json_node.h"
 #include "gipsi/base/version.h"
 #include "gipsi/core/connector.h"
@@ -37,7 +38,7 @@
 #define GIPSI_PLUGIN_ABI_VERSION \
   (GIPSI_VERSION_MAJOR * 1000000 + GIPSI_VERSION_MINOR * 1000 + GIPSI_PLUGIN_INTERFACE)
 
-namespace gipsi {
+namespace GIPSI_EXPORT gipsi {
 
 class TypeRegistry;
 class Coordinator;

@@ -12,6 +12,7 @@
 #include <string_view>
 #include <vector>
 
+#include "gipsi/base/export.h"
 #include "gipsi/base/math.h"
 #include "gipsi/base/object_state.h"
 #include "gipsi/base/state_value.h"
@@ -24,7 +25,7 @@
 #include "gipsi/geometry/mapping.h"
 #include "gipsi/geometry/mesh.h"
 
-namespace gipsi {
+namespace GIPSI_EXPORT gipsi {
 
 /// What an object is drawn with: a triangle surface whose vertices follow the domain through a
 /// mapping (barycentric embedding of a finer or coarser surface), or the boundary itself.

@@ -6,7 +6,9 @@
 
 #include <cstdint>
 
-namespace gipsi {
+#include "gipsi/base/export.h"
+
+namespace GIPSI_EXPORT gipsi {
 
 /// Trivially copyable. `what` points to a string literal (static storage), so making a status
 /// never allocates; `item` and `value` locate the problem (e.g. node 17, value NaN).

@@ -4,10 +4,11 @@
 
 #include <vector>
 
+#include "gipsi/base/export.h"
 #include "gipsi/base/math.h"
 #include "gipsi/geometry/mesh.h"
 
-namespace gipsi {
+namespace GIPSI_EXPORT gipsi {
 
 /// A triangle surface whose vertices are a subset of a domain's nodes.
 /// Plain data: copyable and movable.

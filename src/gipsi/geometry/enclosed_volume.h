@@ -10,10 +10,11 @@
 
 #include <vector>
 
+#include "gipsi/base/export.h"
 #include "gipsi/base/math.h"
 #include "gipsi/geometry/boundary.h"
 
-namespace gipsi {
+namespace GIPSI_EXPORT gipsi {
 
 /// A cavity's wall as its own surface: boundary faces of a tissue, renumbered. Plain struct.
 struct CavitySurface {

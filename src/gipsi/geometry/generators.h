@@ -5,10 +5,11 @@
 
 #include <array>
 
+#include "gipsi/base/export.h"
 #include "gipsi/base/math.h"
 #include "gipsi/geometry/mesh.h"
 
-namespace gipsi {
+namespace GIPSI_EXPORT gipsi {
 
 /// How each hexahedral cell of a structured box is cut into tetrahedra.
 /// The most elements a generator makes (a box of 20 million tets needs about 3 GB to build and

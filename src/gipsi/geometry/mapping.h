@@ -4,9 +4,10 @@
 /// target points. Used for display geometries embedded in a domain (barycentric embedding), for
 /// probes at points, and by connectors between objects on different meshes.
 
+#include "gipsi/base/export.h"
 #include "gipsi/base/math.h"
 
-namespace gipsi {
+namespace GIPSI_EXPORT gipsi {
 
 /// Fixed interpolation weights: target j gets Σ_k weights(k, j) · source[indices(k, j)], with up
 /// to four sources per target (unused slots have weight 0 and index 0). Built once, applied

@@ -9,9 +9,10 @@
 #include <string_view>
 #include <vector>
 
+#include "gipsi/base/export.h"
 #include "gipsi/base/math.h"
 
-namespace gipsi {
+namespace GIPSI_EXPORT gipsi {
 
 /// A named subset of a mesh (a Gmsh physical group, a TetGen/VTK region or boundary marker).
 struct MeshGroup {

@@ -2,9 +2,10 @@
 /// @file
 /// Areas and normals of triangle surfaces. `vertices` is 3 by V, `triangles` 3 by T.
 
+#include "gipsi/base/export.h"
 #include "gipsi/base/math.h"
 
-namespace gipsi {
+namespace GIPSI_EXPORT gipsi {
 
 /// Area of each triangle (T entries).
 VecX TriangleAreas(const Points& vertices, const Triangles& triangles);

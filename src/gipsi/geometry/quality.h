@@ -4,9 +4,10 @@
 
 #include <vector>
 
+#include "gipsi/base/export.h"
 #include "gipsi/base/math.h"
 
-namespace gipsi {
+namespace GIPSI_EXPORT gipsi {
 
 /// Quality of a tet mesh. Aspect ratio is longest edge / (2·sqrt(6)·inradius): 1 for the
 /// regular tetrahedron, growing without bound as an element flattens.

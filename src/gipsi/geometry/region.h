@@ -6,11 +6,12 @@
 #include <variant>
 #include <vector>
 
+#include "gipsi/base/export.h"
 #include "gipsi/base/math.h"
 #include "gipsi/geometry/boundary.h"
 #include "gipsi/geometry/mesh.h"
 
-namespace gipsi {
+namespace GIPSI_EXPORT gipsi {
 
 /// Every node / face.
 struct AllRegion {};

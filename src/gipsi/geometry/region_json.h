@@ -8,10 +8,11 @@
 ///   {"group": "name"}                       a named group of the mesh (Gmsh physical group)
 ///   {"nodes": [i, j, ...]}                  explicit domain node ids
 
+#include "gipsi/base/export.h"
 #include "gipsi/base/json_node.h"
 #include "gipsi/geometry/region.h"
 
-namespace gipsi {
+namespace GIPSI_EXPORT gipsi {
 
 /// Parses a region; throws InputError naming the JSON path for anything else.
 Region ParseRegion(const JsonNode& node);

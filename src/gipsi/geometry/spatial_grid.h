@@ -11,9 +11,10 @@
 #include <limits>
 #include <vector>
 
+#include "gipsi/base/export.h"
 #include "gipsi/base/math.h"
 
-namespace gipsi {
+namespace GIPSI_EXPORT gipsi {
 
 /// Uniform grid over K axis-aligned item boxes. Each item is listed in every cell its box
 /// touches (compressed row storage). The cell size is chosen so that there are about as many

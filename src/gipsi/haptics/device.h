@@ -6,9 +6,10 @@
 
 #include <cstdint>
 
+#include "gipsi/base/export.h"
 #include "gipsi/base/math.h"
 
-namespace gipsi {
+namespace GIPSI_EXPORT gipsi {
 
 /// What a device reports in one tick. Plain struct.
 struct DevicePose {

@@ -5,9 +5,10 @@
 /// local model is stale (the simulation stalled) or the device is disconnected (a watchdog);
 /// when both recover, the force fades back in at the same rate. Allocation-free, noexcept.
 
+#include "gipsi/base/export.h"
 #include "gipsi/base/math.h"
 
-namespace gipsi {
+namespace GIPSI_EXPORT gipsi {
 
 class StateWriter;
 class StateReader;

@@ -15,12 +15,13 @@
 
 #include <memory>
 
+#include "gipsi/base/export.h"
 #include "gipsi/base/latest_value.h"
 #include "gipsi/core/local_model.h"
 #include "gipsi/haptics/local_model.h"
 #include "gipsi/haptics/local_model_tick.h"
 
-namespace gipsi {
+namespace GIPSI_EXPORT gipsi {
 
 class StateWriter;
 class StateReader;

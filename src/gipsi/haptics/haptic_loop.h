@@ -14,9 +14,10 @@
 #include <thread>
 #include <vector>
 
+#include "gipsi/base/export.h"
 #include "gipsi/haptics/haptic_tick.h"
 
-namespace gipsi {
+namespace GIPSI_EXPORT gipsi {
 
 /// Real-time scheduling of the loop thread. Plain struct with defaults.
 struct HapticRealtime {

@@ -40,13 +40,14 @@
 #include "gipsi/core/registry.h"
 #include "gipsi/core/sim_object.h"
 
+#include "gipsi/base/export.h"
 #include "gipsi/haptics/haptic_bridge.h"
 #include "gipsi/haptics/haptic_loop.h"
 #include "gipsi/haptics/igtl_device.h"
 #include "gipsi/haptics/mouse_device.h"
 #include "gipsi/haptics/virtual_device.h"
 
-namespace gipsi {
+namespace GIPSI_EXPORT gipsi {
 
 /// Parameters of a HapticProbe. Plain struct with defaults.
 struct HapticProbeSpec {

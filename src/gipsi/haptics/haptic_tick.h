@@ -9,11 +9,12 @@
 /// `HapticRenderer` is what the haptic loop ticks; `LocalModelTick` (local_model_tick.h)
 /// renders the local dynamic models.
 
+#include "gipsi/base/export.h"
 #include "gipsi/base/latest_value.h"
 #include "gipsi/haptics/device.h"
 #include "gipsi/haptics/force_safety.h"
 
-namespace gipsi {
+namespace GIPSI_EXPORT gipsi {
 
 /// A tangent plane with a stiffness, published by the simulation. Plain struct.
 struct PlaneLocalModel {

@@ -17,10 +17,11 @@
 #include <string>
 #include <thread>
 
+#include "gipsi/base/export.h"
 #include "gipsi/base/latest_value.h"
 #include "gipsi/haptics/device.h"
 
-namespace gipsi {
+namespace GIPSI_EXPORT gipsi {
 
 /// Connection parameters. Plain struct with defaults.
 struct IgtlDeviceParams {

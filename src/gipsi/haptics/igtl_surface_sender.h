@@ -12,12 +12,13 @@
 
 #include <string>
 
+#include "gipsi/base/export.h"
 #include "gipsi/base/json_node.h"
 #include "gipsi/core/connector.h"
 #include "gipsi/core/sim_object.h"
 #include "gipsi/haptics/igtl_device.h"
 
-namespace gipsi {
+namespace GIPSI_EXPORT gipsi {
 
 /// Reads an OpenIGTLink device block (keys above; "type" must be "OpenIGTLink"). Throws
 /// InputError naming the JSON path of an unknown key or a bad value.

@@ -4,9 +4,10 @@
 /// equations are described): the virtual coupling between the device and the contact node, the
 /// local state, and the allocation-free step a haptic tick runs against a published model.
 
+#include "gipsi/base/export.h"
 #include "gipsi/core/local_model.h"
 
-namespace gipsi {
+namespace GIPSI_EXPORT gipsi {
 
 /// The virtual coupling between the device and the contact node. Plain struct.
 struct LocalCoupling {

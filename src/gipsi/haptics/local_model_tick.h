@@ -10,10 +10,11 @@
 /// position and the contact force for the simulation (`HapticFeedback`). No allocation, locks,
 /// exceptions or I/O.
 
+#include "gipsi/base/export.h"
 #include "gipsi/haptics/haptic_tick.h"
 #include "gipsi/haptics/local_model.h"
 
-namespace gipsi {
+namespace GIPSI_EXPORT gipsi {
 
 /// What the haptic side hands back to the simulation. Plain struct.
 struct HapticFeedback {

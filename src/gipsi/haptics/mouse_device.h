@@ -13,10 +13,11 @@
 #include <cstdint>
 #include <optional>
 
+#include "gipsi/base/export.h"
 #include "gipsi/base/latest_value.h"
 #include "gipsi/haptics/device.h"
 
-namespace gipsi {
+namespace GIPSI_EXPORT gipsi {
 
 /// Parameters of a MouseDevice. Plain struct with defaults.
 struct MouseDeviceParams {

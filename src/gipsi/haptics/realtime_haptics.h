@@ -15,10 +15,11 @@
 #include <utility>
 #include <vector>
 
+#include "gipsi/base/export.h"
 #include "gipsi/core/kernel.h"
 #include "gipsi/haptics/haptic_probe.h"
 
-namespace gipsi {
+namespace GIPSI_EXPORT gipsi {
 
 /// The real-time HapticProbes among the kernel's objects (top level; in scene order).
 std::vector<HapticProbe*> RealtimeProbes(Kernel& kernel);

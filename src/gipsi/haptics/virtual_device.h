@@ -7,9 +7,10 @@
 #include <filesystem>
 #include <vector>
 
+#include "gipsi/base/export.h"
 #include "gipsi/haptics/device.h"
 
-namespace gipsi {
+namespace GIPSI_EXPORT gipsi {
 
 class StateWriter;
 class StateReader;

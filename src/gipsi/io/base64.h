@@ -7,7 +7,10 @@
 #include <string>
 #include <string_view>
 
-namespace gipsi::internal {
+#include "gipsi/base/export.h"
+
+namespace GIPSI_EXPORT gipsi {
+namespace internal {
 
 /// Base64 encoding of `bytes`, padded with '='.
 std::string EncodeBase64(std::string_view bytes);
@@ -18,4 +21,5 @@ std::string EncodeBase64(std::string_view bytes);
 /// dangling single character; `bad_at` then receives its index in `text`.
 std::optional<std::string> DecodeBase64(std::string_view text, std::size_t* bad_at = nullptr);
 
-}  // namespace gipsi::internal
+}  // namespace internal
+}  // namespace gipsi

@@ -14,11 +14,12 @@
 #include <string>
 #include <vector>
 
+#include "gipsi/base/export.h"
 #include "gipsi/base/json_node.h"
 #include "gipsi/core/boundary_conditions.h"
 #include "gipsi/core/sim_object.h"
 
-namespace gipsi {
+namespace GIPSI_EXPORT gipsi {
 
 /// One condition resolved on one object's boundary. Copyable and movable.
 struct BoundaryConditionSpec {

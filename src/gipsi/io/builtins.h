@@ -4,9 +4,10 @@
 /// It lives in io, the first layer above models, collision and haptics, since it registers the
 /// types of all three (each of those layers registers only its own, e.g. `RegisterFemSolid`).
 
+#include "gipsi/base/export.h"
 #include "gipsi/core/registry.h"
 
-namespace gipsi {
+namespace GIPSI_EXPORT gipsi {
 
 /// Registers the built-in objects ("MassSpring", "FemSolid", "Aggregate"), connectors
 /// ("FieldCopy", "BoundaryCoupling"), integrators ("ExplicitEuler", "SymplecticEuler", "RK4"),

@@ -14,10 +14,11 @@
 #include <utility>
 #include <vector>
 
+#include "gipsi/base/export.h"
 #include "gipsi/base/json_node.h"
 #include "gipsi/core/sim_object.h"
 
-namespace gipsi {
+namespace GIPSI_EXPORT gipsi {
 
 /// An sRGB colour with components in [0, 1].
 struct Rgb {

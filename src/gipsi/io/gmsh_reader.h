@@ -7,9 +7,10 @@
 #include <filesystem>
 #include <vector>
 
+#include "gipsi/base/export.h"
 #include "gipsi/geometry/mesh.h"
 
-namespace gipsi {
+namespace GIPSI_EXPORT gipsi {
 
 /// Reads a Gmsh mesh file.
 ///

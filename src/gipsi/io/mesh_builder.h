@@ -9,9 +9,11 @@
 #include <utility>
 #include <vector>
 
+#include "gipsi/base/export.h"
 #include "gipsi/geometry/mesh.h"
 
-namespace gipsi::internal {
+namespace GIPSI_EXPORT gipsi {
+namespace internal {
 
 /// Growable mesh under construction. Movable and copyable (plain data).
 struct MeshBuilder {
@@ -71,4 +73,5 @@ inline void AddUniqueGroup(std::vector<MeshGroup>& groups, MeshGroup group,
   groups.push_back(std::move(group));
 }
 
-}  // namespace gipsi::internal
+}  // namespace internal
+}  // namespace gipsi

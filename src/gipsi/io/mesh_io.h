@@ -7,9 +7,10 @@
 #include <string>
 #include <vector>
 
+#include "gipsi/base/export.h"
 #include "gipsi/geometry/mesh.h"
 
-namespace gipsi {
+namespace GIPSI_EXPORT gipsi {
 
 /// Reads a mesh, choosing the reader by the (case-insensitive) extension of `path`:
 ///  - `.msh`: Gmsh 1.0, 2.x, 4.1 ASCII/binary (`ReadGmsh`);

@@ -4,9 +4,10 @@
 
 #include <string>
 
+#include "gipsi/base/export.h"
 #include "gipsi/geometry/mesh.h"
 
-namespace gipsi {
+namespace GIPSI_EXPORT gipsi {
 
 /// Counts (nodes, tets, triangles, boundary faces), named groups, bounding box, element quality
 /// (inverted and degenerate tets with their ids, aspect ratios, volume) and, for surfaces,

@@ -4,10 +4,11 @@
 
 #include <filesystem>
 
+#include "gipsi/base/export.h"
 #include "gipsi/base/math.h"
 #include "gipsi/geometry/mesh.h"
 
-namespace gipsi {
+namespace GIPSI_EXPORT gipsi {
 
 /// Reads the vertices (`v x y z [w]`) and faces (`f ...`) of an OBJ file; everything else
 /// (`vt`, `vn`, `g`, `o`, `s`, `usemtl`, `mtllib`, comments) is ignored. Face corners may be

@@ -15,11 +15,12 @@
 #include <string>
 #include <vector>
 
+#include "gipsi/base/export.h"
 #include "gipsi/core/kernel.h"
 #include "gipsi/io/scene.h"
 #include "gipsi/io/vtu_writer.h"
 
-namespace gipsi {
+namespace GIPSI_EXPORT gipsi {
 
 /// Writes VTU frames and keeps the PVD collections current after every frame, so a run that
 /// stops early leaves a valid series up to its last frame.

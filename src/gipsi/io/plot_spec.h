@@ -27,10 +27,11 @@
 #include <string>
 #include <vector>
 
+#include "gipsi/base/export.h"
 #include "gipsi/base/json_node.h"
 #include "gipsi/io/probes.h"
 
-namespace gipsi {
+namespace GIPSI_EXPORT gipsi {
 
 /// One probe column. Plain struct.
 struct ColumnRef {

@@ -30,11 +30,12 @@
 #include <string>
 #include <vector>
 
+#include "gipsi/base/export.h"
 #include "gipsi/base/json_node.h"
 #include "gipsi/core/kernel.h"
 #include "gipsi/geometry/mapping.h"
 
-namespace gipsi {
+namespace GIPSI_EXPORT gipsi {
 
 /// A probe resolved against the scene's objects. Copyable and movable.
 struct Probe {

@@ -5,7 +5,9 @@
 #include <cmath>
 #include <limits>
 
-namespace gipsi {
+#include "gipsi/base/export.h"
+
+namespace GIPSI_EXPORT gipsi {
 
 /// The first time after `t_due` (the current time plus the kernel's tolerance) on the grid
 /// `next + k * every`, k = 1, 2, ...: the next sample time of an output sampled every `every`

@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "gipsi/base/export.h"
 #include "gipsi/core/kernel.h"
 #include "gipsi/core/registry.h"
 #include "gipsi/io/boundary_condition_spec.h"
@@ -20,7 +21,7 @@
 #include "gipsi/io/plot_spec.h"
 #include "gipsi/io/probes.h"
 
-namespace gipsi {
+namespace GIPSI_EXPORT gipsi {
 
 /// What to write as VTU/PVD series.
 struct VtuOutputSpec {

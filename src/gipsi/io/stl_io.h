@@ -4,10 +4,11 @@
 
 #include <filesystem>
 
+#include "gipsi/base/export.h"
 #include "gipsi/base/math.h"
 #include "gipsi/geometry/mesh.h"
 
-namespace gipsi {
+namespace GIPSI_EXPORT gipsi {
 
 /// Options of `ReadStl`.
 struct StlReadOptions {

@@ -4,9 +4,10 @@
 
 #include <filesystem>
 
+#include "gipsi/base/export.h"
 #include "gipsi/geometry/mesh.h"
 
-namespace gipsi {
+namespace GIPSI_EXPORT gipsi {
 
 /// Reads the TetGen mesh whose files share the stem of `path` (which may name the `.node`, the
 /// `.ele` or the `.face` file): `STEM.node` and `STEM.ele` are required, `STEM.face` is read

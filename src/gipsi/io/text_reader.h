@@ -14,7 +14,10 @@
 #include <unordered_map>
 #include <vector>
 
-namespace gipsi::internal {
+#include "gipsi/base/export.h"
+
+namespace GIPSI_EXPORT gipsi {
+namespace internal {
 
 /// Reads the whole file at `path` as bytes. Throws InputError `PATH: cannot open file` when it
 /// cannot be opened or read.
@@ -157,4 +160,5 @@ class TagMap {
   std::unordered_map<std::int64_t, int> map_;
 };
 
-}  // namespace gipsi::internal
+}  // namespace internal
+}  // namespace gipsi

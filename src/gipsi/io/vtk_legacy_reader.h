@@ -4,9 +4,10 @@
 
 #include <filesystem>
 
+#include "gipsi/base/export.h"
 #include "gipsi/geometry/mesh.h"
 
-namespace gipsi {
+namespace GIPSI_EXPORT gipsi {
 
 /// Reads a legacy VTK file, ASCII or BINARY (big-endian), with `DATASET UNSTRUCTURED_GRID` or
 /// `DATASET POLYDATA`.

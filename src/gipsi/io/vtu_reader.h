@@ -4,9 +4,10 @@
 
 #include <filesystem>
 
+#include "gipsi/base/export.h"
 #include "gipsi/geometry/mesh.h"
 
-namespace gipsi {
+namespace GIPSI_EXPORT gipsi {
 
 /// Reads a VTK XML `UnstructuredGrid` file. Supported data arrays: `format="ascii"`,
 /// `format="binary"` (inline base64) and `format="appended"` (raw or base64 `AppendedData`),

@@ -11,10 +11,11 @@
 
 #include <Eigen/Core>
 
+#include "gipsi/base/export.h"
 #include "gipsi/base/math.h"
 #include "gipsi/geometry/mesh.h"
 
-namespace gipsi {
+namespace GIPSI_EXPORT gipsi {
 
 /// A named data array attached to points or cells: `values` is `components` by count (column j
 /// holds the tuple of point or cell j). Plain data: copyable and movable.

@@ -13,6 +13,7 @@
 #include <string_view>
 #include <vector>
 
+#include "gipsi/base/export.h"
 #include "gipsi/base/json_node.h"
 #include "gipsi/core/cavity_law.h"
 #include "gipsi/core/field.h"
@@ -21,7 +22,7 @@
 #include "gipsi/geometry/mesh.h"
 #include "gipsi/geometry/region.h"
 
-namespace gipsi {
+namespace GIPSI_EXPORT gipsi {
 
 /// A cavity bounded by part of the boundary (an endocardium). Plain struct.
 struct CavitySpec {

@@ -17,11 +17,12 @@
 #include <limits>
 #include <string_view>
 
+#include "gipsi/base/export.h"
 #include "gipsi/base/math.h"
 #include "gipsi/base/state_value.h"
 #include "gipsi/numerics/ode.h"
 
-namespace gipsi {
+namespace GIPSI_EXPORT gipsi {
 
 /// Event functions for AdaptiveOde: `num_events()` values g_i(t, x); event i happens where g_i
 /// crosses zero upward (from ≤ 0 to > 0). A caller that wants a downward crossing negates its

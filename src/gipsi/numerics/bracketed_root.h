@@ -9,7 +9,9 @@
 
 #include <cmath>
 
-namespace gipsi {
+#include "gipsi/base/export.h"
+
+namespace GIPSI_EXPORT gipsi {
 
 /// Root of h (increasing) near `guess`. `h(x, out)` sets out = h(x) and returns false if h
 /// cannot be evaluated there. `first_step(h(guess))` gives the signed first step of the

@@ -7,9 +7,10 @@
 /// the iterate). No preconditioner: the callers' operators are close to the identity (an
 /// implicit step's I − h ∂f/∂x at moderate h·‖∂f/∂x‖).
 
+#include "gipsi/base/export.h"
 #include "gipsi/base/math.h"
 
-namespace gipsi {
+namespace GIPSI_EXPORT gipsi {
 
 /// Options of Gmres. Plain struct.
 struct GmresOptions {

@@ -19,10 +19,11 @@
 
 #include <string_view>
 
+#include "gipsi/base/export.h"
 #include "gipsi/base/math.h"
 #include "gipsi/base/state_value.h"
 
-namespace gipsi {
+namespace GIPSI_EXPORT gipsi {
 
 class StateReader;
 class StateWriter;

@@ -34,12 +34,13 @@
 #include <string_view>
 #include <vector>
 
+#include "gipsi/base/export.h"
 #include "gipsi/base/math.h"
 #include "gipsi/base/state_value.h"
 #include "gipsi/base/stop_token.h"
 #include "gipsi/numerics/sparse/linear_solver.h"
 
-namespace gipsi {
+namespace GIPSI_EXPORT gipsi {
 
 class StateReader;
 class StateWriter;

@@ -10,10 +10,11 @@
 #include <string>
 #include <string_view>
 
+#include "gipsi/base/export.h"
 #include "gipsi/base/math.h"
 #include "gipsi/numerics/gmres.h"
 
-namespace gipsi {
+namespace GIPSI_EXPORT gipsi {
 
 /// Any type with a state size, a position count (0 for a general ODE) and a derivative.
 /// `CalcDerivative(t, x, xdot)` writes f(t, x) into xdot (both of size `ode_size()`) and must

@@ -7,10 +7,11 @@
 
 #include <functional>
 
+#include "gipsi/base/export.h"
 #include "gipsi/base/math.h"
 #include "gipsi/numerics/sparse/linear_solver.h"
 
-namespace gipsi {
+namespace GIPSI_EXPORT gipsi {
 
 /// Plain struct of matrices (both triangles stored, compressed) and the lumped mass.
 struct P1ScalarOperators {

@@ -7,9 +7,11 @@
 
 #include "gipsi/base/math.h"
 
+#include "gipsi/base/export.h"
 #include "gipsi/viz/render_buffers.h"
 
-namespace gipsi::viz {
+namespace GIPSI_EXPORT gipsi {
+namespace viz {
 
 /// Orbit camera looking at `target` from `distance`; the eye direction is given by `azimuth`
 /// (degrees about +z; 0 puts the eye on the -y side, 90 on the +x side) and `elevation`
@@ -44,4 +46,5 @@ struct Camera {
 /// InputError naming `where` and saying what was expected.
 void ParseCamera(std::string_view text, std::string_view where, Camera& camera);
 
-}  // namespace gipsi::viz
+}  // namespace viz
+}  // namespace gipsi

@@ -8,9 +8,11 @@
 #include <string_view>
 #include <vector>
 
+#include "gipsi/base/export.h"
 #include "gipsi/io/display_spec.h"
 
-namespace gipsi::viz {
+namespace GIPSI_EXPORT gipsi {
+namespace viz {
 
 /// A named colour map, piecewise linear in sRGB between evenly spaced anchor colours.
 /// Copyable and movable.
@@ -41,4 +43,5 @@ class ColorMap {
 /// Colour used for NaN values.
 inline constexpr Rgb kNanColor{1.0f, 0.0f, 1.0f};
 
-}  // namespace gipsi::viz
+}  // namespace viz
+}  // namespace gipsi

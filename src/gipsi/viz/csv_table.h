@@ -8,7 +8,10 @@
 #include <string_view>
 #include <vector>
 
-namespace gipsi::viz {
+#include "gipsi/base/export.h"
+
+namespace GIPSI_EXPORT gipsi {
+namespace viz {
 
 /// Columns of numbers by name. Copyable and movable.
 struct CsvTable {
@@ -29,4 +32,5 @@ struct CsvTable {
 /// something that is not a number.
 CsvTable ReadCsv(const std::filesystem::path& file);
 
-}  // namespace gipsi::viz
+}  // namespace viz
+}  // namespace gipsi

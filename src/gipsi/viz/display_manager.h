@@ -10,13 +10,15 @@
 #include <string>
 #include <vector>
 
+#include "gipsi/base/export.h"
 #include "gipsi/core/kernel.h"
 #include "gipsi/core/sim_object.h"
 #include "gipsi/io/display_spec.h"
 #include "gipsi/viz/color_map.h"
 #include "gipsi/viz/render_buffers.h"
 
-namespace gipsi::viz {
+namespace GIPSI_EXPORT gipsi {
+namespace viz {
 
 /// Fills one object's `SurfaceBuffers` from its display geometry: its display surface
 /// (triangles), its springs or mesh edges (lines) or its nodes (points). Built once (it
@@ -134,4 +136,5 @@ void ApplyVisibility(const Kernel& kernel, const std::vector<std::string>& names
                      const std::vector<std::string>& show, const std::vector<std::string>& hide,
                      std::vector<bool>& hidden);
 
-}  // namespace gipsi::viz
+}  // namespace viz
+}  // namespace gipsi

@@ -5,11 +5,13 @@
 /// renderer reads only published frames, so drawing never touches live simulation state and
 /// neither thread waits for the other.
 
+#include "gipsi/base/export.h"
 #include "gipsi/base/latest_value.h"
 #include "gipsi/core/kernel.h"
 #include "gipsi/viz/display_manager.h"
 
-namespace gipsi::viz {
+namespace GIPSI_EXPORT gipsi {
+namespace viz {
 
 /// Publishes a `SceneDisplay` into `buffer` (which must outlive the kernel this observer is
 /// attached to). Not copyable or movable.
@@ -31,4 +33,5 @@ class DisplayPublisher final : public Observer {
   LatestValue<FrameBuffers>& buffer_;
 };
 
-}  // namespace gipsi::viz
+}  // namespace viz
+}  // namespace gipsi

@@ -32,11 +32,13 @@
 #include <optional>
 #include <string>
 
+#include "gipsi/base/export.h"
 #include "gipsi/core/local_model.h"
 #include "gipsi/core/sim_object.h"
 #include "gipsi/viz/render_buffers.h"
 
-namespace gipsi::viz {
+namespace GIPSI_EXPORT gipsi {
+namespace viz {
 
 /// Where a ray first meets a surface of a frame. Plain struct.
 struct SurfaceHit {
@@ -112,4 +114,5 @@ class PullTool {
   Eigen::MatrixXd loads_;  // 3 by nodes: the object's external_force
 };
 
-}  // namespace gipsi::viz
+}  // namespace viz
+}  // namespace gipsi

@@ -5,7 +5,10 @@
 
 #include <string_view>
 
-namespace gipsi::viz {
+#include "gipsi/base/export.h"
+
+namespace GIPSI_EXPORT gipsi {
+namespace viz {
 
 /// The viewer's choice at the end of the schedule (`gipsi view --at-end`).
 enum class AtEnd {
@@ -27,4 +30,5 @@ enum class PlayStep { kStep, kPause, kRestart };
 PlayStep NextPlayStep(double time, double end_time, double macro_dt, AtEnd at_end,
                       bool running_until);
 
-}  // namespace gipsi::viz
+}  // namespace viz
+}  // namespace gipsi

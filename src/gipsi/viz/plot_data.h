@@ -8,10 +8,12 @@
 #include <string>
 #include <vector>
 
+#include "gipsi/base/export.h"
 #include "gipsi/io/plot_spec.h"
 #include "gipsi/io/probes.h"
 
-namespace gipsi::viz {
+namespace GIPSI_EXPORT gipsi {
+namespace viz {
 
 /// A plot's data, ready to draw. Plain struct.
 struct PlotData {
@@ -56,4 +58,5 @@ struct ColumnDisplay {
 ColumnDisplay DisplayOfColumn(const Probe& probe, const std::string& column,
                               const std::vector<PlotSpec>& plots);
 
-}  // namespace gipsi::viz
+}  // namespace viz
+}  // namespace gipsi

@@ -10,9 +10,11 @@
 #include <string>
 #include <vector>
 
+#include "gipsi/base/export.h"
 #include "gipsi/io/display_spec.h"  // Primitive
 
-namespace gipsi::viz {
+namespace GIPSI_EXPORT gipsi {
+namespace viz {
 
 /// One object's display geometry (a surface, a line set or a point set). Vectors are flat,
 /// vertex-major (x0 y0 z0 x1 ...), ready for OpenGL vertex buffers. Copyable and movable; refilling
@@ -69,4 +71,5 @@ struct FrameBuffers {
   std::vector<ProbeTrace> traces;  ///< filled by viewers that plot probes live
 };
 
-}  // namespace gipsi::viz
+}  // namespace viz
+}  // namespace gipsi

@@ -16,7 +16,9 @@
 
 #include <string>
 
-namespace gipsi {
+#include "gipsi/base/export.h"
+
+namespace GIPSI_EXPORT gipsi {
 
 /// Parameters of an activation curve. Plain struct; copyable. Call Normalise() after setting
 /// the double-Hill parameters (the factory does).

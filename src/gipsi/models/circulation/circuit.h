@@ -21,13 +21,14 @@
 #include <string>
 #include <vector>
 
+#include "gipsi/base/export.h"
 #include "gipsi/base/math.h"
 #include "gipsi/base/state_value.h"
 #include "gipsi/models/circulation/activation.h"
 #include "gipsi/models/circulation/valve.h"
 #include "gipsi/numerics/adaptive_ode.h"
 
-namespace gipsi {
+namespace GIPSI_EXPORT gipsi {
 
 /// A blood-holding compartment. Plain struct; copyable.
 struct CompartmentSpec {

@@ -16,13 +16,14 @@
 #include <string_view>
 #include <vector>
 
+#include "gipsi/base/export.h"
 #include "gipsi/base/state_value.h"
 #include "gipsi/core/cavity_law.h"
 #include "gipsi/core/registry.h"
 #include "gipsi/core/sim_object.h"
 #include "gipsi/models/circulation/circuit.h"
 
-namespace gipsi {
+namespace GIPSI_EXPORT gipsi {
 
 /// Everything a Circulation is built from. Plain struct; copyable.
 struct CirculationParams {

@@ -14,7 +14,9 @@
 #include <string_view>
 #include <vector>
 
-namespace gipsi {
+#include "gipsi/base/export.h"
+
+namespace GIPSI_EXPORT gipsi {
 
 /// The discrete state of a valve.
 enum class ValveState : std::uint8_t { kClosed, kOpen };

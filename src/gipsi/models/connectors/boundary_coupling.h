@@ -14,12 +14,13 @@
 
 #include <vector>
 
+#include "gipsi/base/export.h"
 #include "gipsi/core/connector.h"
 #include "gipsi/core/registry.h"
 #include "gipsi/geometry/mapping.h"
 #include "gipsi/geometry/region.h"
 
-namespace gipsi {
+namespace GIPSI_EXPORT gipsi {
 
 /// Not copyable or movable.
 class BoundaryCoupling final : public Connector {

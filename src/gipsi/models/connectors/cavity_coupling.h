@@ -26,12 +26,13 @@
 
 #include <string>
 
+#include "gipsi/base/export.h"
 #include "gipsi/core/cavity_law.h"
 #include "gipsi/core/connector.h"
 #include "gipsi/core/registry.h"
 #include "gipsi/core/sim_object.h"
 
-namespace gipsi {
+namespace GIPSI_EXPORT gipsi {
 
 /// Not copyable or movable (a Connector).
 class CavityCoupling final : public Connector, public CavityLaw {

@@ -19,12 +19,13 @@
 #include <optional>
 #include <string>
 
+#include "gipsi/base/export.h"
 #include "gipsi/core/connector.h"
 #include "gipsi/core/registry.h"
 #include "gipsi/core/sim_object.h"
 #include "gipsi/geometry/mapping.h"
 
-namespace gipsi {
+namespace GIPSI_EXPORT gipsi {
 
 /// Parameters. Plain struct with defaults (a demonstration twitch: about 40 kPa after 300 ms of
 /// excitation, relaxing with a 33 ms time constant; not fitted to data).

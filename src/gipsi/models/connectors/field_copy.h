@@ -18,11 +18,12 @@
 
 #include <optional>
 
+#include "gipsi/base/export.h"
 #include "gipsi/core/connector.h"
 #include "gipsi/core/registry.h"
 #include "gipsi/geometry/mapping.h"
 
-namespace gipsi {
+namespace GIPSI_EXPORT gipsi {
 
 /// Not copyable or movable.
 class FieldCopy final : public Connector {

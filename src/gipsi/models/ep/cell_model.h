@@ -21,9 +21,10 @@
 #include <string_view>
 #include <vector>
 
+#include "gipsi/base/export.h"
 #include "gipsi/base/state_value.h"
 
-namespace gipsi {
+namespace GIPSI_EXPORT gipsi {
 
 class CellModel;
 

@@ -11,11 +11,12 @@
 #include <functional>
 #include <memory>
 
+#include "gipsi/base/export.h"
 #include "gipsi/base/json_node.h"
 #include "gipsi/core/registry.h"
 #include "gipsi/models/ep/cell_model.h"
 
-namespace gipsi {
+namespace GIPSI_EXPORT gipsi {
 
 /// Builds a cardiac cell model from its JSON object ({"model": name, ...parameters}); throws
 /// InputError naming the JSON path of a bad parameter.

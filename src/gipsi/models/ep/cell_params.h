@@ -5,10 +5,11 @@
 
 #include <string_view>
 
+#include "gipsi/base/export.h"
 #include "gipsi/base/json_node.h"
 #include "gipsi/models/ep/cell_model.h"
 
-namespace gipsi {
+namespace GIPSI_EXPORT gipsi {
 
 /// node[key], a number strictly between 0 and 1, or `fallback` when absent.
 double ReadFraction(const JsonNode& node, std::string_view key, double fallback);

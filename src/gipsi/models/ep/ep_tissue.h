@@ -26,13 +26,14 @@
 #include <string>
 #include <vector>
 
+#include "gipsi/base/export.h"
 #include "gipsi/core/sim_object.h"
 #include "gipsi/geometry/region.h"
 #include "gipsi/models/ep/cell_model.h"
 #include "gipsi/models/fibres/rule_based_fibres.h"
 #include "gipsi/numerics/sparse/linear_solver.h"
 
-namespace gipsi {
+namespace GIPSI_EXPORT gipsi {
 
 /// A train of rectangular pulses (times in ms): pulse k (0 ≤ k < count) is active on
 /// [start + k·period, start + k·period + duration). Plain struct.

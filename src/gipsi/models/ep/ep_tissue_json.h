@@ -6,10 +6,11 @@
 #include <string>
 #include <vector>
 
+#include "gipsi/base/export.h"
 #include "gipsi/core/registry.h"
 #include "gipsi/models/ep/ep_tissue.h"
 
-namespace gipsi {
+namespace GIPSI_EXPORT gipsi {
 
 /// Checks that the object's keys are the common ones, the EP tissue keys, or `extra`.
 void CheckEpTissueKeys(const ObjectBuildContext& ctx, const std::vector<std::string>& extra = {});

@@ -22,10 +22,11 @@
 #include <memory>
 #include <string>
 
+#include "gipsi/base/export.h"
 #include "gipsi/core/registry.h"
 #include "gipsi/models/ep/ep_tissue.h"
 
-namespace gipsi {
+namespace GIPSI_EXPORT gipsi {
 
 /// A regular grid [min, max] with `cells` cells per axis (scene units, m). Plain struct.
 struct CartesianGrid {

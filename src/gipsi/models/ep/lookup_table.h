@@ -9,7 +9,9 @@
 #include <functional>
 #include <vector>
 
-namespace gipsi {
+#include "gipsi/base/export.h"
+
+namespace GIPSI_EXPORT gipsi {
 
 /// `num_columns` functions tabulated at x_min, x_min + dx, ..., x_max, row-major (the columns of
 /// one x are contiguous, so an interpolation reads two adjacent rows). Immutable after

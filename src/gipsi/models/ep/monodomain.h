@@ -11,10 +11,11 @@
 #include <memory>
 #include <string>
 
+#include "gipsi/base/export.h"
 #include "gipsi/core/registry.h"
 #include "gipsi/models/ep/ep_tissue.h"
 
-namespace gipsi {
+namespace GIPSI_EXPORT gipsi {
 
 /// Not copyable or movable (a SimObject).
 class Monodomain final : public EpTissue {

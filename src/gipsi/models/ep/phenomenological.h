@@ -13,10 +13,11 @@
 
 #include <memory>
 
+#include "gipsi/base/export.h"
 #include "gipsi/base/json_node.h"
 #include "gipsi/models/ep/cell_model.h"
 
-namespace gipsi {
+namespace GIPSI_EXPORT gipsi {
 
 /// Parameters of AlievPanfilov (defaults: the paper's). Trivially copyable.
 struct AlievPanfilovParams {

@@ -25,7 +25,10 @@
 #include <bit>
 #include <cstdint>
 
-namespace gipsi::simd {
+#include "gipsi/base/export.h"
+
+namespace GIPSI_EXPORT gipsi {
+namespace simd {
 
 /// `x`, read back through a volatile so that the optimiser cannot see the value (see the file
 /// comment): for constants selected inside a vectorised loop, e.g. `open ? one : zero`. Call
@@ -109,4 +112,5 @@ struct ExpRange {
   return k * kLn2Hi + (log_m + k * kLn2Lo);
 }
 
-}  // namespace gipsi::simd
+}  // namespace simd
+}  // namespace gipsi

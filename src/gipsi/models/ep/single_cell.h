@@ -12,9 +12,10 @@
 #include <string>
 #include <vector>
 
+#include "gipsi/base/export.h"
 #include "gipsi/models/ep/cell_model.h"
 
-namespace gipsi {
+namespace GIPSI_EXPORT gipsi {
 
 /// How to pace the cell. Plain configuration; copyable.
 ///

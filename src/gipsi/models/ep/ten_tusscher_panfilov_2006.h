@@ -42,11 +42,12 @@
 #include <string>
 #include <vector>
 
+#include "gipsi/base/export.h"
 #include "gipsi/base/json_node.h"
 #include "gipsi/models/ep/cell_model.h"
 #include "gipsi/models/ep/lookup_table.h"
 
-namespace gipsi {
+namespace GIPSI_EXPORT gipsi {
 
 struct TenTusscherPanfilov2006Constants;  // derived from the parameters; internal to the .cc
 

@@ -2,9 +2,10 @@
 /// @file
 /// Small geometric helpers shared by the solid objects (FemSolid, MixedSolid) and their loads.
 
+#include "gipsi/base/export.h"
 #include "gipsi/base/math.h"
 
-namespace gipsi {
+namespace GIPSI_EXPORT gipsi {
 
 /// Orthonormal material axes as columns (fibre f, sheet s, sheet-normal n = f × s): f is the
 /// normalised `fibre` (non-zero), s the part of `sheet` orthogonal to it, normalised (any unit

@@ -11,10 +11,11 @@
 #include <memory>
 #include <vector>
 
+#include "gipsi/base/export.h"
 #include "gipsi/core/local_model.h"
 #include "gipsi/numerics/sparse/linear_solver.h"
 
-namespace gipsi {
+namespace GIPSI_EXPORT gipsi {
 
 class FemSolid;
 

@@ -31,6 +31,7 @@
 #include <string>
 #include <vector>
 
+#include "gipsi/base/export.h"
 #include "gipsi/core/registry.h"
 #include "gipsi/core/sim_object.h"
 #include "gipsi/geometry/enclosed_volume.h"
@@ -43,7 +44,7 @@
 #include "gipsi/numerics/newton.h"
 #include "gipsi/numerics/ode.h"
 
-namespace gipsi {
+namespace GIPSI_EXPORT gipsi {
 
 /// Parameters. Plain struct with defaults.
 struct FemParams {

@@ -9,12 +9,13 @@
 #include <cstdint>
 #include <vector>
 
+#include "gipsi/base/export.h"
 #include "gipsi/base/math.h"
 #include "gipsi/base/state_value.h"
 #include "gipsi/numerics/implicit_scheme.h"
 #include "gipsi/numerics/newton.h"
 
-namespace gipsi {
+namespace GIPSI_EXPORT gipsi {
 
 /// A coupled or pressure-driven cavity's state. Copyable.
 struct FemCavityState {

@@ -55,6 +55,7 @@
 #include <string>
 #include <vector>
 
+#include "gipsi/base/export.h"
 #include "gipsi/core/registry.h"
 #include "gipsi/core/sim_object.h"
 #include "gipsi/models/fem/mixed_state.h"
@@ -62,7 +63,7 @@
 #include "gipsi/models/fem/solid_material.h"
 #include "gipsi/numerics/newton.h"
 
-namespace gipsi {
+namespace GIPSI_EXPORT gipsi {
 
 /// Parameters. Plain struct with defaults.
 struct MixedSolidParams {

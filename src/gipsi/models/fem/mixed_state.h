@@ -9,11 +9,12 @@
 #include <cstdint>
 #include <vector>
 
+#include "gipsi/base/export.h"
 #include "gipsi/base/math.h"
 #include "gipsi/base/state_value.h"
 #include "gipsi/numerics/newton.h"
 
-namespace gipsi {
+namespace GIPSI_EXPORT gipsi {
 
 /// Copyable. Shapes: N P2 nodes, V vertices, E elements, F boundary faces.
 struct MixedState {

@@ -27,10 +27,11 @@
 
 #include <Eigen/Core>
 
+#include "gipsi/base/export.h"
 #include "gipsi/base/math.h"
 #include "gipsi/geometry/mesh.h"
 
-namespace gipsi {
+namespace GIPSI_EXPORT gipsi {
 
 /// Local vertex pairs of the six edge midpoints of a 10-node tet (nodes 4..9).
 inline constexpr int kTetEdges[6][2] = {{0, 1}, {1, 2}, {0, 2}, {0, 3}, {1, 3}, {2, 3}};

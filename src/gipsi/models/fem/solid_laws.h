@@ -31,9 +31,10 @@
 
 #include <string_view>
 
+#include "gipsi/base/export.h"
 #include "gipsi/models/fem/solid_material.h"
 
-namespace gipsi {
+namespace GIPSI_EXPORT gipsi {
 
 /// Smallest J = det F accepted by the laws with ln J (dimensionless).
 inline constexpr double kMinJacobian = 1e-12;

@@ -10,11 +10,12 @@
 
 #include <Eigen/Core>
 
+#include "gipsi/base/export.h"
 #include "gipsi/base/math.h"
 #include "gipsi/core/material.h"
 #include "gipsi/core/registry.h"
 
-namespace gipsi {
+namespace GIPSI_EXPORT gipsi {
 
 using Mat9 = Eigen::Matrix<double, 9, 9>;
 /// Stiffness matrix of one P1 tetrahedron: row 3a + i, column 3b + k (a, b local nodes).

@@ -2,10 +2,11 @@
 /// @file
 /// Scene-file parsing shared by the solid objects' factories ("FemSolid", "MixedSolid").
 
+#include "gipsi/base/export.h"
 #include "gipsi/base/json_node.h"
 #include "gipsi/numerics/newton.h"
 
-namespace gipsi {
+namespace GIPSI_EXPORT gipsi {
 
 /// The "newton" object of a solid (keys in docs/scene-format.md) over `defaults`; throws
 /// InputError naming the JSON path of a bad value.

@@ -12,9 +12,10 @@
 
 #include <Eigen/Core>
 
+#include "gipsi/base/export.h"
 #include "gipsi/base/math.h"
 
-namespace gipsi {
+namespace GIPSI_EXPORT gipsi {
 
 using Mat99 = Eigen::Matrix<double, 9, 9>;
 

@@ -17,11 +17,12 @@
 #include <algorithm>
 #include <vector>
 
+#include "gipsi/base/export.h"
 #include "gipsi/base/math.h"
 #include "gipsi/geometry/mesh.h"
 #include "gipsi/numerics/sparse/linear_solver.h"
 
-namespace gipsi {
+namespace GIPSI_EXPORT gipsi {
 
 /// Precomputed data for one tet mesh. Immutable after construction; copyable and movable.
 class TetAssembly {

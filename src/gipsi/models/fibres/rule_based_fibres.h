@@ -12,11 +12,12 @@
 /// Where k ∥ t (at the apex) c is taken perpendicular to t along the first coordinate axis that
 /// is not parallel to it.
 
+#include "gipsi/base/export.h"
 #include "gipsi/base/json_node.h"
 #include "gipsi/geometry/mesh.h"
 #include "gipsi/geometry/region.h"
 
-namespace gipsi {
+namespace GIPSI_EXPORT gipsi {
 
 /// The rule's inputs. Plain struct with defaults (±60°, a common choice for the human LV).
 struct TransmuralFibreRule {

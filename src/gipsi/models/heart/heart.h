@@ -18,10 +18,11 @@
 #include <string>
 #include <vector>
 
+#include "gipsi/base/export.h"
 #include "gipsi/core/aggregate.h"
 #include "gipsi/core/registry.h"
 
-namespace gipsi {
+namespace GIPSI_EXPORT gipsi {
 
 /// Which blood fields the monitor reads. Plain struct.
 struct HeartMonitorSpec {

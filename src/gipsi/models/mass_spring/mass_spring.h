@@ -69,6 +69,7 @@
 #include <string>
 #include <vector>
 
+#include "gipsi/base/export.h"
 #include "gipsi/core/registry.h"
 #include "gipsi/core/sim_object.h"
 #include "gipsi/geometry/enclosed_volume.h"
@@ -77,7 +78,7 @@
 #include "gipsi/models/wall_cavity.h"
 #include "gipsi/numerics/ode.h"
 
-namespace gipsi {
+namespace GIPSI_EXPORT gipsi {
 
 /// A cavity's state. Copyable.
 struct MassSpringCavityState {

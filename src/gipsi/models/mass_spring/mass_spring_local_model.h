@@ -7,9 +7,10 @@
 
 #include <vector>
 
+#include "gipsi/base/export.h"
 #include "gipsi/core/local_model.h"
 
-namespace gipsi {
+namespace GIPSI_EXPORT gipsi {
 
 class MassSpring;
 

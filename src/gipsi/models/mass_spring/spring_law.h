@@ -11,10 +11,11 @@
 
 #include <cmath>
 
+#include "gipsi/base/export.h"
 #include "gipsi/core/material.h"
 #include "gipsi/core/registry.h"
 
-namespace gipsi {
+namespace GIPSI_EXPORT gipsi {
 
 /// Not copyable; immutable after construction.
 class SpringLaw : public Material {

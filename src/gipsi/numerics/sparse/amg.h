@@ -39,10 +39,11 @@
 
 #include <Eigen/Dense>
 
+#include "gipsi/base/export.h"
 #include "gipsi/numerics/sparse/linear_solver.h"
 #include "gipsi/numerics/sparse/node_block_copy.h"
 
-namespace gipsi {
+namespace GIPSI_EXPORT gipsi {
 
 /// See the file comment. Not copyable; not movable (holds a CHOLMOD factor).
 class SmoothedAggregationAmg {

@@ -15,7 +15,9 @@
 #include <functional>
 #include <string_view>
 
-namespace gipsi {
+#include "gipsi/base/export.h"
+
+namespace GIPSI_EXPORT gipsi {
 
 /// What `UseSingleThreadedBlas` did.
 struct BlasThreadsResult {

@@ -19,10 +19,11 @@
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
 
+#include "gipsi/base/export.h"
 #include "gipsi/base/json_node.h"
 #include "gipsi/base/math.h"
 
-namespace gipsi {
+namespace GIPSI_EXPORT gipsi {
 
 /// Square sparse matrix, compressed columns, 32-bit indices. Symmetric matrices store both
 /// triangles, so a column is also a row (SpMV can run row-parallel).

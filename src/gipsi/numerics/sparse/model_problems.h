@@ -7,10 +7,11 @@
 
 #include <functional>
 
+#include "gipsi/base/export.h"
 #include "gipsi/base/math.h"
 #include "gipsi/numerics/sparse/linear_solver.h"
 
-namespace gipsi {
+namespace GIPSI_EXPORT gipsi {
 
 /// The 7-point Laplacian (6 on the diagonal, −1 to each grid neighbour, homogeneous Dirichlet
 /// outside) on an n×n×n grid of unknowns, plus `shift`·I. n³ rows, lexicographic order (x

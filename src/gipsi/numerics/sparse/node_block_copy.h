@@ -13,9 +13,10 @@
 
 #include <vector>
 
+#include "gipsi/base/export.h"
 #include "gipsi/numerics/sparse/linear_solver.h"
 
-namespace gipsi {
+namespace GIPSI_EXPORT gipsi {
 
 class NodeBlockCopy {
  public:

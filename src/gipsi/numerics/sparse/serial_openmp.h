@@ -13,9 +13,11 @@
 
 #ifdef _OPENMP
 #include <omp.h>
+
+#include "gipsi/base/export.h"
 #endif
 
-namespace gipsi {
+namespace GIPSI_EXPORT gipsi {
 
 /// Scope guard; not copyable.
 class SerialOpenMp {

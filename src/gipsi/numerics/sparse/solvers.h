@@ -5,9 +5,10 @@
 
 #include <memory>
 
+#include "gipsi/base/export.h"
 #include "gipsi/numerics/sparse/linear_solver.h"
 
-namespace gipsi {
+namespace GIPSI_EXPORT gipsi {
 
 /// Preconditioned CG (pcg.cc). `options` must already be validated (type "cg", known
 /// preconditioner, tolerance > 0, max_iterations ≥ 1).

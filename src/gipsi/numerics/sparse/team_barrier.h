@@ -26,9 +26,11 @@
 
 #if defined(__x86_64__) || defined(__i386__)
 #include <immintrin.h>
+
+#include "gipsi/base/export.h"
 #endif
 
-namespace gipsi {
+namespace GIPSI_EXPORT gipsi {
 
 /// The number of cores this process may run on (its affinity mask; at least 1), read once.
 int AvailableCores();

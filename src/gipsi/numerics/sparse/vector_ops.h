@@ -11,9 +11,10 @@
 
 #include <omp.h>
 
+#include "gipsi/base/export.h"
 #include "gipsi/base/math.h"
 
-namespace gipsi {
+namespace GIPSI_EXPORT gipsi {
 
 /// Ranges shorter than this run serially: a parallel region costs a few microseconds.
 inline constexpr Index kMinParallelLength = 8192;

@@ -11,7 +11,10 @@
 
 #include <string>
 
-namespace gipsi::viz {
+#include "gipsi/base/export.h"
+
+namespace GIPSI_EXPORT gipsi {
+namespace viz {
 
 // clang-format off
 #define GIPSI_GL_FUNCTIONS(X) \
@@ -45,4 +48,5 @@ struct GlApi {
   std::string Load(GetProc get_proc);
 };
 
-}  // namespace gipsi::viz
+}  // namespace viz
+}  // namespace gipsi

@@ -7,9 +7,11 @@
 #include <filesystem>
 #include <vector>
 
+#include "gipsi/base/export.h"
 #include "gipsi/viz/color_map.h"
 
-namespace gipsi::viz {
+namespace GIPSI_EXPORT gipsi {
+namespace viz {
 
 /// Width by height RGB pixels, rows top to bottom. Copyable and movable.
 struct Image {
@@ -32,4 +34,5 @@ Image ReadPng(const std::filesystem::path& file);
 /// Preconditions (checked): the size is a multiple of `factor`.
 Image Downsample(const Image& image, int factor);
 
-}  // namespace gipsi::viz
+}  // namespace viz
+}  // namespace gipsi

@@ -9,13 +9,15 @@
 #include <string>
 #include <vector>
 
+#include "gipsi/base/export.h"
 #include "gipsi/viz/camera.h"
 #include "gipsi/viz/render/gl_api.h"
 #include "gipsi/viz/render/image.h"
 #include "gipsi/viz/render/surface_renderer.h"
 #include "gipsi/viz/render_buffers.h"
 
-namespace gipsi::viz {
+namespace GIPSI_EXPORT gipsi {
+namespace viz {
 
 /// A software OpenGL 3.3 core context drawing into memory. Makes itself current on the
 /// constructing thread. Not copyable or movable.
@@ -63,4 +65,5 @@ void DrawLabels(Image& image, const FrameBuffers& frame, const RenderOptions& re
 /// to the time it wants drawn. Throws std::runtime_error if rendering is unavailable.
 Image RenderFrame(const FrameBuffers& frame, FrameImageOptions options, std::string* gl = nullptr);
 
-}  // namespace gipsi::viz
+}  // namespace viz
+}  // namespace gipsi

@@ -6,9 +6,11 @@
 #include <filesystem>
 #include <vector>
 
+#include "gipsi/base/export.h"
 #include "gipsi/viz/plot_data.h"
 
-namespace gipsi::viz {
+namespace GIPSI_EXPORT gipsi {
+namespace viz {
 
 /// Line colours of the series, in order (then repeated), as 0xRRGGBB.
 inline constexpr unsigned kPlotColors[] = {0x1f77b4, 0xff7f0e, 0x2ca02c, 0xd62728,
@@ -26,4 +28,5 @@ void WritePlot(const PlotData& data, const std::filesystem::path& file);
 std::vector<std::filesystem::path> WritePlots(const std::vector<PlotSpec>& specs,
                                               const std::filesystem::path& directory);
 
-}  // namespace gipsi::viz
+}  // namespace viz
+}  // namespace gipsi

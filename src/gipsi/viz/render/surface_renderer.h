@@ -8,12 +8,14 @@
 
 #include <vector>
 
+#include "gipsi/base/export.h"
 #include "gipsi/viz/camera.h"
 #include "gipsi/viz/color_map.h"
 #include "gipsi/viz/render/gl_api.h"
 #include "gipsi/viz/render_buffers.h"
 
-namespace gipsi::viz {
+namespace GIPSI_EXPORT gipsi {
+namespace viz {
 
 /// What to draw besides the surfaces. Plain struct.
 struct RenderOptions {
@@ -80,4 +82,5 @@ class SurfaceRenderer {
   GpuMesh bar_;
 };
 
-}  // namespace gipsi::viz
+}  // namespace viz
+}  // namespace gipsi

@@ -9,9 +9,11 @@
 #include <string_view>
 #include <vector>
 
+#include "gipsi/base/export.h"
 #include "gipsi/viz/render/image.h"
 
-namespace gipsi::viz {
+namespace GIPSI_EXPORT gipsi {
+namespace viz {
 
 /// Not copyable; movable.
 class TextPainter {
@@ -37,4 +39,5 @@ class TextPainter {
 /// Where the font is looked for.
 inline constexpr const char* kFontFile = "/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf";
 
-}  // namespace gipsi::viz
+}  // namespace viz
+}  // namespace gipsi
