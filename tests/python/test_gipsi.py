@@ -444,6 +444,59 @@ class Outputs(unittest.TestCase):
             self.assertTrue(os.path.exists(os.path.join(tmp, "sheet.pvd")))
             self.assertTrue(os.path.exists(os.path.join(tmp, "probes", "energy.csv")))
 
+    def test_probes_in_memory_hold_the_rows_of_the_csvs(self):
+        # Point, region and line probes, the sampling interval off the macro-step grid: memory
+        # and files take their samples at the same times, with the same values.
+        scene = sheet_scene(end=0.1)
+        scene["probes"] = {
+            "energy": {"object": "sheet", "fields": ["kinetic_energy"], "every": 0.025},
+            "corner": {"object": "sheet", "point": [0, 0, 0], "fields": ["displacement"],
+                       "every": 0.03},
+            "edge": {"object": "sheet", "field": "displacement", "at": [0.02, 0.05, 0.051],
+                     "line": {"from": [0, 0, 0], "to": [0.1, 0, 0], "points": 5}},
+            "final": {"object": "sheet", "field": "displacement",
+                      "line": {"from": [0, 0.05, 0], "to": [0.1, 0.05, 0], "points": 3}}}
+        with tempfile.TemporaryDirectory() as tmp:
+            sim = gipsi.Simulation.from_dict(scene)
+            sim.write_outputs(tmp)
+            self.assertEqual(sim.run()["outcome"], "completed")
+            probes = sim.probes
+            for name in ("energy", "corner"):
+                csv = np.loadtxt(os.path.join(tmp, "probes", name + ".csv"), delimiter=",",
+                                 skiprows=1, ndmin=2)
+                columns = list(probes[name])
+                np.testing.assert_allclose(
+                    np.column_stack([probes[name][c] for c in columns]), csv, rtol=1e-9,
+                    atol=1e-15)
+            self.assertEqual(len(probes["energy"]["time"]), 5)  # 0, 0.025 .. 0.1 (on 0.03, ...)
+            # 0.051 is first reached by the macro step at 0.06.
+            for name, times in (("edge", [0.02, 0.05, 0.06]), ("final", [0.1])):
+                memory = probes[name]
+                np.testing.assert_allclose(memory["time"], times, atol=1e-12)
+                points = len(memory["distance"])
+                self.assertEqual(memory["displacement_z"].shape, (len(times), points))
+                csv = np.loadtxt(os.path.join(tmp, "probes", name + ".csv"), delimiter=",",
+                                 skiprows=1, ndmin=2)
+                # The CSV: one row per point and time (time, distance, x, y, z, fields).
+                np.testing.assert_allclose(csv[:, 0], np.repeat(memory["time"], points))
+                np.testing.assert_allclose(csv[:, 1], np.tile(memory["distance"], len(times)))
+                np.testing.assert_allclose(csv[:, 4], np.tile(memory["z"], len(times)))
+                np.testing.assert_allclose(csv[:, 7], memory["displacement_z"].ravel(),
+                                           rtol=1e-9, atol=1e-15)
+            self.assertLess(probes["edge"]["displacement_z"][1, 0], 0)  # falling
+        # A restore to t = 0.03 drops the later rows, and running again records them anew.
+        state_at = gipsi.Simulation.from_dict(scene)
+        state_at.run(until=0.03)
+        saved = state_at.save()
+        state_at.run()
+        rows = {k: v["time"].copy() for k, v in state_at.probes.items()}
+        state_at.restore(saved)
+        self.assertEqual(len(state_at.probes["edge"]["time"]), 1)
+        state_at.run()
+        for k, v in state_at.probes.items():
+            np.testing.assert_array_equal(v["time"], rows[k])
+
+
 
 class Decay:
     """dx/dt = -k x, stepped in closed form; reads its input u (added to x once per step)."""
