@@ -35,6 +35,7 @@
 #include "gipsi/core/port.h"
 #include "gipsi/core/registry.h"
 #include "gipsi/core/sim_object.h"
+#include "gipsi/geometry/boundary.h"
 #include "gipsi/io/builtins.h"
 #include "gipsi/io/mesh_io.h"
 #include "gipsi/io/outputs.h"
@@ -248,6 +249,9 @@ class MemoryProbes final : public Observer {
   std::vector<std::pair<double, std::int64_t>> pending_;
 };
 
+/// A mesh as a dict of arrays (read_mesh's): nodes, tets, triangles, groups.
+py::dict MeshDict(const Mesh& mesh);
+
 /// A Python exception in one line, "Type: message" (pybind11's what() adds the traceback).
 std::string OneLine(const py::error_already_set& e) {
   std::string what = e.what();
@@ -261,16 +265,38 @@ std::string OneLine(const py::error_already_set& e) {
 /// it checkpointable (and so retry-able). Every call holds the GIL.
 class PythonObject final : public SimObject {
  public:
-  PythonObject(std::string name, std::string type, py::object impl)
+  /// `domain`: the scene's mesh named by the object's "domain" key, or nullptr (then only
+  /// global fields may be declared).
+  PythonObject(std::string name, std::string type, py::object impl,
+               std::shared_ptr<const Mesh> domain)
       : SimObject(std::move(name)), type_(std::move(type)), impl_(std::move(impl)) {
-    SetGeometry(std::make_shared<const Mesh>(), BoundarySurface{});
+    if (domain) {
+      BoundarySurface boundary = MakeBoundary(*domain);
+      positions_ = domain->nodes;
+      SetGeometry(std::move(domain), std::move(boundary));
+    } else {
+      SetGeometry(std::make_shared<const Mesh>(), BoundarySurface{});
+    }
     if (!py::hasattr(impl_, "fields") || !py::isinstance<py::dict>(impl_.attr("fields")))
       throw InputError("its 'fields' attribute must be a dict {name: {units, access, ...}}");
     for (const auto& [key, spec_handle] : impl_.attr("fields").cast<py::dict>()) {
       FieldInfo info;
       info.name = py::str(key).cast<std::string>();
-      info.location = FieldLocation::kGlobal;
       const py::dict spec = py::reinterpret_borrow<py::object>(spec_handle).cast<py::dict>();
+      const std::string location =
+          spec.contains("location") ? py::str(spec["location"]).cast<std::string>() : "global";
+      if (location == "global") {
+        info.location = FieldLocation::kGlobal;
+      } else if (location == "node" || location == "element") {
+        if (this->domain().num_nodes() == 0)
+          throw InputError(fmt::format(
+              "field '{}' is a {} field, but the object has no \"domain\" mesh to have {}s",
+              info.name, location, location));
+        info.location = location == "node" ? FieldLocation::kNode : FieldLocation::kElement;
+      } else {
+        throw InputError(fmt::format("field '{}': location '{}' is not global, node or element",
+                                     info.name, location));
+      }
       info.units = spec.contains("units") ? py::str(spec["units"]).cast<std::string>() : "1";
       const std::string access =
           spec.contains("access") ? py::str(spec["access"]).cast<std::string>() : "read";
@@ -296,7 +322,8 @@ class PythonObject final : public SimObject {
   std::string_view type_name() const override { return type_; }
   /// The Python instance the factory returned.
   [[nodiscard]] const py::object& impl() const { return impl_; }
-  const Points& domain_positions() const override { return no_positions_; }
+  /// The rest nodes, or what its `positions()` (if it has one) returned after the last step.
+  const Points& domain_positions() const override { return positions_; }
   std::string failure_detail() const override { return detail_; }
 
   void SaveObjectState(StateWriter& out) const override {
@@ -313,6 +340,14 @@ class PythonObject final : public SimObject {
     const std::string state = in.ReadString();
     in.EndSection();
     Call("set_state", py::bytes(state));
+    std::string problem;
+    try {
+      problem = RefreshPositions();
+    } catch (py::error_already_set& e) {
+      problem = fmt::format("positions() raised {}", OneLine(e));
+    }
+    if (!problem.empty())
+      throw std::runtime_error(fmt::format("{} '{}': {}", type_, name(), problem));
   }
 
  protected:
@@ -322,6 +357,10 @@ class PythonObject final : public SimObject {
       if (impl_.attr("step")(t, dt).is(py::bool_(false))) {
         detail_ = "step() returned False";
         return StepStatus::Failed("the Python object's step failed");
+      }
+      if (std::string problem = RefreshPositions(); !problem.empty()) {
+        detail_ = std::move(problem);
+        return StepStatus::Failed("the Python object's positions() failed");
       }
     } catch (py::error_already_set& e) {
       detail_ = fmt::format("step() raised {}", OneLine(e));
@@ -342,7 +381,11 @@ class PythonObject final : public SimObject {
   }
   void DoWriteField(FieldId id, const Eigen::Ref<const Eigen::MatrixXd>& in) override {
     py::gil_scoped_acquire gil;
-    py::array_t<double> values(static_cast<py::ssize_t>(in.size()));
+    // A global field as (components,), as before; node and element fields as (count, components).
+    py::array_t<double> values = field_info(id).location == FieldLocation::kGlobal
+                                     ? py::array_t<double>(static_cast<py::ssize_t>(in.size()))
+                                     : py::array_t<double>({static_cast<py::ssize_t>(in.cols()),
+                                                            static_cast<py::ssize_t>(in.rows())});
     std::copy(in.data(), in.data() + in.size(), values.mutable_data());
     Call("write", field_info(id).name, values);
   }
@@ -358,11 +401,26 @@ class PythonObject final : public SimObject {
           fmt::format("{} '{}': {}() raised {}", type_, name(), method, OneLine(e)));
     }
   }
+  /// Takes the node positions from impl.positions(), if it has a domain and that method (with
+  /// the GIL); what is wrong with them, or empty. Throws error_already_set if it raises.
+  std::string RefreshPositions() {
+    if (positions_.cols() == 0 || !py::hasattr(impl_, "positions")) return {};
+    const auto x = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(
+        impl_.attr("positions")());
+    if (!x || x.ndim() != 2 || x.shape(0) != positions_.cols() || x.shape(1) != 3)
+      return fmt::format("positions() must return an array of shape ({}, 3)", positions_.cols());
+    for (py::ssize_t i = 0; i < x.size(); ++i)
+      if (!std::isfinite(x.data()[i]))
+        return fmt::format("positions() returned a non-finite value at node {}: {}", i / 3,
+                           x.data()[i]);
+    std::copy(x.data(), x.data() + x.size(), positions_.data());
+    return {};
+  }
 
   std::string type_;
   py::object impl_;
   std::string detail_;
-  Points no_positions_ = Points(3, 0);
+  Points positions_ = Points(3, 0);
 };
 
 /// A connector type written in Python (gipsi.register_connector): an instance declares `ports`
@@ -547,14 +605,18 @@ void RegisterPythonTypes(TypeRegistry& registry) {
           py::gil_scoped_acquire gil;
           const py::object params =
               py::module_::import("json").attr("loads")(ctx.params.raw().dump());
+          // Its "domain" mesh, if any (an InputError here already names the path).
+          const std::shared_ptr<const Mesh> mesh =
+              ctx.params.Has("domain") ? ctx.DomainMesh() : nullptr;
           py::object impl;
           try {
             impl = (*factory)(ctx.name, params);
+            if (mesh && py::hasattr(impl, "set_domain")) impl.attr("set_domain")(MeshDict(*mesh));
           } catch (py::error_already_set& e) {
             ctx.params.Fail(fmt::format("{}: {}", type, OneLine(e)));
           }
           try {
-            return std::make_unique<PythonObject>(ctx.name, type, impl);
+            return std::make_unique<PythonObject>(ctx.name, type, impl, mesh);
           } catch (py::error_already_set& e) {
             ctx.params.Fail(fmt::format("{}: its fields: {}", type, OneLine(e)));
           } catch (const std::exception& e) {  // InputError, or a field spec of the wrong type

@@ -846,6 +846,90 @@ class PythonConnectors(unittest.TestCase):
                       result["diagnostic"])
 
 
+class Drifter(gipsi.ObjectBase):
+    """Warms at 1 K/s at every node and drifts at 0.1 m/s along x, on its "domain" mesh."""
+    fields = {"temperature": {"location": "node", "units": "K", "access": "read_write"},
+              "volume": {"location": "element", "units": "m3"}}
+
+    def set_domain(self, mesh):
+        self.rest, self.tets = mesh["nodes"], mesh["tets"]
+        self.temperature = np.full((len(self.rest), 1), 300.0)
+        self.t = 0.0
+
+    def step(self, t, dt):
+        self.t = t + dt
+        self.temperature += dt
+
+    def positions(self):
+        return self.rest + [0.1 * self.t, 0.0, 0.0]
+
+    def read(self, name):
+        if name == "temperature":
+            return self.temperature
+        x = self.rest[self.tets]
+        return np.abs(np.linalg.det(x[:, 1:] - x[:, :1])) / 6
+
+    def write(self, name, values):
+        assert values.shape == self.temperature.shape, values.shape
+        self.temperature = values.copy()
+
+    def get_state(self):
+        return np.append(self.temperature.ravel(), self.t).tobytes()
+
+    def set_state(self, state):
+        values = np.frombuffer(state)
+        self.temperature, self.t = values[:-1].reshape(-1, 1).copy(), values[-1]
+
+
+class PythonObjectsOnAMesh(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        gipsi.register_object("Drifter", Drifter, "warms and drifts")
+
+    def scene(self, with_domain=True):
+        obj = {"type": "Drifter", "dt": 0.01}
+        if with_domain:
+            obj["domain"] = "box"
+        return {"gipsi": 1, "units": "SI",
+                "meshes": {"box": {"generate": "box", "min": [0, 0, 0], "max": [0.1, 0.1, 0.1],
+                                   "cells": [2, 2, 2]}},
+                "objects": {"d": obj},
+                "schedule": {"end": 0.5, "dt": 0.01},
+                "probes": {"centre": {"object": "d", "point": [0.05, 0.05, 0.05],
+                                      "fields": ["temperature"], "every": 0.1}}}
+
+    def test_node_and_element_fields_are_probed_and_its_nodes_move(self):
+        sim = gipsi.Simulation.from_dict(self.scene())
+        d = sim.object("d")
+        self.assertEqual(d.fields["temperature"]["location"], "node")
+        self.assertEqual(d.fields["temperature"]["count"], 27)
+        self.assertEqual(d.fields["volume"]["count"], 48)
+        self.assertEqual(sim.run()["outcome"], "completed")
+        probe = sim.probes["centre"]
+        # A uniform field interpolates exactly: 300 K + 1 K/s t.
+        np.testing.assert_allclose(probe["temperature"], 300 + probe["time"], rtol=1e-12)
+        self.assertAlmostEqual(d.field("volume").sum(), 0.001, delta=1e-15)
+        np.testing.assert_allclose(d.positions, d.rest_positions + [0.05, 0, 0], atol=1e-15)
+        d.set_field("temperature", np.full((27, 1), 250.0))  # written as (count, components)
+        sim.step()
+        self.assertAlmostEqual(d.field("temperature")[13, 0], 250.01, delta=1e-12)
+        self.assertIs(type(d.impl), Drifter)
+        # A restore brings its nodes back with its state.
+        fresh = gipsi.Simulation.from_dict(self.scene())
+        fresh.run(until=0.2)
+        state = fresh.save()
+        fresh.run(until=0.4)
+        fresh.restore(state)
+        np.testing.assert_allclose(fresh.object("d").positions,
+                                   fresh.object("d").rest_positions + [0.02, 0, 0], atol=1e-15)
+
+    def test_a_node_field_without_a_domain_is_refused_at_the_objects_path(self):
+        with self.assertRaises(gipsi.InputError) as raised:
+            gipsi.Simulation.from_dict(self.scene(with_domain=False))
+        self.assertEqual(raised.exception.path, "objects.d")
+        self.assertIn("field 'temperature' is a node field, but the object has no \"domain\" "
+                      "mesh", raised.exception.what)
+
 class DocsSnippets(unittest.TestCase):
     def test_every_python_snippet_of_docs_python_md_runs(self):
         with open(os.path.join(SOURCE_DIR, "docs", "python.md"), encoding="utf-8") as f:
