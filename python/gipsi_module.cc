@@ -889,8 +889,18 @@ FieldId FindFieldOrRaise(const SimObject& o, const std::string& name) {
                                   o.type_name(), name, known));
 }
 
+/// `a` as a gipsi.FieldArray (the same memory) carrying the field's name, units and location.
+py::object Annotated(const py::array& a, const SimObject& o, FieldId id) {
+  const FieldInfo& f = o.field_info(id);
+  py::object out = a.attr("view")(py::module_::import("gipsi").attr("FieldArray"));
+  out.attr("field") = f.name;
+  out.attr("units") = f.units;
+  out.attr("location") = std::string(ToString(f.location));
+  return out;
+}
+
 /// The field as a new (count, components) array: one copy, straight from the object.
-py::array_t<double> ReadField(const ObjectHandle& h, const std::string& name) {
+py::object ReadField(const ObjectHandle& h, const std::string& name) {
   h.sim->CheckSameThread("field");
   const SimObject& o = *h.object;
   const FieldId id = FindFieldOrRaise(o, name);
@@ -902,7 +912,7 @@ py::array_t<double> ReadField(const ObjectHandle& h, const std::string& name) {
       {static_cast<py::ssize_t>(count), static_cast<py::ssize_t>(f.components)});
   Eigen::Map<Eigen::MatrixXd> view(out.mutable_data(), f.components, count);
   o.ReadField(id, view);
-  return out;
+  return Annotated(out, o, id);
 }
 
 /// Writes a field with the checks a connector's port gets: writable, the shape (count,
@@ -1052,11 +1062,12 @@ PYBIND11_MODULE(gipsi, m) {
                                     with += (with.empty() ? "" : ", ") + f.name;
                                 return with.empty() ? std::string("none") : with;
                               }()));
-            return View(memory, o.FieldCount(id), o.field_info(id).components, self);
+            return Annotated(View(memory, o.FieldCount(id), o.field_info(id).components, self), o,
+                             id);
           },
           py::arg("name"),
           "A stored field as a read-only (count, components) view of the object's memory, no "
-          "copy: it follows the simulation as it runs (fields()[name]['view'] says which "
+          "copy: it follows the simulation as it runs (fields[name]['view'] says which "
           "fields are stored). Write with set_field.")
       .def("field", &ReadField, py::arg("name"),
            "The field as a new (count, components) array, in its declared units.")
@@ -1240,6 +1251,20 @@ PYBIND11_MODULE(gipsi, m) {
       "replaces it.");
   // Base classes that document the protocols (any object with these attributes will do).
   py::exec(R"py(
+import numpy as _numpy
+
+
+class FieldArray(_numpy.ndarray):
+    """A field's values: a NumPy array with the field's name, units and location (node,
+    element, boundary_vertex, boundary_face or global) as attributes. Arithmetic on it gives
+    plain values of the same class; the attributes describe the field it was read from."""
+
+    def __array_finalize__(self, obj):
+        self.field = getattr(obj, "field", None)
+        self.units = getattr(obj, "units", None)
+        self.location = getattr(obj, "location", None)
+
+
 class ConnectorBase:
     """Base of connectors written in Python (gipsi.register_connector(type, cls)).
 

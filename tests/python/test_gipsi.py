@@ -91,6 +91,13 @@ class Running(unittest.TestCase):
         sim.run(until=0.05)
         check()
         self.assertTrue(np.any(views["velocity"] != 0))  # it falls
+        # Views and copies carry the field's name, units and location.
+        velocity = views["velocity"]
+        self.assertEqual((velocity.field, velocity.units, velocity.location),
+                         ("velocity", "m/s", "node"))
+        energy = sheet.field("kinetic_energy")
+        self.assertIsInstance(energy, gipsi.FieldArray)
+        self.assertEqual((energy.units, energy.location, energy.shape), ("J", "global", (1, 1)))
         force = np.tile([0.0, 0.0, 0.5], (25, 1))
         sheet.set_field("external_force", force)  # a write, seen through the view
         np.testing.assert_array_equal(views["external_force"], force)
@@ -237,9 +244,22 @@ class Running(unittest.TestCase):
         def fail(t):
             raise RuntimeError("from the callback")
 
-        with self.assertRaisesRegex(RuntimeError, "from the callback"):
-            sim.run(callback=fail)
-        self.assertAlmostEqual(sim.time, 0.06, delta=1e-12)  # stopped after that step
+        with tempfile.TemporaryDirectory() as tmp:
+            sim.write_outputs(tmp)
+            with self.assertRaisesRegex(RuntimeError, "from the callback"):
+                sim.run(callback=fail)
+            self.assertAlmostEqual(sim.time, 0.06, delta=1e-12)  # stopped after that step
+            # The outputs are kept and complete up to the stop: the probe's row at 0.06 in
+            # memory and in its CSV, and a closed PVD index listing the frame written then.
+            self.assertAlmostEqual(sim.probes["energy"]["time"][-1], 0.06, delta=1e-12)
+            csv = np.loadtxt(os.path.join(tmp, "probes", "energy.csv"), delimiter=",",
+                             skiprows=1, ndmin=2)
+            self.assertAlmostEqual(csv[-1, 0], 0.06, delta=1e-12)
+            with open(os.path.join(tmp, "sheet.pvd"), encoding="utf-8") as f:
+                pvd = f.read()
+            self.assertTrue(pvd.rstrip().endswith("</VTKFile>"))
+            self.assertIn('timestep="0.06"', pvd)
+            self.assertEqual(sim.run(until=0.08)["outcome"], "completed")  # it may go on
 
 
     def test_a_scheduled_python_event_fires_once_at_its_time(self):
