@@ -9,7 +9,8 @@
 
 #include "gipsi/base/export.h"
 
-namespace GIPSI_EXPORT gipsi {
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
 
 /// The optional parts of this build. Plain struct.
 struct BuildFeatures {
@@ -29,3 +30,4 @@ struct BuildFeatures {
                                          const std::string& option);
 
 }  // namespace gipsi
+GIPSI_EXPORT_END

@@ -15,7 +15,8 @@
 
 #include "gipsi/base/export.h"
 
-namespace GIPSI_EXPORT gipsi {
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
 
 /// Bad user input: a malformed file, an unknown type name, an out-of-range parameter.
 /// The message is complete and meant for the user, e.g.
@@ -40,6 +41,7 @@ namespace internal {
 }  // namespace internal
 
 }  // namespace gipsi
+GIPSI_EXPORT_END
 
 /// Always-on check of a programmer error (a violated precondition of a public API). Aborts.
 #define GIPSI_CHECK(cond, ...)                                            \

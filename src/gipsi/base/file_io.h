@@ -12,7 +12,8 @@
 
 #include "gipsi/base/export.h"
 
-namespace GIPSI_EXPORT gipsi {
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
 
 /// Writing an output failed. The message names the file and the system's reason (errno text),
 /// e.g. `out/sheet/sheet_000003.vtu: cannot write: No space left on device`. Copyable.
@@ -40,3 +41,4 @@ std::string ReadRegularFile(const std::filesystem::path& path, std::uintmax_t ma
 std::string DescribeFilesystemError(const std::filesystem::filesystem_error& e);
 
 }  // namespace gipsi
+GIPSI_EXPORT_END

@@ -19,7 +19,8 @@
 #include "gipsi/base/export.h"
 #include "gipsi/base/math.h"
 
-namespace GIPSI_EXPORT gipsi {
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
 
 /// A read-only view of one value inside a JSON document, with its file name and JSON path.
 /// Object members keep their order in the file (declaration order matters for schedules).
@@ -132,3 +133,4 @@ std::size_t EditDistance(std::string_view a, std::string_view b);
 std::string SuggestClosest(std::string_view name, const std::vector<std::string>& candidates);
 
 }  // namespace gipsi
+GIPSI_EXPORT_END

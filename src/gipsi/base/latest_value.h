@@ -14,7 +14,8 @@
 
 #include "gipsi/base/export.h"
 
-namespace GIPSI_EXPORT gipsi {
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
 
 /// Not copyable or movable (the two threads hold references).
 template <class T>
@@ -82,3 +83,4 @@ class LatestValue {
 };
 
 }  // namespace gipsi
+GIPSI_EXPORT_END

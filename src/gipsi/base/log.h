@@ -7,9 +7,11 @@
 
 #include "gipsi/base/export.h"
 
-namespace GIPSI_EXPORT gipsi {
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
 
 /// The framework's logger (stderr, colour when a terminal).
 spdlog::logger& Log();
 
 }  // namespace gipsi
+GIPSI_EXPORT_END

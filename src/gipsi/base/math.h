@@ -8,7 +8,8 @@
 
 #include "gipsi/base/export.h"
 
-namespace GIPSI_EXPORT gipsi {
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
 
 using Index = Eigen::Index;
 using Vec3 = Eigen::Vector3d;
@@ -22,3 +23,4 @@ using Triangles = Eigen::Matrix<int, 3, Eigen::Dynamic>;
 using Tets = Eigen::Matrix<int, 4, Eigen::Dynamic>;
 
 }  // namespace gipsi
+GIPSI_EXPORT_END

@@ -20,7 +20,8 @@
 #include "gipsi/base/export.h"
 #include "gipsi/base/state_value.h"
 
-namespace GIPSI_EXPORT gipsi {
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
 
 /// Base of the snapshot boxes. Not copyable (copy through Assign, which keeps the storage).
 class ObjectState {
@@ -112,3 +113,4 @@ class CompositeState final : public TypedState<CompositeState> {
 };
 
 }  // namespace gipsi
+GIPSI_EXPORT_END

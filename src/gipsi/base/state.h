@@ -24,7 +24,8 @@
 #include "gipsi/base/export.h"
 #include "gipsi/base/math.h"
 
-namespace GIPSI_EXPORT gipsi {
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
 
 /// Appends typed entries to a byte buffer. Copyable and movable.
 class StateWriter {
@@ -156,3 +157,4 @@ void WriteCheckpointFile(const std::filesystem::path& path, std::string_view pay
 [[nodiscard]] std::string ReadCheckpointFile(const std::filesystem::path& path);
 
 }  // namespace gipsi
+GIPSI_EXPORT_END

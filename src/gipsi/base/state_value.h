@@ -43,7 +43,8 @@
 #include "gipsi/base/math.h"
 #include "gipsi/base/state.h"
 
-namespace GIPSI_EXPORT gipsi {
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
 
 /// How a field may change between a state and its serialised copy.
 enum class Shape : std::uint8_t {
@@ -368,3 +369,4 @@ template <class S>
 }
 
 }  // namespace gipsi
+GIPSI_EXPORT_END

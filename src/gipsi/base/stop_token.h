@@ -9,7 +9,8 @@
 
 #include "gipsi/base/export.h"
 
-namespace GIPSI_EXPORT gipsi {
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
 
 /// Trivially copyable; does not own the flag, which must outlive every copy (the kernel's).
 /// A default-constructed token never requests a stop.
@@ -27,3 +28,4 @@ class StopToken {
 };
 
 }  // namespace gipsi
+GIPSI_EXPORT_END

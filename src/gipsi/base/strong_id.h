@@ -8,7 +8,8 @@
 
 #include "gipsi/base/export.h"
 
-namespace GIPSI_EXPORT gipsi {
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
 
 /// A typed index. `Tag` is any (incomplete) type that distinguishes one kind of id from another.
 /// Trivially copyable; default-constructed ids are invalid (-1).
@@ -27,6 +28,7 @@ class StrongId {
 };
 
 }  // namespace gipsi
+GIPSI_EXPORT_END
 
 template <class Tag>
 struct std::hash<gipsi::StrongId<Tag>> {

@@ -13,7 +13,8 @@
 #include "gipsi/base/export.h"
 #include "gipsi/base/json_node.h"
 
-namespace GIPSI_EXPORT gipsi {
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
 
 /// The value of `node` in the SI unit `si_unit` (a UDUNITS-2 expression such as "S/m",
 /// "F/m^2", "1/m", "s", "A/m^3", "V"). Throws InputError naming the JSON path for anything that
@@ -40,3 +41,4 @@ WrittenQuantity ReadWrittenQuantity(const JsonNode& node, std::string_view expec
 double UnitFactor(std::string_view unit, std::string_view si_unit);
 
 }  // namespace gipsi
+GIPSI_EXPORT_END

@@ -20,7 +20,8 @@
 #include "gipsi/base/export.h"
 #include "gipsi/base/math.h"
 
-namespace GIPSI_EXPORT gipsi {
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
 
 /// A box, min and max corners. Plain struct.
 struct Box3 {
@@ -144,3 +145,4 @@ class AabbTree {
 NormalCone MergeCones(const NormalCone& a, const NormalCone& b);
 
 }  // namespace gipsi
+GIPSI_EXPORT_END

@@ -8,7 +8,8 @@
 #include "gipsi/base/export.h"
 #include "gipsi/base/math.h"
 
-namespace GIPSI_EXPORT gipsi {
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
 
 /// Which feature of a triangle holds the closest point.
 enum class TriangleFeature : std::uint8_t {
@@ -53,3 +54,4 @@ SegmentSegmentResult ClosestPointsOfSegments(const Vec3& p0, const Vec3& p1, con
 double ClosestParameterOnSegment(const Vec3& p, const Vec3& a, const Vec3& b);
 
 }  // namespace gipsi
+GIPSI_EXPORT_END

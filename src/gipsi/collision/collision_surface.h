@@ -11,7 +11,8 @@
 #include "gipsi/base/math.h"
 #include "gipsi/collision/aabb_tree.h"
 
-namespace GIPSI_EXPORT gipsi {
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
 
 /// Not copyable (holds a tree over its own triangles); movable.
 class CollisionSurface {
@@ -73,3 +74,4 @@ class CollisionSurface {
 };
 
 }  // namespace gipsi
+GIPSI_EXPORT_END

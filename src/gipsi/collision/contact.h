@@ -32,7 +32,8 @@
 #include "gipsi/core/connector.h"
 #include "gipsi/core/registry.h"
 
-namespace GIPSI_EXPORT gipsi {
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
 
 /// Options besides the contact material. Plain struct with defaults.
 struct ContactOptions {
@@ -103,3 +104,4 @@ class Contact final : public Connector {
 void RegisterContact(TypeRegistry& registry);
 
 }  // namespace gipsi
+GIPSI_EXPORT_END

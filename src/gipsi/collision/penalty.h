@@ -15,7 +15,8 @@
 #include "gipsi/base/export.h"
 #include "gipsi/base/math.h"
 
-namespace GIPSI_EXPORT gipsi {
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
 
 /// Contact parameters. Plain struct with defaults.
 struct ContactMaterial {
@@ -43,3 +44,4 @@ inline Vec3 PenaltyForce(const ContactMaterial& m, double gap, const Vec3& norma
 }
 
 }  // namespace gipsi
+GIPSI_EXPORT_END

@@ -23,7 +23,8 @@
 #include "gipsi/base/math.h"
 #include "gipsi/collision/collision_surface.h"
 
-namespace GIPSI_EXPORT gipsi {
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
 
 /// A vertex of one surface near a triangle of another (or the same) surface. Plain struct.
 struct VertexTriangleContact {
@@ -110,3 +111,4 @@ void BruteForceProximity(const CollisionSurface& a, const CollisionSurface& b, d
                          bool edge_edge, bool self, ProximityResult& out);
 
 }  // namespace gipsi
+GIPSI_EXPORT_END

@@ -12,7 +12,8 @@
 #include "gipsi/base/export.h"
 #include "gipsi/base/math.h"
 
-namespace GIPSI_EXPORT gipsi {
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
 
 /// A capsule: the points within `radius` of the segment [start, end] [m]. Plain struct.
 struct Capsule {
@@ -33,3 +34,4 @@ class RigidCollider {
 };
 
 }  // namespace gipsi
+GIPSI_EXPORT_END

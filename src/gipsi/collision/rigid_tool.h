@@ -21,7 +21,8 @@
 #include "gipsi/core/registry.h"
 #include "gipsi/core/sim_object.h"
 
-namespace GIPSI_EXPORT gipsi {
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
 
 /// Shape and motion of a tool. Plain struct with defaults.
 struct RigidToolSpec {
@@ -103,3 +104,4 @@ class RigidTool final : public SimObject, public RigidCollider {
 void RegisterRigidTool(TypeRegistry& registry);
 
 }  // namespace gipsi
+GIPSI_EXPORT_END

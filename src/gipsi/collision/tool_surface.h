@@ -5,7 +5,8 @@
 #include "gipsi/base/export.h"
 #include "gipsi/geometry/mesh.h"
 
-namespace GIPSI_EXPORT gipsi {
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
 
 /// A closed, outward-oriented triangle surface of a capsule: the points within `radius` of the
 /// segment from the origin to (0, 0, length) (a sphere when length is 0). `segments` (>= 3)
@@ -14,3 +15,4 @@ namespace GIPSI_EXPORT gipsi {
 Mesh MakeCapsuleSurface(double radius, double length, int segments);
 
 }  // namespace gipsi
+GIPSI_EXPORT_END

@@ -13,7 +13,8 @@
 #include "gipsi/core/registry.h"
 #include "gipsi/core/sim_object.h"
 
-namespace GIPSI_EXPORT gipsi {
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
 
 /// Not copyable or movable.
 class AggregateObject : public SimObject {
@@ -70,3 +71,4 @@ Coordinator BuildAggregateParts(const ObjectBuildContext& ctx, const JsonNode& p
 void RegisterAggregate(TypeRegistry& registry);
 
 }  // namespace gipsi
+GIPSI_EXPORT_END

@@ -17,7 +17,8 @@
 #include "gipsi/base/math.h"
 #include "gipsi/base/state_value.h"
 
-namespace GIPSI_EXPORT gipsi {
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
 
 /// Bit mask of constrained axes: 1 = x, 2 = y, 4 = z.
 using AxisMask = std::uint8_t;
@@ -136,3 +137,4 @@ class BoundaryConditions {
 };
 
 }  // namespace gipsi
+GIPSI_EXPORT_END

@@ -15,7 +15,8 @@
 
 #include "gipsi/base/export.h"
 
-namespace GIPSI_EXPORT gipsi {
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
 
 class SimObject;
 
@@ -74,3 +75,4 @@ LumpedChambers& LumpedChambersOf(SimObject& object);
 CavityWall& CavityWallOf(SimObject& object);
 
 }  // namespace gipsi
+GIPSI_EXPORT_END

@@ -14,7 +14,8 @@
 #include "gipsi/core/port.h"
 #include "gipsi/core/step_status.h"
 
-namespace GIPSI_EXPORT gipsi {
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
 
 class ObjectState;
 class SimObject;
@@ -94,3 +95,4 @@ class Connector {
 };
 
 }  // namespace gipsi
+GIPSI_EXPORT_END

@@ -16,7 +16,8 @@
 #include "gipsi/core/pacing.h"
 #include "gipsi/core/sim_object.h"
 
-namespace GIPSI_EXPORT gipsi {
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
 
 /// Where a macro step stopped, if it did not complete. `who` names the object or connector
 /// (points into its name; valid while the coordinator lives).
@@ -128,3 +129,4 @@ class Coordinator {
 };
 
 }  // namespace gipsi
+GIPSI_EXPORT_END

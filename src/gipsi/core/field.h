@@ -11,7 +11,8 @@
 #include "gipsi/base/export.h"
 #include "gipsi/base/strong_id.h"
 
-namespace GIPSI_EXPORT gipsi {
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
 
 /// Where a field's items live; the item count follows from the object's geometries.
 enum class FieldLocation {
@@ -51,3 +52,4 @@ struct FieldInfo {
 };
 
 }  // namespace gipsi
+GIPSI_EXPORT_END

@@ -19,7 +19,8 @@
 #include "gipsi/base/object_state.h"
 #include "gipsi/core/coordinator.h"
 
-namespace GIPSI_EXPORT gipsi {
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
 
 class Kernel;
 class StateReader;
@@ -189,3 +190,4 @@ class Kernel {
 };
 
 }  // namespace gipsi
+GIPSI_EXPORT_END

@@ -42,7 +42,8 @@
 #include "gipsi/base/math.h"
 #include "gipsi/core/registry.h"
 
-namespace GIPSI_EXPORT gipsi {
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
 
 class SimObject;
 
@@ -134,3 +135,4 @@ inline const FactoryTable<LocalModelFactory>& LocalModels(const TypeRegistry& re
 [[nodiscard]] std::vector<std::uint8_t> ConstrainedNodes(const SimObject& object);
 
 }  // namespace gipsi
+GIPSI_EXPORT_END

@@ -8,7 +8,8 @@
 
 #include "gipsi/base/export.h"
 
-namespace GIPSI_EXPORT gipsi {
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
 
 /// Base of every constitutive law. Immutable after construction (shared by all elements).
 class Material {
@@ -21,3 +22,4 @@ class Material {
 };
 
 }  // namespace gipsi
+GIPSI_EXPORT_END

@@ -10,7 +10,8 @@
 #include "gipsi/base/export.h"
 #include "gipsi/base/stop_token.h"
 
-namespace GIPSI_EXPORT gipsi {
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
 
 /// The capability of an object paced by the wall clock.
 class WallClockPaced {
@@ -27,3 +28,4 @@ class WallClockPaced {
 void WaitForWallClock(const WallClockPaced& clock, double sim_time, double until, StopToken stop);
 
 }  // namespace gipsi
+GIPSI_EXPORT_END

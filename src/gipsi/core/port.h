@@ -16,7 +16,8 @@
 #include "gipsi/base/export.h"
 #include "gipsi/core/field.h"
 
-namespace GIPSI_EXPORT gipsi {
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
 
 class SimObject;
 
@@ -80,3 +81,4 @@ std::string DescribePort(const PortUse& port);
 std::string DescribeOrderRule(const OrderRule& rule);
 
 }  // namespace gipsi
+GIPSI_EXPORT_END

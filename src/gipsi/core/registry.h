@@ -38,7 +38,8 @@
 #define GIPSI_PLUGIN_ABI_VERSION \
   (GIPSI_VERSION_MAJOR * 1000000 + GIPSI_VERSION_MINOR * 1000 + GIPSI_PLUGIN_INTERFACE)
 
-namespace GIPSI_EXPORT gipsi {
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
 
 class TypeRegistry;
 class Coordinator;
@@ -236,3 +237,4 @@ class TypeRegistry {
 void RegisterIntegrators(TypeRegistry& registry);
 
 }  // namespace gipsi
+GIPSI_EXPORT_END

@@ -25,7 +25,8 @@
 #include "gipsi/geometry/mapping.h"
 #include "gipsi/geometry/mesh.h"
 
-namespace GIPSI_EXPORT gipsi {
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
 
 /// What an object is drawn with: a triangle surface whose vertices follow the domain through a
 /// mapping (barycentric embedding of a finer or coarser surface), or the boundary itself.
@@ -297,3 +298,4 @@ class SimObject {
 Index NumDomainElements(const Mesh& mesh);
 
 }  // namespace gipsi
+GIPSI_EXPORT_END

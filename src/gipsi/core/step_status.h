@@ -8,7 +8,8 @@
 
 #include "gipsi/base/export.h"
 
-namespace GIPSI_EXPORT gipsi {
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
 
 /// Trivially copyable. `what` points to a string literal (static storage), so making a status
 /// never allocates; `item` and `value` locate the problem (e.g. node 17, value NaN).
@@ -41,3 +42,4 @@ struct StepStatus {
 };
 
 }  // namespace gipsi
+GIPSI_EXPORT_END

@@ -8,7 +8,8 @@
 #include "gipsi/base/math.h"
 #include "gipsi/geometry/mesh.h"
 
-namespace GIPSI_EXPORT gipsi {
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
 
 /// A triangle surface whose vertices are a subset of a domain's nodes.
 /// Plain data: copyable and movable.
@@ -39,3 +40,4 @@ BoundarySurface ExtractTetBoundary(const Points& nodes, const Tets& tets);
 BoundarySurface MakeBoundary(const Mesh& mesh);
 
 }  // namespace gipsi
+GIPSI_EXPORT_END

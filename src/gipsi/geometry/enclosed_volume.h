@@ -14,7 +14,8 @@
 #include "gipsi/base/math.h"
 #include "gipsi/geometry/boundary.h"
 
-namespace GIPSI_EXPORT gipsi {
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
 
 /// A cavity's wall as its own surface: boundary faces of a tissue, renumbered. Plain struct.
 struct CavitySurface {
@@ -50,3 +51,4 @@ class EnclosedVolume {
 };
 
 }  // namespace gipsi
+GIPSI_EXPORT_END

@@ -9,7 +9,8 @@
 #include "gipsi/base/math.h"
 #include "gipsi/geometry/mesh.h"
 
-namespace GIPSI_EXPORT gipsi {
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
 
 /// How each hexahedral cell of a structured box is cut into tetrahedra.
 /// The most elements a generator makes (a box of 20 million tets needs about 3 GB to build and
@@ -67,3 +68,4 @@ Mesh MakeCylinderShell(double inner_radius, double outer_radius, double height, 
 Mesh MakeTetsInSurface(const Points& vertices, const Triangles& triangles, double mesh_size);
 
 }  // namespace gipsi
+GIPSI_EXPORT_END

@@ -7,7 +7,8 @@
 #include "gipsi/base/export.h"
 #include "gipsi/base/math.h"
 
-namespace GIPSI_EXPORT gipsi {
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
 
 /// Fixed interpolation weights: target j gets Σ_k weights(k, j) · source[indices(k, j)], with up
 /// to four sources per target (unused slots have weight 0 and index 0). Built once, applied
@@ -59,3 +60,4 @@ class PointMap {
 };
 
 }  // namespace gipsi
+GIPSI_EXPORT_END

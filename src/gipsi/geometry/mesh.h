@@ -12,7 +12,8 @@
 #include "gipsi/base/export.h"
 #include "gipsi/base/math.h"
 
-namespace GIPSI_EXPORT gipsi {
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
 
 /// A named subset of a mesh (a Gmsh physical group, a TetGen/VTK region or boundary marker).
 struct MeshGroup {
@@ -67,3 +68,4 @@ struct Mesh {
 };
 
 }  // namespace gipsi
+GIPSI_EXPORT_END

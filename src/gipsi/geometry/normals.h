@@ -5,7 +5,8 @@
 #include "gipsi/base/export.h"
 #include "gipsi/base/math.h"
 
-namespace GIPSI_EXPORT gipsi {
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
 
 /// Area of each triangle (T entries).
 VecX TriangleAreas(const Points& vertices, const Triangles& triangles);
@@ -18,3 +19,4 @@ Points FaceNormals(const Points& vertices, const Triangles& triangles);
 void VertexNormals(const Points& vertices, const Triangles& triangles, Points& normals);
 
 }  // namespace gipsi
+GIPSI_EXPORT_END

@@ -7,7 +7,8 @@
 #include "gipsi/base/export.h"
 #include "gipsi/base/math.h"
 
-namespace GIPSI_EXPORT gipsi {
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
 
 /// Quality of a tet mesh. Aspect ratio is longest edge / (2·sqrt(6)·inradius): 1 for the
 /// regular tetrahedron, growing without bound as an element flattens.
@@ -29,3 +30,4 @@ TetQualityReport CheckTetQuality(const Points& nodes, const Tets& tets,
                                  double degenerate_tolerance = 1e-10);
 
 }  // namespace gipsi
+GIPSI_EXPORT_END

@@ -11,7 +11,8 @@
 #include "gipsi/geometry/boundary.h"
 #include "gipsi/geometry/mesh.h"
 
-namespace GIPSI_EXPORT gipsi {
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
 
 /// Every node / face.
 struct AllRegion {};
@@ -60,3 +61,4 @@ std::vector<int> SelectBoundaryFaces(const Region& region, const Mesh& mesh,
                                      const BoundarySurface& boundary);
 
 }  // namespace gipsi
+GIPSI_EXPORT_END

@@ -12,9 +12,11 @@
 #include "gipsi/base/json_node.h"
 #include "gipsi/geometry/region.h"
 
-namespace GIPSI_EXPORT gipsi {
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
 
 /// Parses a region; throws InputError naming the JSON path for anything else.
 Region ParseRegion(const JsonNode& node);
 
 }  // namespace gipsi
+GIPSI_EXPORT_END

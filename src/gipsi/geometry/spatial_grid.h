@@ -14,7 +14,8 @@
 #include "gipsi/base/export.h"
 #include "gipsi/base/math.h"
 
-namespace GIPSI_EXPORT gipsi {
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
 
 /// Uniform grid over K axis-aligned item boxes. Each item is listed in every cell its box
 /// touches (compressed row storage). The cell size is chosen so that there are about as many
@@ -152,3 +153,4 @@ class SpatialGrid {
 };
 
 }  // namespace gipsi
+GIPSI_EXPORT_END

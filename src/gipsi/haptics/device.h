@@ -9,7 +9,8 @@
 #include "gipsi/base/export.h"
 #include "gipsi/base/math.h"
 
-namespace GIPSI_EXPORT gipsi {
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
 
 /// What a device reports in one tick. Plain struct.
 struct DevicePose {
@@ -49,3 +50,4 @@ class HapticDevice {
 };
 
 }  // namespace gipsi
+GIPSI_EXPORT_END

@@ -8,7 +8,8 @@
 #include "gipsi/base/export.h"
 #include "gipsi/base/math.h"
 
-namespace GIPSI_EXPORT gipsi {
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
 
 class StateWriter;
 class StateReader;
@@ -51,3 +52,4 @@ class ForceSafety {
 };
 
 }  // namespace gipsi
+GIPSI_EXPORT_END

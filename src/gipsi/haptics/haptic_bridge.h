@@ -21,7 +21,8 @@
 #include "gipsi/haptics/local_model.h"
 #include "gipsi/haptics/local_model_tick.h"
 
-namespace GIPSI_EXPORT gipsi {
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
 
 class StateWriter;
 class StateReader;
@@ -76,3 +77,4 @@ class HapticBridge {
 };
 
 }  // namespace gipsi
+GIPSI_EXPORT_END

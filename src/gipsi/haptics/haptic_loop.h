@@ -17,7 +17,8 @@
 #include "gipsi/base/export.h"
 #include "gipsi/haptics/haptic_tick.h"
 
-namespace GIPSI_EXPORT gipsi {
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
 
 /// Real-time scheduling of the loop thread. Plain struct with defaults.
 struct HapticRealtime {
@@ -84,3 +85,4 @@ class HapticLoop {
 };
 
 }  // namespace gipsi
+GIPSI_EXPORT_END

@@ -47,7 +47,8 @@
 #include "gipsi/haptics/mouse_device.h"
 #include "gipsi/haptics/virtual_device.h"
 
-namespace GIPSI_EXPORT gipsi {
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
 
 /// Parameters of a HapticProbe. Plain struct with defaults.
 struct HapticProbeSpec {
@@ -184,3 +185,4 @@ class HapticCoupling final : public Connector {
 void RegisterHaptics(TypeRegistry& registry);
 
 }  // namespace gipsi
+GIPSI_EXPORT_END

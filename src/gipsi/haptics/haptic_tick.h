@@ -14,7 +14,8 @@
 #include "gipsi/haptics/device.h"
 #include "gipsi/haptics/force_safety.h"
 
-namespace GIPSI_EXPORT gipsi {
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
 
 /// A tangent plane with a stiffness, published by the simulation. Plain struct.
 struct PlaneLocalModel {
@@ -69,3 +70,4 @@ class HapticTick final : public HapticRenderer {
 };
 
 }  // namespace gipsi
+GIPSI_EXPORT_END

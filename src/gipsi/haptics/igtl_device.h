@@ -21,7 +21,8 @@
 #include "gipsi/base/latest_value.h"
 #include "gipsi/haptics/device.h"
 
-namespace GIPSI_EXPORT gipsi {
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
 
 /// Connection parameters. Plain struct with defaults.
 struct IgtlDeviceParams {
@@ -92,3 +93,4 @@ class IgtlDevice final : public HapticDevice {
 };
 
 }  // namespace gipsi
+GIPSI_EXPORT_END

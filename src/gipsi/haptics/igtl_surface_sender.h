@@ -18,7 +18,8 @@
 #include "gipsi/core/sim_object.h"
 #include "gipsi/haptics/igtl_device.h"
 
-namespace GIPSI_EXPORT gipsi {
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
 
 /// Reads an OpenIGTLink device block (keys above; "type" must be "OpenIGTLink"). Throws
 /// InputError naming the JSON path of an unknown key or a bad value.
@@ -54,3 +55,4 @@ class IgtlSurfaceSender final : public Connector {
 };
 
 }  // namespace gipsi
+GIPSI_EXPORT_END

@@ -7,7 +7,8 @@
 #include "gipsi/base/export.h"
 #include "gipsi/core/local_model.h"
 
-namespace GIPSI_EXPORT gipsi {
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
 
 /// The virtual coupling between the device and the contact node. Plain struct.
 struct LocalCoupling {
@@ -40,3 +41,4 @@ double StepLocalModel(const LocalDynamicModel& model, const LocalCoupling& coupl
                                  const LocalState& state, double depth) noexcept;
 
 }  // namespace gipsi
+GIPSI_EXPORT_END

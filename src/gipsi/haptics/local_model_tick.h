@@ -14,7 +14,8 @@
 #include "gipsi/haptics/haptic_tick.h"
 #include "gipsi/haptics/local_model.h"
 
-namespace GIPSI_EXPORT gipsi {
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
 
 /// What the haptic side hands back to the simulation. Plain struct.
 struct HapticFeedback {
@@ -80,3 +81,4 @@ class LocalModelTick final : public HapticRenderer {
 };
 
 }  // namespace gipsi
+GIPSI_EXPORT_END

@@ -17,7 +17,8 @@
 #include "gipsi/base/latest_value.h"
 #include "gipsi/haptics/device.h"
 
-namespace GIPSI_EXPORT gipsi {
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
 
 /// Parameters of a MouseDevice. Plain struct with defaults.
 struct MouseDeviceParams {
@@ -81,3 +82,4 @@ class MouseDevice final : public HapticDevice {
 };
 
 }  // namespace gipsi
+GIPSI_EXPORT_END

@@ -19,7 +19,8 @@
 #include "gipsi/core/kernel.h"
 #include "gipsi/haptics/haptic_probe.h"
 
-namespace GIPSI_EXPORT gipsi {
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
 
 /// The real-time HapticProbes among the kernel's objects (top level; in scene order).
 std::vector<HapticProbe*> RealtimeProbes(Kernel& kernel);
@@ -52,3 +53,4 @@ class RealtimeHaptics {
 };
 
 }  // namespace gipsi
+GIPSI_EXPORT_END

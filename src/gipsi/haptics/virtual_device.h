@@ -10,7 +10,8 @@
 #include "gipsi/base/export.h"
 #include "gipsi/haptics/device.h"
 
-namespace GIPSI_EXPORT gipsi {
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
 
 class StateWriter;
 class StateReader;
@@ -53,3 +54,4 @@ class VirtualDevice final : public HapticDevice {
 };
 
 }  // namespace gipsi
+GIPSI_EXPORT_END

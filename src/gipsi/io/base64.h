@@ -9,8 +9,8 @@
 
 #include "gipsi/base/export.h"
 
-namespace GIPSI_EXPORT gipsi {
-namespace internal {
+GIPSI_EXPORT_BEGIN
+namespace gipsi::internal {
 
 /// Base64 encoding of `bytes`, padded with '='.
 std::string EncodeBase64(std::string_view bytes);
@@ -21,5 +21,5 @@ std::string EncodeBase64(std::string_view bytes);
 /// dangling single character; `bad_at` then receives its index in `text`.
 std::optional<std::string> DecodeBase64(std::string_view text, std::size_t* bad_at = nullptr);
 
-}  // namespace internal
-}  // namespace gipsi
+}  // namespace gipsi::internal
+GIPSI_EXPORT_END

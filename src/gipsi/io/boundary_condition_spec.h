@@ -19,7 +19,8 @@
 #include "gipsi/core/boundary_conditions.h"
 #include "gipsi/core/sim_object.h"
 
-namespace GIPSI_EXPORT gipsi {
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
 
 /// One condition resolved on one object's boundary. Copyable and movable.
 struct BoundaryConditionSpec {
@@ -45,3 +46,4 @@ BoundaryConditionSpec ParseBoundaryCondition(const JsonNode& node, const SimObje
                                              std::size_t index);
 
 }  // namespace gipsi
+GIPSI_EXPORT_END

@@ -7,7 +7,8 @@
 #include "gipsi/base/export.h"
 #include "gipsi/core/registry.h"
 
-namespace GIPSI_EXPORT gipsi {
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
 
 /// Registers the built-in objects ("MassSpring", "FemSolid", "Aggregate"), connectors
 /// ("FieldCopy", "BoundaryCoupling"), integrators ("ExplicitEuler", "SymplecticEuler", "RK4"),
@@ -17,3 +18,4 @@ namespace GIPSI_EXPORT gipsi {
 void RegisterBuiltins(TypeRegistry& registry);
 
 }  // namespace gipsi
+GIPSI_EXPORT_END

@@ -18,7 +18,8 @@
 #include "gipsi/base/json_node.h"
 #include "gipsi/core/sim_object.h"
 
-namespace GIPSI_EXPORT gipsi {
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
 
 /// An sRGB colour with components in [0, 1].
 struct Rgb {
@@ -99,3 +100,4 @@ struct ResolvedDraw {
 ResolvedDraw CheckDrawSpec(const SimObject& object, const DrawSpec& spec, const std::string& name);
 
 }  // namespace gipsi
+GIPSI_EXPORT_END

@@ -10,7 +10,8 @@
 #include "gipsi/base/export.h"
 #include "gipsi/geometry/mesh.h"
 
-namespace GIPSI_EXPORT gipsi {
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
 
 /// Reads a Gmsh mesh file.
 ///
@@ -40,3 +41,4 @@ Mesh ReadGmsh(const std::filesystem::path& path);
 Mesh ReadGmsh(const std::filesystem::path& path, std::vector<std::int64_t>* tet_tags);
 
 }  // namespace gipsi
+GIPSI_EXPORT_END

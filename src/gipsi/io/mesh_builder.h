@@ -12,8 +12,8 @@
 #include "gipsi/base/export.h"
 #include "gipsi/geometry/mesh.h"
 
-namespace GIPSI_EXPORT gipsi {
-namespace internal {
+GIPSI_EXPORT_BEGIN
+namespace gipsi::internal {
 
 /// Growable mesh under construction. Movable and copyable (plain data).
 struct MeshBuilder {
@@ -73,5 +73,5 @@ inline void AddUniqueGroup(std::vector<MeshGroup>& groups, MeshGroup group,
   groups.push_back(std::move(group));
 }
 
-}  // namespace internal
-}  // namespace gipsi
+}  // namespace gipsi::internal
+GIPSI_EXPORT_END

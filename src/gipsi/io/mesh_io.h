@@ -10,7 +10,8 @@
 #include "gipsi/base/export.h"
 #include "gipsi/geometry/mesh.h"
 
-namespace GIPSI_EXPORT gipsi {
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
 
 /// Reads a mesh, choosing the reader by the (case-insensitive) extension of `path`:
 ///  - `.msh`: Gmsh 1.0, 2.x, 4.1 ASCII/binary (`ReadGmsh`);
@@ -33,3 +34,4 @@ Mesh ReadMesh(const std::filesystem::path& path);
 void WriteMesh(const std::filesystem::path& path, const Mesh& mesh);
 
 }  // namespace gipsi
+GIPSI_EXPORT_END

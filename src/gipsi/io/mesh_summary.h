@@ -7,7 +7,8 @@
 #include "gipsi/base/export.h"
 #include "gipsi/geometry/mesh.h"
 
-namespace GIPSI_EXPORT gipsi {
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
 
 /// Counts (nodes, tets, triangles, boundary faces), named groups, bounding box, element quality
 /// (inverted and degenerate tets with their ids, aspect ratios, volume) and, for surfaces,
@@ -17,3 +18,4 @@ namespace GIPSI_EXPORT gipsi {
 std::string DescribeMesh(const Mesh& mesh);
 
 }  // namespace gipsi
+GIPSI_EXPORT_END

@@ -8,7 +8,8 @@
 #include "gipsi/base/math.h"
 #include "gipsi/geometry/mesh.h"
 
-namespace GIPSI_EXPORT gipsi {
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
 
 /// Reads the vertices (`v x y z [w]`) and faces (`f ...`) of an OBJ file; everything else
 /// (`vt`, `vn`, `g`, `o`, `s`, `usemtl`, `mtllib`, comments) is ignored. Face corners may be
@@ -27,3 +28,4 @@ Mesh ReadObj(const std::filesystem::path& path);
 void WriteObj(const std::filesystem::path& path, const Points& nodes, const Triangles& triangles);
 
 }  // namespace gipsi
+GIPSI_EXPORT_END

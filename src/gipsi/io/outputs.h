@@ -20,7 +20,8 @@
 #include "gipsi/io/scene.h"
 #include "gipsi/io/vtu_writer.h"
 
-namespace GIPSI_EXPORT gipsi {
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
 
 /// Writes VTU frames and keeps the PVD collections current after every frame, so a run that
 /// stops early leaves a valid series up to its last frame.
@@ -79,3 +80,4 @@ OutputEstimate EstimateOutputs(const Scene& scene);
 void AttachOutputs(Scene& scene, const std::filesystem::path& directory, bool resume = false);
 
 }  // namespace gipsi
+GIPSI_EXPORT_END

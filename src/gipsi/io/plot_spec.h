@@ -31,7 +31,8 @@
 #include "gipsi/base/json_node.h"
 #include "gipsi/io/probes.h"
 
-namespace GIPSI_EXPORT gipsi {
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
 
 /// One probe column. Plain struct.
 struct ColumnRef {
@@ -68,3 +69,4 @@ std::vector<std::string> ProbeColumns(const Probe& probe);
 std::string ProbeColumnUnits(const Probe& probe, const std::string& column);
 
 }  // namespace gipsi
+GIPSI_EXPORT_END

@@ -35,7 +35,8 @@
 #include "gipsi/core/kernel.h"
 #include "gipsi/geometry/mapping.h"
 
-namespace GIPSI_EXPORT gipsi {
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
 
 /// A probe resolved against the scene's objects. Copyable and movable.
 struct Probe {
@@ -98,3 +99,4 @@ class ProbeRecorder final : public Observer {
 };
 
 }  // namespace gipsi
+GIPSI_EXPORT_END

@@ -7,7 +7,8 @@
 
 #include "gipsi/base/export.h"
 
-namespace GIPSI_EXPORT gipsi {
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
 
 /// The first time after `t_due` (the current time plus the kernel's tolerance) on the grid
 /// `next + k * every`, k = 1, 2, ...: the next sample time of an output sampled every `every`
@@ -31,3 +32,4 @@ inline double NextSampleTime(double next, double every, double t_due) {
 }
 
 }  // namespace gipsi
+GIPSI_EXPORT_END

@@ -21,7 +21,8 @@
 #include "gipsi/io/plot_spec.h"
 #include "gipsi/io/probes.h"
 
-namespace GIPSI_EXPORT gipsi {
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
 
 /// What to write as VTU/PVD series.
 struct VtuOutputSpec {
@@ -94,3 +95,4 @@ std::string ResolvePlugin(const std::string& entry, const std::filesystem::path&
 Mesh BuildMesh(const JsonNode& node, const std::filesystem::path& base_dir);
 
 }  // namespace gipsi
+GIPSI_EXPORT_END

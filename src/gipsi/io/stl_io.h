@@ -8,7 +8,8 @@
 #include "gipsi/base/math.h"
 #include "gipsi/geometry/mesh.h"
 
-namespace GIPSI_EXPORT gipsi {
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
 
 /// Options of `ReadStl`.
 struct StlReadOptions {
@@ -44,3 +45,4 @@ void WriteStl(const std::filesystem::path& path, const Points& nodes, const Tria
               StlFormat format = StlFormat::kBinary);
 
 }  // namespace gipsi
+GIPSI_EXPORT_END

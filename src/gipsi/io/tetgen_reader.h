@@ -7,7 +7,8 @@
 #include "gipsi/base/export.h"
 #include "gipsi/geometry/mesh.h"
 
-namespace GIPSI_EXPORT gipsi {
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
 
 /// Reads the TetGen mesh whose files share the stem of `path` (which may name the `.node`, the
 /// `.ele` or the `.face` file): `STEM.node` and `STEM.ele` are required, `STEM.face` is read
@@ -25,3 +26,4 @@ namespace GIPSI_EXPORT gipsi {
 Mesh ReadTetGen(const std::filesystem::path& path);
 
 }  // namespace gipsi
+GIPSI_EXPORT_END

@@ -16,8 +16,8 @@
 
 #include "gipsi/base/export.h"
 
-namespace GIPSI_EXPORT gipsi {
-namespace internal {
+GIPSI_EXPORT_BEGIN
+namespace gipsi::internal {
 
 /// Reads the whole file at `path` as bytes. Throws InputError `PATH: cannot open file` when it
 /// cannot be opened or read.
@@ -160,5 +160,5 @@ class TagMap {
   std::unordered_map<std::int64_t, int> map_;
 };
 
-}  // namespace internal
-}  // namespace gipsi
+}  // namespace gipsi::internal
+GIPSI_EXPORT_END

@@ -7,7 +7,8 @@
 #include "gipsi/base/export.h"
 #include "gipsi/geometry/mesh.h"
 
-namespace GIPSI_EXPORT gipsi {
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
 
 /// Reads a legacy VTK file, ASCII or BINARY (big-endian), with `DATASET UNSTRUCTURED_GRID` or
 /// `DATASET POLYDATA`.
@@ -27,3 +28,4 @@ namespace GIPSI_EXPORT gipsi {
 Mesh ReadVtkLegacy(const std::filesystem::path& path);
 
 }  // namespace gipsi
+GIPSI_EXPORT_END

@@ -7,7 +7,8 @@
 #include "gipsi/base/export.h"
 #include "gipsi/geometry/mesh.h"
 
-namespace GIPSI_EXPORT gipsi {
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
 
 /// Reads a VTK XML `UnstructuredGrid` file. Supported data arrays: `format="ascii"`,
 /// `format="binary"` (inline base64) and `format="appended"` (raw or base64 `AppendedData`),
@@ -24,3 +25,4 @@ namespace GIPSI_EXPORT gipsi {
 Mesh ReadVtu(const std::filesystem::path& path);
 
 }  // namespace gipsi
+GIPSI_EXPORT_END

@@ -15,7 +15,8 @@
 #include "gipsi/base/math.h"
 #include "gipsi/geometry/mesh.h"
 
-namespace GIPSI_EXPORT gipsi {
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
 
 /// A named data array attached to points or cells: `values` is `components` by count (column j
 /// holds the tuple of point or cell j). Plain data: copyable and movable.
@@ -109,3 +110,4 @@ class PvdWriter {
 };
 
 }  // namespace gipsi
+GIPSI_EXPORT_END

@@ -22,7 +22,8 @@
 #include "gipsi/geometry/mesh.h"
 #include "gipsi/geometry/region.h"
 
-namespace GIPSI_EXPORT gipsi {
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
 
 /// A cavity bounded by part of the boundary (an endocardium). Plain struct.
 struct CavitySpec {
@@ -79,3 +80,4 @@ std::size_t FindUncoupledCavity(std::string_view object, std::string_view type,
 }
 
 }  // namespace gipsi
+GIPSI_EXPORT_END

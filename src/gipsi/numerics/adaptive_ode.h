@@ -22,7 +22,8 @@
 #include "gipsi/base/state_value.h"
 #include "gipsi/numerics/ode.h"
 
-namespace GIPSI_EXPORT gipsi {
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
 
 /// Event functions for AdaptiveOde: `num_events()` values g_i(t, x); event i happens where g_i
 /// crosses zero upward (from ≤ 0 to > 0). A caller that wants a downward crossing negates its
@@ -175,3 +176,4 @@ class AdaptiveOde {
 };
 
 }  // namespace gipsi
+GIPSI_EXPORT_END

@@ -11,7 +11,8 @@
 
 #include "gipsi/base/export.h"
 
-namespace GIPSI_EXPORT gipsi {
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
 
 /// Root of h (increasing) near `guess`. `h(x, out)` sets out = h(x) and returns false if h
 /// cannot be evaluated there. `first_step(h(guess))` gives the signed first step of the
@@ -76,3 +77,4 @@ bool SolveIncreasingRoot(H&& h, double guess, FirstStep&& first_step, double tol
 }
 
 }  // namespace gipsi
+GIPSI_EXPORT_END

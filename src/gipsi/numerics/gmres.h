@@ -10,7 +10,8 @@
 #include "gipsi/base/export.h"
 #include "gipsi/base/math.h"
 
-namespace GIPSI_EXPORT gipsi {
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
 
 /// Options of Gmres. Plain struct.
 struct GmresOptions {
@@ -68,3 +69,4 @@ class Gmres {
 };
 
 }  // namespace gipsi
+GIPSI_EXPORT_END

@@ -23,7 +23,8 @@
 #include "gipsi/base/math.h"
 #include "gipsi/base/state_value.h"
 
-namespace GIPSI_EXPORT gipsi {
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
 
 class StateReader;
 class StateWriter;
@@ -96,3 +97,4 @@ class ImplicitScheme {
 };
 
 }  // namespace gipsi
+GIPSI_EXPORT_END

@@ -40,7 +40,8 @@
 #include "gipsi/base/stop_token.h"
 #include "gipsi/numerics/sparse/linear_solver.h"
 
-namespace GIPSI_EXPORT gipsi {
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
 
 class StateReader;
 class StateWriter;
@@ -223,3 +224,4 @@ std::string Describe(const NewtonStats& stats, const NewtonOptions& options,
                      std::string_view solver = {});
 
 }  // namespace gipsi
+GIPSI_EXPORT_END

@@ -14,7 +14,8 @@
 #include "gipsi/base/math.h"
 #include "gipsi/numerics/gmres.h"
 
-namespace GIPSI_EXPORT gipsi {
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
 
 /// Any type with a state size, a position count (0 for a general ODE) and a derivative.
 /// `CalcDerivative(t, x, xdot)` writes f(t, x) into xdot (both of size `ode_size()`) and must
@@ -184,3 +185,4 @@ class BackwardEulerOde final : public OdeIntegrator {
 };
 
 }  // namespace gipsi
+GIPSI_EXPORT_END

@@ -11,7 +11,8 @@
 #include "gipsi/base/math.h"
 #include "gipsi/numerics/sparse/linear_solver.h"
 
-namespace GIPSI_EXPORT gipsi {
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
 
 /// Plain struct of matrices (both triangles stored, compressed) and the lumped mass.
 struct P1ScalarOperators {
@@ -33,3 +34,4 @@ Eigen::Matrix<double, 4, 3> P1Gradients(const Points& nodes, const Tets& tets, I
                                         double* volume = nullptr);
 
 }  // namespace gipsi
+GIPSI_EXPORT_END

@@ -10,8 +10,8 @@
 #include "gipsi/base/export.h"
 #include "gipsi/viz/render_buffers.h"
 
-namespace GIPSI_EXPORT gipsi {
-namespace viz {
+GIPSI_EXPORT_BEGIN
+namespace gipsi::viz {
 
 /// Orbit camera looking at `target` from `distance`; the eye direction is given by `azimuth`
 /// (degrees about +z; 0 puts the eye on the -y side, 90 on the +x side) and `elevation`
@@ -46,5 +46,5 @@ struct Camera {
 /// InputError naming `where` and saying what was expected.
 void ParseCamera(std::string_view text, std::string_view where, Camera& camera);
 
-}  // namespace viz
-}  // namespace gipsi
+}  // namespace gipsi::viz
+GIPSI_EXPORT_END

@@ -11,8 +11,8 @@
 #include "gipsi/base/export.h"
 #include "gipsi/io/display_spec.h"
 
-namespace GIPSI_EXPORT gipsi {
-namespace viz {
+GIPSI_EXPORT_BEGIN
+namespace gipsi::viz {
 
 /// A named colour map, piecewise linear in sRGB between evenly spaced anchor colours.
 /// Copyable and movable.
@@ -43,5 +43,5 @@ class ColorMap {
 /// Colour used for NaN values.
 inline constexpr Rgb kNanColor{1.0f, 0.0f, 1.0f};
 
-}  // namespace viz
-}  // namespace gipsi
+}  // namespace gipsi::viz
+GIPSI_EXPORT_END

@@ -10,8 +10,8 @@
 
 #include "gipsi/base/export.h"
 
-namespace GIPSI_EXPORT gipsi {
-namespace viz {
+GIPSI_EXPORT_BEGIN
+namespace gipsi::viz {
 
 /// Columns of numbers by name. Copyable and movable.
 struct CsvTable {
@@ -32,5 +32,5 @@ struct CsvTable {
 /// something that is not a number.
 CsvTable ReadCsv(const std::filesystem::path& file);
 
-}  // namespace viz
-}  // namespace gipsi
+}  // namespace gipsi::viz
+GIPSI_EXPORT_END

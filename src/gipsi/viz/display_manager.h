@@ -17,8 +17,8 @@
 #include "gipsi/viz/color_map.h"
 #include "gipsi/viz/render_buffers.h"
 
-namespace GIPSI_EXPORT gipsi {
-namespace viz {
+GIPSI_EXPORT_BEGIN
+namespace gipsi::viz {
 
 /// Fills one object's `SurfaceBuffers` from its display geometry: its display surface
 /// (triangles), its springs or mesh edges (lines) or its nodes (points). Built once (it
@@ -136,5 +136,5 @@ void ApplyVisibility(const Kernel& kernel, const std::vector<std::string>& names
                      const std::vector<std::string>& show, const std::vector<std::string>& hide,
                      std::vector<bool>& hidden);
 
-}  // namespace viz
-}  // namespace gipsi
+}  // namespace gipsi::viz
+GIPSI_EXPORT_END

@@ -10,8 +10,8 @@
 #include "gipsi/core/kernel.h"
 #include "gipsi/viz/display_manager.h"
 
-namespace GIPSI_EXPORT gipsi {
-namespace viz {
+GIPSI_EXPORT_BEGIN
+namespace gipsi::viz {
 
 /// Publishes a `SceneDisplay` into `buffer` (which must outlive the kernel this observer is
 /// attached to). Not copyable or movable.
@@ -33,5 +33,5 @@ class DisplayPublisher final : public Observer {
   LatestValue<FrameBuffers>& buffer_;
 };
 
-}  // namespace viz
-}  // namespace gipsi
+}  // namespace gipsi::viz
+GIPSI_EXPORT_END

@@ -37,8 +37,8 @@
 #include "gipsi/core/sim_object.h"
 #include "gipsi/viz/render_buffers.h"
 
-namespace GIPSI_EXPORT gipsi {
-namespace viz {
+GIPSI_EXPORT_BEGIN
+namespace gipsi::viz {
 
 /// Where a ray first meets a surface of a frame. Plain struct.
 struct SurfaceHit {
@@ -114,5 +114,5 @@ class PullTool {
   Eigen::MatrixXd loads_;  // 3 by nodes: the object's external_force
 };
 
-}  // namespace viz
-}  // namespace gipsi
+}  // namespace gipsi::viz
+GIPSI_EXPORT_END

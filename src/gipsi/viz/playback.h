@@ -7,8 +7,8 @@
 
 #include "gipsi/base/export.h"
 
-namespace GIPSI_EXPORT gipsi {
-namespace viz {
+GIPSI_EXPORT_BEGIN
+namespace gipsi::viz {
 
 /// The viewer's choice at the end of the schedule (`gipsi view --at-end`).
 enum class AtEnd {
@@ -30,5 +30,5 @@ enum class PlayStep { kStep, kPause, kRestart };
 PlayStep NextPlayStep(double time, double end_time, double macro_dt, AtEnd at_end,
                       bool running_until);
 
-}  // namespace viz
-}  // namespace gipsi
+}  // namespace gipsi::viz
+GIPSI_EXPORT_END

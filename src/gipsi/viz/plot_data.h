@@ -12,8 +12,8 @@
 #include "gipsi/io/plot_spec.h"
 #include "gipsi/io/probes.h"
 
-namespace GIPSI_EXPORT gipsi {
-namespace viz {
+GIPSI_EXPORT_BEGIN
+namespace gipsi::viz {
 
 /// A plot's data, ready to draw. Plain struct.
 struct PlotData {
@@ -58,5 +58,5 @@ struct ColumnDisplay {
 ColumnDisplay DisplayOfColumn(const Probe& probe, const std::string& column,
                               const std::vector<PlotSpec>& plots);
 
-}  // namespace viz
-}  // namespace gipsi
+}  // namespace gipsi::viz
+GIPSI_EXPORT_END

@@ -13,8 +13,8 @@
 #include "gipsi/base/export.h"
 #include "gipsi/io/display_spec.h"  // Primitive
 
-namespace GIPSI_EXPORT gipsi {
-namespace viz {
+GIPSI_EXPORT_BEGIN
+namespace gipsi::viz {
 
 /// One object's display geometry (a surface, a line set or a point set). Vectors are flat,
 /// vertex-major (x0 y0 z0 x1 ...), ready for OpenGL vertex buffers. Copyable and movable; refilling
@@ -71,5 +71,5 @@ struct FrameBuffers {
   std::vector<ProbeTrace> traces;  ///< filled by viewers that plot probes live
 };
 
-}  // namespace viz
-}  // namespace gipsi
+}  // namespace gipsi::viz
+GIPSI_EXPORT_END

@@ -18,7 +18,8 @@
 
 #include "gipsi/base/export.h"
 
-namespace GIPSI_EXPORT gipsi {
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
 
 /// Parameters of an activation curve. Plain struct; copyable. Call Normalise() after setting
 /// the double-Hill parameters (the factory does).
@@ -44,3 +45,4 @@ struct Activation {
 };
 
 }  // namespace gipsi
+GIPSI_EXPORT_END

@@ -28,7 +28,8 @@
 #include "gipsi/models/circulation/valve.h"
 #include "gipsi/numerics/adaptive_ode.h"
 
-namespace GIPSI_EXPORT gipsi {
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
 
 /// A blood-holding compartment. Plain struct; copyable.
 struct CompartmentSpec {
@@ -199,3 +200,4 @@ class Circuit {
 };
 
 }  // namespace gipsi
+GIPSI_EXPORT_END

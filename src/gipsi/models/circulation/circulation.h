@@ -23,7 +23,8 @@
 #include "gipsi/core/sim_object.h"
 #include "gipsi/models/circulation/circuit.h"
 
-namespace GIPSI_EXPORT gipsi {
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
 
 /// Everything a Circulation is built from. Plain struct; copyable.
 struct CirculationParams {
@@ -172,3 +173,4 @@ class Circulation final : public SimObject, public LumpedChambers {
 void RegisterCirculation(TypeRegistry& registry);
 
 }  // namespace gipsi
+GIPSI_EXPORT_END

@@ -16,7 +16,8 @@
 
 #include "gipsi/base/export.h"
 
-namespace GIPSI_EXPORT gipsi {
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
 
 /// The discrete state of a valve.
 enum class ValveState : std::uint8_t { kClosed, kOpen };
@@ -84,3 +85,4 @@ class ValveEventLog {
 };
 
 }  // namespace gipsi
+GIPSI_EXPORT_END

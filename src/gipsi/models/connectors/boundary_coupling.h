@@ -20,7 +20,8 @@
 #include "gipsi/geometry/mapping.h"
 #include "gipsi/geometry/region.h"
 
-namespace GIPSI_EXPORT gipsi {
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
 
 /// Not copyable or movable.
 class BoundaryCoupling final : public Connector {
@@ -51,3 +52,4 @@ class BoundaryCoupling final : public Connector {
 void RegisterBoundaryCoupling(TypeRegistry& registry);
 
 }  // namespace gipsi
+GIPSI_EXPORT_END

@@ -32,7 +32,8 @@
 #include "gipsi/core/registry.h"
 #include "gipsi/core/sim_object.h"
 
-namespace GIPSI_EXPORT gipsi {
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
 
 /// Not copyable or movable (a Connector).
 class CavityCoupling final : public Connector, public CavityLaw {
@@ -69,3 +70,4 @@ class CavityCoupling final : public Connector, public CavityLaw {
 void RegisterCavityCoupling(TypeRegistry& registry);
 
 }  // namespace gipsi
+GIPSI_EXPORT_END

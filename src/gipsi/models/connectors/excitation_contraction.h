@@ -25,7 +25,8 @@
 #include "gipsi/core/sim_object.h"
 #include "gipsi/geometry/mapping.h"
 
-namespace GIPSI_EXPORT gipsi {
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
 
 /// Parameters. Plain struct with defaults (a demonstration twitch: about 40 kPa after 300 ms of
 /// excitation, relaxing with a 33 ms time constant; not fitted to data).
@@ -72,3 +73,4 @@ class ExcitationContraction final : public Connector {
 void RegisterExcitationContraction(TypeRegistry& registry);
 
 }  // namespace gipsi
+GIPSI_EXPORT_END

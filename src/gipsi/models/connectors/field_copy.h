@@ -23,7 +23,8 @@
 #include "gipsi/core/registry.h"
 #include "gipsi/geometry/mapping.h"
 
-namespace GIPSI_EXPORT gipsi {
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
 
 /// Not copyable or movable.
 class FieldCopy final : public Connector {
@@ -62,3 +63,4 @@ class FieldCopy final : public Connector {
 void RegisterFieldCopy(TypeRegistry& registry);
 
 }  // namespace gipsi
+GIPSI_EXPORT_END

@@ -5,7 +5,8 @@
 #include "gipsi/base/export.h"
 #include "gipsi/core/sim_object.h"
 
-namespace GIPSI_EXPORT gipsi {
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
 
 /// 3 by count rest positions of the items of a field at `location` on `object`: domain nodes,
 /// element centroids, boundary vertices or boundary face centroids. Global fields have none
@@ -13,3 +14,4 @@ namespace GIPSI_EXPORT gipsi {
 Points ItemRestPositions(const SimObject& object, FieldLocation location);
 
 }  // namespace gipsi
+GIPSI_EXPORT_END

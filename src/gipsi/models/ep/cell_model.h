@@ -24,7 +24,8 @@
 #include "gipsi/base/export.h"
 #include "gipsi/base/state_value.h"
 
-namespace GIPSI_EXPORT gipsi {
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
 
 class CellModel;
 
@@ -181,3 +182,4 @@ struct VoltageScale {
 };
 
 }  // namespace gipsi
+GIPSI_EXPORT_END

@@ -16,7 +16,8 @@
 #include "gipsi/core/registry.h"
 #include "gipsi/models/ep/cell_model.h"
 
-namespace GIPSI_EXPORT gipsi {
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
 
 /// Builds a cardiac cell model from its JSON object ({"model": name, ...parameters}); throws
 /// InputError naming the JSON path of a bad parameter.
@@ -41,3 +42,4 @@ std::shared_ptr<const CellModel> CreateCellModel(const TypeRegistry& registry,
                                                  const JsonNode& node);
 
 }  // namespace gipsi
+GIPSI_EXPORT_END

@@ -9,7 +9,8 @@
 #include "gipsi/base/json_node.h"
 #include "gipsi/models/ep/cell_model.h"
 
-namespace GIPSI_EXPORT gipsi {
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
 
 /// node[key], a number strictly between 0 and 1, or `fallback` when absent.
 double ReadFraction(const JsonNode& node, std::string_view key, double fallback);
@@ -19,3 +20,4 @@ double ReadFraction(const JsonNode& node, std::string_view key, double fallback)
 VoltageScale ReadVoltageScale(const JsonNode& node, const VoltageScale& fallback);
 
 }  // namespace gipsi
+GIPSI_EXPORT_END

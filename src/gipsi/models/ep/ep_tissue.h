@@ -33,7 +33,8 @@
 #include "gipsi/models/fibres/rule_based_fibres.h"
 #include "gipsi/numerics/sparse/linear_solver.h"
 
-namespace GIPSI_EXPORT gipsi {
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
 
 /// A train of rectangular pulses (times in ms): pulse k (0 ≤ k < count) is active on
 /// [start + k·period, start + k·period + duration). Plain struct.
@@ -209,3 +210,4 @@ class EpTissue : public SimObject {
 };
 
 }  // namespace gipsi
+GIPSI_EXPORT_END

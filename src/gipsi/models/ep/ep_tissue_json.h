@@ -10,7 +10,8 @@
 #include "gipsi/core/registry.h"
 #include "gipsi/models/ep/ep_tissue.h"
 
-namespace GIPSI_EXPORT gipsi {
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
 
 /// Checks that the object's keys are the common ones, the EP tissue keys, or `extra`.
 void CheckEpTissueKeys(const ObjectBuildContext& ctx, const std::vector<std::string>& extra = {});
@@ -20,3 +21,4 @@ void CheckEpTissueKeys(const ObjectBuildContext& ctx, const std::vector<std::str
 EpTissueParams ParseEpTissueParams(const ObjectBuildContext& ctx);
 
 }  // namespace gipsi
+GIPSI_EXPORT_END

@@ -26,7 +26,8 @@
 #include "gipsi/core/registry.h"
 #include "gipsi/models/ep/ep_tissue.h"
 
-namespace GIPSI_EXPORT gipsi {
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
 
 /// A regular grid [min, max] with `cells` cells per axis (scene units, m). Plain struct.
 struct CartesianGrid {
@@ -70,3 +71,4 @@ class GridMonodomain final : public EpTissue {
 void RegisterGridMonodomain(TypeRegistry& registry);
 
 }  // namespace gipsi
+GIPSI_EXPORT_END

@@ -11,7 +11,8 @@
 
 #include "gipsi/base/export.h"
 
-namespace GIPSI_EXPORT gipsi {
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
 
 /// `num_columns` functions tabulated at x_min, x_min + dx, ..., x_max, row-major (the columns of
 /// one x are contiguous, so an interpolation reads two adjacent rows). Immutable after
@@ -69,3 +70,4 @@ class LookupTable {
 };
 
 }  // namespace gipsi
+GIPSI_EXPORT_END

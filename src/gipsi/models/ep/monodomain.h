@@ -15,7 +15,8 @@
 #include "gipsi/core/registry.h"
 #include "gipsi/models/ep/ep_tissue.h"
 
-namespace GIPSI_EXPORT gipsi {
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
 
 /// Not copyable or movable (a SimObject).
 class Monodomain final : public EpTissue {
@@ -44,3 +45,4 @@ class Monodomain final : public EpTissue {
 void RegisterMonodomain(TypeRegistry& registry);
 
 }  // namespace gipsi
+GIPSI_EXPORT_END

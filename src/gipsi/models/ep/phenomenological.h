@@ -17,7 +17,8 @@
 #include "gipsi/base/json_node.h"
 #include "gipsi/models/ep/cell_model.h"
 
-namespace GIPSI_EXPORT gipsi {
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
 
 /// Parameters of AlievPanfilov (defaults: the paper's). Trivially copyable.
 struct AlievPanfilovParams {
@@ -168,3 +169,4 @@ class FitzHughNagumo final : public CellModel {
 };
 
 }  // namespace gipsi
+GIPSI_EXPORT_END

@@ -27,8 +27,8 @@
 
 #include "gipsi/base/export.h"
 
-namespace GIPSI_EXPORT gipsi {
-namespace simd {
+GIPSI_EXPORT_BEGIN
+namespace gipsi::simd {
 
 /// `x`, read back through a volatile so that the optimiser cannot see the value (see the file
 /// comment): for constants selected inside a vectorised loop, e.g. `open ? one : zero`. Call
@@ -112,5 +112,5 @@ struct ExpRange {
   return k * kLn2Hi + (log_m + k * kLn2Lo);
 }
 
-}  // namespace simd
-}  // namespace gipsi
+}  // namespace gipsi::simd
+GIPSI_EXPORT_END

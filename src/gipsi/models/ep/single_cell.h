@@ -15,7 +15,8 @@
 #include "gipsi/base/export.h"
 #include "gipsi/models/ep/cell_model.h"
 
-namespace GIPSI_EXPORT gipsi {
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
 
 /// How to pace the cell. Plain configuration; copyable.
 ///
@@ -72,3 +73,4 @@ SingleCellResult PaceSingleCell(const CellModel& model, const PacingProtocol& pr
 std::string CellTraceCsvHeader(const CellModel& model);
 
 }  // namespace gipsi
+GIPSI_EXPORT_END

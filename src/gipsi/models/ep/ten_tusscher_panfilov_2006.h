@@ -47,7 +47,8 @@
 #include "gipsi/models/ep/cell_model.h"
 #include "gipsi/models/ep/lookup_table.h"
 
-namespace GIPSI_EXPORT gipsi {
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
 
 struct TenTusscherPanfilov2006Constants;  // derived from the parameters; internal to the .cc
 
@@ -159,3 +160,4 @@ class TenTusscherPanfilov2006 final : public CellModel {
 };
 
 }  // namespace gipsi
+GIPSI_EXPORT_END

@@ -5,7 +5,8 @@
 #include "gipsi/base/export.h"
 #include "gipsi/base/math.h"
 
-namespace GIPSI_EXPORT gipsi {
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
 
 /// Orthonormal material axes as columns (fibre f, sheet s, sheet-normal n = f × s): f is the
 /// normalised `fibre` (non-zero), s the part of `sheet` orthogonal to it, normalised (any unit
@@ -30,3 +31,4 @@ inline Mat3 CrossMatrix(const Vec3& u) {
 }
 
 }  // namespace gipsi
+GIPSI_EXPORT_END

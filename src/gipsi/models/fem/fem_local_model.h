@@ -15,7 +15,8 @@
 #include "gipsi/core/local_model.h"
 #include "gipsi/numerics/sparse/linear_solver.h"
 
-namespace GIPSI_EXPORT gipsi {
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
 
 class FemSolid;
 
@@ -44,3 +45,4 @@ class FemCondensation final : public LocalModelBuilder {
 };
 
 }  // namespace gipsi
+GIPSI_EXPORT_END

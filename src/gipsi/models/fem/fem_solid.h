@@ -44,7 +44,8 @@
 #include "gipsi/numerics/newton.h"
 #include "gipsi/numerics/ode.h"
 
-namespace GIPSI_EXPORT gipsi {
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
 
 /// Parameters. Plain struct with defaults.
 struct FemParams {
@@ -280,3 +281,4 @@ class FemSolid final : public SimObject, public CavityWall {
 void RegisterFemSolid(TypeRegistry& registry);
 
 }  // namespace gipsi
+GIPSI_EXPORT_END

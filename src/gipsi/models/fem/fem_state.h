@@ -15,7 +15,8 @@
 #include "gipsi/numerics/implicit_scheme.h"
 #include "gipsi/numerics/newton.h"
 
-namespace GIPSI_EXPORT gipsi {
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
 
 /// A coupled or pressure-driven cavity's state. Copyable.
 struct FemCavityState {
@@ -72,3 +73,4 @@ struct FemState {
 };
 
 }  // namespace gipsi
+GIPSI_EXPORT_END

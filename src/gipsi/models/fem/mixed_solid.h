@@ -63,7 +63,8 @@
 #include "gipsi/models/fem/solid_material.h"
 #include "gipsi/numerics/newton.h"
 
-namespace GIPSI_EXPORT gipsi {
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
 
 /// Parameters. Plain struct with defaults.
 struct MixedSolidParams {
@@ -204,3 +205,4 @@ class MixedSolid final : public SimObject {
 void RegisterMixedSolid(TypeRegistry& registry);
 
 }  // namespace gipsi
+GIPSI_EXPORT_END

@@ -14,7 +14,8 @@
 #include "gipsi/base/state_value.h"
 #include "gipsi/numerics/newton.h"
 
-namespace GIPSI_EXPORT gipsi {
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
 
 /// Copyable. Shapes: N P2 nodes, V vertices, E elements, F boundary faces.
 struct MixedState {
@@ -53,3 +54,4 @@ struct MixedState {
 };
 
 }  // namespace gipsi
+GIPSI_EXPORT_END

@@ -31,7 +31,8 @@
 #include "gipsi/base/math.h"
 #include "gipsi/geometry/mesh.h"
 
-namespace GIPSI_EXPORT gipsi {
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
 
 /// Local vertex pairs of the six edge midpoints of a 10-node tet (nodes 4..9).
 inline constexpr int kTetEdges[6][2] = {{0, 1}, {1, 2}, {0, 2}, {0, 3}, {1, 3}, {2, 3}};
@@ -88,3 +89,4 @@ struct TriangleQuadrature {
 [[nodiscard]] const TriangleQuadrature& TriangleRuleDegree4();
 
 }  // namespace gipsi
+GIPSI_EXPORT_END

@@ -34,7 +34,8 @@
 #include "gipsi/base/export.h"
 #include "gipsi/models/fem/solid_material.h"
 
-namespace GIPSI_EXPORT gipsi {
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
 
 /// Smallest J = det F accepted by the laws with ln J (dimensionless).
 inline constexpr double kMinJacobian = 1e-12;
@@ -224,3 +225,4 @@ class GuccioneSolid final : public SolidMaterial {
 };
 
 }  // namespace gipsi
+GIPSI_EXPORT_END

@@ -15,7 +15,8 @@
 #include "gipsi/core/material.h"
 #include "gipsi/core/registry.h"
 
-namespace GIPSI_EXPORT gipsi {
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
 
 using Mat9 = Eigen::Matrix<double, 9, 9>;
 /// Stiffness matrix of one P1 tetrahedron: row 3a + i, column 3b + k (a, b local nodes).
@@ -74,3 +75,4 @@ class SolidMaterial : public Material {
 void RegisterSolidLaws(TypeRegistry& registry);
 
 }  // namespace gipsi
+GIPSI_EXPORT_END

@@ -6,7 +6,8 @@
 #include "gipsi/base/json_node.h"
 #include "gipsi/numerics/newton.h"
 
-namespace GIPSI_EXPORT gipsi {
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
 
 /// The "newton" object of a solid (keys in docs/scene-format.md) over `defaults`; throws
 /// InputError naming the JSON path of a bad value.
@@ -17,3 +18,4 @@ namespace GIPSI_EXPORT gipsi {
 void ParseLoadStepping(const JsonNode& object, int& load_steps, int& max_bisections);
 
 }  // namespace gipsi
+GIPSI_EXPORT_END

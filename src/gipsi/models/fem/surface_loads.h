@@ -15,7 +15,8 @@
 #include "gipsi/base/export.h"
 #include "gipsi/base/math.h"
 
-namespace GIPSI_EXPORT gipsi {
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
 
 using Mat99 = Eigen::Matrix<double, 9, 9>;
 
@@ -30,3 +31,4 @@ void FaceLoads(const Vec3& x0, const Vec3& x1, const Vec3& x2, double p, const V
 Mat99 FaceLoadJacobian(const Vec3& x0, const Vec3& x1, const Vec3& x2, double p, const Vec3& t);
 
 }  // namespace gipsi
+GIPSI_EXPORT_END

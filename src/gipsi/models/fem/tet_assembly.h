@@ -22,7 +22,8 @@
 #include "gipsi/geometry/mesh.h"
 #include "gipsi/numerics/sparse/linear_solver.h"
 
-namespace GIPSI_EXPORT gipsi {
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
 
 /// Precomputed data for one tet mesh. Immutable after construction; copyable and movable.
 class TetAssembly {
@@ -128,3 +129,4 @@ class TetAssembly {
 };
 
 }  // namespace gipsi
+GIPSI_EXPORT_END

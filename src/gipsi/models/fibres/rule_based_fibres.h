@@ -17,7 +17,8 @@
 #include "gipsi/geometry/mesh.h"
 #include "gipsi/geometry/region.h"
 
-namespace GIPSI_EXPORT gipsi {
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
 
 /// The rule's inputs. Plain struct with defaults (±60°, a common choice for the human LV).
 struct TransmuralFibreRule {
@@ -51,3 +52,4 @@ FibreField MakeTransmuralFibres(const Mesh& mesh, const TransmuralFibreRule& rul
 TransmuralFibreRule ParseTransmuralFibreRule(const JsonNode& node);
 
 }  // namespace gipsi
+GIPSI_EXPORT_END

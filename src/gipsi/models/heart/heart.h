@@ -22,7 +22,8 @@
 #include "gipsi/core/aggregate.h"
 #include "gipsi/core/registry.h"
 
-namespace GIPSI_EXPORT gipsi {
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
 
 /// Which blood fields the monitor reads. Plain struct.
 struct HeartMonitorSpec {
@@ -88,3 +89,4 @@ class Heart final : public AggregateObject {
 void RegisterHeart(TypeRegistry& registry);
 
 }  // namespace gipsi
+GIPSI_EXPORT_END

@@ -78,7 +78,8 @@
 #include "gipsi/models/wall_cavity.h"
 #include "gipsi/numerics/ode.h"
 
-namespace GIPSI_EXPORT gipsi {
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
 
 /// A cavity's state. Copyable.
 struct MassSpringCavityState {
@@ -280,3 +281,4 @@ class MassSpring final : public SimObject, public CavityWall {
 void RegisterMassSpring(TypeRegistry& registry);
 
 }  // namespace gipsi
+GIPSI_EXPORT_END

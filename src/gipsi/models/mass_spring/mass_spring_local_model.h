@@ -10,7 +10,8 @@
 #include "gipsi/base/export.h"
 #include "gipsi/core/local_model.h"
 
-namespace GIPSI_EXPORT gipsi {
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
 
 class MassSpring;
 
@@ -36,3 +37,4 @@ class MassSpringNeighbourhood final : public LocalModelBuilder {
 };
 
 }  // namespace gipsi
+GIPSI_EXPORT_END

@@ -15,7 +15,8 @@
 #include "gipsi/core/material.h"
 #include "gipsi/core/registry.h"
 
-namespace GIPSI_EXPORT gipsi {
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
 
 /// Not copyable; immutable after construction.
 class SpringLaw : public Material {
@@ -68,3 +69,4 @@ class ExponentialSpring final : public SpringLaw {
 void RegisterSpringLaws(TypeRegistry& registry);
 
 }  // namespace gipsi
+GIPSI_EXPORT_END

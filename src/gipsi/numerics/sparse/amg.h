@@ -43,7 +43,8 @@
 #include "gipsi/numerics/sparse/linear_solver.h"
 #include "gipsi/numerics/sparse/node_block_copy.h"
 
-namespace GIPSI_EXPORT gipsi {
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
 
 /// See the file comment. Not copyable; not movable (holds a CHOLMOD factor).
 class SmoothedAggregationAmg {
@@ -123,3 +124,4 @@ class SmoothedAggregationAmg {
 };
 
 }  // namespace gipsi
+GIPSI_EXPORT_END

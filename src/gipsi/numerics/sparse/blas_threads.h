@@ -17,7 +17,8 @@
 
 #include "gipsi/base/export.h"
 
-namespace GIPSI_EXPORT gipsi {
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
 
 /// What `UseSingleThreadedBlas` did.
 struct BlasThreadsResult {
@@ -37,3 +38,4 @@ BlasThreadsResult UseSingleThreadedBlas(const SymbolLookup& lookup);
 void UseSingleThreadedBlasOnce();
 
 }  // namespace gipsi
+GIPSI_EXPORT_END

@@ -23,7 +23,8 @@
 #include "gipsi/base/json_node.h"
 #include "gipsi/base/math.h"
 
-namespace GIPSI_EXPORT gipsi {
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
 
 /// Square sparse matrix, compressed columns, 32-bit indices. Symmetric matrices store both
 /// triangles, so a column is also a row (SpMV can run row-parallel).
@@ -156,3 +157,4 @@ std::unique_ptr<LinearSolver> MakeLinearSolver(const LinearSolverOptions& option
 LinearSolverOptions ParseLinearSolverOptions(const JsonNode& node);
 
 }  // namespace gipsi
+GIPSI_EXPORT_END

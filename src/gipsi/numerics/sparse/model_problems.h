@@ -11,7 +11,8 @@
 #include "gipsi/base/math.h"
 #include "gipsi/numerics/sparse/linear_solver.h"
 
-namespace GIPSI_EXPORT gipsi {
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
 
 /// The 7-point Laplacian (6 on the diagonal, −1 to each grid neighbour, homogeneous Dirichlet
 /// outside) on an n×n×n grid of unknowns, plus `shift`·I. n³ rows, lexicographic order (x
@@ -31,3 +32,4 @@ using StiffnessField = std::function<double(const Vec3&)>;
 SparseMatrix MakeSpringLattice3D(int n, double shift, const StiffnessField& stiffness = {});
 
 }  // namespace gipsi
+GIPSI_EXPORT_END

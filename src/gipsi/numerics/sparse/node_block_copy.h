@@ -16,7 +16,8 @@
 #include "gipsi/base/export.h"
 #include "gipsi/numerics/sparse/linear_solver.h"
 
-namespace GIPSI_EXPORT gipsi {
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
 
 class NodeBlockCopy {
  public:
@@ -51,3 +52,4 @@ class NodeBlockCopy {
 };
 
 }  // namespace gipsi
+GIPSI_EXPORT_END

@@ -17,7 +17,8 @@
 #include "gipsi/base/export.h"
 #endif
 
-namespace GIPSI_EXPORT gipsi {
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
 
 /// Scope guard; not copyable.
 class SerialOpenMp {
@@ -41,3 +42,4 @@ class SerialOpenMp {
 };
 
 }  // namespace gipsi
+GIPSI_EXPORT_END

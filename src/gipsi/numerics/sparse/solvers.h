@@ -8,7 +8,8 @@
 #include "gipsi/base/export.h"
 #include "gipsi/numerics/sparse/linear_solver.h"
 
-namespace GIPSI_EXPORT gipsi {
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
 
 /// Preconditioned CG (pcg.cc). `options` must already be validated (type "cg", known
 /// preconditioner, tolerance > 0, max_iterations ≥ 1).
@@ -31,3 +32,4 @@ bool AllValuesFinite(const SparseMatrix& A);
 void CheckAnalysedShape(const SparseMatrix& A, Index rows, Index nonzeros, const char* who);
 
 }  // namespace gipsi
+GIPSI_EXPORT_END

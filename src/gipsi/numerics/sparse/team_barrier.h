@@ -30,7 +30,8 @@
 #include "gipsi/base/export.h"
 #endif
 
-namespace GIPSI_EXPORT gipsi {
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
 
 /// The number of cores this process may run on (its affinity mask; at least 1), read once.
 int AvailableCores();
@@ -81,3 +82,4 @@ class TeamBarrier {
 };
 
 }  // namespace gipsi
+GIPSI_EXPORT_END

@@ -14,7 +14,8 @@
 #include "gipsi/base/export.h"
 #include "gipsi/base/math.h"
 
-namespace GIPSI_EXPORT gipsi {
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
 
 /// Ranges shorter than this run serially: a parallel region costs a few microseconds.
 inline constexpr Index kMinParallelLength = 8192;
@@ -83,3 +84,4 @@ inline void ParallelXpby(const VecX& x, double beta, VecX& y) {
 }
 
 }  // namespace gipsi
+GIPSI_EXPORT_END

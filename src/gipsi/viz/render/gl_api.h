@@ -13,8 +13,8 @@
 
 #include "gipsi/base/export.h"
 
-namespace GIPSI_EXPORT gipsi {
-namespace viz {
+GIPSI_EXPORT_BEGIN
+namespace gipsi::viz {
 
 // clang-format off
 #define GIPSI_GL_FUNCTIONS(X) \
@@ -48,5 +48,5 @@ struct GlApi {
   std::string Load(GetProc get_proc);
 };
 
-}  // namespace viz
-}  // namespace gipsi
+}  // namespace gipsi::viz
+GIPSI_EXPORT_END

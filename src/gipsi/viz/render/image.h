@@ -10,8 +10,8 @@
 #include "gipsi/base/export.h"
 #include "gipsi/viz/color_map.h"
 
-namespace GIPSI_EXPORT gipsi {
-namespace viz {
+GIPSI_EXPORT_BEGIN
+namespace gipsi::viz {
 
 /// Width by height RGB pixels, rows top to bottom. Copyable and movable.
 struct Image {
@@ -34,5 +34,5 @@ Image ReadPng(const std::filesystem::path& file);
 /// Preconditions (checked): the size is a multiple of `factor`.
 Image Downsample(const Image& image, int factor);
 
-}  // namespace viz
-}  // namespace gipsi
+}  // namespace gipsi::viz
+GIPSI_EXPORT_END

@@ -16,8 +16,8 @@
 #include "gipsi/viz/render/surface_renderer.h"
 #include "gipsi/viz/render_buffers.h"
 
-namespace GIPSI_EXPORT gipsi {
-namespace viz {
+GIPSI_EXPORT_BEGIN
+namespace gipsi::viz {
 
 /// A software OpenGL 3.3 core context drawing into memory. Makes itself current on the
 /// constructing thread. Not copyable or movable.
@@ -65,5 +65,5 @@ void DrawLabels(Image& image, const FrameBuffers& frame, const RenderOptions& re
 /// to the time it wants drawn. Throws std::runtime_error if rendering is unavailable.
 Image RenderFrame(const FrameBuffers& frame, FrameImageOptions options, std::string* gl = nullptr);
 
-}  // namespace viz
-}  // namespace gipsi
+}  // namespace gipsi::viz
+GIPSI_EXPORT_END

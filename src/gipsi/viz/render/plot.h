@@ -9,8 +9,8 @@
 #include "gipsi/base/export.h"
 #include "gipsi/viz/plot_data.h"
 
-namespace GIPSI_EXPORT gipsi {
-namespace viz {
+GIPSI_EXPORT_BEGIN
+namespace gipsi::viz {
 
 /// Line colours of the series, in order (then repeated), as 0xRRGGBB.
 inline constexpr unsigned kPlotColors[] = {0x1f77b4, 0xff7f0e, 0x2ca02c, 0xd62728,
@@ -28,5 +28,5 @@ void WritePlot(const PlotData& data, const std::filesystem::path& file);
 std::vector<std::filesystem::path> WritePlots(const std::vector<PlotSpec>& specs,
                                               const std::filesystem::path& directory);
 
-}  // namespace viz
-}  // namespace gipsi
+}  // namespace gipsi::viz
+GIPSI_EXPORT_END

@@ -14,8 +14,8 @@
 #include "gipsi/viz/render/gl_api.h"
 #include "gipsi/viz/render_buffers.h"
 
-namespace GIPSI_EXPORT gipsi {
-namespace viz {
+GIPSI_EXPORT_BEGIN
+namespace gipsi::viz {
 
 /// What to draw besides the surfaces. Plain struct.
 struct RenderOptions {
@@ -82,5 +82,5 @@ class SurfaceRenderer {
   GpuMesh bar_;
 };
 
-}  // namespace viz
-}  // namespace gipsi
+}  // namespace gipsi::viz
+GIPSI_EXPORT_END

@@ -12,8 +12,8 @@
 #include "gipsi/base/export.h"
 #include "gipsi/viz/render/image.h"
 
-namespace GIPSI_EXPORT gipsi {
-namespace viz {
+GIPSI_EXPORT_BEGIN
+namespace gipsi::viz {
 
 /// Not copyable; movable.
 class TextPainter {
@@ -39,5 +39,5 @@ class TextPainter {
 /// Where the font is looked for.
 inline constexpr const char* kFontFile = "/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf";
 
-}  // namespace viz
-}  // namespace gipsi
+}  // namespace gipsi::viz
+GIPSI_EXPORT_END
