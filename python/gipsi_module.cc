@@ -398,44 +398,49 @@ PYBIND11_MODULE(gipsi, m) {
       .def("write_outputs", &Simulation::WriteOutputs, py::arg("directory") = py::none(),
            "Writes the scene's VTU/PVD series and probe CSVs while it runs, as gipsi run does.");
 
+  // Python-written types go into the module's dicts `_object_types` and `_connector_types`,
+  // which every simulation loaded later adds to its registry (python_types.cc).
   m.attr("_object_types") = py::dict();
+  m.attr("_connector_types") = py::dict();
+  const auto add_type = [](const char* function, const char* kind, const char* dict, bool built_in,
+                           const std::string& type, const py::object& factory,
+                           const std::string& description) {
+    if (!PyCallable_Check(factory.ptr()))
+      throw py::type_error(
+          fmt::format("{}: the factory must be callable (name, params)", function));
+    if (built_in)
+      throw py::value_error(fmt::format("{}: '{}' is a built-in {} type", function, type, kind));
+    py::dict types = py::module_::import("gipsi").attr(dict);
+    types[py::str(type)] = py::make_tuple(factory, "(Python) " + description);
+  };
   m.def(
       "register_object",
-      [](const std::string& type, const py::object& factory, const std::string& description) {
-        if (!PyCallable_Check(factory.ptr()))
-          throw py::type_error("register_object: the factory must be callable (name, params)");
+      [add_type](const std::string& type, const py::object& factory,
+                 const std::string& description) {
         TypeRegistry builtins;
         RegisterBuiltins(builtins);
-        if (builtins.objects.Contains(type))
-          throw py::value_error(
-              fmt::format("register_object: '{}' is a built-in object type", type));
-        py::dict types = py::module_::import("gipsi").attr("_object_types");
-        types[py::str(type)] = py::make_tuple(factory, "(Python) " + description);
+        add_type("register_object", "object", "_object_types", builtins.objects.Contains(type),
+                 type, factory, description);
       },
       py::arg("type"), py::arg("factory"), py::arg("description") = "",
       "Registers an object type written in Python for the simulations loaded after it: "
-      "factory(name, params) returns an object with `fields` and step/read/write (see "
-      "docs/python.md). Registering a name again replaces it; a built-in name is refused when a "
-      "scene is loaded.");
-  m.attr("_connector_types") = py::dict();
+      "factory(name, params) returns an object with `fields` and step/read/write (e.g. a "
+      "gipsi.ObjectBase subclass; see docs/python.md). Registering a name again replaces it; a "
+      "built-in type's name is refused.");
   m.def(
       "register_connector",
-      [](const std::string& type, const py::object& factory, const std::string& description) {
-        if (!PyCallable_Check(factory.ptr()))
-          throw py::type_error("register_connector: the factory must be callable (name, params)");
+      [add_type](const std::string& type, const py::object& factory,
+                 const std::string& description) {
         TypeRegistry builtins;
         RegisterBuiltins(builtins);
-        if (builtins.connectors.Contains(type))
-          throw py::value_error(
-              fmt::format("register_connector: '{}' is a built-in connector type", type));
-        py::dict types = py::module_::import("gipsi").attr("_connector_types");
-        types[py::str(type)] = py::make_tuple(factory, "(Python) " + description);
+        add_type("register_connector", "connector", "_connector_types",
+                 builtins.connectors.Contains(type), type, factory, description);
       },
       py::arg("type"), py::arg("factory"), py::arg("description") = "",
       "Registers a connector type written in Python for the simulations loaded after it: "
       "factory(name, params) returns an object with `ports`, `parameters` and fire(t, values) "
       "(e.g. a gipsi.ConnectorBase subclass; see docs/python.md). Registering a name again "
-      "replaces it.");
+      "replaces it; a built-in type's name is refused.");
   // Base classes that document the protocols (any object with these attributes will do).
   py::exec(R"py(
 import numpy as _numpy
