@@ -25,6 +25,7 @@
 #include <thread>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <CLI/CLI.hpp>
 
 #include "cli_checks.h"
@@ -341,7 +342,7 @@ int Run(const std::string& file, const std::string& out_dir, double until, bool 
           fmt::format("the scene's HapticProbe '{}' is real-time (objects.{}.realtime): a "
                       "real-time run is not deterministic and cannot be checkpointed or resumed; "
                       "drop \"realtime\" for a reproducible run",
-                      probes.front()->name(), probes.front()->name()));
+                      probes.front().object->name(), probes.front().object->name()));
   if (checkpoints.every > 0) {
     const double steps = checkpoints.every / kernel.macro_dt();
     const auto every = static_cast<std::int64_t>(std::llround(steps));
@@ -464,6 +465,24 @@ void PrintConnectors(const gipsi::Coordinator& coordinator, const std::string& p
       PrintConnectors(aggregate->parts(), prefix + aggregate->name() + ".");
 }
 
+/// The objects and connectors whose snapshots serialise their state (no state value type, see
+/// SimObject::state_is_value), by path, those inside aggregates under the aggregate's name.
+void CollectSerialisedStates(const gipsi::Coordinator& coordinator, const std::string& prefix,
+                             std::vector<std::string>& out) {
+  for (std::size_t i = 0; i < coordinator.num_objects(); ++i) {
+    const auto& object = coordinator.object(i);
+    if (const auto* aggregate = dynamic_cast<const gipsi::AggregateObject*>(&object))
+      CollectSerialisedStates(aggregate->parts(), prefix + object.name() + ".", out);
+    else if (!object.state_is_value())
+      out.push_back(fmt::format("{}{} ({})", prefix, object.name(), object.type_name()));
+  }
+  for (std::size_t i = 0; i < coordinator.num_connectors(); ++i) {
+    const auto& connector = coordinator.connector(i);
+    if (!connector.state_is_value())
+      out.push_back(fmt::format("{}{} ({})", prefix, connector.name(), connector.type_name()));
+  }
+}
+
 int Validate(const std::string& file, const std::vector<std::string>& plugins,
              const gipsi::SceneLimits& limits) {
   gipsi::TypeRegistry registry;
@@ -487,6 +506,13 @@ int Validate(const std::string& file, const std::vector<std::string>& plugins,
           field.writable() ? (field.readable() ? "read/write" : "write") : "read");
   }
   PrintConnectors(coordinator, "");
+  std::vector<std::string> serialised;
+  CollectSerialisedStates(coordinator, "", serialised);
+  std::cout << (serialised.empty()
+                    ? std::string("  state: every object and connector keeps it as a value "
+                                  "(a step retry copies it)\n")
+                    : fmt::format("  state: a step retry serialises {} (no state value type)\n",
+                                  fmt::join(serialised, ", ")));
   for (const auto& [key, bc] : scene.boundary_conditions)
     std::cout << fmt::format("  condition {:<22} {} vertices, {} faces\n", key, bc.vertices.size(),
                              bc.faces.size());

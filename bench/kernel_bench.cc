@@ -98,7 +98,9 @@ void BM_CheckpointRestore(benchmark::State& state, const std::string& scene, dou
 }
 
 // The coupled heart (EP + FEM wall with its kept factorisation + cavity + blood), in its first
-// contraction; the mass-spring heart; the FEM liver (10 ms macro steps); the EP slab on tets.
+// contraction; the mass-spring heart; the FEM liver (10 ms macro steps); the EP slab on tets;
+// the liver palpated by a synchronous haptic probe, in contact (the haptic pair's state: the
+// tick, the device and both lock-free buffers with their local models).
 // Each scene gets the five benchmarks, named BM_MacroStep/<id> and so on.
 const bool kRegistered = [] {
   struct Case {
@@ -115,7 +117,8 @@ const bool kRegistered = [] {
   for (const Case& c :
        {Case{"heart", "heart.json", 0.1}, Case{"heart_mass_spring", "heart_mass_spring.json", 0.1},
         Case{"liver_fem", "hanging_liver_fem.json", 0.1},
-        Case{"slab_ep_0_5mm", "slab_ep_0.5mm.json", 0.005}})
+        Case{"slab_ep_0_5mm", "slab_ep_0.5mm.json", 0.005},
+        Case{"palpation", "liver_palpation.json", 1.25}})
     for (const auto& [kind, fn] : kinds)
       benchmark::RegisterBenchmark((std::string(kind) + "/" + c.id).c_str(), fn,
                                    std::string(c.scene), c.warm)

@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "gipsi/base/latest_value.h"
+#include "gipsi/haptics/haptic_probe.h"
 #include "gipsi/haptics/mouse_device.h"
 #include "gipsi/haptics/realtime_haptics.h"
 #include "gipsi/io/scene.h"

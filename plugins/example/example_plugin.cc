@@ -88,12 +88,11 @@ class Follow final : public gipsi::Connector {
     // them. The velocity is read in m/s and prescribed on the target's boundary.
     UseField("from", source, source.field_info(field).name, gipsi::FieldAccess::kRead, "m/s", 3);
     UseBoundaryConditions("to", target);
+    // Its state: none. Follow only transfers values (the prescribed velocities are the
+    // target's boundary conditions, saved with it), so checkpoints and retries copy nothing.
+    BindNoState();
   }
   std::string_view type_name() const override { return "Follow"; }
-  // Checkpoints: Follow only transfers values (the prescribed velocities are the target's
-  // boundary conditions, saved with it).
-  void SaveConnectorState(gipsi::StateWriter&) const override {}
-  void RestoreConnectorState(gipsi::StateReader&) override {}
 
  protected:
   gipsi::StepStatus DoFire(double) override {

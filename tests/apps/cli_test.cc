@@ -186,6 +186,20 @@ TEST(GipsiValidate, ListsEachConnectorsPortsAndOrderRules) {
     EXPECT_THAT(r.output, HasSubstr(line));
 }
 
+TEST(GipsiValidate, SaysWhichStatesAStepRetrySerialises) {
+  // Every part of the heart, its connectors and its monitor keep their state as a value.
+  const Result heart = Gipsi("validate " + Scene("heart.json"));
+  ASSERT_EQ(heart.code, 0) << heart.output;
+  EXPECT_THAT(heart.output,
+              HasSubstr("state: every object and connector keeps it as a value (a step retry "
+                        "copies it)"));
+  // So do the haptic probe and its coupling (a value gathered from the device, the tick and
+  // the bridge's buffers).
+  const Result palpation = Gipsi("validate " + Scene("liver_palpation.json"));
+  ASSERT_EQ(palpation.code, 0) << palpation.output;
+  EXPECT_THAT(palpation.output, HasSubstr("state: every object and connector keeps it as a value"));
+}
+
 TEST(GipsiRun, ResourceLimitsRefuseOversizedRunsBeforeWriting) {
   // hanging_sheet.json until 0.2 s writes 5 frames of the 441-node sheet (about 60 kB each).
   fs::path out = TempDir("limits");

@@ -190,5 +190,45 @@ TEST(StateValue, BoxesCopyAndCompareThroughTheBase) {
   EXPECT_EQ(bytes_a.FirstDifference(bytes_b), "");
 }
 
+struct Unbounded {
+  VecX v;
+  template <class Self, class V>
+  static void Fields(Self& s, V& v) {
+    v("v", s.v);
+  }
+};
+
+/// The same field with inline storage for at most 4 values.
+struct Bounded {
+  Eigen::Matrix<double, Eigen::Dynamic, 1, Eigen::ColMajor, 4, 1> v;
+  template <class Self, class V>
+  static void Fields(Self& s, V& v) {
+    v("v", s.v);
+  }
+};
+
+TEST(StateValue, AMatrixWithInlineStorageRefusesASizeItCannotHold) {
+  Unbounded small{VecX::LinSpaced(3, 1, 3)}, big{VecX::Zero(6)};
+  StateWriter fits, too_big;
+  WriteFields(fits, small);
+  WriteFields(too_big, big);
+  Bounded read;
+  StateReader ok(fits.TakeBytes(), "fits.gck");
+  ReadFields(ok, read);
+  ASSERT_EQ(read.v.size(), 3);
+  EXPECT_EQ(read.v[2], 3.0);
+  StateReader bad(too_big.TakeBytes(), "big.gck");
+  try {
+    ReadFields(bad, read);
+    FAIL() << "6 values were read into storage for 4";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("v is 6 by 1 in the checkpoint, more than its storage "
+                                         "holds (4 by 1)"),
+              std::string::npos)
+        << e.what();
+  }
+  EXPECT_EQ(read.v.size(), 3);
+}
+
 }  // namespace
 }  // namespace gipsi

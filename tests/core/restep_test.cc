@@ -21,12 +21,15 @@
 #include <cstring>
 #include <map>
 #include <string>
+#include <vector>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <Eigen/Core>
 
 #include "gipsi/base/object_state.h"
 #include "gipsi/base/state.h"
+#include "gipsi/core/aggregate.h"
 #include "gipsi/core/kernel.h"
 #include "gipsi/io/builtins.h"
 #include "gipsi/io/scene.h"
@@ -129,27 +132,65 @@ void ExpectSnapshotRestepIsBitwise(const std::string& scene, double t1, double t
 }
 
 /// Every built-in object and connector type, in the scenes of the tests below.
+const struct {
+  const char* scene;
+  double t1, t2;
+} kEveryType[] = {{"hanging_sheet.json", 1.0, 1.6},
+                  {"block_drop.json", 0.15, 0.2},
+                  {"coupled_blocks.json", 0.02, 0.03},
+                  {"cantilever.json", 0.05, 0.08},
+                  {"cantilever_explicit.json", 0.05, 0.08},
+                  {"land_beam.json", 0, 1},
+                  {"land_beam_p2.json", 0, 1},
+                  {"probe_indentation.json", 0.5, 0.6},
+                  {"slab_ep_0.5mm.json", 0.002, 0.004},
+                  {"slab_ep_grid_0.5mm.json", 0.002, 0.004},
+                  {"circulation_closed_loop.json", 0.4, 0.9},
+                  {"heart.json", 0.1, 0.13},
+                  {"heart_mass_spring.json", 0.1, 0.13},
+                  {"liver_palpation.json", 1.25, 1.3}};
+
 TEST(Restep, FromOneSnapshotEveryBuiltInTypeIsBitwise) {
-  const struct {
-    const char* scene;
-    double t1, t2;
-  } cases[] = {{"hanging_sheet.json", 1.0, 1.6},
-               {"block_drop.json", 0.15, 0.2},
-               {"coupled_blocks.json", 0.02, 0.03},
-               {"cantilever.json", 0.05, 0.08},
-               {"cantilever_explicit.json", 0.05, 0.08},
-               {"land_beam.json", 0, 1},
-               {"land_beam_p2.json", 0, 1},
-               {"probe_indentation.json", 0.5, 0.6},
-               {"slab_ep_0.5mm.json", 0.002, 0.004},
-               {"slab_ep_grid_0.5mm.json", 0.002, 0.004},
-               {"circulation_closed_loop.json", 0.4, 0.9},
-               {"heart.json", 0.1, 0.13},
-               {"heart_mass_spring.json", 0.1, 0.13},
-               {"liver_palpation.json", 1.25, 1.3}};
-  for (const auto& c : cases) {
+  for (const auto& c : kEveryType) {
     SCOPED_TRACE(c.scene);
     ExpectSnapshotRestepIsBitwise(c.scene, c.t1, c.t2);
+  }
+}
+
+/// The objects and connectors of `coordinator` (and of its aggregates, with their own state)
+/// whose snapshots serialise instead of copying a state value, as "name (type)".
+void CollectSerialised(const Coordinator& coordinator, std::vector<std::string>& out) {
+  for (std::size_t i = 0; i < coordinator.num_objects(); ++i) {
+    const SimObject& object = coordinator.object(i);
+    if (const auto* aggregate = dynamic_cast<const AggregateObject*>(&object))
+      CollectSerialised(aggregate->parts(), out);
+    else if (!object.state_is_value())
+      out.push_back(fmt::format("{} ({})", object.name(), object.type_name()));
+  }
+  for (std::size_t i = 0; i < coordinator.num_connectors(); ++i)
+    if (!coordinator.connector(i).state_is_value())
+      out.push_back(fmt::format("{} ({})", coordinator.connector(i).name(),
+                                coordinator.connector(i).type_name()));
+}
+
+// Issue 18: a step retry copies values, never serialises, for every built-in type (the haptic
+// pair gathers its value from the probe's device, tick and safety stage and the bridge's
+// buffers). Aggregates count only if all their parts do.
+TEST(Restep, EveryBuiltInTypeKeepsItsStateAsAValue) {
+  for (const auto& c : kEveryType) {
+    SCOPED_TRACE(c.scene);
+    TypeRegistry registry;
+    RegisterBuiltins(registry);
+    const Scene loaded = LoadScene(std::string(GIPSI_SOURCE_DIR) + "/scenes/" + c.scene, registry);
+    std::vector<std::string> serialised;
+    CollectSerialised(loaded.kernel->coordinator(), serialised);
+    EXPECT_EQ(fmt::format("{}", fmt::join(serialised, ", ")), "");
+    const Coordinator& top = loaded.kernel->coordinator();
+    for (std::size_t i = 0; i < top.num_objects(); ++i) {
+      if (dynamic_cast<const AggregateObject*>(&top.object(i)) != nullptr) {
+        EXPECT_TRUE(top.object(i).state_is_value()) << top.object(i).name();
+      }
+    }
   }
 }
 

@@ -5,7 +5,11 @@
 
 #include <gtest/gtest.h>
 
+#include <string>
+
+#include "gipsi/base/error.h"
 #include "gipsi/base/state.h"
+#include "gipsi/base/state_value.h"
 #include "gipsi/geometry/generators.h"
 #include "gipsi/haptics/haptic_bridge.h"
 #include "gipsi/haptics/virtual_device.h"
@@ -62,17 +66,28 @@ TEST(HapticState, ATickRestoredInTheMiddleOfAModelContinuesBitwise) {
   for (int k = 1; k <= 30; ++k) a.tick->Run(k * h, h);
   ASSERT_GT(a.tick->model_force(), 0);
   ASSERT_GT(a.tick->state().v.norm(), 0);
+  // The three state values, through the generic checkpoint format.
+  HapticBridgeState bridge;
+  LocalTickState tick;
+  a.bridge.GetState(bridge);
+  a.tick->GetState(tick);
   StateWriter out;
-  a.device.SaveState(out);
-  a.bridge.SaveState(out);
-  a.tick->SaveState(out);
+  WriteFields(out, a.device.state());
+  WriteFields(out, bridge);
+  WriteFields(out, tick);
 
   HapticSide b(builder);  // a fresh side, as in a new process
   StateReader in(out.TakeBytes(), "the test's state");
-  b.device.RestoreState(in);
-  b.bridge.RestoreState(in);
-  b.tick->RestoreState(in);
+  VirtualDeviceState read_device;
+  HapticBridgeState read_bridge;
+  LocalTickState read_tick;
+  ReadFields(in, read_device);
+  ReadFields(in, read_bridge);
+  ReadFields(in, read_tick);
   ASSERT_TRUE(in.at_end());
+  b.device.set_state(read_device);
+  b.bridge.SetState(read_bridge);
+  b.tick->SetState(read_tick);
   for (int k = 31; k <= 120; ++k) {
     if (k == 60) {  // a hand-over after the restore: the same model is built for both
       a.bridge.ApplyFeedback();
@@ -90,6 +105,37 @@ TEST(HapticState, ATickRestoredInTheMiddleOfAModelContinuesBitwise) {
   EXPECT_EQ(a.tick->num_handovers(), 2);
   EXPECT_EQ(b.tick->num_handovers(), 2);
   EXPECT_EQ(a.device.num_commands(), b.device.num_commands());
+}
+
+TEST(HapticState, ABridgeRefusesAStateThatDoesNotFitItAndKeepsItsOwn) {
+  auto fem = Block();
+  FemCondensation builder(*fem);
+  HapticSide side(builder);
+  side.bridge.SeedTool(Vec3(0, 0, 0.0199));
+  side.bridge.Publish(0);
+  HapticBridgeState good;
+  side.bridge.GetState(good);
+  ASSERT_GE(good.contact, 0);
+  const auto expect_refused = [&](const HapticBridgeState& bad, const std::string& why) {
+    try {
+      side.bridge.SetState(bad);
+      ADD_FAILURE() << "accepted: " << why;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(why), std::string::npos) << e.what();
+    }
+    HapticBridgeState now;
+    side.bridge.GetState(now);
+    EXPECT_EQ(FirstDifference(good, now), "");
+  };
+  HapticBridgeState bad = good;
+  bad.models.roles = {0, 0, 2};  // two sides on one slot
+  expect_refused(bad, "the local model buffer's layout is corrupted");
+  bad = good;
+  bad.contact = fem->boundary().num_vertices();
+  expect_refused(bad, "the state was written for another scene");
+  bad = good;
+  bad.models.slots[1].num_nodes += 1;  // arrays sized for another model
+  expect_refused(bad, "has arrays of other sizes");
 }
 
 TEST(HapticState, ABufferLayoutIsRestoredWholeOrNotAtAll) {

@@ -73,7 +73,9 @@ TEST(LiverPalpationScene, BadHapticKeysAreErrorsNamingTheJsonPath) {
   };
   using ::testing::HasSubstr;
   EXPECT_THAT(error(R"("device": "probe")", R"("device": "liver")"),
-              HasSubstr("connectors.haptics.device: expected the name of a HapticProbe object"));
+              HasSubstr("connectors.haptics.device: object 'liver' (FemSolid) is not a haptic "
+                        "device; a device is a HapticProbe (or a plugin type implementing "
+                        "HapticEndpoint)"));
   EXPECT_THAT(error(R"("rate": 1000,)", R"("rate": 1000, "ratee": 3,)"),
               HasSubstr("objects.probe: unknown key 'ratee' (did you mean 'rate'?)"));
   EXPECT_THAT(error("[1.5, -0.0175", "[0.4, -0.0175"),

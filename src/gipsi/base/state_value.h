@@ -117,6 +117,18 @@ struct IsFixedEigen<T, true> : std::bool_constant<T::RowsAtCompileTime != Eigen:
 template <class T>
 inline constexpr bool kIsFixedEigen = IsFixedEigen<T>::value;
 
+/// A dynamic size with inline storage of a maximum size (e.g. Matrix<double, Dynamic, Dynamic,
+/// ColMajor, 60, 60>; not VecX, whose one fixed dimension is not a bound on a dynamic one).
+template <class T, bool = kIsEigen<T>>
+struct IsBoundedEigen : std::false_type {};
+template <class T>
+struct IsBoundedEigen<T, true>
+    : std::bool_constant<
+          (T::RowsAtCompileTime == Eigen::Dynamic && T::MaxRowsAtCompileTime != Eigen::Dynamic) ||
+          (T::ColsAtCompileTime == Eigen::Dynamic && T::MaxColsAtCompileTime != Eigen::Dynamic)> {};
+template <class T>
+inline constexpr bool kIsBoundedEigen = IsBoundedEigen<T>::value;
+
 /// Calls `v(name, field, shape)` for every field of `s` (const or not).
 template <class S, class V>
 void Visit(S& s, V& v) {
@@ -187,6 +199,8 @@ struct Reader {
       if (shape == Shape::kFixed && value != x)
         in.Fail(fmt::format("{} is '{}' in the checkpoint but '{}' in this scene", name, value, x));
       x = std::move(value);
+    } else if constexpr (kIsBoundedEigen<T>) {
+      ReadBounded(x, name, shape);
     } else if constexpr (kIsEigen<T>) {
       if (shape == Shape::kFixed || kIsFixedEigen<T>)
         in.ReadMatrixExact(x, name);
@@ -232,6 +246,28 @@ struct Reader {
       Reader nested{in, name + "."};
       Visit(x, nested);
     }
+  }
+  /// A matrix of dynamic size with inline storage (a maximum size): a size that does not fit
+  /// the storage is refused, not written past it.
+  template <class T>
+  void ReadBounded(T& x, const std::string& name, Shape shape) {
+    Eigen::Matrix<typename T::Scalar, Eigen::Dynamic, Eigen::Dynamic> m;
+    in.ReadMatrix(m);
+    const bool fits =
+        (T::MaxRowsAtCompileTime == Eigen::Dynamic || m.rows() <= T::MaxRowsAtCompileTime) &&
+        (T::MaxColsAtCompileTime == Eigen::Dynamic || m.cols() <= T::MaxColsAtCompileTime) &&
+        (T::RowsAtCompileTime == Eigen::Dynamic || m.rows() == T::RowsAtCompileTime) &&
+        (T::ColsAtCompileTime == Eigen::Dynamic || m.cols() == T::ColsAtCompileTime);
+    if (!fits)
+      in.Fail(
+          fmt::format("{} is {} by {} in the checkpoint, more than its storage holds ({} by {})",
+                      name, m.rows(), m.cols(), static_cast<int>(T::MaxRowsAtCompileTime),
+                      static_cast<int>(T::MaxColsAtCompileTime)));
+    if (shape == Shape::kFixed && (m.rows() != x.rows() || m.cols() != x.cols()))
+      in.Fail(fmt::format("{} is {} by {} in the checkpoint but {} by {} in this scene", name,
+                          m.rows(), m.cols(), x.rows(), x.cols()));
+    x.resize(m.rows(), m.cols());
+    if (m.size() > 0) x = m;
   }
 };
 

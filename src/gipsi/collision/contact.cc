@@ -7,7 +7,6 @@
 #include <fmt/format.h>
 
 #include "gipsi/base/error.h"
-#include "gipsi/base/state.h"
 #include "gipsi/collision/rigid_collider.h"
 #include "gipsi/core/coordinator.h"
 
@@ -20,13 +19,14 @@ struct Contact::Body {
   CollisionSurface surface;
   Points velocities;
   Points forces;
-  // Projection response: the reaction field, its values, and which vertices this connector
-  // holds on a tool (1) or not (0).
+  // Projection response: the reaction field and its values (which vertices are held is the
+  // state's held[index]).
   std::optional<FieldId> reaction;
   Points reactions;
-  std::vector<char> held;
-  Body(SimObject& o, const RigidCollider* t, FieldId p, FieldId v, CollisionSurface s)
-      : object(o), tool(t), position(p), velocity(v), surface(std::move(s)) {
+  std::size_t index;  // in objects order
+  Body(SimObject& o, const RigidCollider* t, FieldId p, FieldId v, CollisionSurface s,
+       std::size_t i)
+      : object(o), tool(t), position(p), velocity(v), surface(std::move(s)), index(i) {
     velocities.setZero(3, surface.num_vertices());
     forces.setZero(3, surface.num_vertices());
   }
@@ -61,14 +61,16 @@ Contact::Contact(std::string name, const std::vector<SimObject*>& objects,
       ++deformables;
     const bool closed = !b.face_to_tet.empty() && b.face_to_tet.front() >= 0;
     bodies_.push_back(std::make_unique<Body>(
-        *o, tool, p, v, CollisionSurface(b.triangles, b.num_vertices(), closed)));
+        *o, tool, p, v, CollisionSurface(b.triangles, b.num_vertices(), closed), bodies_.size()));
+    state_.held.emplace_back();
     if (!tool && options_.tool_response == ContactOptions::ToolResponse::kProjection) {
       bodies_.back()->reaction = o->FindField("reaction_force");
       UseField(key, *o, "reaction_force", FieldAccess::kRead, "N", 3);
       bodies_.back()->reactions.setZero(3, b.num_vertices());
-      bodies_.back()->held.assign(static_cast<std::size_t>(b.num_vertices()), 0);
+      state_.held.back().assign(static_cast<std::size_t>(b.num_vertices()), 0);
     }
   }
+  BindState(state_);
   if (deformables == 0 || (objects.size() < 2 && !options_.self_collision))
     throw InputError(fmt::format(
         "connector '{}': nothing to collide; list at least one deformable object and a second "
@@ -186,7 +188,7 @@ void Contact::ToolProjection(Body& tool, Body& body) {
     const PrimitiveContact* c = nullptr;
     while (k < primitive_.size() && primitive_[k].vertex < v) ++k;
     if (k < primitive_.size() && primitive_[k].vertex == v) c = &primitive_[k];
-    char& held = body.held[static_cast<std::size_t>(v)];
+    char& held = state_.held[body.index][static_cast<std::size_t>(v)];
     bool keep = false;
     if (c) {
       if (held) {
@@ -302,20 +304,6 @@ void RegisterContact(TypeRegistry& registry) {
       },
       "collision: penalty contact (damping, friction) between objects and tools, as boundary "
       "forces");
-}
-
-// Checkpoints: which boundary vertices the projection response holds on a tool (the
-// constraints themselves are the objects' boundary conditions, saved with them). Forces,
-// velocities and proximity results are recomputed by every Fire.
-void Contact::SaveConnectorState(StateWriter& out) const {
-  out.WriteInt(static_cast<std::int64_t>(bodies_.size()));
-  for (const auto& body : bodies_) out.WriteArray(body->held);
-}
-
-void Contact::RestoreConnectorState(StateReader& in) {
-  if (in.ReadInt() != static_cast<std::int64_t>(bodies_.size()))
-    in.Fail("the contact connector has a different number of objects in the checkpoint");
-  for (auto& body : bodies_) in.ReadArrayExact(body->held, "the held vertices of a contact body");
 }
 
 }  // namespace gipsi

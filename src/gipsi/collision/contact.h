@@ -62,6 +62,19 @@ struct ContactStats {
   double min_gap = 0;
 };
 
+/// What Contact carries from one firing to the next (a state value type,
+/// gipsi/base/state_value.h): per object (in objects order), which boundary vertices the
+/// projection response holds on a tool (1) or not (0); empty for tools and under the penalty
+/// response. The constraints themselves are the objects' boundary conditions, saved with them;
+/// forces, velocities and proximity results are recomputed by every firing.
+struct ContactState {
+  std::vector<std::vector<char>> held;
+  template <class Self, class V>
+  static void Fields(Self& s, V& v) {
+    v("held", s.held, Shape::kFixed);
+  }
+};
+
 /// Not copyable or movable.
 class Contact final : public Connector {
  public:
@@ -74,9 +87,9 @@ class Contact final : public Connector {
   ~Contact() override;
 
   [[nodiscard]] std::string_view type_name() const override { return "Contact"; }
-  void SaveConnectorState(StateWriter& out) const override;
-  void RestoreConnectorState(StateReader& in) override;
   [[nodiscard]] const ContactStats& stats() const { return stats_; }
+  /// The state (bound with BindState: checkpoints and snapshots copy it).
+  [[nodiscard]] const ContactState& state() const { return state_; }
   [[nodiscard]] const ContactMaterial& material() const { return material_; }
   /// Force each object received at the last firing (3 by boundary vertices), in objects order.
   [[nodiscard]] const Points& last_forces(std::size_t object) const;
@@ -98,6 +111,7 @@ class Contact final : public Connector {
   ProximityResult result_;
   std::vector<PrimitiveContact> primitive_;
   ContactStats stats_;
+  ContactState state_;
 };
 
 /// Registers the "Contact" connector.

@@ -13,6 +13,8 @@ namespace gipsi {
 
 AggregateObject::AggregateObject(std::string name, Coordinator parts)
     : SimObject(std::move(name)), parts_(std::move(parts)) {
+  static NoState nothing;                // has no fields: never read or written
+  own_state_ = BindStateValue(nothing);  // until a subclass binds its own
   for (std::size_t i = 0; i < parts_.num_objects(); ++i) {
     SimObject& part = parts_.object(i);
     for (std::size_t f = 0; f < part.fields().size(); ++f) {

@@ -8,7 +8,9 @@
 #include <memory>
 #include <vector>
 
+#include "gipsi/base/error.h"
 #include "gipsi/base/export.h"
+#include "gipsi/base/state_binding.h"
 #include "gipsi/core/coordinator.h"
 #include "gipsi/core/registry.h"
 #include "gipsi/core/sim_object.h"
@@ -32,14 +34,23 @@ class AggregateObject : public SimObject {
   [[nodiscard]] std::string failure_detail() const override { return failure_detail_; }
   /// Wall time per part and per connector, then each part's own breakdown ("part: entry").
   [[nodiscard]] std::vector<ProfileEntry> ProfileBreakdown() const override;
-  /// The parts, the connectors, then SaveAggregateState.
+  /// The parts, the connectors, then the state bound by BindAggregateState.
   void SaveObjectState(StateWriter& out) const override;
+  /// Whether every part and connector keeps its state as a value (see SimObject).
+  [[nodiscard]] bool state_is_value() const override;
   void RestoreObjectState(StateReader& in) override;
 
  protected:
-  /// State of the subclass itself (e.g. a monitor's record), after the parts'. Default: none.
-  virtual void SaveAggregateState(StateWriter& /*out*/) const {}
-  virtual void RestoreAggregateState(StateReader& /*in*/) {}
+  /// State of the subclass itself (e.g. a monitor's record), kept after the parts': a subclass
+  /// with one binds its state value type (gipsi/base/state_value.h) once, from its constructor,
+  /// and checkpoints and snapshots then copy it with no hook of its own (as
+  /// SimObject::BindState). Without it the aggregate has no state of its own.
+  template <class S>
+  void BindAggregateState(S& state) {
+    GIPSI_CHECK(!own_state_bound_, "aggregate '{}': BindAggregateState called twice", name());
+    own_state_ = BindStateValue(state);
+    own_state_bound_ = true;
+  }
   /// Snapshots: the parts' snapshots (Coordinator::TakeSnapshot) and the subclass's own state.
   [[nodiscard]] std::unique_ptr<ObjectState> NewObjectState() const override;
   void CopyObjectState(ObjectState& into) const override;
@@ -59,7 +70,9 @@ class AggregateObject : public SimObject {
   Coordinator parts_;
   std::vector<Proxy> proxies_;  // indexed by this object's FieldId
   Points empty_ = Points(3, 0);
-  std::string failure_detail_;  // set only when a part fails
+  std::string failure_detail_;               // set only when a part fails
+  std::unique_ptr<StateBinding> own_state_;  // BindAggregateState's, or an empty NoState
+  bool own_state_bound_ = false;
 };
 
 /// Builds the parts, connectors and order of an aggregate from `p` ({"dt", "parts",

@@ -1,6 +1,7 @@
 /// @file
 /// AggregateObject checkpoints and snapshots: every part, then every connector, in the
-/// coordinator's order, then the subclass's own state (SaveAggregateState).
+/// coordinator's order, then the subclass's own state (bound by BindAggregateState; none by
+/// default).
 
 #include "gipsi/base/object_state.h"
 #include "gipsi/base/state.h"
@@ -13,7 +14,7 @@ void AggregateObject::SaveObjectState(StateWriter& out) const {
   out.WriteInt(static_cast<std::int64_t>(parts_.num_connectors()));
   for (std::size_t i = 0; i < parts_.num_objects(); ++i) parts_.object(i).SaveState(out);
   for (std::size_t i = 0; i < parts_.num_connectors(); ++i) parts_.connector(i).SaveState(out);
-  SaveAggregateState(out);
+  own_state_->Write(out);
 }
 
 void AggregateObject::RestoreObjectState(StateReader& in) {
@@ -22,30 +23,35 @@ void AggregateObject::RestoreObjectState(StateReader& in) {
     in.Fail("the aggregate has a different number of parts or connectors in the checkpoint");
   for (std::size_t i = 0; i < parts_.num_objects(); ++i) parts_.object(i).RestoreState(in);
   for (std::size_t i = 0; i < parts_.num_connectors(); ++i) parts_.connector(i).RestoreState(in);
-  RestoreAggregateState(in);
+  own_state_->Read(in);
 }
 
-// The snapshot: {the parts' composite snapshot, the subclass's own state serialised}.
+// The snapshot: {the parts' composite snapshot, a copy of the subclass's own state}.
 std::unique_ptr<ObjectState> AggregateObject::NewObjectState() const {
   auto box = std::make_unique<CompositeState>();
   box->parts.push_back(parts_.NewSnapshot());
-  box->parts.push_back(std::make_unique<ByteState>());
+  box->parts.push_back(own_state_->New());
   return box;
 }
 
 void AggregateObject::CopyObjectState(ObjectState& into) const {
   CompositeState& box = CompositeState::Of(into);
   parts_.TakeSnapshot(*box.parts[0]);
-  StateWriter out;
-  SaveAggregateState(out);
-  ByteState::Of(*box.parts[1]).bytes = out.TakeBytes();
+  own_state_->Copy(*box.parts[1]);
 }
 
 void AggregateObject::SetObjectState(const ObjectState& from) {
   const CompositeState& box = CompositeState::Of(from);
   parts_.RestoreSnapshot(*box.parts[0]);
-  StateReader in(ByteState::Of(*box.parts[1]).bytes, "the snapshot of aggregate '" + name() + "'");
-  RestoreAggregateState(in);
+  own_state_->Set(*box.parts[1]);
+}
+
+bool AggregateObject::state_is_value() const {
+  for (std::size_t i = 0; i < parts_.num_objects(); ++i)
+    if (!parts_.object(i).state_is_value()) return false;
+  for (std::size_t i = 0; i < parts_.num_connectors(); ++i)
+    if (!parts_.connector(i).state_is_value()) return false;
+  return true;
 }
 
 }  // namespace gipsi

@@ -11,16 +11,14 @@
 #include <vector>
 
 #include "gipsi/base/export.h"
+#include "gipsi/base/state_binding.h"
 #include "gipsi/core/port.h"
 #include "gipsi/core/step_status.h"
 
 GIPSI_EXPORT_BEGIN
 namespace gipsi {
 
-class ObjectState;
 class SimObject;
-class StateReader;
-class StateWriter;
 
 /// Base class of connectors. Not copyable or movable.
 ///
@@ -34,7 +32,7 @@ class Connector {
  public:
   Connector(const Connector&) = delete;
   Connector& operator=(const Connector&) = delete;
-  virtual ~Connector() = default;
+  virtual ~Connector();
 
   [[nodiscard]] const std::string& name() const { return name_; }
   [[nodiscard]] virtual std::string_view type_name() const = 0;
@@ -56,9 +54,9 @@ class Connector {
   /// (SaveConnectorState). RestoreState throws InputError for state from another scene.
   void SaveState(StateWriter& out) const;
   void RestoreState(StateReader& in);
-  /// State that outlives a Fire (e.g. a low-pass filtered value); connectors that only transfer
-  /// values override these with empty bodies. The defaults throw InputError("connector type X
-  /// does not support checkpoints").
+  /// State that outlives a Fire (e.g. a low-pass filtered value), for a connector that bound
+  /// none with BindState. The defaults write and read the bound state, and throw
+  /// InputError("connector type X does not support checkpoints") when none is bound.
   virtual void SaveConnectorState(StateWriter& out) const;
   virtual void RestoreConnectorState(StateReader& in);
   /// Snapshots (gipsi/base/object_state.h), as SimObject's: a new box with the current state,
@@ -66,6 +64,9 @@ class Connector {
   [[nodiscard]] std::unique_ptr<ObjectState> NewSnapshot() const;
   void TakeSnapshot(ObjectState& into) const;
   void RestoreSnapshot(const ObjectState& from);
+  /// Whether snapshots copy the state as a value (BindState, BindNoState) rather than
+  /// serialising it through SaveConnectorState.
+  [[nodiscard]] bool state_is_value() const { return state_binding_ != nullptr; }
 
  protected:
   explicit Connector(std::string name) : name_(std::move(name)) {}
@@ -81,14 +82,37 @@ class Connector {
   /// The connector calls `object` through the capability interface called `capability`.
   void UseCapability(std::string key, const SimObject& object, std::string capability);
   void RequireOrder(OrderRule rule) { order_rules_.push_back(std::move(rule)); }
-  /// Hooks of the snapshots, as SimObject's; the defaults serialise through
-  /// SaveConnectorState / RestoreConnectorState into a ByteState.
+  /// Declares the connector's state value type (gipsi/base/state_value.h), as
+  /// SimObject::BindState: checkpoints write it and snapshots copy it with no hook of the
+  /// connector's own. Call once, from the constructor.
+  template <class S>
+  void BindState(S& state) {
+    BindStateBinding(BindStateValue(state));
+  }
+  /// A state value type `S` whose live values are kept in several members, as
+  /// SimObject::BindGatheredState.
+  template <class S, class Get, class Set>
+  void BindGatheredState(Get get, Set set) {
+    BindStateBinding(BindGatheredStateValue<S>(std::move(get), std::move(set)));
+  }
+  /// Declares that the connector keeps nothing from one Fire to the next (it only moves
+  /// values): its checkpoints are empty and its snapshots copy nothing. Call from the
+  /// constructor, instead of BindState.
+  void BindNoState();
+  /// Called after the bound state was replaced (a checkpoint or a snapshot restored). Default:
+  /// nothing.
+  virtual void StateRestored() {}
+  /// Hooks of the snapshots, as SimObject's; the defaults copy the bound state, else serialise
+  /// through SaveConnectorState / RestoreConnectorState into a ByteState.
   [[nodiscard]] virtual std::unique_ptr<ObjectState> NewConnectorState() const;
   virtual void CopyConnectorState(ObjectState& into) const;
   virtual void SetConnectorState(const ObjectState& from);
 
  private:
+  void BindStateBinding(std::unique_ptr<StateBinding> binding);
+
   std::string name_;
+  std::unique_ptr<StateBinding> state_binding_;
   std::int64_t fire_count_ = 0;
   std::vector<PortUse> ports_;
   std::vector<OrderRule> order_rules_;

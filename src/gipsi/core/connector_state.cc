@@ -83,11 +83,28 @@ void Connector::RestoreSnapshot(const ObjectState& from) {
   SetConnectorState(*s.own);
 }
 
+Connector::~Connector() = default;
+
+void Connector::BindStateBinding(std::unique_ptr<StateBinding> binding) {
+  GIPSI_CHECK(state_binding_ == nullptr, "connector '{}': BindState called twice", name_);
+  state_binding_ = std::move(binding);
+}
+
+void Connector::BindNoState() {
+  static NoState nothing;  // has no fields: never read or written
+  BindState(nothing);
+}
+
 std::unique_ptr<ObjectState> Connector::NewConnectorState() const {
+  if (state_binding_) return state_binding_->New();
   return std::make_unique<ByteState>();
 }
 
 void Connector::CopyConnectorState(ObjectState& into) const {
+  if (state_binding_) {
+    state_binding_->Copy(into);
+    return;
+  }
   StateWriter out;
   out.BeginSection(type_name(), 1);
   SaveConnectorState(out);
@@ -96,18 +113,32 @@ void Connector::CopyConnectorState(ObjectState& into) const {
 }
 
 void Connector::SetConnectorState(const ObjectState& from) {
+  if (state_binding_) {
+    state_binding_->Set(from);
+    StateRestored();
+    return;
+  }
   StateReader in(ByteState::Of(from).bytes, fmt::format("the snapshot of connector '{}'", name_));
   in.BeginSection(type_name(), 1);
   RestoreConnectorState(in);
   in.EndSection();
 }
 
-void Connector::SaveConnectorState(StateWriter& /*out*/) const {
+void Connector::SaveConnectorState(StateWriter& out) const {
+  if (state_binding_) {
+    state_binding_->Write(out);
+    return;
+  }
   throw InputError(fmt::format("connector '{}': connector type {} does not support checkpoints",
                                name_, type_name()));
 }
 
-void Connector::RestoreConnectorState(StateReader& /*in*/) {
+void Connector::RestoreConnectorState(StateReader& in) {
+  if (state_binding_) {
+    state_binding_->Read(in);
+    StateRestored();
+    return;
+  }
   throw InputError(fmt::format("connector '{}': connector type {} does not support checkpoints",
                                name_, type_name()));
 }

@@ -82,6 +82,27 @@ struct LocalDynamicModel {
   LocalVector load;       ///< q [N]
 
   [[nodiscard]] int dofs() const { return 3 * num_nodes; }
+  template <class Self, class V>
+  static void Fields(Self& s, V& v) {
+    v("active", s.active);
+    v("published_at", s.published_at);
+    v("period", s.period);
+    v("point", s.point);
+    v("normal", s.normal);
+    v("anchor_force", s.anchor_force);
+    v("contact_vertex", s.contact_vertex);
+    v("num_nodes", s.num_nodes);
+    v("step_v", s.step_v);
+    v("step_u", s.step_u);
+    v("step_bias", s.step_bias);
+    v("gain", s.gain);
+    v("push", s.push);
+    v("compliance", s.compliance);
+    v("initial_velocity", s.initial_velocity);
+    v("stiffness", s.stiffness);
+    v("mass", s.mass);
+    v("load", s.load);
+  }
 };
 
 /// Builds the discretised model from M (diagonal, per dof), C, K (3m square), the anchor

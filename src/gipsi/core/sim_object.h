@@ -3,7 +3,6 @@
 /// `SimObject`: one physical process (or an aggregate of processes) with its three geometries,
 /// named fields, boundary conditions and a `Step`. The GiPSi simulation API.
 
-#include <concepts>
 #include <cstdint>
 #include <memory>
 #include <optional>
@@ -15,6 +14,7 @@
 #include "gipsi/base/export.h"
 #include "gipsi/base/math.h"
 #include "gipsi/base/object_state.h"
+#include "gipsi/base/state_binding.h"
 #include "gipsi/base/state_value.h"
 #include "gipsi/base/stop_token.h"
 #include "gipsi/core/boundary_conditions.h"
@@ -153,6 +153,10 @@ class SimObject {
   virtual void SaveObjectState(StateWriter& out) const;
   virtual void RestoreObjectState(StateReader& in);
 
+  /// Whether snapshots copy the type's state as a value (it bound one with BindState) rather
+  /// than serialising it through SaveObjectState (`gipsi validate` lists the objects that
+  /// serialise: their retries cost more).
+  [[nodiscard]] virtual bool state_is_value() const { return state_binding_ != nullptr; }
   /// Snapshots (gipsi/base/object_state.h), the kernel's step retry: a new box holding the
   /// object's current state (clock, step count, applied boundary conditions, the type's state).
   [[nodiscard]] std::unique_ptr<ObjectState> NewSnapshot() const;
@@ -207,7 +211,17 @@ class SimObject {
   template <class S>
   void BindState(S& state) {
     GIPSI_CHECK(state_binding_ == nullptr, "object '{}': BindState called twice", name_);
-    state_binding_ = std::make_unique<BoundState<S>>(state);
+    state_binding_ = BindStateValue(state);
+  }
+  /// Declares a state value type `S` whose live values are kept in several members (a device,
+  /// a tick, a safety stage): `get(S&)` copies them into a value, `set(const S&)` copies one
+  /// back, validating it first (throw InputError, changing nothing). Checkpoints and snapshots
+  /// then hold an `S`, as with BindState (gipsi/base/state_binding.h). Call once, from the
+  /// constructor, instead of BindState.
+  template <class S, class Get, class Set>
+  void BindGatheredState(Get get, Set set) {
+    GIPSI_CHECK(state_binding_ == nullptr, "object '{}': BindState called twice", name_);
+    state_binding_ = BindGatheredStateValue<S>(std::move(get), std::move(set));
   }
   /// Called after the state bound by BindState was replaced (a checkpoint or a snapshot
   /// restored): rebuild what derives from it. Default: nothing.
@@ -237,51 +251,6 @@ class SimObject {
   virtual void DoWriteField(FieldId id, const Eigen::Ref<const Eigen::MatrixXd>& in) = 0;
 
  private:
-  /// The state bound by BindState, behind a type-free interface.
-  class StateBinding {
-   public:
-    virtual ~StateBinding() = default;
-    [[nodiscard]] virtual std::unique_ptr<ObjectState> New() const = 0;
-    virtual void Copy(ObjectState& into) const = 0;
-    virtual void Set(const ObjectState& from) = 0;
-    /// Checkpoints: the state, then the owner's cache (SaveStateCache); reading both before
-    /// the state is replaced.
-    virtual void Write(StateWriter& out, const SimObject& owner) const = 0;
-    virtual void Read(StateReader& in, SimObject& owner) = 0;
-  };
-  template <class S>
-  class BoundState final : public StateBinding {
-    static constexpr bool kVersioned = requires {
-      { S::kTag } -> std::convertible_to<std::string_view>;
-      { S::kVersion } -> std::convertible_to<std::uint32_t>;
-    };
-
-   public:
-    explicit BoundState(S& state) : state_(state) {}
-    [[nodiscard]] std::unique_ptr<ObjectState> New() const override {
-      return std::make_unique<StateBox<S>>(state_);
-    }
-    void Copy(ObjectState& into) const override { CopyFields(StateBox<S>::Of(into).value, state_); }
-    void Set(const ObjectState& from) override { CopyFields(state_, StateBox<S>::Of(from).value); }
-    void Write(StateWriter& out, const SimObject& owner) const override {
-      if constexpr (kVersioned) out.BeginSection(S::kTag, S::kVersion);
-      WriteFields(out, state_);
-      if constexpr (kVersioned) out.EndSection();
-      owner.SaveStateCache(out);
-    }
-    void Read(StateReader& in, SimObject& owner) override {
-      S read = state_;  // kFixed fields are checked against the current shapes
-      if constexpr (kVersioned) in.BeginSection(S::kTag, S::kVersion);
-      ReadFields(in, read);
-      if constexpr (kVersioned) in.EndSection();
-      owner.RestoreStateCache(in);
-      CopyFields(state_, read);  // into the existing storage (kept capacities, references)
-    }
-
-   private:
-    S& state_;
-  };
-
   std::string name_;
   std::unique_ptr<StateBinding> state_binding_;
   std::shared_ptr<const Mesh> domain_;

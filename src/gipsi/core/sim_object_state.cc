@@ -134,7 +134,8 @@ void SimObject::SetObjectState(const ObjectState& from) {
 
 void SimObject::SaveObjectState(StateWriter& out) const {
   if (state_binding_) {
-    state_binding_->Write(out, *this);
+    state_binding_->Write(out);
+    SaveStateCache(out);
     return;
   }
   throw InputError(
@@ -143,7 +144,7 @@ void SimObject::SaveObjectState(StateWriter& out) const {
 
 void SimObject::RestoreObjectState(StateReader& in) {
   if (state_binding_) {
-    state_binding_->Read(in, *this);
+    state_binding_->Read(in, [this](StateReader& r) { RestoreStateCache(r); });
     StateRestored();
     return;
   }

@@ -5,14 +5,27 @@
 /// local model is stale (the simulation stalled) or the device is disconnected (a watchdog);
 /// when both recover, the force fades back in at the same rate. Allocation-free, noexcept.
 
+#include <cstdint>
+
 #include "gipsi/base/export.h"
 #include "gipsi/base/math.h"
 
 GIPSI_EXPORT_BEGIN
 namespace gipsi {
 
-class StateWriter;
-class StateReader;
+/// What a ForceSafety carries from one tick to the next (a state value type,
+/// gipsi/base/state_value.h).
+struct ForceSafetyState {
+  double gain = 1;           ///< watchdog gain in [0, 1]
+  Vec3 last = Vec3::Zero();  ///< the last commanded force [N]
+  std::int64_t limited = 0;  ///< ticks whose force was clamped or rate limited
+  template <class Self, class V>
+  static void Fields(Self& s, V& v) {
+    v("gain", s.gain);
+    v("last", s.last);
+    v("limited", s.limited);
+  }
+};
 
 /// Parameters. Plain struct with defaults.
 struct ForceSafetyParams {
@@ -40,9 +53,13 @@ class ForceSafety {
   [[nodiscard]] const ForceSafetyParams& params() const { return params_; }
   /// Number of ticks whose force was clamped or rate limited.
   [[nodiscard]] std::int64_t num_limited() const { return limited_; }
-  /// Checkpoints (haptic_state.cc): the watchdog gain, the last output and the count.
-  void SaveState(StateWriter& out) const;
-  void RestoreState(StateReader& in);
+  /// Checkpoints and roll-back: the watchdog gain, the last output and the count.
+  [[nodiscard]] ForceSafetyState state() const { return {gain_, last_, limited_}; }
+  void set_state(const ForceSafetyState& s) {
+    gain_ = s.gain;
+    last_ = s.last;
+    limited_ = s.limited;
+  }
 
  private:
   ForceSafetyParams params_;

@@ -13,7 +13,10 @@
 /// `capture_distance`, with its area-weighted outward normal at the current state; farther away
 /// an inactive model is published (free motion).
 
+#include <array>
+#include <cstdint>
 #include <memory>
+#include <string_view>
 
 #include "gipsi/base/export.h"
 #include "gipsi/base/latest_value.h"
@@ -24,13 +27,48 @@
 GIPSI_EXPORT_BEGIN
 namespace gipsi {
 
-class StateWriter;
-class StateReader;
-
 /// Parameters. Plain struct with defaults.
 struct HapticBridgeParams {
   double period = 1e-3;            ///< haptic period the models are discretised for [s]
   double capture_distance = 0.01;  ///< m, see the file comment
+};
+
+/// A LatestValue's contents (gipsi/base/latest_value.h) as a value: the three slots in index
+/// order, which side holds which slot, and whether the exchanged slot holds an unfetched value.
+template <class T>
+struct LatestValueSlots {
+  std::array<T, 3> slots;
+  std::array<std::int32_t, 3> roles = {0, 1, 2};  ///< back, middle, front
+  bool fresh = false;
+  template <class Self, class V>
+  static void Fields(Self& s, V& v) {
+    v("slots", s.slots);
+    v("roles", s.roles);
+    v("fresh", s.fresh);
+  }
+};
+
+/// What a HapticBridge carries from one firing to the next (a state value type,
+/// gipsi/base/state_value.h): the feedback taken, the contact kept, the vertex carrying the tool
+/// force, and both buffers whole (all three slots and their layout, so that a model published
+/// but not yet fetched is handed over as it would have been).
+struct HapticBridgeState {
+  static constexpr std::string_view kTag = "HapticBridge";
+  static constexpr std::uint32_t kVersion = 2;
+  HapticFeedback latest;
+  std::int64_t applied_vertex = -1, contact = -1;
+  Vec3 normal = Vec3::UnitZ();
+  LatestValueSlots<LocalDynamicModel> models;
+  LatestValueSlots<HapticFeedback> feedback;
+  template <class Self, class V>
+  static void Fields(Self& s, V& v) {
+    v("latest", s.latest);
+    v("applied_vertex", s.applied_vertex);
+    v("contact", s.contact);
+    v("normal", s.normal);
+    v("models", s.models);
+    v("feedback", s.feedback);
+  }
 };
 
 /// Not copyable or movable (the haptic loop holds references to its buffers).
@@ -58,12 +96,12 @@ class HapticBridge {
   /// Contact vertex of the last published model (−1: none).
   [[nodiscard]] Index contact_vertex() const { return contact_; }
   [[nodiscard]] LocalModelBuilder& builder() { return builder_; }
-  /// Checkpoints (haptic_state.cc): the feedback taken, the contact kept, the vertex carrying
-  /// the tool force, and both buffers whole (all three slots and their layout, so a model
-  /// published but not yet fetched is handed over as it would have been). Only while the
-  /// haptic side does not run (a synchronous probe).
-  void SaveState(StateWriter& out) const;
-  void RestoreState(StateReader& in);
+  /// Checkpoints and roll-back (haptic_state.cc), only while the haptic side does not run (a
+  /// synchronous probe). SetState throws InputError, changing nothing, for a state that does
+  /// not fit this object (a contact vertex it does not have, a buffer layout that is not a
+  /// permutation, a model whose arrays disagree with its size).
+  void GetState(HapticBridgeState& out) const;
+  void SetState(const HapticBridgeState& in);
 
  private:
   LocalModelBuilder& builder_;

@@ -74,6 +74,8 @@ HapticProbe::HapticProbe(std::string name, const HapticProbeSpec& spec)
     loop_ =
         std::make_unique<HapticLoop>(*renderer_, spec_.rate, std::size_t{1} << 20, *spec_.realtime);
   }
+  BindGatheredState<HapticProbeState>([this](HapticProbeState& s) { GetState(s); },
+                                      [this](const HapticProbeState& s) { SetState(s); });
 }
 
 HapticProbe::~HapticProbe() { StopLoop(); }
@@ -161,29 +163,36 @@ void HapticProbe::DoWriteField(FieldId /*id*/, const Eigen::Ref<const Eigen::Mat
 // ---------------------------------------------------------------------------------------------
 
 HapticCoupling::HapticCoupling(std::string name, std::unique_ptr<LocalModelBuilder> builder,
-                               HapticProbe& probe, const HapticBridgeParams& params)
-    : Connector(std::move(name)), probe_(probe), builder_(std::move(builder)) {
+                               SimObject& device, HapticBridgeParams params)
+    : Connector(std::move(name)),
+      device_(device),
+      endpoint_(HapticEndpointOf(device)),
+      builder_(std::move(builder)) {
   GIPSI_CHECK(builder_ != nullptr);
   const SimObject& object = builder_->object();
   if (object.boundary().num_vertices() == 0)
     throw InputError(fmt::format("object '{}' has no boundary surface", object.name()));
   UseCapability("object", object, "haptic local model");
   UseBoundaryConditions("object", object);
-  UseCapability("device", probe, "haptic device");
+  UseCapability("device", device_, "haptic device");
+  params.period = 1.0 / endpoint_.haptic_rate();
   bridge_ = std::make_unique<HapticBridge>(*builder_, params);
-  bridge_->SeedTool(probe.initial_position());
-  probe.Attach(bridge_->models(), bridge_->feedback());
+  BindGatheredState<HapticBridgeState>(
+      [this](HapticBridgeState& s) { bridge_->GetState(s); },
+      [this](const HapticBridgeState& s) { bridge_->SetState(s); });
+  bridge_->SeedTool(endpoint_.initial_position());
+  endpoint_.Attach(bridge_->models(), bridge_->feedback());
   // A first model at the object's initial state, so a real-time loop started before the first
   // step (the viewer, paused) already renders the contact. The first firing supersedes it
   // before any synchronous tick could fetch it.
-  bridge_->Publish(probe.time());
+  bridge_->Publish(device_.time());
 }
 
-HapticCoupling::~HapticCoupling() { probe_.StopLoop(); }
+HapticCoupling::~HapticCoupling() { endpoint_.StopLoop(); }
 
 StepStatus HapticCoupling::DoFire(double t) {
   bridge_->ApplyFeedback();
-  bridge_->Publish(probe_.HapticTime(t));
+  bridge_->Publish(endpoint_.HapticTime(t));
   return StepStatus::Ok();
 }
 
@@ -292,10 +301,13 @@ void RegisterHaptics(TypeRegistry& registry) {
         const JsonNode& p = ctx.params;
         ctx.CheckKeys({"object", "device", "capture_distance", "rings"});
         SimObject& object = ctx.Object("object");
-        auto* probe = dynamic_cast<HapticProbe*>(&ctx.Object("device"));
-        if (!probe) p.At("device").Expected("the name of a HapticProbe object");
+        SimObject& device = ctx.Object("device");
+        try {
+          (void)HapticEndpointOf(device);
+        } catch (const InputError& e) {
+          p.At("device").Fail(e.what());
+        }
         HapticBridgeParams params;
-        params.period = 1.0 / probe->spec().rate;
         params.capture_distance = p.NonNegative("capture_distance", params.capture_distance);
         const std::int64_t rings = p.Int("rings", 1);
         if (rings < 0 || rings > 5) p.At("rings").Expected("an integer in [0, 5]");
@@ -308,7 +320,7 @@ void RegisterHaptics(TypeRegistry& registry) {
           return std::make_unique<HapticCoupling>(
               ctx.name,
               LocalModels(ctx.registry).Get(type, p.At("object"))(object, static_cast<int>(rings)),
-              *probe, params);
+              device, params);
         } catch (const InputError& e) {
           p.Fail(e.what());
         }
@@ -320,15 +332,15 @@ void RegisterHaptics(TypeRegistry& registry) {
         const JsonNode& p = ctx.params;
         ctx.CheckKeys({"object", "device", "rate", "name"});
         const SimObject& object = ctx.Object("object");
-        auto* probe = dynamic_cast<HapticProbe*>(&ctx.Object("device"));
-        if (probe == nullptr || probe->igtl_device() == nullptr)
+        auto* endpoint = dynamic_cast<HapticEndpoint*>(&ctx.Object("device"));
+        if (endpoint == nullptr || endpoint->igtl_device() == nullptr)
           p.At("device").Expected("the name of a HapticProbe with an OpenIGTLink device");
         const double rate = p.Positive("rate", 30.0);
         const std::string name = p.String("name", object.name());
         if (name.empty()) p.At("name").Expected("a non-empty POLYDATA device name");
         try {
-          return std::make_unique<IgtlSurfaceSender>(ctx.name, object, *probe->igtl_device(), rate,
-                                                     name);
+          return std::make_unique<IgtlSurfaceSender>(ctx.name, object, *endpoint->igtl_device(),
+                                                     rate, name);
         } catch (const InputError& e) {
           p.Fail(e.what());
         }

@@ -31,9 +31,11 @@
 ///   "haptics": {"type": "HapticCoupling", "object": "liver", "device": "probe",
 ///               "capture_distance": 0.01, "rings": 1}
 
+#include <cstdint>
 #include <limits>
 #include <memory>
 #include <optional>
+#include <string_view>
 
 #include "gipsi/core/connector.h"
 #include "gipsi/core/pacing.h"
@@ -42,6 +44,7 @@
 
 #include "gipsi/base/export.h"
 #include "gipsi/haptics/haptic_bridge.h"
+#include "gipsi/haptics/haptic_endpoint.h"
 #include "gipsi/haptics/haptic_loop.h"
 #include "gipsi/haptics/igtl_device.h"
 #include "gipsi/haptics/mouse_device.h"
@@ -65,8 +68,33 @@ struct HapticProbeSpec {
   std::optional<HapticRealtime> realtime;
 };
 
+/// What a synchronous HapticProbe carries from one step to the next (a state value type,
+/// gipsi/base/state_value.h): its fields, the tick count, the scripted device's and, once a
+/// HapticCoupling attached it, the tick's state.
+struct HapticProbeState {
+  static constexpr std::string_view kTag = "HapticProbe";
+  static constexpr std::uint32_t kVersion = 1;
+  Vec3 force = Vec3::Zero(), position = Vec3::Zero(), proxy = Vec3::Zero();
+  double model_force = 0;
+  std::int64_t ticks = 0;
+  VirtualDeviceState device;
+  bool coupled = false;  ///< whether `tick` is in use
+  LocalTickState tick;
+  template <class Self, class V>
+  static void Fields(Self& s, V& v) {
+    v("force", s.force);
+    v("position", s.position);
+    v("proxy", s.proxy);
+    v("model_force", s.model_force);
+    v("ticks", s.ticks);
+    v("device", s.device);
+    v("coupled", s.coupled);
+    v("tick", s.tick);
+  }
+};
+
 /// Not copyable or movable (a SimObject).
-class HapticProbe final : public SimObject, public WallClockPaced {
+class HapticProbe final : public SimObject, public WallClockPaced, public HapticEndpoint {
  public:
   /// Throws InputError for an empty or non-increasing path, a rate outside (0, 10 kHz] or an
   /// OpenIGTLink device that cannot connect (IgtlDevice's constructor).
@@ -78,32 +106,35 @@ class HapticProbe final : public SimObject, public WallClockPaced {
   [[nodiscard]] const Points& domain_positions() const override { return no_positions_; }
   [[nodiscard]] const HapticProbeSpec& spec() const { return spec_; }
   /// The device's position when the probe was built [m, simulation coordinates].
-  [[nodiscard]] const Vec3& initial_position() const { return initial_; }
+  [[nodiscard]] const Vec3& initial_position() const override { return initial_; }
   /// The OpenIGTLink device, or null for another kind.
-  [[nodiscard]] IgtlDevice* igtl_device() { return igtl_; }
+  [[nodiscard]] IgtlDevice* igtl_device() override { return igtl_; }
   /// The mouse device, or null for another kind.
   [[nodiscard]] MouseDevice* mouse_device() { return mouse_; }
   /// Connects the probe to a bridge's buffers (once; the HapticCoupling connector does it).
   /// Throws InputError if it is already connected.
-  void Attach(LatestValue<LocalDynamicModel>& models, LatestValue<HapticFeedback>& feedback);
+  void Attach(LatestValue<LocalDynamicModel>& models,
+              LatestValue<HapticFeedback>& feedback) override;
   [[nodiscard]] bool attached() const { return tick_ != nullptr; }
   /// Number of haptic ticks run so far (for a real-time probe: as of its last step).
   [[nodiscard]] std::int64_t num_ticks() const { return ticks_; }
 
   /// Whether the probe ticks in a real-time HapticLoop (scene key "realtime").
-  [[nodiscard]] bool realtime() const { return spec_.realtime.has_value(); }
+  [[nodiscard]] bool realtime() const override { return spec_.realtime.has_value(); }
+  /// Ticks per second (scene key "rate").
+  [[nodiscard]] double haptic_rate() const override { return spec_.rate; }
   /// Starts the real-time loop with the haptic clock at `sim_time` [s] (RealtimeHaptics does
   /// it when a run starts). Preconditions (checked, abort): realtime(), the loop is not running.
-  void StartLoop(double sim_time);
+  void StartLoop(double sim_time) override;
   /// Stops and joins the real-time loop and returns its statistics (all zero for a loop that
   /// never ran). Idempotent; does nothing for a synchronous probe.
-  HapticLoopStats StopLoop();
+  HapticLoopStats StopLoop() override;
   /// Whether the real-time loop runs.
-  [[nodiscard]] bool loop_running() const { return loop_ && loop_->running(); }
+  [[nodiscard]] bool loop_running() const override { return loop_ && loop_->running(); }
   /// The haptic clock at simulation time `sim_time` [s]: `sim_time` itself for a synchronous
   /// probe; for a real-time one with its loop running, the simulation time the loop started at
   /// plus the wall-clock seconds since (models are stamped with it, so their age is real).
-  [[nodiscard]] double HapticTime(double sim_time) const;
+  [[nodiscard]] double HapticTime(double sim_time) const override;
   /// The haptic clock (HapticTime) while the real-time loop runs: the probe is never stepped
   /// past it, the coordinator waits for it (gipsi/core/pacing.h). +infinity otherwise.
   [[nodiscard]] double WallClockTime(double sim_time) const override {
@@ -113,12 +144,12 @@ class HapticProbe final : public SimObject, public WallClockPaced {
   /// can tick it on its own thread while the loop is stopped (e.g. under an allocation guard).
   [[nodiscard]] HapticRenderer* loop_renderer();
 
-  /// Checkpoints and roll-back (haptic_state.cc) of a synchronous probe on a scripted path: its
-  /// fields, tick count, the tick's state and the virtual device's. A real-time probe (ticks on
-  /// the wall clock), a Mouse or an OpenIGTLink device (moved by a person or a tracker) makes a
-  /// run that cannot be reproduced: InputError saying so.
-  void SaveObjectState(StateWriter& out) const override;
-  void RestoreObjectState(StateReader& in) override;
+  /// Checkpoints and roll-back (haptic_state.cc) of a synchronous probe on a scripted path: a
+  /// HapticProbeState, gathered from the probe, its device and its tick (BindGatheredState). A
+  /// real-time probe (ticks on the wall clock), a Mouse or an OpenIGTLink device (moved by a
+  /// person or a tracker) makes a run that cannot be reproduced: InputError saying so.
+  void GetState(HapticProbeState& out) const;
+  void SetState(const HapticProbeState& in);
 
  protected:
   StepStatus DoStep(double t, double dt) override;
@@ -159,23 +190,24 @@ class HapticProbe final : public SimObject, public WallClockPaced {
 class HapticCoupling final : public Connector {
  public:
   /// Renders the local models `builder` makes of its object (see LocalModels,
-  /// gipsi/core/local_model.h): attaches `probe` to the bridge and publishes a first model at the
-  /// object's current state. Throws InputError if the object has no boundary surface.
-  HapticCoupling(std::string name, std::unique_ptr<LocalModelBuilder> builder, HapticProbe& probe,
-                 const HapticBridgeParams& params);
+  /// gipsi/core/local_model.h) on `device`, an object with the HapticEndpoint capability (a
+  /// HapticProbe): attaches the device to the bridge and publishes a first model at the
+  /// object's current state. The bridge's period is the device's (`params.period` is
+  /// overwritten). Throws InputError if the object has no boundary surface or the device is
+  /// not a HapticEndpoint or already coupled.
+  HapticCoupling(std::string name, std::unique_ptr<LocalModelBuilder> builder, SimObject& device,
+                 HapticBridgeParams params);
   [[nodiscard]] std::string_view type_name() const override { return "HapticCoupling"; }
-  /// Stops the probe's real-time loop (it reads this connector's buffers).
+  /// Stops the device's real-time loop (it reads this connector's buffers).
   ~HapticCoupling() override;
   [[nodiscard]] HapticBridge& bridge() { return *bridge_; }
-  /// Checkpoints and roll-back (haptic_state.cc): the bridge's state and buffers.
-  void SaveConnectorState(StateWriter& out) const override;
-  void RestoreConnectorState(StateReader& in) override;
 
  protected:
   StepStatus DoFire(double t) override;
 
  private:
-  HapticProbe& probe_;
+  SimObject& device_;
+  HapticEndpoint& endpoint_;
   std::unique_ptr<LocalModelBuilder> builder_;
   std::unique_ptr<HapticBridge> bridge_;
 };

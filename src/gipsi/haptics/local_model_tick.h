@@ -10,6 +10,8 @@
 /// position and the contact force for the simulation (`HapticFeedback`). No allocation, locks,
 /// exceptions or I/O.
 
+#include <cstdint>
+
 #include "gipsi/base/export.h"
 #include "gipsi/haptics/haptic_tick.h"
 #include "gipsi/haptics/local_model.h"
@@ -23,6 +25,45 @@ struct HapticFeedback {
   Vec3 force = Vec3::Zero();  ///< force of the tool on the object at the contact node [N]
   int contact_vertex = -1;    ///< boundary vertex the force acts on (−1: none)
   double time = -1;           ///< haptic time of the tick [s]
+  template <class Self, class V>
+  static void Fields(Self& s, V& v) {
+    v("tool", s.tool);
+    v("force", s.force);
+    v("contact_vertex", s.contact_vertex);
+    v("time", s.time);
+  }
+};
+
+/// What a LocalModelTick carries from one tick to the next (a state value type,
+/// gipsi/base/state_value.h): the local state, the hand-over blend, the depth history, the
+/// last outputs and the safety stage. The models it renders live in the buffer, which its
+/// producer (HapticBridge) keeps.
+struct LocalTickState {
+  LocalVector u, v;  ///< the local displacements [m] and velocities [m/s]
+  bool anchored = false, blend_pending = false, have_depth = false;
+  double previous_depth = 0, depth = 0, proxy_depth = 0, model_force = 0, blend_left = 0;
+  Vec3 rendered = Vec3::Zero(), offset = Vec3::Zero(), proxy = Vec3::Zero(), tool = Vec3::Zero();
+  std::int64_t handovers = 0;
+  ForceSafetyState safety;
+  template <class Self, class V>
+  static void Fields(Self& s, V& v) {
+    v("u", s.u);
+    v("v", s.v);
+    v("anchored", s.anchored);
+    v("blend_pending", s.blend_pending);
+    v("have_depth", s.have_depth);
+    v("previous_depth", s.previous_depth);
+    v("depth", s.depth);
+    v("proxy_depth", s.proxy_depth);
+    v("model_force", s.model_force);
+    v("blend_left", s.blend_left);
+    v("rendered", s.rendered);
+    v("offset", s.offset);
+    v("proxy", s.proxy);
+    v("tool", s.tool);
+    v("handovers", s.handovers);
+    v("safety", s.safety);
+  }
 };
 
 /// Parameters of the tick. Plain struct with defaults.
@@ -58,11 +99,9 @@ class LocalModelTick final : public HapticRenderer {
   [[nodiscard]] const LocalDynamicModel& model() const { return models_.front(); }
   [[nodiscard]] const ForceSafety& safety() const { return safety_; }
   [[nodiscard]] std::int64_t num_handovers() const { return handovers_; }
-  /// Checkpoints (haptic_state.cc): everything the next ticks depend on (local state, hand-over
-  /// blend, depth history, safety stage). The models it renders live in the buffer, which its
-  /// producer (HapticBridge) saves.
-  void SaveState(StateWriter& out) const;
-  void RestoreState(StateReader& in);
+  /// Checkpoints and roll-back (haptic_state.cc): everything the next ticks depend on.
+  void GetState(LocalTickState& out) const;
+  void SetState(const LocalTickState& in);
 
  private:
   HapticDevice& device_;

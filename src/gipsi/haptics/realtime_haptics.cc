@@ -6,12 +6,14 @@
 
 namespace gipsi {
 
-std::vector<HapticProbe*> RealtimeProbes(Kernel& kernel) {
-  std::vector<HapticProbe*> probes;
+std::vector<RealtimeProbe> RealtimeProbes(Kernel& kernel) {
+  std::vector<RealtimeProbe> probes;
   Coordinator& coordinator = kernel.coordinator();
-  for (std::size_t i = 0; i < coordinator.num_objects(); ++i)
-    if (auto* probe = dynamic_cast<HapticProbe*>(&coordinator.object(i)))
-      if (probe->realtime()) probes.push_back(probe);
+  for (std::size_t i = 0; i < coordinator.num_objects(); ++i) {
+    SimObject& object = coordinator.object(i);
+    if (auto* endpoint = dynamic_cast<HapticEndpoint*>(&object))
+      if (endpoint->realtime()) probes.push_back({&object, endpoint});
+  }
   return probes;
 }
 
@@ -37,19 +39,20 @@ RealtimeHaptics::~RealtimeHaptics() {
 void RealtimeHaptics::Start() {
   if (running_) return;
   running_ = true;
-  for (HapticProbe* probe : probes_)
-    if (!probe->loop_running()) probe->StartLoop(kernel_.time());
+  for (const RealtimeProbe& probe : probes_)
+    if (!probe.endpoint->loop_running()) probe.endpoint->StartLoop(kernel_.time());
 }
 
 std::vector<std::pair<std::string, HapticLoopStats>> RealtimeHaptics::Stop() {
   std::vector<std::pair<std::string, HapticLoopStats>> out;
   if (!running_) return out;
   running_ = false;
-  for (HapticProbe* probe : probes_) {
-    const HapticLoopStats stats = probe->StopLoop();
+  for (const RealtimeProbe& probe : probes_) {
+    const HapticLoopStats stats = probe.endpoint->StopLoop();
     if (stats.ticks == 0) continue;
-    Log().info("haptic loop of '{}': {}", probe->name(), DescribeLoopStats(stats));
-    out.emplace_back(probe->name(), stats);
+    const std::string& name = probe.object->name();
+    Log().info("haptic loop of '{}': {}", name, DescribeLoopStats(stats));
+    out.emplace_back(name, stats);
   }
   return out;
 }

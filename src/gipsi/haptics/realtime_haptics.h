@@ -1,7 +1,8 @@
 #pragma once
 /// @file
 /// `RealtimeHaptics`: runs the real-time haptic loops of a scene's probes (HapticProbe with
-/// "realtime") for the duration of a run. `gipsi run`, `gipsi view` and `gipsi snapshot` hold
+/// "realtime", or any object with the HapticEndpoint capability that is real-time) for the
+/// duration of a run. `gipsi run`, `gipsi view` and `gipsi snapshot` hold
 /// one around their runs; a program that runs such a scene's kernel itself does the same:
 ///
 ///     RealtimeHaptics haptics(*scene.kernel);
@@ -17,13 +18,20 @@
 
 #include "gipsi/base/export.h"
 #include "gipsi/core/kernel.h"
-#include "gipsi/haptics/haptic_probe.h"
+#include "gipsi/haptics/haptic_endpoint.h"
 
 GIPSI_EXPORT_BEGIN
 namespace gipsi {
 
-/// The real-time HapticProbes among the kernel's objects (top level; in scene order).
-std::vector<HapticProbe*> RealtimeProbes(Kernel& kernel);
+/// A real-time haptic device among a kernel's objects: the object and its capability.
+struct RealtimeProbe {
+  SimObject* object;
+  HapticEndpoint* endpoint;
+};
+
+/// The real-time haptic devices (HapticEndpoint::realtime()) among the kernel's objects (top
+/// level; in scene order).
+std::vector<RealtimeProbe> RealtimeProbes(Kernel& kernel);
 
 /// One line describing a finished loop: ticks, rate, period percentiles and scheduling.
 std::string DescribeLoopStats(const HapticLoopStats& stats);
@@ -44,11 +52,11 @@ class RealtimeHaptics {
   /// ran. Idempotent (a second call returns nothing).
   std::vector<std::pair<std::string, HapticLoopStats>> Stop();
   /// The real-time probes it runs.
-  [[nodiscard]] const std::vector<HapticProbe*>& probes() const { return probes_; }
+  [[nodiscard]] const std::vector<RealtimeProbe>& probes() const { return probes_; }
 
  private:
   Kernel& kernel_;
-  std::vector<HapticProbe*> probes_;
+  std::vector<RealtimeProbe> probes_;
   bool running_ = false;
 };
 

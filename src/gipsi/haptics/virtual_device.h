@@ -4,6 +4,7 @@
 /// tests. Positions are interpolated linearly between keyframes and held outside them; the
 /// commanded forces are kept for inspection.
 
+#include <cstdint>
 #include <filesystem>
 #include <vector>
 
@@ -13,8 +14,20 @@
 GIPSI_EXPORT_BEGIN
 namespace gipsi {
 
-class StateWriter;
-class StateReader;
+/// What a VirtualDevice carries from one tick to the next (a state value type,
+/// gipsi/base/state_value.h); its pose is a function of time.
+struct VirtualDeviceState {
+  bool connected = true;
+  Vec3 force = Vec3::Zero(), torque = Vec3::Zero();  ///< the last command
+  std::int64_t commands = 0;
+  template <class Self, class V>
+  static void Fields(Self& s, V& v) {
+    v("connected", s.connected);
+    v("force", s.force);
+    v("torque", s.torque);
+    v("commands", s.commands);
+  }
+};
 
 /// One keyframe of a trajectory. Plain struct.
 struct DeviceKeyframe {
@@ -41,10 +54,16 @@ class VirtualDevice final : public HapticDevice {
   [[nodiscard]] const Vec3& last_force() const { return force_; }
   [[nodiscard]] const Vec3& last_torque() const { return torque_; }
   [[nodiscard]] std::int64_t num_commands() const { return commands_; }
-  /// Checkpoints (haptic_state.cc): the connection flag and the commands received. The pose is
-  /// a function of time.
-  void SaveState(StateWriter& out) const;
-  void RestoreState(StateReader& in);
+  /// Checkpoints and roll-back: the connection flag and the commands received.
+  [[nodiscard]] VirtualDeviceState state() const {
+    return {connected_, force_, torque_, commands_};
+  }
+  void set_state(const VirtualDeviceState& s) {
+    connected_ = s.connected;
+    force_ = s.force;
+    torque_ = s.torque;
+    commands_ = s.commands;
+  }
 
  private:
   std::vector<DeviceKeyframe> path_;

@@ -12,6 +12,7 @@ namespace gipsi {
 BoundaryCoupling::BoundaryCoupling(std::string name, SimObject& driver, SimObject& follower,
                                    const std::optional<Region>& follower_region, double tolerance)
     : Connector(std::move(name)), driver_(driver), follower_(follower) {
+  BindNoState();  // every Fire rewrites its buffers
   driver_displacement_ = driver.FindField("boundary_displacement");
   follower_reaction_ = follower.FindField("reaction_force");
   (void)driver.FindField("reaction_force");

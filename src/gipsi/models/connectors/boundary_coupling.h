@@ -32,8 +32,6 @@ class BoundaryCoupling final : public Connector {
                    const std::optional<Region>& follower_region, double tolerance);
 
   [[nodiscard]] std::string_view type_name() const override { return "BoundaryCoupling"; }
-  void SaveConnectorState(StateWriter& out) const override;
-  void RestoreConnectorState(StateReader& in) override;
   /// Follower boundary vertices on the interface.
   [[nodiscard]] const std::vector<int>& interface_vertices() const { return follower_vertices_; }
 

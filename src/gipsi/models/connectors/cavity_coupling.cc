@@ -17,6 +17,7 @@ CavityCoupling::CavityCoupling(std::string name, SimObject& wall, const std::str
       blood_(blood),
       chambers_(LumpedChambersOf(blood)),
       bulk_modulus_(bulk_modulus) {
+  BindNoState();  // the pressure is the wall's state, the volumes the blood's
   if (!(bulk_modulus_ > 0))
     throw InputError(
         fmt::format("connector '{}': the blood bulk modulus must be positive", this->name()));

@@ -50,8 +50,6 @@ class CavityCoupling final : public Connector, public CavityLaw {
   /// Trial integrations of the blood so far (what the coupling costs the circulation).
   [[nodiscard]] std::int64_t trials() const { return trials_; }
   /// Nothing of the future lives here (the pressure is the wall's, the volumes the blood's).
-  void SaveConnectorState(StateWriter& /*out*/) const override {}
-  void RestoreConnectorState(StateReader& /*in*/) override {}
 
  protected:
   StepStatus DoFire(double t) override;

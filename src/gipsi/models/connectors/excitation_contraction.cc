@@ -46,13 +46,15 @@ ExcitationContraction::ExcitationContraction(std::string name, const SimObject& 
   if (!coincide) map_ = ep.MapFromNodes(dst);
   source_.resize(1, src.cols());
   mapped_.resize(1, dst.cols());
-  tension_ = VecX::Zero(dst.cols());
+  state_.tension = VecX::Zero(dst.cols());
+  BindState(state_);
 }
 
 StepStatus ExcitationContraction::DoFire(double t) {
-  const double dt = fired_ ? t - last_time_ : 0.0;
-  fired_ = true;
-  last_time_ = t;
+  VecX& tension = state_.tension;
+  const double dt = state_.fired ? t - state_.last_time : 0.0;
+  state_.fired = true;
+  state_.last_time = t;
   ep_.ReadField(voltage_, source_);
   if (map_) {
     map_->Apply(source_, mapped_);
@@ -60,15 +62,15 @@ StepStatus ExcitationContraction::DoFire(double t) {
     mapped_ = source_;
   }
   const ExcitationContractionParams& p = params_;
-  for (Index i = 0; i < tension_.size(); ++i) {
+  for (Index i = 0; i < tension.size(); ++i) {
     const double v = mapped_(0, i);
     if (!std::isfinite(v)) return StepStatus::Diverged("non-finite voltage at item", i, v);
     const double u = std::clamp((v - p.v_rest) / (p.v_peak - p.v_rest), 0.0, 1.0);
     const double rate = u >= p.threshold ? p.rise_rate : p.decay_rate;
     const double target = p.gain * u;
-    tension_[i] = target + (tension_[i] - target) * std::exp(-rate * dt);
+    tension[i] = target + (tension[i] - target) * std::exp(-rate * dt);
   }
-  muscle_.WriteField(tension_field_, tension_.transpose());
+  muscle_.WriteField(tension_field_, tension.transpose());
   return StepStatus::Ok();
 }
 

@@ -16,8 +16,10 @@
 ///
 /// Units: V in mV (the EP objects' unit); k in Pa; rates in 1/s; kernel time in s.
 
+#include <cstdint>
 #include <optional>
 #include <string>
+#include <string_view>
 
 #include "gipsi/base/export.h"
 #include "gipsi/core/connector.h"
@@ -39,6 +41,22 @@ struct ExcitationContractionParams {
   double decay_rate = 30.0;  ///< 1/s
 };
 
+/// What ExcitationContraction carries from one firing to the next (a state value type,
+/// gipsi/base/state_value.h).
+struct ExcitationContractionState {
+  static constexpr std::string_view kTag = "ExcitationContractionState";
+  static constexpr std::uint32_t kVersion = 1;
+  VecX tension;          ///< the active tension [Pa] per target item (last value Set)
+  double last_time = 0;  ///< when it last fired [s]
+  bool fired = false;    ///< whether it has fired (the first firing integrates over 0 s)
+  template <class Self, class V>
+  static void Fields(Self& s, V& v) {
+    v("tension", s.tension, Shape::kFixed);
+    v("last_time", s.last_time);
+    v("fired", s.fired);
+  }
+};
+
 /// Not copyable or movable (a Connector).
 class ExcitationContraction final : public Connector {
  public:
@@ -48,10 +66,10 @@ class ExcitationContraction final : public Connector {
                         FieldId tension, const ExcitationContractionParams& params);
 
   [[nodiscard]] std::string_view type_name() const override { return "ExcitationContraction"; }
-  void SaveConnectorState(StateWriter& out) const override;
-  void RestoreConnectorState(StateReader& in) override;
   /// The active tension [Pa] per target item (last value Set).
-  [[nodiscard]] const VecX& tension() const { return tension_; }
+  [[nodiscard]] const VecX& tension() const { return state_.tension; }
+  /// The state (bound with BindState: checkpoints and snapshots copy it).
+  [[nodiscard]] const ExcitationContractionState& state() const { return state_; }
 
  protected:
   StepStatus DoFire(double t) override;
@@ -64,9 +82,7 @@ class ExcitationContraction final : public Connector {
   ExcitationContractionParams params_;
   std::optional<PointMap> map_;  // empty: the items coincide
   Eigen::MatrixXd source_, mapped_;
-  VecX tension_;
-  double last_time_ = 0;
-  bool fired_ = false;
+  ExcitationContractionState state_;
 };
 
 /// Registers "ExcitationContraction" (keys in docs/scene-format.md).

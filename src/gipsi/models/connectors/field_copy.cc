@@ -21,6 +21,7 @@ FieldCopy::FieldCopy(std::string name, SimObject& from, FieldId from_field, SimO
       to_field_(to_field),
       mapping_(mapping),
       scale_(scale) {
+  BindNoState();  // every Fire rewrites its buffers
   const FieldInfo& src = from.field_info(from_field);
   const FieldInfo& dst = to.field_info(to_field);
   auto fail = [&](const std::string& what) {

@@ -39,8 +39,6 @@ class FieldCopy final : public Connector {
             Mapping mapping, double scale, const std::string& scale_units = {});
 
   [[nodiscard]] std::string_view type_name() const override { return "FieldCopy"; }
-  void SaveConnectorState(StateWriter& out) const override;
-  void RestoreConnectorState(StateReader& in) override;
   /// The mapping in use (kDirect when values are copied item by item).
   [[nodiscard]] Mapping mapping() const { return mapping_; }
   /// The factor applied: the scale times the conversion of its units into the target's.

@@ -7,7 +7,6 @@
 
 #include "gipsi/base/error.h"
 #include "gipsi/base/log.h"
-#include "gipsi/base/state.h"
 #include "gipsi/base/units.h"
 
 namespace gipsi {
@@ -97,6 +96,7 @@ Heart::Heart(std::string name, Coordinator parts, HeartMonitorSpec monitor)
   artery_pressure_ = blood_->FindField(monitor_.artery + "_pressure");
   if (!(monitor_.period > 0))
     throw InputError(fmt::format("heart '{}': the beat period must be positive", this->name()));
+  BindAggregateState(state_);
   first_own_field_ = num_part_fields();
   using L = FieldLocation;
   using A = FieldAccess;
@@ -131,45 +131,48 @@ void Heart::Track(double t) {
   blood_->ReadField(chamber_volume_, v);
   blood_->ReadField(chamber_pressure_, p);
   blood_->ReadField(artery_pressure_, a);
-  if (!beat_started_) {
-    v_max_ = v_min_ = v(0, 0);
-    p_max_ = p(0, 0);
-    a_max_ = a_min_ = a(0, 0);
-    beat_started_ = true;
+  HeartMonitorState& m = state_;
+  if (!m.beat_started) {
+    m.v_max = m.v_min = v(0, 0);
+    m.p_max = p(0, 0);
+    m.a_max = m.a_min = a(0, 0);
+    m.beat_started = true;
   } else {
-    v_max_ = std::max(v_max_, v(0, 0));
-    v_min_ = std::min(v_min_, v(0, 0));
-    p_max_ = std::max(p_max_, p(0, 0));
-    a_max_ = std::max(a_max_, a(0, 0));
-    a_min_ = std::min(a_min_, a(0, 0));
+    m.v_max = std::max(m.v_max, v(0, 0));
+    m.v_min = std::min(m.v_min, v(0, 0));
+    m.p_max = std::max(m.p_max, p(0, 0));
+    m.a_max = std::max(m.a_max, a(0, 0));
+    m.a_min = std::min(m.a_min, a(0, 0));
   }
-  if (t >= (beat_index_ + 1) * monitor_.period - 1e-9 * monitor_.period) {
+  if (t >= (m.beat_index + 1) * monitor_.period - 1e-9 * monitor_.period) {
     FinishBeat(t);
     // The beat's last sample opens the next one (it is both end-diastolic and first).
-    v_max_ = v_min_ = v(0, 0);
-    p_max_ = p(0, 0);
-    a_max_ = a_min_ = a(0, 0);
+    m.v_max = m.v_min = v(0, 0);
+    m.p_max = p(0, 0);
+    m.a_max = m.a_min = a(0, 0);
   }
 }
 
 void Heart::FinishBeat(double t) {
+  HeartMonitorState& m = state_;
   BeatSummary beat;
-  beat.beat = ++beat_index_;
+  beat.beat = ++m.beat_index;
   beat.end_time = t;
-  beat.edv = v_max_;
-  beat.esv = v_min_;
-  beat.peak_pressure = p_max_;
-  beat.arterial_systolic = a_max_;
-  beat.arterial_diastolic = a_min_;
-  if (!beats_.empty()) {
-    const BeatSummary& prev = beats_.back();
+  beat.edv = m.v_max;
+  beat.esv = m.v_min;
+  beat.peak_pressure = m.p_max;
+  beat.arterial_systolic = m.a_max;
+  beat.arterial_diastolic = m.a_min;
+  const std::vector<BeatSummary>& beats = m.beats.get();
+  if (!beats.empty()) {
+    const BeatSummary& prev = beats.back();
     auto rel = [](double x, double y) { return std::abs(x - y) / std::max(std::abs(x), 1e-300); };
     beat.change = std::max({rel(beat.edv, prev.edv), rel(beat.esv, prev.esv),
                             rel(beat.peak_pressure, prev.peak_pressure),
                             rel(beat.arterial_systolic, prev.arterial_systolic),
                             rel(beat.arterial_diastolic, prev.arterial_diastolic)});
   }
-  beats_.push_back(beat);
+  m.beats.Write().push_back(beat);
   constexpr double kMl = 1e6, kMmHg = 1.0 / 133.322387415;
   Log().info(
       "{}: beat {} ({:.3f} s): EDV {:.1f} mL, ESV {:.1f} mL, SV {:.1f} mL, EF {:.1f} %, peak {} "
@@ -177,8 +180,8 @@ void Heart::FinishBeat(double t) {
       name(), beat.beat, t, kMl * beat.edv, kMl * beat.esv, kMl * beat.stroke_volume(),
       100 * beat.ejection_fraction(), monitor_.chamber, kMmHg * beat.peak_pressure, monitor_.artery,
       kMmHg * beat.arterial_systolic, kMmHg * beat.arterial_diastolic,
-      beats_.size() == 1 ? std::string("—")  // no previous beat to compare with
-                         : fmt::format("{:.2f} %", 100 * beat.change));
+      beats.size() == 1 ? std::string("—")  // no previous beat to compare with
+                        : fmt::format("{:.2f} %", 100 * beat.change));
 }
 
 void Heart::DoReadField(FieldId id, Eigen::Ref<Eigen::MatrixXd> out) const {
@@ -187,14 +190,15 @@ void Heart::DoReadField(FieldId id, Eigen::Ref<Eigen::MatrixXd> out) const {
     AggregateObject::DoReadField(id, out);
     return;
   }
-  if (index > first_own_field_ && beats_.empty()) {  // no completed beat: no figures yet
+  const std::vector<BeatSummary>& beats = state_.beats.get();
+  if (index > first_own_field_ && beats.empty()) {  // no completed beat: no figures yet
     out(0, 0) = kNoBeat;
     return;
   }
-  const BeatSummary last = beats_.empty() ? BeatSummary{} : beats_.back();
+  const BeatSummary last = beats.empty() ? BeatSummary{} : beats.back();
   switch (index - first_own_field_) {
     case 0:
-      out(0, 0) = static_cast<double>(beats_.size());
+      out(0, 0) = static_cast<double>(beats.size());
       break;
     case 1:
       out(0, 0) = last.edv;
@@ -226,40 +230,6 @@ void Heart::DoReadField(FieldId id, Eigen::Ref<Eigen::MatrixXd> out) const {
 void Heart::DoWriteField(FieldId id, const Eigen::Ref<const Eigen::MatrixXd>& in) {
   // Only the parts' writable fields reach here (the monitor's are read-only).
   AggregateObject::DoWriteField(id, in);
-}
-
-void Heart::SaveAggregateState(StateWriter& out) const {
-  out.BeginSection("HeartMonitor", 1);
-  std::vector<double> flat;
-  for (const BeatSummary& b : beats_)
-    flat.insert(flat.end(), {static_cast<double>(b.beat), b.end_time, b.edv, b.esv, b.peak_pressure,
-                             b.arterial_systolic, b.arterial_diastolic, b.change});
-  out.WriteArray(flat);
-  out.WriteArray(std::vector<double>{v_max_, v_min_, p_max_, a_max_, a_min_});
-  out.WriteBool(beat_started_);
-  out.WriteInt(beat_index_);
-  out.EndSection();
-}
-
-void Heart::RestoreAggregateState(StateReader& in) {
-  in.BeginSection("HeartMonitor", 1);
-  std::vector<double> flat, running;
-  in.ReadArray(flat);
-  in.ReadArray(running);
-  if (flat.size() % 8 != 0 || running.size() != 5)
-    in.Fail("the heart monitor's record is malformed");
-  beats_.clear();
-  for (std::size_t i = 0; i < flat.size(); i += 8)
-    beats_.push_back({static_cast<int>(flat[i]), flat[i + 1], flat[i + 2], flat[i + 3], flat[i + 4],
-                      flat[i + 5], flat[i + 6], flat[i + 7]});
-  v_max_ = running[0];
-  v_min_ = running[1];
-  p_max_ = running[2];
-  a_max_ = running[3];
-  a_min_ = running[4];
-  beat_started_ = in.ReadBool();
-  beat_index_ = static_cast<int>(in.ReadInt());
-  in.EndSection();
 }
 
 void RegisterHeart(TypeRegistry& registry) {

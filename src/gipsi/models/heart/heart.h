@@ -15,7 +15,9 @@
 /// run is to its periodic state). They are global fields (of the last completed beat) and a
 /// line in the log per beat.
 
+#include <cstdint>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "gipsi/base/export.h"
@@ -50,6 +52,41 @@ struct BeatSummary {
   double change = kNoBeat;
   [[nodiscard]] double stroke_volume() const { return edv - esv; }
   [[nodiscard]] double ejection_fraction() const { return edv > 0 ? (edv - esv) / edv : 0; }
+  template <class Self, class V>
+  static void Fields(Self& s, V& v) {
+    v("beat", s.beat);
+    v("end_time", s.end_time);
+    v("edv", s.edv);
+    v("esv", s.esv);
+    v("peak_pressure", s.peak_pressure);
+    v("arterial_systolic", s.arterial_systolic);
+    v("arterial_diastolic", s.arterial_diastolic);
+    v("change", s.change);
+  }
+};
+
+/// What the beat monitor carries from one step to the next (a state value type,
+/// gipsi/base/state_value.h): the completed beats (copied only when one was added) and the
+/// beat in progress.
+struct HeartMonitorState {
+  static constexpr std::string_view kTag = "HeartMonitor";
+  static constexpr std::uint32_t kVersion = 2;
+  Stamped<std::vector<BeatSummary>> beats;
+  // Running extremes of the beat in progress.
+  double v_max = 0, v_min = 0, p_max = 0, a_max = 0, a_min = 0;
+  bool beat_started = false;
+  int beat_index = 0;  // of the beat in progress
+  template <class Self, class V>
+  static void Fields(Self& s, V& v) {
+    v("beats", s.beats);
+    v("v_max", s.v_max);
+    v("v_min", s.v_min);
+    v("p_max", s.p_max);
+    v("a_max", s.a_max);
+    v("a_min", s.a_min);
+    v("beat_started", s.beat_started);
+    v("beat_index", s.beat_index);
+  }
 };
 
 /// Not copyable or movable (a SimObject).
@@ -60,12 +97,11 @@ class Heart final : public AggregateObject {
 
   [[nodiscard]] std::string_view type_name() const override { return "Heart"; }
   /// Every completed beat so far.
-  [[nodiscard]] const std::vector<BeatSummary>& beats() const { return beats_; }
+  [[nodiscard]] const std::vector<BeatSummary>& beats() const { return state_.beats.get(); }
+  /// The monitor's state (bound with BindAggregateState: checkpoints and snapshots copy it).
+  [[nodiscard]] const HeartMonitorState& monitor_state() const { return state_; }
 
  protected:
-  /// The monitor's state (completed beats, the beat in progress), after the aggregate's.
-  void SaveAggregateState(StateWriter& out) const override;
-  void RestoreAggregateState(StateReader& in) override;
   StepStatus DoStep(double t, double dt) override;
   void DoReadField(FieldId id, Eigen::Ref<Eigen::MatrixXd> out) const override;
   void DoWriteField(FieldId id, const Eigen::Ref<const Eigen::MatrixXd>& in) override;
@@ -77,11 +113,7 @@ class Heart final : public AggregateObject {
   HeartMonitorSpec monitor_;
   SimObject* blood_ = nullptr;
   FieldId chamber_volume_, chamber_pressure_, artery_pressure_;
-  std::vector<BeatSummary> beats_;
-  // Running extremes of the beat in progress.
-  double v_max_ = 0, v_min_ = 0, p_max_ = 0, a_max_ = 0, a_min_ = 0;
-  bool beat_started_ = false;
-  int beat_index_ = 0;  // of the beat in progress
+  HeartMonitorState state_;
   std::size_t first_own_field_ = 0;
 };
 

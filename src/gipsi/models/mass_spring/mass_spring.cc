@@ -94,6 +94,7 @@ MassSpring::MassSpring(std::string name, const Points& nodes, const Eigen::Matri
 void MassSpring::Finish() {
   if (!params_.law) params_.law = std::make_shared<HookeSpring>();
   hooke_ = dynamic_cast<const HookeSpring*>(params_.law.get()) != nullptr;
+  BindState(state_);  // checkpoints and snapshots; StateRestored rebuilds what derives from it
   const Mesh& mesh = domain();
   const Index n = mesh.num_nodes();
   rest_length_.resize(num_springs());

@@ -98,6 +98,8 @@ struct MassSpringCavityState {
 /// from this (positions, the springs' active weights, which follow the fibres). Copyable.
 /// Shapes: N nodes, E tets.
 struct MassSpringState {
+  static constexpr std::string_view kTag = "MassSpringState";
+  static constexpr std::uint32_t kVersion = 1;
   VecX x;                     ///< [q; v], 6N: positions then velocities
   Points external_force;      ///< 3 by N [N], the volume-coupling input
   VecX nodal_active_tension;  ///< per node [Pa]
@@ -158,8 +160,6 @@ class MassSpring final : public SimObject, public CavityWall {
 
   [[nodiscard]] std::string_view type_name() const override { return "MassSpring"; }
   [[nodiscard]] const Points& domain_positions() const override { return positions_; }
-  void SaveObjectState(StateWriter& out) const override;
-  void RestoreObjectState(StateReader& in) override;
 
   // --- OdeSystem contract: x = [q (3N); v (3N)] ---
   [[nodiscard]] Index ode_size() const { return 6 * num_nodes(); }
@@ -203,9 +203,9 @@ class MassSpring final : public SimObject, public CavityWall {
   [[nodiscard]] Vec3 Momentum() const;
 
  protected:
-  [[nodiscard]] std::unique_ptr<ObjectState> NewObjectState() const override;
-  void CopyObjectState(ObjectState& into) const override;
-  void SetObjectState(const ObjectState& from) override;
+  /// After a checkpoint or snapshot replaced the bound state (BindState): positions,
+  /// any_active_, and the active weights if the fibres changed.
+  void StateRestored() override;
   StepStatus DoStep(double t, double dt) override;
   void DoReadField(FieldId id, Eigen::Ref<Eigen::MatrixXd> out) const override;
   [[nodiscard]] const double* DoFieldMemory(FieldId id) const override;
@@ -240,9 +240,6 @@ class MassSpring final : public SimObject, public CavityWall {
   /// Adds p ∂V/∂x of every cavity at positions q (3N) to f; coupled ones only if
   /// `include_coupled`.
   void AddCavityForces(Eigen::Ref<const VecX> q, Eigen::Ref<VecX> f, bool include_coupled) const;
-  /// After the state was replaced: any_active_, positions_, and the active weights if the
-  /// fibres changed (UpdateActiveWeights allocates).
-  void UpdateDerived(bool fibres_changed);
   /// ∂V/∂x at the start of the step (g) of every coupled cavity, zero on held axes.
   void BeginCoupledStep();
   /// Solves each coupled cavity's pressure after the p = 0 step and moves the state by it; false
@@ -263,9 +260,10 @@ class MassSpring final : public SimObject, public CavityWall {
   FieldId f_kinetic_, f_potential_, f_momentum_;
   FieldId f_fibre_, f_nodal_active_;
 
-  VecX tet_rest_volume_;     // signed, per tet
-  VecX active_weight_;       // per spring [m²], from state_.fibres (E = 0: no fibres)
-  bool any_active_ = false;  // some node has non-zero tension
+  VecX tet_rest_volume_;             // signed, per tet
+  VecX active_weight_;               // per spring [m²], from state_.fibres (E = 0: no fibres)
+  std::uint64_t weights_stamp_ = 0;  // state_.fibres' stamp active_weight_ was computed from
+  bool any_active_ = false;          // some node has non-zero tension
 
   struct Cavity : WallCavity {
     explicit Cavity(WallCavity wall)

@@ -14,6 +14,7 @@
 namespace gipsi {
 
 void MassSpring::UpdateActiveWeights() {
+  weights_stamp_ = state_.fibres.stamp();
   active_weight_ = VecX::Zero(num_springs());
   const Mesh& mesh = domain();
   if (mesh.num_tets() == 0 || state_.fibres.get().cols() != mesh.num_tets()) return;
