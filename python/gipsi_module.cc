@@ -105,7 +105,7 @@ FieldId FindFieldOrRaise(const SimObject& o, const std::string& name) {
   if (auto id = o.TryFindField(name)) return *id;
   std::string known;
   for (const FieldInfo& f : o.fields()) known += (known.empty() ? "" : ", ") + f.name;
-  throw py::key_error(fmt::format("object '{}' ({}) has no field '{}'; its fields: {}", o.name(),
+  throw py::key_error(fmt::format("object '{}' ({}) has no field '{}'; its fields: {}", o.path(),
                                   o.type_name(), name, known));
 }
 
@@ -126,7 +126,7 @@ py::object ReadField(const ObjectHandle& h, const std::string& name) {
   const FieldId id = FindFieldOrRaise(o, name);
   const FieldInfo& f = o.field_info(id);
   if (!f.readable())
-    throw py::value_error(fmt::format("field '{}' of '{}' is write-only", name, o.name()));
+    throw py::value_error(fmt::format("field '{}' of '{}' is write-only", name, o.path()));
   const Index count = o.FieldCount(id);
   py::array_t<double> out(
       {static_cast<py::ssize_t>(count), static_cast<py::ssize_t>(f.components)});
@@ -145,7 +145,7 @@ void WriteField(ObjectHandle& h, const std::string& name,
   const FieldInfo& f = o.field_info(id);
   if (!f.writable())
     throw py::value_error(
-        fmt::format("field '{}' of '{}' is read-only ({})", name, o.name(), f.description));
+        fmt::format("field '{}' of '{}' is read-only ({})", name, o.path(), f.description));
   const Index count = o.FieldCount(id);
   const bool global_vector = count == 1 && values.ndim() == 1 && values.shape(0) == f.components;
   const bool full =
@@ -155,12 +155,12 @@ void WriteField(ObjectHandle& h, const std::string& name,
     throw py::value_error(fmt::format(
         "field '{}' of '{}' takes an array of shape ({}, {}) in [{}], got ({}); nothing was "
         "written",
-        name, o.name(), count, f.components, f.units, fmt::join(shape, ", ")));
+        name, o.path(), count, f.components, f.units, fmt::join(shape, ", ")));
   }
   for (py::ssize_t i = 0; i < values.size(); ++i)
     if (!std::isfinite(values.data()[i]))
       throw py::value_error(fmt::format("field '{}' of '{}': value {} is not finite ({})", name,
-                                        o.name(), i, values.data()[i]));
+                                        o.path(), i, values.data()[i]));
   Eigen::Map<const Eigen::MatrixXd> in(values.data(), f.components, count);
   o.WriteField(id, in);
 }
@@ -246,7 +246,7 @@ PYBIND11_MODULE(gipsi, m) {
               throw py::value_error(
                   fmt::format("field '{}' of '{}' is computed on request, not stored: read it with "
                               "field('{}') (a copy); fields with views: {}",
-                              name, o.name(), name, [&] {
+                              name, o.path(), name, [&] {
                                 std::string with;
                                 for (const FieldInfo& f : o.fields())
                                   if (o.FieldMemory(o.FindField(f.name)) != nullptr)

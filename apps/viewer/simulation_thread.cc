@@ -101,16 +101,20 @@ void SimulationThread::Load(const std::vector<std::pair<std::string, ColorSpec>>
       s.draws.push_back(display_->manager(i).draw());
       const SimObject& object = display_->manager(i).object();
       std::vector<std::string> fields;
+      std::vector<int> components;
       for (const FieldInfo& f : object.fields())
-        if (f.name == s.draws.back().color.field || OffersField(object, object.FindField(f.name)))
+        if (f.name == s.draws.back().color.field || OffersField(object, object.FindField(f.name))) {
           fields.push_back(f.name);
+          components.push_back(f.components);
+        }
       // Pulled is the tissue it is drawn on (a heart's bioelectricity: its muscle).
       const SimObject& tissue = display_->manager(i).geometry_object();
       const auto external = tissue.TryFindField("external_force");
       const bool pullable = LocalModels(*registry_).Contains(tissue.type_name()) && external &&
                             tissue.field_info(*external).writable() &&
                             tissue.boundary().num_vertices() > 0;
-      s.objects.push_back({display_->manager(i).name(), std::move(fields), pullable});
+      s.objects.push_back(
+          {display_->manager(i).name(), std::move(fields), std::move(components), pullable});
     }
   });
 }

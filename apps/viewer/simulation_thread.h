@@ -31,6 +31,7 @@ namespace gipsi::viz {
 struct DrawnObject {
   std::string name;                 ///< the object's full (dotted) name
   std::vector<std::string> fields;  ///< fields it can be coloured by
+  std::vector<int> components;      ///< each field's number of components (1: a scalar)
   /// The mouse can pull it: it has a free boundary, an `external_force` node field and a
   /// haptic local model (LocalModels, gipsi/core/local_model.h) to scale the pull's spring.
   bool pullable = false;

@@ -51,8 +51,6 @@ std::pair<Vec3, Vec3> MouseRay(const Camera& camera, double x, double y, int lef
   return camera.Ray(2 * (x - left) / width - 1, 1 - 2 * y / height, double(width) / height);
 }
 
-const char* const kComponents[] = {"magnitude", "x", "y", "z"};
-
 /// The haptic tool at `position` as a point surface: black without force, red with.
 SurfaceBuffers HapticToolPoint(const Vec3& position, const Vec3& force) {
   SurfaceBuffers s;
@@ -71,7 +69,7 @@ struct SurfaceUi {
   bool visible = true;
   bool wireframe = false;
   int field = 0;      // 0 = solid, else index + 1 into the object's fields
-  int component = 0;  // kComponents
+  int component = 0;  // ComponentChoices: 0 the magnitude, k component k-1
   int map = 0;        // ColorMap::Names()
 };
 
@@ -313,7 +311,15 @@ int RunViewer(const ViewerOptions& options) {
           for (const auto& f : fields) items += f + '\0';
           bool changed = ImGui::Combo("field", &ui[i].field, items.c_str());
           if (ui[i].field > 0) {
-            changed |= ImGui::Combo("component", &ui[i].component, kComponents, 4);
+            // Scalars (V, pressure) have no component box: they are drawn as their value.
+            const auto choices =
+                ComponentChoices(status.objects[i].components[std::size_t(ui[i].field - 1)]);
+            if (ui[i].component >= static_cast<int>(choices.size())) ui[i].component = 0;
+            if (!choices.empty()) {
+              std::string component_items;
+              for (const auto& c : choices) component_items += c + '\0';
+              changed |= ImGui::Combo("component", &ui[i].component, component_items.c_str());
+            }
             std::string map_items;
             for (const auto& m : maps) map_items += m + '\0';
             changed |= ImGui::Combo("map", &ui[i].map, map_items.c_str());

@@ -80,6 +80,25 @@ TEST(DisplayDefaults, ANoDataMarkerIsNotDrawnAsAValue) {
   }
 }
 
+TEST(DisplayDefaults, AScalarHasNoComponentBoxAndAVectorNamesItsAxes) {
+  // The viewer offered "magnitude, x, y, z" for the potential V too, which has no axes
+  // (choosing y or z failed: "component 1 does not exist").
+  TypeRegistry registry;
+  Scene scene = LoadBar(registry);
+  const SimObject& bar = scene.kernel->FindObject("bar");
+  EXPECT_TRUE(ComponentChoices(bar.field_info(bar.FindField("V")).components).empty());
+  Scene liver = LoadScene(std::string(GIPSI_SOURCE_DIR) + "/scenes/hanging_liver.json", registry);
+  const SimObject& mass_spring = liver.kernel->FindObject("liver");
+  EXPECT_EQ(
+      ComponentChoices(mass_spring.field_info(mass_spring.FindField("displacement")).components),
+      (std::vector<std::string>{"magnitude", "x", "y", "z"}));
+  // A tensor's components by index, as the colour bar labels them.
+  const std::vector<std::string> tensor = ComponentChoices(9);
+  ASSERT_EQ(tensor.size(), 10u);
+  EXPECT_EQ(tensor[1], "[0]");
+  EXPECT_EQ(tensor[9], "[8]");
+}
+
 TEST(DisplayDefaults, InputsNothingDrivesAreNotOfferedToColourBy) {
   // A mass-spring liver declares the heart's coupling inputs (fibre, nodal_active_tension);
   // nothing drives them there, so the viewer does not offer them. Before, it offered every

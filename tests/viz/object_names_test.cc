@@ -75,6 +75,43 @@ TEST(ObjectNames, AnAmbiguousShortNameNamesItsCandidates) {
   EXPECT_EQ(&scene.kernel->FindObject("other.lower"), scene.kernel->ObjectPaths().back().second);
 }
 
+TEST(ObjectNames, MessagesNameAPartByItsFullName) {
+  // Scene-load messages named a part by its own name ("object 'muscle': its time step ..."),
+  // which the command line then refused or found ambiguous.
+  TypeRegistry registry;
+  Scene scene = LoadTissue(registry, true);
+  const SimObject& lower = scene.kernel->FindObject("other.lower");
+  EXPECT_EQ(lower.name(), "lower");  // its key, for orders and connectors
+  EXPECT_EQ(lower.path(), "other.lower");
+  EXPECT_EQ(scene.kernel->FindObject("tissue").path(), "tissue");
+  const auto load = [&](const std::string& parts) {
+    return Message([&] {
+      TypeRegistry fresh;
+      RegisterBuiltins(fresh);
+      (void)LoadSceneFromString(R"({
+        "meshes": {"box": {"generate": "box", "min": [0, 0, 0], "max": [1, 1, 1],
+                           "cells": [1, 1, 1]}},
+        "objects": {"outer": {"type": "Aggregate", "dt": 0.001, "parts": {"inner": {
+          "type": "Aggregate", "dt": 0.001, "parts": )" +
+                                    parts + R"(}}}},
+        "schedule": {"end": 0.01}})",
+                                "nested.json", ".", fresh);
+    });
+  };
+  // Nested aggregates: the path runs from the top level, for a part (its time step) and for a
+  // connector (its wiring).
+  EXPECT_THAT(load(R"({"block": {"type": "MassSpring", "domain": "box", "stiffness": 2000,
+                                   "dt": 0.003}})"),
+              HasSubstr("object 'outer.inner.block': its time step 0.003 s does not divide"));
+  // A connector of the nested aggregate, wired to a field of other units.
+  const std::string block = R"({"type": "MassSpring", "domain": "box", "stiffness": 2000,
+                                 "dt": 0.001})";
+  EXPECT_THAT(load(R"({"a": )" + block + R"(, "b": )" + block + R"(},
+                       "connectors": {"copy": {"type": "FieldCopy", "from": "a.kinetic_energy",
+                                               "to": "b.external_force"}})"),
+              HasSubstr("connector 'outer.inner.copy'"));
+}
+
 TEST(ObjectNames, DrawnObjectsCarryTheirFullNamesAndTheOptionsTakeEitherName) {
   TypeRegistry registry;
   Scene scene = LoadTissue(registry);

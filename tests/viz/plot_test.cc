@@ -1,5 +1,6 @@
 #include "gipsi/viz/render/plot.h"
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <sstream>
@@ -103,6 +104,70 @@ TEST(WritePlot, WritesSvgWithALegendForSeveralSeries) {
   EXPECT_THAT(text.str(), HasSubstr("<svg"));
   EXPECT_THAT(text.str(), HasSubstr("stroke:rgb(12.156863%,46.666667%,70.588235%)"));  // #1f77b4
   EXPECT_THAT(text.str(), HasSubstr("stroke:rgb(100%,49.803922%,5.490196%)"));         // #ff7f0e
+}
+
+TEST(WritePlot, PutsTheLegendRightOfTheAxesAndNeverOnTheData) {
+  // Two series with long labels (as the heart's pressure plot has): the legend must sit in a
+  // strip right of the axes' frame, inside the image, and no legend text may fall inside the
+  // frame, where it would cover the curves (it once sat on them).
+  PlotData data = Series({0, 1, 2}, {0, 1, 4});
+  data.series[0].label = "left ventricular pressure [mmHg]";
+  data.series.push_back({"aortic pressure at the valve [mmHg]", {0, 1, 2}, {4, 1, 0}});
+  const auto dir = gipsi::testing::TempDir("gipsi_plot_", "legend");
+  WritePlot(data, dir / "p.png");
+  const Image image = ReadPng(dir / "p.png");
+  // Black lines and text, anti-aliased over two pixels (a 1-px frame line reads as two 50 %
+  // grey columns): a dark neutral grey. The series' colours and their blends are not neutral.
+  const auto dark = [&](int x, int y) {
+    const Rgb c = image.At(x, y);
+    const float hi = std::max({c.r, c.g, c.b}), lo = std::min({c.r, c.g, c.b});
+    return hi < 0.6f && hi - lo < 0.1f;
+  };
+  // The frame's vertical sides are the columns of dark pixels taller than half the image (the
+  // legend's own box is a few text lines tall).
+  std::vector<int> frame_columns;
+  for (int x = 0; x < image.width; ++x) {
+    int count = 0;
+    for (int y = 0; y < image.height; ++y) count += dark(x, y) ? 1 : 0;
+    if (count > image.height / 2) frame_columns.push_back(x);
+  }
+  ASSERT_GE(frame_columns.size(), 2u);
+  const int left = frame_columns.front(), right = frame_columns.back();
+  ASSERT_GT(right - left, image.width / 3);  // the data keep most of the width
+  int top = image.height, bottom = 0;        // the frame's rows, from its right side
+  for (int y = 0; y < image.height; ++y)
+    if (dark(right, y)) top = std::min(top, y), bottom = std::max(bottom, y);
+  // Legend samples: the second series' colour right of the frame, within the image and the
+  // frame's height (the strip is centred on the axes).
+  const double r = (kPlotColors[1] >> 16) & 0xff, g = (kPlotColors[1] >> 8) & 0xff,
+               b = kPlotColors[1] & 0xff;
+  int samples = 0;
+  for (int y = 0; y < image.height; ++y)
+    for (int x = right + 1; x < image.width; ++x) {
+      const Rgb c = image.At(x, y);
+      if (std::abs(c.r * 255 - r) < 30 && std::abs(c.g * 255 - g) < 30 &&
+          std::abs(c.b * 255 - b) < 30) {
+        ++samples;
+        EXPECT_GT(y, top);
+        EXPECT_LT(y, bottom);
+      }
+    }
+  EXPECT_GT(samples, 20);  // a 2 px line about 0.08 of the viewport wide
+  // Inside the frame (away from its ticks, 12 px) only curves and the light grid are drawn:
+  // no dark legend text or box.
+  int dark_inside = 0;
+  for (int y = top + 12; y < bottom - 12; ++y)
+    for (int x = left + 12; x < right - 12; ++x) dark_inside += dark(x, y) ? 1 : 0;
+  EXPECT_EQ(dark_inside, 0);
+  // The legend's text is dark and right of the frame, and it is not cut at the image's edge:
+  // the last column holds no text.
+  int dark_right = 0, dark_edge = 0;
+  for (int y = 0; y < image.height; ++y) {
+    for (int x = right + 4; x < image.width; ++x) dark_right += dark(x, y) ? 1 : 0;
+    dark_edge += dark(image.width - 1, y) ? 1 : 0;
+  }
+  EXPECT_GT(dark_right, 200);
+  EXPECT_EQ(dark_edge, 0);
 }
 
 TEST(WritePlot, RejectsUnknownFormatsAndEmptyData) {

@@ -42,7 +42,7 @@ Contact::Contact(std::string name, const std::vector<SimObject*>& objects,
     GIPSI_CHECK(o != nullptr);
     if (!seen.insert(o).second)
       throw InputError(
-          fmt::format("connector '{}': object '{}' is listed twice", this->name(), o->name()));
+          fmt::format("connector '{}': object '{}' is listed twice", this->path(), o->path()));
     const FieldId p = o->FindField("boundary_position");
     const FieldId v = o->FindField("boundary_velocity");
     const std::string key = fmt::format("objects[{}]", bodies_.size());
@@ -53,7 +53,7 @@ Contact::Contact(std::string name, const std::vector<SimObject*>& objects,
     if (b.num_triangles() == 0)
       throw InputError(
           fmt::format("connector '{}': object '{}' has no boundary triangles to collide with",
-                      this->name(), o->name()));
+                      this->path(), o->path()));
     const auto* tool = dynamic_cast<const RigidCollider*>(o);
     if (tool)
       UseCapability(key, *o, "rigid collider");
@@ -75,7 +75,7 @@ Contact::Contact(std::string name, const std::vector<SimObject*>& objects,
     throw InputError(fmt::format(
         "connector '{}': nothing to collide; list at least one deformable object and a second "
         "object or tool, or enable self_collision",
-        this->name()));
+        this->path()));
 }
 
 Contact::~Contact() = default;

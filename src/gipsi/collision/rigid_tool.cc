@@ -28,7 +28,7 @@ RigidTool::RigidTool(std::string name, const RigidToolSpec& spec, std::shared_pt
     : SimObject(std::move(name)), spec_(spec) {
   for (std::size_t i = 1; i < spec_.path.size(); ++i)
     if (!(spec_.path[i].first > spec_.path[i - 1].first))
-      throw InputError(fmt::format("tool '{}': path times must increase strictly", this->name()));
+      throw InputError(fmt::format("tool '{}': path times must increase strictly", this->path()));
   if (spec_.shape == RigidToolSpec::Shape::kSphere) spec_.length = 0;  // axis_end == start
   auto domain = ToolMesh(this->name(), spec_, std::move(mesh));
   Mesh surface_only = *domain;

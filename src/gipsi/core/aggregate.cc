@@ -73,6 +73,8 @@ void AggregateObject::DoWriteField(FieldId id, const Eigen::Ref<const Eigen::Mat
 }
 
 Coordinator BuildAggregateParts(const ObjectBuildContext& ctx, const JsonNode& p) {
+  // Parts and connectors built here are called "<aggregate>.<name>" in messages.
+  const ObjectPathScope scope(ScopedObjectPath(ctx.name));
   Coordinator parts;
   JsonNode part_nodes = p.At("parts");
   if (part_nodes.size() == 0) part_nodes.Expected("at least one part");

@@ -24,7 +24,7 @@ std::string_view PortAccessName(FieldAccess access) {
 }
 
 std::string DescribePort(const PortUse& port) {
-  const std::string& object = port.object->name();
+  const std::string& object = port.object->path();
   switch (port.kind) {
     case PortUse::Kind::kField:
       return fmt::format("{} {}.{}{} ({})", PortAccessName(port.access), object, port.name,
@@ -39,8 +39,8 @@ std::string DescribePort(const PortUse& port) {
 
 std::string DescribeOrderRule(const OrderRule& rule) {
   std::vector<std::string> parts;
-  if (rule.first) parts.push_back("after " + rule.first->name() + " steps");
-  if (rule.then) parts.push_back("before " + rule.then->name() + " steps");
+  if (rule.first) parts.push_back("after " + rule.first->path() + " steps");
+  if (rule.then) parts.push_back("before " + rule.then->path() + " steps");
   if (rule.same_step) parts.emplace_back("same time step, every macro step");
   return fmt::format("fires {} ({})", fmt::join(parts, ", "), rule.reason);
 }

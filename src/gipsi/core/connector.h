@@ -12,6 +12,7 @@
 
 #include "gipsi/base/export.h"
 #include "gipsi/base/state_binding.h"
+#include "gipsi/core/object_path.h"
 #include "gipsi/core/port.h"
 #include "gipsi/core/step_status.h"
 
@@ -34,7 +35,11 @@ class Connector {
   Connector& operator=(const Connector&) = delete;
   virtual ~Connector();
 
+  /// The connector's own name: its key in "connectors".
   [[nodiscard]] const std::string& name() const { return name_; }
+  /// The name messages give: "heart.cavity_coupling" for a connector of the aggregate "heart"
+  /// (as SimObject::path); name() at the scene's top level.
+  [[nodiscard]] const std::string& path() const { return path_; }
   [[nodiscard]] virtual std::string_view type_name() const = 0;
 
   /// Transfers values at simulated time `t`.
@@ -69,7 +74,7 @@ class Connector {
   [[nodiscard]] bool state_is_value() const { return state_binding_ != nullptr; }
 
  protected:
-  explicit Connector(std::string name) : name_(std::move(name)) {}
+  explicit Connector(std::string name) : name_(std::move(name)), path_(ScopedObjectPath(name_)) {}
   virtual StepStatus DoFire(double t) = 0;
   /// Port declarations; call from the constructor. `key` is the connector's parameter naming
   /// that end ("from", "wall"). A field is read and/or written (`access`) in `units` (a
@@ -112,6 +117,7 @@ class Connector {
   void BindStateBinding(std::unique_ptr<StateBinding> binding);
 
   std::string name_;
+  std::string path_;  // name_ under the ObjectPathScope active at construction
   std::unique_ptr<StateBinding> state_binding_;
   std::int64_t fire_count_ = 0;
   std::vector<PortUse> ports_;

@@ -20,10 +20,10 @@ SimObject& Coordinator::AddObject(std::unique_ptr<SimObject> object, double dt) 
   GIPSI_CHECK(object != nullptr);
   if (!(dt > 0) || !std::isfinite(dt))
     throw InputError(
-        fmt::format("object '{}': time step must be positive, got {}", object->name(), dt));
+        fmt::format("object '{}': time step must be positive, got {}", object->path(), dt));
   for (const auto& slot : objects_)
     if (slot.object->name() == object->name())
-      throw InputError(fmt::format("duplicate object name '{}'", object->name()));
+      throw InputError(fmt::format("duplicate object name '{}'", object->path()));
   const auto* paced = dynamic_cast<const WallClockPaced*>(object.get());
   objects_.push_back({std::move(object), dt, 1, 0.0, paced});
   return *objects_.back().object;
@@ -33,10 +33,10 @@ Connector& Coordinator::AddConnector(std::unique_ptr<Connector> connector, int e
   GIPSI_CHECK(connector != nullptr);
   if (every < 1)
     throw InputError(
-        fmt::format("connector '{}': 'every' must be >= 1, got {}", connector->name(), every));
+        fmt::format("connector '{}': 'every' must be >= 1, got {}", connector->path(), every));
   for (const auto& slot : connectors_)
     if (slot.connector->name() == connector->name())
-      throw InputError(fmt::format("duplicate connector name '{}'", connector->name()));
+      throw InputError(fmt::format("duplicate connector name '{}'", connector->path()));
   connectors_.push_back({std::move(connector), every});
   return *connectors_.back().connector;
 }
@@ -91,7 +91,7 @@ void Coordinator::Prepare(double macro_dt) {
       throw InputError(fmt::format(
           "object '{}': its time step {} s does not divide the macro step {} s; choose a dt "
           "that divides it (multi-rate objects sub-step an integer number of times)",
-          slot.object->name(), slot.dt, macro_dt));
+          slot.object->path(), slot.dt, macro_dt));
     slot.substeps = static_cast<int>(n);
   }
   macro_dt_ = macro_dt;

@@ -25,14 +25,14 @@ bool Contains(const SimObject& top, const SimObject* object) {
 }
 
 std::string Describe(const SimObject& object) {
-  return fmt::format("'{}' ({})", object.name(), object.type_name());
+  return fmt::format("'{}' ({})", object.path(), object.type_name());
 }
 
 // The field end of a port: its declaration must allow what the connector does, in the units
 // and components it works with.
 void CheckFieldPort(const Connector& c, const PortUse& port) {
   const SimObject& object = *port.object;
-  const std::string who = fmt::format("connector '{}' ({})", c.name(), c.type_name());
+  const std::string who = fmt::format("connector '{}' ({})", c.path(), c.type_name());
   const std::string end =
       fmt::format("field '{}' of {} at its '{}' key", port.name, Describe(object), port.key);
   auto fail = [&](const std::string& what) {
@@ -93,13 +93,13 @@ void Coordinator::CheckWiring() const {
 
   for (std::size_t ci = 0; ci < connectors_.size(); ++ci) {
     const Connector& c = *connectors_[ci].connector;
-    const std::string who = fmt::format("connector '{}' ({})", c.name(), c.type_name());
+    const std::string who = fmt::format("connector '{}' ({})", c.path(), c.type_name());
     for (const PortUse& port : c.ports()) {
-      GIPSI_CHECK(port.object != nullptr, "a port of connector '{}' names no object", c.name());
+      GIPSI_CHECK(port.object != nullptr, "a port of connector '{}' names no object", c.path());
       if (TopLevelIndex(port.object) < 0)
         throw WiringError(fmt::format("{} uses object '{}' at its '{}' key, which is not among "
                                       "the objects it is scheduled with",
-                                      who, port.object->name(), port.key),
+                                      who, port.object->path(), port.key),
                           c.name(), "");
       if (port.kind == PortUse::Kind::kField) CheckFieldPort(c, port);
     }
@@ -109,7 +109,7 @@ void Coordinator::CheckWiring() const {
       const int then = rule.then ? TopLevelIndex(rule.then) : -1;
       GIPSI_CHECK((rule.first == nullptr || first >= 0) && (rule.then == nullptr || then >= 0),
                   "an order rule of connector '{}' names an object it is not scheduled with",
-                  c.name());
+                  c.path());
       const int here = connector_position[ci];
       const bool first_ok = first < 0 || object_position[static_cast<std::size_t>(first)] < here;
       const bool then_ok = then < 0 || object_position[static_cast<std::size_t>(then)] > here;

@@ -28,7 +28,9 @@ Index NumDomainElements(const Mesh& mesh) {
 }
 
 SimObject::SimObject(std::string name)
-    : name_(std::move(name)), domain_(std::make_shared<const Mesh>()) {}
+    : name_(std::move(name)),
+      path_(ScopedObjectPath(name_)),
+      domain_(std::make_shared<const Mesh>()) {}
 
 void SimObject::SetGeometry(std::shared_ptr<const Mesh> domain, BoundarySurface boundary) {
   GIPSI_CHECK(domain != nullptr);

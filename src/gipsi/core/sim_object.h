@@ -20,6 +20,7 @@
 #include "gipsi/core/boundary_conditions.h"
 #include "gipsi/core/cavity_law.h"
 #include "gipsi/core/field.h"
+#include "gipsi/core/object_path.h"
 #include "gipsi/core/step_status.h"
 #include "gipsi/geometry/boundary.h"
 #include "gipsi/geometry/mapping.h"
@@ -60,7 +61,13 @@ class SimObject {
   SimObject& operator=(const SimObject&) = delete;
   virtual ~SimObject() = default;
 
+  /// The object's own name: its key in the scene or in its aggregate's "parts" ("muscle").
+  /// Lookups (orders, connectors, FindPart) use it.
   [[nodiscard]] const std::string& name() const { return name_; }
+  /// The name messages give: the path from the scene's top level ("heart.muscle" for a part
+  /// of the aggregate "heart"), the name the command line and the viewer accept. Set at
+  /// construction from the enclosing ObjectPathScope; equal to name() at the top level.
+  [[nodiscard]] const std::string& path() const { return path_; }
   /// The registered type name, e.g. "MassSpring".
   [[nodiscard]] virtual std::string_view type_name() const = 0;
 
@@ -252,6 +259,7 @@ class SimObject {
 
  private:
   std::string name_;
+  std::string path_;  // name_ under the ObjectPathScope active at construction
   std::unique_ptr<StateBinding> state_binding_;
   std::shared_ptr<const Mesh> domain_;
   BoundarySurface boundary_;

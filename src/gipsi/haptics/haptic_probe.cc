@@ -55,7 +55,7 @@ HapticProbe::HapticProbe(std::string name, const HapticProbeSpec& spec)
   }
   if (!(spec.rate > 0 && spec.rate <= 10000))
     throw InputError(
-        fmt::format("haptic probe '{}': rate {} Hz outside (0, 10000]", this->name(), spec.rate));
+        fmt::format("haptic probe '{}': rate {} Hz outside (0, 10000]", this->path(), spec.rate));
   using L = FieldLocation;
   using A = FieldAccess;
   f_force_ = DeclareField({"tool_force", L::kGlobal, 3, "N", A::kRead,
@@ -81,8 +81,8 @@ HapticProbe::HapticProbe(std::string name, const HapticProbeSpec& spec)
 HapticProbe::~HapticProbe() { StopLoop(); }
 
 void HapticProbe::StartLoop(double sim_time) {
-  GIPSI_CHECK(loop_ != nullptr, "HapticProbe '{}' is not real-time", name());
-  GIPSI_CHECK(!loop_->running(), "HapticProbe '{}': loop started twice", name());
+  GIPSI_CHECK(loop_ != nullptr, "HapticProbe '{}' is not real-time", path());
+  GIPSI_CHECK(!loop_->running(), "HapticProbe '{}': loop started twice", path());
   loop_origin_ = sim_time;  // before the thread starts: it reads it
   loop_->Start();
 }
@@ -102,7 +102,7 @@ double HapticProbe::HapticTime(double sim_time) const {
 
 void HapticProbe::Attach(LatestValue<LocalDynamicModel>& models,
                          LatestValue<HapticFeedback>& feedback) {
-  if (tick_) throw InputError(fmt::format("haptic probe '{}' is coupled to two objects", name()));
+  if (tick_) throw InputError(fmt::format("haptic probe '{}' is coupled to two objects", path()));
   tick_ =
       std::make_unique<LocalModelTick>(*device_, spec_.workspace, models, &feedback, spec_.tick);
 }
@@ -171,7 +171,7 @@ HapticCoupling::HapticCoupling(std::string name, std::unique_ptr<LocalModelBuild
   GIPSI_CHECK(builder_ != nullptr);
   const SimObject& object = builder_->object();
   if (object.boundary().num_vertices() == 0)
-    throw InputError(fmt::format("object '{}' has no boundary surface", object.name()));
+    throw InputError(fmt::format("object '{}' has no boundary surface", object.path()));
   UseCapability("object", object, "haptic local model");
   UseBoundaryConditions("object", object);
   UseCapability("device", device_, "haptic device");
@@ -315,7 +315,7 @@ void RegisterHaptics(TypeRegistry& registry) {
         if (!LocalModels(ctx.registry).Contains(type))
           p.At("object").Fail(fmt::format(
               "object '{}' is a {}, which has no haptic local model (types with one: {})",
-              object.name(), type, fmt::join(LocalModels(ctx.registry).Names(), ", ")));
+              object.path(), type, fmt::join(LocalModels(ctx.registry).Names(), ", ")));
         try {
           return std::make_unique<HapticCoupling>(
               ctx.name,

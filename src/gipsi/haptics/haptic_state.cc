@@ -175,7 +175,7 @@ void HapticProbe::SetState(const HapticProbeState& in) {
   RefuseUnreproducible(name(), realtime(), igtl_ != nullptr, mouse_ != nullptr);
   if (in.coupled != (tick_ != nullptr))
     throw InputError(
-        fmt::format("haptic probe '{}' is {} in this scene but was not in the saved state", name(),
+        fmt::format("haptic probe '{}' is {} in this scene but was not in the saved state", path(),
                     tick_ ? "coupled to an object" : "not coupled"));
   force_ = in.force;
   position_ = in.position;

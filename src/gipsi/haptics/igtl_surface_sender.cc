@@ -39,7 +39,7 @@ IgtlSurfaceSender::IgtlSurfaceSender(std::string name, const SimObject& object, 
       surface_name_(std::move(surface_name)) {
   GIPSI_CHECK(rate > 0, "IgtlSurfaceSender: rate must be positive");
   if (object.boundary().num_vertices() == 0)
-    throw InputError(fmt::format("object '{}' has no boundary surface", object.name()));
+    throw InputError(fmt::format("object '{}' has no boundary surface", object.path()));
   UseField("object", object, "boundary_position", FieldAccess::kRead, "m", 3);
   positions_.resize(3, object.boundary().num_vertices());
 }

@@ -44,7 +44,7 @@ BoundaryConditionSpec ParseBoundaryCondition(const JsonNode& node, const SimObje
   if (auto r = node.Find("region")) region = ParseRegion(*r);
   if (object.boundary().num_vertices() == 0)
     node.Fail(
-        fmt::format("object '{}' has no boundary geometry to put conditions on", object.name()));
+        fmt::format("object '{}' has no boundary geometry to put conditions on", object.path()));
 
   bool on_faces = node.Has("pressure") || node.Has("traction");
   try {
@@ -58,7 +58,7 @@ BoundaryConditionSpec ParseBoundaryCondition(const JsonNode& node, const SimObje
   }
   if (spec.faces.empty() && spec.vertices.empty())
     node.Fail(fmt::format("the region selects no boundary {} of object '{}'",
-                          on_faces ? "triangle" : "vertex", object.name()));
+                          on_faces ? "triangle" : "vertex", object.path()));
   if (node.Has("axes") && !node.Has("displacement") && !node.Has("velocity"))
     node.At("axes").Fail("'axes' applies to 'displacement' and 'velocity' only");
 

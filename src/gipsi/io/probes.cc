@@ -178,7 +178,7 @@ Probe ParseProbe(const std::string& name, const JsonNode& node, const Kernel& ke
     const double diag = (mesh.nodes.rowwise().maxCoeff() - mesh.nodes.rowwise().minCoeff()).norm();
     if (probe.point->max_distance() > 1e-6 * diag)
       p->Fail(fmt::format("the point lies {:.4g} outside the domain of '{}'",
-                          probe.point->max_distance(), object.name()));
+                          probe.point->max_distance(), object.path()));
   } else if (auto l = node.Find("line")) {
     if (location != FieldLocation::kNode || !needs_location)
       node.At(node.Has("field") ? "field" : "fields")
@@ -207,7 +207,7 @@ Probe ParseProbe(const std::string& name, const JsonNode& node, const Kernel& ke
     const double diag = (mesh.nodes.rowwise().maxCoeff() - mesh.nodes.rowwise().minCoeff()).norm();
     if (probe.point->max_distance() > 1e-6 * diag)
       l->Fail(fmt::format("the line leaves the domain of '{}' (a point lies {:.4g} outside it)",
-                          object.name(), probe.point->max_distance()));
+                          object.path(), probe.point->max_distance()));
     if (auto at = node.Find("at")) {
       if (at->is_array()) {
         for (const auto& item : at->Items())

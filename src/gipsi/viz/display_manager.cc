@@ -372,6 +372,14 @@ bool OffersField(const SimObject& object, FieldId id) {
   return !(values.colwise() - values.col(0)).isZero(0.0);
 }
 
+std::vector<std::string> ComponentChoices(int components) {
+  if (components <= 1) return {};
+  std::vector<std::string> choices{"magnitude"};
+  for (int k = 0; k < components; ++k)
+    choices.push_back(components == 3 ? std::string(1, "xyz"[k]) : fmt::format("[{}]", k));
+  return choices;
+}
+
 std::optional<ColorSpec> DefaultColor(const SimObject& object) {
   const auto v = object.TryFindField("V");
   if (!v) return std::nullopt;

@@ -116,6 +116,12 @@ class SceneDisplay {
 /// offered; the mechanical state (`position`, `velocity`) always. Reads the field (allocates).
 bool OffersField(const SimObject& object, FieldId id);
 
+/// The viewer's component box for a field with `components` values per item, in
+/// ColorSpec::component order from -1: "magnitude", then one name per component ("x", "y", "z"
+/// for a vector, "[k]" otherwise, as the colour bar labels them). Empty for a scalar, which is
+/// drawn as its value with its sign: the viewer shows no component box for it.
+std::vector<std::string> ComponentChoices(int components);
+
 /// The default colour of an object the scene and command line leave uncoloured: an
 /// electrophysiology object (a readable node field "V", the transmembrane potential) is coloured
 /// by V through the cool-warm map; std::nullopt for others (solid colours).

@@ -96,7 +96,7 @@ void Circulation::Declare(FieldInfo info, Quantity quantity, int index) {
     throw InputError(fmt::format(
         "object '{}': the field name '{}' arises twice from the compartment and connection "
         "names; rename one of them",
-        name(), info.name));
+        path(), info.name));
   const FieldId id = DeclareField(std::move(info));
   GIPSI_CHECK(id.value() == static_cast<std::int64_t>(targets_.size()));
   targets_.push_back({quantity, index});
@@ -120,14 +120,14 @@ int Circulation::FindPressureDrivenChamber(std::string_view name) const {
                      : fmt::format("those that are: {}", fmt::join(driven, ", "));
   if (c < 0)
     throw InputError(
-        fmt::format("object '{}' has no compartment '{}' ({})", this->name(), name, those));
+        fmt::format("object '{}' has no compartment '{}' ({})", this->path(), name, those));
   const CompartmentSpec& spec = circuit_.compartments()[static_cast<std::size_t>(c)];
   if (spec.kind != CompartmentSpec::Kind::kChamber ||
       spec.drive != CompartmentSpec::Drive::kPressure)
     throw InputError(fmt::format(
         "compartment '{}' of '{}' must be a chamber with \"driven_by\": \"pressure\" (the wall "
         "solves its pressure; {})",
-        name, this->name(), those));
+        name, this->path(), those));
   return c;
 }
 
@@ -274,7 +274,7 @@ void Circulation::LogNewEvents() {
   const ValveEventLog& events = state_.events.get();
   if (events.total() == state_.logged_events) return;
   for (const ValveEvent& e : events.EventsSince(state_.logged_events))
-    Log().info("{}: t = {:.6f} s: valve {} {}", name(), e.time, valve_name(e.valve),
+    Log().info("{}: t = {:.6f} s: valve {} {}", path(), e.time, valve_name(e.valve),
                e.state == ValveState::kOpen ? "opens" : "closes");
   state_.logged_events = events.total();
 }

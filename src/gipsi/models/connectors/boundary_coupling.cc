@@ -29,7 +29,7 @@ BoundaryCoupling::BoundaryCoupling(std::string name, SimObject& driver, SimObjec
   fb.Gather(follower.domain().nodes, follower_rest);
   if (db.num_triangles() == 0 || fb.num_vertices() == 0)
     throw InputError(
-        fmt::format("connector '{}': both objects need a boundary surface", this->name()));
+        fmt::format("connector '{}': both objects need a boundary surface", this->path()));
   if (!(tolerance > 0)) {
     const Points& nodes = follower.domain().nodes;
     tolerance = 1e-6 * (nodes.rowwise().maxCoeff() - nodes.rowwise().minCoeff()).norm();
@@ -58,7 +58,7 @@ BoundaryCoupling::BoundaryCoupling(std::string name, SimObject& driver, SimObjec
       throw InputError(fmt::format(
           "connector '{}': follower boundary vertex {} (node {}) is {:.3g} from the driver's "
           "boundary, more than the tolerance {:.3g}",
-          this->name(), candidates[k], fb.vertex_to_node[static_cast<std::size_t>(candidates[k])],
+          this->path(), candidates[k], fb.vertex_to_node[static_cast<std::size_t>(candidates[k])],
           gap, tolerance));
     }
   }
@@ -66,7 +66,7 @@ BoundaryCoupling::BoundaryCoupling(std::string name, SimObject& driver, SimObjec
     throw InputError(
         fmt::format("connector '{}': no boundary vertex of '{}' lies on the boundary "
                     "of '{}' (tolerance {:.3g}); the objects share no interface",
-                    this->name(), follower.name(), driver.name(), tolerance));
+                    this->path(), follower.path(), driver.path(), tolerance));
   kept.conservativeResize(3, static_cast<Index>(follower_vertices_.size()));
   map_ = PointMap::BarycentricOnTriangles(driver_rest, db.triangles, kept);
   driver_u_.resize(3, db.num_vertices());

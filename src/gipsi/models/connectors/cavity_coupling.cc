@@ -20,7 +20,7 @@ CavityCoupling::CavityCoupling(std::string name, SimObject& wall, const std::str
   BindNoState();  // the pressure is the wall's state, the volumes the blood's
   if (!(bulk_modulus_ > 0))
     throw InputError(
-        fmt::format("connector '{}': the blood bulk modulus must be positive", this->name()));
+        fmt::format("connector '{}': the blood bulk modulus must be positive", this->path()));
   chamber_ = chambers_.FindPressureDrivenChamber(chamber);
   // Throws for an object without cavities, or without this one.
   CavityWallOf(wall_).AttachCavityLaw(cavity, this);
@@ -39,7 +39,7 @@ CavityCoupling::CavityCoupling(std::string name, SimObject& wall, const std::str
   wall_.ReadField(wall_pressure_, p);
   const double blood_volume = v(0, 0) / (1 - p(0, 0) / bulk_modulus_);
   Log().info("connector '{}': chamber '{}' starts with the cavity's {:.2f} mL (was {:.2f} mL)",
-             this->name(), chamber, 1e6 * blood_volume, 1e6 * chambers_.chamber_volume(chamber_));
+             this->path(), chamber, 1e6 * blood_volume, 1e6 * chambers_.chamber_volume(chamber_));
   chambers_.SetChamberVolume(chamber_, blood_volume);
   blood_.WriteField(blood_pressure_, p);
 }

@@ -29,13 +29,13 @@ ExcitationContraction::ExcitationContraction(std::string name, const SimObject& 
     throw InputError(
         fmt::format("'from' must be a readable scalar node field (the voltage); "
                     "'{}.{}' is not",
-                    ep.name(), v.name));
+                    ep.path(), v.name));
   if ((ta.location != FieldLocation::kNode && ta.location != FieldLocation::kElement) ||
       ta.components != 1 || !ta.writable())
     throw InputError(
         fmt::format("'to' must be a writable scalar node or element field (an "
                     "active tension); '{}.{}' is not",
-                    muscle.name(), ta.name));
+                    muscle.path(), ta.name));
   if (!(params.v_peak > params.v_rest)) throw InputError("v_peak must exceed v_rest");
   // v_rest and v_peak are in mV; the tension it writes in Pa.
   UseField("from", ep, v.name, FieldAccess::kRead, "mV", 1);

@@ -25,8 +25,8 @@ FieldCopy::FieldCopy(std::string name, SimObject& from, FieldId from_field, SimO
   const FieldInfo& src = from.field_info(from_field);
   const FieldInfo& dst = to.field_info(to_field);
   auto fail = [&](const std::string& what) {
-    throw InputError(fmt::format("connector '{}' ({}.{} → {}.{}): {}", this->name(), from.name(),
-                                 src.name, to.name(), dst.name, what));
+    throw InputError(fmt::format("connector '{}' ({}.{} → {}.{}): {}", this->path(), from.path(),
+                                 src.name, to.path(), dst.name, what));
   };
   UseField("from", from, src.name, FieldAccess::kRead);
   UseField("to", to, dst.name, FieldAccess::kWrite, dst.units, dst.components);

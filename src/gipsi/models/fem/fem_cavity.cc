@@ -55,7 +55,7 @@ void FemSolid::AttachCavityLaw(std::string_view cavity, CavityLaw* law) {
         "object '{}' (FemSolid): cavity '{}' coupled to blood needs an implicit scheme "
         "(\"integrator\": \"BackwardEuler\", \"BDF2\" or \"Newmark\"), which solves the pressure "
         "with the wall; '{}' cannot",
-        name(), cavity, ode_integrator_->name()));
+        path(), cavity, ode_integrator_->name()));
   cavities_[i].law = law;
   cavity_follower_tangent_ = newton_->linear_solver().AcceptIndefinite();
   if (!cavity_follower_tangent_)
@@ -64,7 +64,7 @@ void FemSolid::AttachCavityLaw(std::string_view cavity, CavityLaw* law) {
         "positive definite matrices, so the pressure's follower tangent is left out and "
         "Newton converges linearly; \"linear_solver\": {{\"type\": \"cholmod\"}} or "
         "{{\"type\": \"ldlt\"}} keeps it",
-        name(), cavity, newton_->linear_solver().name());
+        path(), cavity, newton_->linear_solver().name());
 }
 
 double FemSolid::CavityPressure(std::size_t i) const {

@@ -168,8 +168,9 @@ void RegisterFemSolid(TypeRegistry& registry) {
           const double value = ReadPositiveQuantity(*dt, "s");
           const double limit = solid->stable_dt_estimate();
           if (value > limit)
-            Log().warn("{}: dt = {:.3g} s exceeds the estimated explicit stability limit {:.3g} s",
-                       dt->path(), value, limit);
+            Log().warn(
+                "{}: {}: dt = {:.3g} s exceeds the estimated explicit stability limit {:.3g} s",
+                dt->file(), dt->path(), value, limit);
         }
         return solid;
       },

@@ -31,7 +31,7 @@ FemSolid::FemSolid(std::string name, std::shared_ptr<const Mesh> domain, FemPara
         "object '{}': integrator '{}' steps the equations of motion as an ODE, which needs the "
         "lumped mass: set \"mass\": \"lumped\" (or use an implicit scheme: \"BackwardEuler\", "
         "\"BDF2\", \"Newmark\")",
-        this->name(), integrator->name()));
+        this->path(), integrator->name()));
   ode_integrator_ = std::move(integrator);
   ode_integrator_->Prepare(ode_size());
   ode_y_ = VecX::Zero(ode_size());

@@ -36,16 +36,16 @@ MixedSolid::MixedSolid(std::string name, std::shared_ptr<const Mesh> domain,
                        MixedSolidParams params)
     : SimObject(std::move(name)), params_(std::move(params)) {
   if (!params_.material)
-    throw InputError(fmt::format("object '{}': MixedSolid needs a material", this->name()));
+    throw InputError(fmt::format("object '{}': MixedSolid needs a material", this->path()));
   law_ = params_.material.get();
   kappa_ = law_->log_volumetric_modulus();
   if (!(kappa_ > 0))
     throw InputError(fmt::format(
         "object '{}': law '{}' has no volumetric term κ/2 (ln J)² for the mixed pressure to "
         "replace; MixedSolid takes \"NeoHookean\" or \"Guccione\"",
-        this->name(), law_->law()));
+        this->path(), law_->law()));
   if (params_.fibre.norm() == 0)
-    throw InputError(fmt::format("object '{}': the fibre direction is zero", this->name()));
+    throw InputError(fmt::format("object '{}': the fibre direction is zero", this->path()));
   mesh_ = ElevateToQuadratic(*domain);
   state_.axes.Write().assign(static_cast<std::size_t>(kQuad * mesh_.num_elements()),
                              MaterialAxes(params_.fibre, params_.sheet));
@@ -67,7 +67,7 @@ MixedSolid::MixedSolid(std::string name, std::shared_ptr<const Mesh> domain,
       throw InputError(
           fmt::format("object '{}': {} is degenerate or inverted (rest "
                       "volume {:.3g} m³)",
-                      this->name(), domain->TetName(e), det / 6));
+                      this->path(), domain->TetName(e), det / 6));
     volume_[e] = det / 6;
     const Mat3 inv = dm.inverse();
     Eigen::Matrix<double, 3, 4> gl;
@@ -90,7 +90,7 @@ MixedSolid::MixedSolid(std::string name, std::shared_ptr<const Mesh> domain,
         "{}: {} has aspect ratio {:.3g} (1 for a regular tet): mixed P2-P1 elements can "
         "collapse in such slivers under load; remesh (or refine) if a step fails there "
         "(docs/incompressible.md)",
-        this->name(), domain->TetName(quality.worst_aspect_tet), quality.max_aspect);
+        this->path(), domain->TetName(quality.worst_aspect_tet), quality.max_aspect);
   double edge_sum = 0;
   for (Index k = 0; k < mesh_.edges.cols(); ++k)
     edge_sum += (mesh_.rest.col(mesh_.edges(0, k)) - mesh_.rest.col(mesh_.edges(1, k))).norm();

@@ -90,12 +90,12 @@ Heart::Heart(std::string name, Coordinator parts, HeartMonitorSpec monitor)
   blood_ = FindPart(monitor_.blood);
   if (blood_ == nullptr)
     throw InputError(
-        fmt::format("heart '{}': no part '{}' to monitor", this->name(), monitor_.blood));
+        fmt::format("heart '{}': no part '{}' to monitor", this->path(), monitor_.blood));
   chamber_volume_ = blood_->FindField(monitor_.chamber + "_volume");
   chamber_pressure_ = blood_->FindField(monitor_.chamber + "_pressure");
   artery_pressure_ = blood_->FindField(monitor_.artery + "_pressure");
   if (!(monitor_.period > 0))
-    throw InputError(fmt::format("heart '{}': the beat period must be positive", this->name()));
+    throw InputError(fmt::format("heart '{}': the beat period must be positive", this->path()));
   BindAggregateState(state_);
   first_own_field_ = num_part_fields();
   using L = FieldLocation;
@@ -177,7 +177,7 @@ void Heart::FinishBeat(double t) {
   Log().info(
       "{}: beat {} ({:.3f} s): EDV {:.1f} mL, ESV {:.1f} mL, SV {:.1f} mL, EF {:.1f} %, peak {} "
       "pressure {:.1f} mmHg, {} {:.1f}/{:.1f} mmHg, change from the previous beat {}",
-      name(), beat.beat, t, kMl * beat.edv, kMl * beat.esv, kMl * beat.stroke_volume(),
+      path(), beat.beat, t, kMl * beat.edv, kMl * beat.esv, kMl * beat.stroke_volume(),
       100 * beat.ejection_fraction(), monitor_.chamber, kMmHg * beat.peak_pressure, monitor_.artery,
       kMmHg * beat.arterial_systolic, kMmHg * beat.arterial_diastolic,
       beats.size() == 1 ? std::string("—")  // no previous beat to compare with

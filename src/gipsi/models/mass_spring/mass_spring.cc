@@ -41,7 +41,7 @@ MassSpring::MassSpring(std::string name, std::shared_ptr<const Mesh> domain,
   const Mesh& mesh = *domain;
   if (mesh.num_tets() == 0 && mesh.num_triangles() == 0)
     throw InputError(
-        fmt::format("object '{}': a MassSpring domain needs tets or triangles", this->name()));
+        fmt::format("object '{}': a MassSpring domain needs tets or triangles", this->path()));
   SetGeometry(domain, MakeBoundary(mesh));
   const Index n = mesh.num_nodes();
 
@@ -75,12 +75,12 @@ MassSpring::MassSpring(std::string name, const Points& nodes, const Eigen::Matri
   const Index n = nodes.cols();
   if (masses.size() != n)
     throw InputError(
-        fmt::format("object '{}': {} masses for {} nodes", this->name(), masses.size(), n));
+        fmt::format("object '{}': {} masses for {} nodes", this->path(), masses.size(), n));
   for (Index s = 0; s < springs.cols(); ++s)
     for (int a = 0; a < 2; ++a)
       if (springs(a, s) < 0 || springs(a, s) >= n)
         throw InputError(fmt::format("object '{}': spring {} refers to node {} (have {})",
-                                     this->name(), s, springs(a, s), n));
+                                     this->path(), s, springs(a, s), n));
   auto mesh = std::make_shared<Mesh>();
   mesh->nodes = nodes;
   BoundarySurface boundary;
@@ -104,14 +104,14 @@ void MassSpring::Finish() {
       throw InputError(
           fmt::format("object '{}': spring between nodes {} and {} has zero rest "
                       "length (coincident nodes)",
-                      this->name(), springs_(0, s), springs_(1, s)));
+                      this->path(), springs_(0, s), springs_(1, s)));
   }
   for (Index i = 0; i < n; ++i)
     if (!(mass_[i] > 0))
       throw InputError(
           fmt::format("object '{}': node {} has no mass (it belongs to no element "
                       "or only to degenerate ones)",
-                      this->name(), i));
+                      this->path(), i));
 
   state_.x = VecX::Zero(6 * n);
   state_.x.head(3 * n) = Eigen::Map<const VecX>(mesh.nodes.data(), 3 * n);
@@ -124,7 +124,7 @@ void MassSpring::Finish() {
   state_.fibres.Write() = Points(3, mesh.num_tets());
   const Vec3 fibre = params_.fibre.normalized();
   if (!fibre.allFinite())
-    throw InputError(fmt::format("object '{}': the fibre direction must be non-zero", name()));
+    throw InputError(fmt::format("object '{}': the fibre direction must be non-zero", path()));
   state_.fibres.Write().colwise() = fibre;
   tet_rest_volume_.resize(mesh.num_tets());
   for (Index e = 0; e < mesh.num_tets(); ++e)
@@ -132,7 +132,7 @@ void MassSpring::Finish() {
         TetSignedVolume(mesh.nodes.col(mesh.tets(0, e)), mesh.nodes.col(mesh.tets(1, e)),
                         mesh.nodes.col(mesh.tets(2, e)), mesh.nodes.col(mesh.tets(3, e)));
   if (params_.volume_stiffness > 0 && mesh.num_tets() == 0)
-    throw InputError(fmt::format("object '{}': volume_stiffness needs a tet domain", this->name()));
+    throw InputError(fmt::format("object '{}': volume_stiffness needs a tet domain", this->path()));
   UpdateActiveWeights();
 
   using L = FieldLocation;
@@ -150,7 +150,7 @@ void MassSpring::Finish() {
       {"nodal_active_tension", L::kNode, 1, "Pa", A::kReadWrite,
        "active tension per node; springs contract with the mean of their nodes' (fibre-weighted)"});
   if (!params_.cavities.empty() && mesh.num_tets() == 0)
-    throw InputError(fmt::format("object '{}': cavities need a tet domain", name()));
+    throw InputError(fmt::format("object '{}': cavities need a tet domain", path()));
   SetUpCavities();
 }
 

@@ -41,7 +41,7 @@ void MassSpring::AttachCavityLaw(std::string_view cavity, CavityLaw* law) {
     throw InputError(
         fmt::format("object '{}' (MassSpring): a cavity coupled to blood needs \"integrator\": "
                     "\"SymplecticEuler\" (its end positions are affine in the pressure), not '{}'",
-                    name(), integrator_->name()));
+                    path(), integrator_->name()));
   for (const Cavity& other : cavities_) {
     if (other.law == nullptr) continue;
     for (int node : cavities_[i].nodes)
@@ -49,7 +49,7 @@ void MassSpring::AttachCavityLaw(std::string_view cavity, CavityLaw* law) {
         throw InputError(fmt::format(
             "object '{}': cavity '{}' shares node {} with another cavity coupled to blood; "
             "coupled cavities must be disjoint",
-            name(), cavity, node));
+            path(), cavity, node));
   }
   cavities_[i].law = law;
 }

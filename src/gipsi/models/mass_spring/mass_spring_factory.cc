@@ -86,8 +86,9 @@ void RegisterMassSpring(TypeRegistry& registry) {
         if (auto dt = p.Find("dt")) {
           const double value = ReadPositiveQuantity(*dt, "s");
           if (object->integrator().is_explicit() && value > object->stable_dt_estimate())
-            Log().warn("{}: dt = {:.3g} s exceeds the estimated explicit stability limit {:.3g} s",
-                       dt->path(), value, object->stable_dt_estimate());
+            Log().warn(
+                "{}: {}: dt = {:.3g} s exceeds the estimated explicit stability limit {:.3g} s",
+                dt->file(), dt->path(), value, object->stable_dt_estimate());
         }
         return object;
       },
