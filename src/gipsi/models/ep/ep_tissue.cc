@@ -22,6 +22,13 @@ double Seconds(Clock::time_point since) {
 constexpr std::size_t kReactionChunk = 1024;
 // Below this many nodes the reaction and tracking loops stay on the calling thread.
 constexpr Index kMinParallelNodes = 4096;
+// Share of an adaptive loop's timed calls that ran on the team [%] (0 before any).
+double TeamShare(const AdaptiveParallel& loop) {
+  const auto all = loop.parallel_calls() + loop.serial_calls();
+  return all > 0 ? 100.0 * static_cast<double>(loop.parallel_calls()) / static_cast<double>(all)
+                 : 0.0;
+}
+
 // |V| beyond this is no cardiac potential: the explicit reaction step has blown up.
 constexpr double kVoltageBound = 1000.0;  // mV
 
@@ -171,11 +178,14 @@ void EpTissue::ReactionSteps(double t0_ms, double length_ms) {
     const bool stimulated = FillStimulus(ta, ta + h);
     const std::span<const double> stim =
         stimulated ? std::span<const double>(i_stim_.data(), n) : std::span<const double>();
-#pragma omp parallel for schedule(static) if (static_cast <Index>(n) >= kMinParallelNodes)
+    const bool parallel = reaction_parallel_.Begin(static_cast<Index>(n) >= kMinParallelNodes &&
+                                                   MaxTeamThreads() > 1);
+#pragma omp parallel for schedule(static) if (parallel)
     for (std::ptrdiff_t c = 0; c < chunks; ++c) {
       const auto begin = static_cast<std::size_t>(c) * kReactionChunk;
       model.Step(view, begin, std::min(n, begin + kReactionChunk), h, stim);
     }
+    reaction_parallel_.End();
     ApplyClamps(ta + h);
   }
   profile_.reaction += Seconds(start);
@@ -271,7 +281,8 @@ void EpTissue::TrackActivation(double t0_ms, double dt_ms) {
   const double threshold = params_.activation_threshold;
   const double fraction = params_.apd_repolarisation;
   const Index n = num_nodes();
-#pragma omp parallel for schedule(static) if (n >= kMinParallelNodes)
+  const bool parallel = tracking_parallel_.Begin(n >= kMinParallelNodes && MaxTeamThreads() > 1);
+#pragma omp parallel for schedule(static) if (parallel)
   for (Index i = 0; i < n; ++i) {
     const double v0 = v_prev_[i];
     const double v1 = v[i];
@@ -297,6 +308,7 @@ void EpTissue::TrackActivation(double t0_ms, double dt_ms) {
       }
     }
   }
+  tracking_parallel_.End();
   profile_.tracking += Seconds(start);
 }
 
@@ -304,7 +316,9 @@ std::vector<SimObject::ProfileEntry> EpTissue::ProfileBreakdown() const {
   return {{"reaction (cell models)", profile_.reaction, "s"},
           {"diffusion (assembly and solves)", profile_.diffusion, "s"},
           {"activation and APD tracking", profile_.tracking, "s"},
-          {"diffusion solver iterations", static_cast<double>(profile_.cg_iterations), ""}};
+          {"diffusion solver iterations", static_cast<double>(profile_.cg_iterations), ""},
+          {"reaction loops run on the thread team", TeamShare(reaction_parallel_), "%"},
+          {"tracking loops run on the thread team", TeamShare(tracking_parallel_), "%"}};
 }
 
 const double* EpTissue::DoFieldMemory(FieldId id) const {

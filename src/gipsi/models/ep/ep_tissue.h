@@ -31,6 +31,7 @@
 #include "gipsi/geometry/region.h"
 #include "gipsi/models/ep/cell_model.h"
 #include "gipsi/models/fibres/rule_based_fibres.h"
+#include "gipsi/numerics/adaptive_parallel.h"
 #include "gipsi/numerics/sparse/linear_solver.h"
 
 GIPSI_EXPORT_BEGIN
@@ -206,6 +207,9 @@ class EpTissue : public SimObject {
     double reaction = 0, diffusion = 0, tracking = 0;
     std::int64_t cg_iterations = 0, steps = 0;
   } profile_;
+  // The cell-model and tracking loops run on the team or serially, whichever has been faster
+  // lately (a busy neighbour makes a two-thread region wait for a time slice).
+  AdaptiveParallel reaction_parallel_, tracking_parallel_;
   std::string failure_detail_;
 };
 

@@ -26,9 +26,9 @@ double Seconds(Clock::time_point since) {
 FemSolid::FemSolid(std::string name, std::shared_ptr<const Mesh> domain, FemParams params)
     : SimObject(std::move(name)), params_(std::move(params)), assembly_(*domain) {
   if (!params_.material)
-    throw InputError(fmt::format("object '{}': FemSolid needs a material", this->name()));
+    throw InputError(fmt::format("object '{}': FemSolid needs a material", this->path()));
   if (!(params_.density > 0))
-    throw InputError(fmt::format("object '{}': density must be positive", this->name()));
+    throw InputError(fmt::format("object '{}': density must be positive", this->path()));
   law_ = params_.material.get();
   SetGeometry(domain, MakeBoundary(*domain));
   const Index n = domain->num_nodes();
@@ -45,7 +45,7 @@ FemSolid::FemSolid(std::string name, std::shared_ptr<const Mesh> domain, FemPara
       throw InputError(
           fmt::format("object '{}': node {} belongs to no tetrahedron (remove unused "
                       "nodes from the mesh)",
-                      this->name(), i));
+                      this->path(), i));
   jac_ = assembly_.MakePattern();
   if (!params_.lumped_mass) {
     mass_ = jac_;
@@ -136,44 +136,46 @@ bool FemSolid::AssembleElements(const double* u, VecX& f, double* k_values) cons
   f.setZero(3 * num_nodes());
   if (k_values) {
     const Index nnz = jac_.nonZeros();
-#pragma omp parallel for schedule(static) if (nnz >= 65536)
+#pragma omp parallel for schedule(static) if (nnz >= 65536 && tangent_team_.prefers_parallel())
     for (Index j = 0; j < nnz; ++j) k_values[j] = 0.0;
   }
   std::atomic<bool> any_invalid{false};
   double* fp = f.data();
-  assembly_.ForEachElementColoured([&](Index e) {
-    const TetGradients g = assembly_.gradients(e);
-    const Mat3 F = assembly_.DeformationGradient(e, u);
-    const MaterialPoint mp = PointOf(e);
-    const double vol = assembly_.volume(e);
-    Mat3 P;
-    Mat12 K;
-    const bool ok =
-        k_values ? law_->ElementStressAndStiffness(F, mp, g, vol, P, K) : law_->Stress(F, mp, P);
-    invalid_[static_cast<std::size_t>(e)] = ok ? 0 : 1;
-    element_force_sum_[e] = 0;
-    if (!ok) {
-      any_invalid.store(true, std::memory_order_relaxed);
-      return;
-    }
-    const Eigen::Matrix<double, 3, 4> fe = vol * P * g;
-    element_force_sum_[e] = fe.cwiseAbs().sum();
-    for (int a = 0; a < 4; ++a) {
-      double* fa = fp + 3 * assembly_.tets()(a, e);
-      fa[0] += fe(0, a);
-      fa[1] += fe(1, a);
-      fa[2] += fe(2, a);
-    }
-    if (!k_values) return;
-    for (int b = 0; b < 4; ++b)
-      for (int a = 0; a < 4; ++a)
-        for (int k = 0; k < 3; ++k) {
-          double* col = k_values + assembly_.ValueIndex(e, a, b, 0, k);
-          col[0] += K(3 * a, 3 * b + k);
-          col[1] += K(3 * a + 1, 3 * b + k);
-          col[2] += K(3 * a + 2, 3 * b + k);
+  assembly_.ForEachElementColoured(
+      [&](Index e) {
+        const TetGradients g = assembly_.gradients(e);
+        const Mat3 F = assembly_.DeformationGradient(e, u);
+        const MaterialPoint mp = PointOf(e);
+        const double vol = assembly_.volume(e);
+        Mat3 P;
+        Mat12 K;
+        const bool ok = k_values ? law_->ElementStressAndStiffness(F, mp, g, vol, P, K)
+                                 : law_->Stress(F, mp, P);
+        invalid_[static_cast<std::size_t>(e)] = ok ? 0 : 1;
+        element_force_sum_[e] = 0;
+        if (!ok) {
+          any_invalid.store(true, std::memory_order_relaxed);
+          return;
         }
-  });
+        const Eigen::Matrix<double, 3, 4> fe = vol * P * g;
+        element_force_sum_[e] = fe.cwiseAbs().sum();
+        for (int a = 0; a < 4; ++a) {
+          double* fa = fp + 3 * assembly_.tets()(a, e);
+          fa[0] += fe(0, a);
+          fa[1] += fe(1, a);
+          fa[2] += fe(2, a);
+        }
+        if (!k_values) return;
+        for (int b = 0; b < 4; ++b)
+          for (int a = 0; a < 4; ++a)
+            for (int k = 0; k < 3; ++k) {
+              double* col = k_values + assembly_.ValueIndex(e, a, b, 0, k);
+              col[0] += K(3 * a, 3 * b + k);
+              col[1] += K(3 * a + 1, 3 * b + k);
+              col[2] += K(3 * a + 2, 3 * b + k);
+            }
+      },
+      k_values ? tangent_team_ : residual_team_);
   // Assembling contributions of magnitude |f| into a residual loses ~ε|f| each, and forces
   // evaluated at a displacement u carry ~ε ‖K‖ ‖u‖: 100 ε times their sum bounds what any
   // iterate's residual can be told apart from zero (still ~1e-14 of the element forces).
@@ -374,7 +376,10 @@ bool FemSolid::IncrementResidualAndJacobian(double s, const VecX& d, VecX& r, Sp
   const double unit = diag_sum > 0 ? diag_sum / static_cast<double>(ncols) : 1.0;
   const std::uint8_t* constraint = constraint_.data();
   double max_row_sum = 0;
-#pragma omp parallel for schedule(static) reduction(max : max_row_sum) if (nnz >= 65536)
+  // (A maximum is exact in any order: the team's choice cannot change the bits.)
+#pragma omp parallel for schedule(static) \
+    reduction(max                         \
+              : max_row_sum) if (nnz >= 65536 && tangent_team_.prefers_parallel())
   for (int c = 0; c < ncols; ++c) {
     const bool fixed_col = constraint[c] != 0;
     double row_sum = 0;
@@ -522,7 +527,7 @@ StepStatus FemSolid::Advance(double s0, double s1, double dt, int depth) {
           "{}: t = {:.6g} s, load increment to {:.4g} % of the step: the tangent is not "
           "positive definite (a large load increment, a follower pressure or a stiff "
           "bulk_modulus); the '{}' solver factorises it as LDLT from now on (docs/newton.md)",
-          name(), time(), 100 * s1, newton_->linear_solver().name());
+          path(), time(), 100 * s1, newton_->linear_solver().name());
   };
   solve(predict);
   if (predict && state_.last_newton.inadmissible && state_.last_newton.iterations == 0) {

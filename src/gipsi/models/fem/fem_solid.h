@@ -256,6 +256,9 @@ class FemSolid final : public SimObject, public CavityWall {
   mutable VecX element_force_sum_;             // per element Σ|f_e| (round-off floor)
   mutable double residual_floor_ = 0;
   mutable Index first_invalid_ = -1;
+  // The element loops of the residual and of the residual with the tangent, on the team or
+  // serially, whichever has been faster lately (a busy neighbour makes each region wait).
+  mutable AdaptiveParallel residual_team_, tangent_team_;
   VecX d_;
   VecX rest_;  // 3N rest positions
   VecX x_;     // 3N current positions

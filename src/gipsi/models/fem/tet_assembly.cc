@@ -130,12 +130,15 @@ SparseMatrix TetAssembly::MakePattern() const {
 
 void TetAssembly::AssembleConsistentMass(double density, VecX& values) const {
   values.setZero(static_cast<Index>(row_index_.size()));
-  ForEachElementColoured([&](Index e) {
-    const double m = density * volume_[e] / 20.0;
-    for (int a = 0; a < 4; ++a)
-      for (int b = 0; b < 4; ++b)
-        for (int k = 0; k < 3; ++k) values[ValueIndex(e, a, b, k, k)] += (a == b ? 2 : 1) * m;
-  });
+  AdaptiveParallel once;  // assembled once: on the team
+  ForEachElementColoured(
+      [&](Index e) {
+        const double m = density * volume_[e] / 20.0;
+        for (int a = 0; a < 4; ++a)
+          for (int b = 0; b < 4; ++b)
+            for (int k = 0; k < 3; ++k) values[ValueIndex(e, a, b, k, k)] += (a == b ? 2 : 1) * m;
+      },
+      once);
 }
 
 VecX TetAssembly::LumpedMass(double density) const {

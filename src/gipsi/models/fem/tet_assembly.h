@@ -20,6 +20,7 @@
 #include "gipsi/base/export.h"
 #include "gipsi/base/math.h"
 #include "gipsi/geometry/mesh.h"
+#include "gipsi/numerics/adaptive_parallel.h"
 #include "gipsi/numerics/sparse/linear_solver.h"
 
 GIPSI_EXPORT_BEGIN
@@ -86,20 +87,27 @@ class TetAssembly {
   /// Runs `fn(e)` for every element: colour by colour, the chunks of a colour in parallel
   /// (OpenMP, static schedule, if the colour has at least kMinParallelElements elements), the
   /// elements of a chunk in order. `fn` may scatter into node-indexed storage without locks.
+  /// Each node's sum is taken in the same order (colours, then the one chunk of a colour that
+  /// holds it) whatever the team, so the bits do not depend on the thread count, and `team`
+  /// (one per kind of `fn`: their costs differ) may run it serially beside a busy neighbour,
+  /// where every colour's region would wait for a descheduled thread (AdaptiveParallel).
   template <class Fn>
-  void ForEachElementColoured(Fn&& fn) const {
+  void ForEachElementColoured(Fn&& fn, AdaptiveParallel& team) const {
     const int ne = static_cast<int>(num_elements());
+    const bool parallel = team.Begin(ne >= kMinParallelElements && MaxTeamThreads() > 1);
     for (int c = 0; c < num_colours(); ++c) {
       const int begin = colour_start_[static_cast<std::size_t>(c)];
       const int end = colour_start_[static_cast<std::size_t>(c) + 1];
       const int elements = (end - begin) * kChunkElements;  // an upper bound
-#pragma omp parallel for schedule(static) if (end - begin >= 2 && elements >= kMinParallelElements)
+#pragma omp parallel for schedule(static) if (parallel && end - begin >= 2 && \
+                                              elements >= kMinParallelElements)
       for (int k = begin; k < end; ++k) {
         const int first = colour_chunks_[static_cast<std::size_t>(k)] * kChunkElements;
         const int last = std::min(first + kChunkElements, ne);
         for (int e = first; e < last; ++e) fn(static_cast<Index>(e));
       }
     }
+    team.End();
   }
   /// Runs `fn(e)` for every element in parallel (no scatter allowed: write per-element data).
   template <class Fn>

@@ -2,9 +2,11 @@
 // and five preconditioners (none, Jacobi, incomplete Cholesky, lagged CHOLMOD Cholesky,
 // smoothed-aggregation AMG with a lagged hierarchy).
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -13,6 +15,7 @@
 #include <Eigen/OrderingMethods>
 
 #include "gipsi/base/error.h"
+#include "gipsi/numerics/adaptive_parallel.h"
 #include "gipsi/numerics/sparse/amg.h"
 #include "gipsi/numerics/sparse/node_block_copy.h"
 #include "gipsi/numerics/sparse/serial_openmp.h"
@@ -159,6 +162,13 @@ class PcgSolver final : public LinearSolver {
       stats.converged = true;
       return stats;
     }
+    // The fused CG's solve runs on the team or on this thread alone, whichever has been faster
+    // per iteration lately (team_choice_; its kernels give the same bits either way).
+    const bool adaptive = fused();
+    const bool team =
+        adaptive && team_choice_.Begin(rows_ >= kMinFusedParallelRows && omp_get_max_threads() > 1);
+    std::optional<SerialOpenMp> alone;
+    if (adaptive && !team) alone.emplace();
     double r_norm = std::numeric_limits<double>::quiet_NaN();
     if (std::isfinite(b_norm)) {
       const double target = options_.tolerance * b_norm;
@@ -177,6 +187,7 @@ class PcgSolver final : public LinearSolver {
       }
     }
     stats.relative_residual = r_norm / b_norm;
+    if (adaptive) team_choice_.End(std::max(1, stats.iterations));  // per iteration
     if (kind_ == Preconditioner::kLaggedCholesky) {
       // Refactorise when the factor got too weak, or (amortised) when this solve took at least
       // the mean cost per solve since the last factorisation, the factorisation included:
@@ -315,25 +326,54 @@ class PcgSolver final : public LinearSolver {
   /// form of PCG (Chronopoulos & Gear, "s-step iterative methods for symmetric linear
   /// systems", J. Comput. Appl. Math. 25, 1989), which keeps s = A p by the recurrence
   /// s ← w + β s with w = A z, so that both inner products of an iteration, (r, z) and (w, z),
-  /// are taken together. An iteration is then two sweeps, each one pass over the team's own
-  /// rows: (1) p ← z + βp, s ← w + βs, x += αp, r −= αs, z = M⁻¹r with the partial sums of
-  /// (r, r) and (r, z); (2) w = A z with the partial sum of (w, z). One OpenMP region covers
-  /// all iterations, its threads meeting at a TeamBarrier after each sweep (two per
-  /// iteration, against five region starts for Iterate). Rows are split into one contiguous
-  /// range per thread (whole nodes for a node-block matrix) and partial sums are added in
-  /// thread order, so the bits depend on the thread count only. In exact arithmetic the
-  /// iterates are those of Iterate; the recurred s can drift from A p in floating point,
-  /// which Solve's true-residual check catches (it restarts CG from the true residual).
+  /// are taken together. An iteration is then two sweeps over the rows: (1) p ← z + βp,
+  /// s ← w + βs, x += αp, r −= αs, z = M⁻¹r with the partial sums of (r, r) and (r, z); (2)
+  /// w = A z with the partial sum of (w, z). One OpenMP region covers all iterations, its
+  /// threads meeting at a TeamBarrier after each sweep (two per iteration, against five region
+  /// starts for Iterate). The rows are split into kSumBlocks contiguous blocks of about equal
+  /// work (whole nodes for a node-block matrix), whatever the team; each thread sweeps a run of
+  /// whole blocks, and the blocks' partial sums are added in block order, so the bits do not
+  /// depend on the thread count. That lets each solve choose its team (Solve's team_choice_):
+  /// beside a busy neighbour a two-thread team waits at every barrier for a descheduled
+  /// thread, and one thread is faster. In exact arithmetic the iterates are those of Iterate; the
+  /// recurred s can drift from A p in floating point, which Solve's true-residual check catches (it
+  /// restarts CG from the true residual).
   bool IterateFused(double target, int& iterations, VecX& x) {
     const int n = static_cast<int>(rows_);
-    const int threads = n >= kMinFusedParallelRows ? omp_get_max_threads() : 1;
-    // Per thread and round parity: (r, r), (r, z), (w, z), padded to a cache line. Two rounds
-    // alternate, so a thread that runs ahead never overwrites sums another is still reading.
-    partials_.assign(static_cast<std::size_t>(2 * threads), PartialSums{});
-    TeamBarrier barrier;
-    const double* __restrict inverse = inverse_diagonal_.data();
     const SparseMatrix& A = *matrix_;
     const bool blocks = block_copy_ready_;
+    // Row blocks, split so that every block gets about the same work, counted as nonzeros plus
+    // 8 per row (the vector updates' loads and stores).
+    const int unit = blocks ? 3 : 1;
+    const int units = n / unit;
+    const int count = std::max(1, std::min(kSumBlocks, units));
+    const int* outer = A.outerIndexPtr();
+    block_start_.resize(static_cast<std::size_t>(count) + 1);
+    for (int k = 0; k <= count; ++k) {
+      if (k == count) {
+        block_start_[static_cast<std::size_t>(k)] = n;
+        break;
+      }
+      const std::int64_t goal = (std::int64_t{outer[n]} + 8 * std::int64_t{n}) * k / count;
+      int lo = 0, hi = units;  // the first unit whose start reaches the goal
+      while (lo < hi) {
+        const int mid = lo + (hi - lo) / 2;
+        if (outer[unit * mid] + 8 * std::int64_t{unit} * mid < goal)
+          lo = mid + 1;
+        else
+          hi = mid;
+      }
+      block_start_[static_cast<std::size_t>(k)] = unit * lo;
+    }
+    // On one thread below kMinFusedParallelRows, or when Solve chose this thread alone (its
+    // SerialOpenMp makes the region inactive).
+    const int threads = n >= kMinFusedParallelRows ? omp_get_max_threads() : 1;
+    // Per block and round parity: (r, r), (r, z), (w, z), padded to a cache line. Two rounds
+    // alternate, so a thread that runs ahead never overwrites sums another is still reading.
+    partials_.assign(static_cast<std::size_t>(2 * count), PartialSums{});
+    TeamBarrier barrier;
+    const double* __restrict inverse = inverse_diagonal_.data();
+    const int* start = block_start_.data();
     double* __restrict px = x.data();
     double* __restrict pr = r_.data();
     double* __restrict pz = z_.data();
@@ -347,58 +387,40 @@ class PcgSolver final : public LinearSolver {
     {
       const int team = omp_get_num_threads();
       const int t = omp_get_thread_num();
-      // Row range of this thread: whole nodes when the SpMV works on node blocks, split so
-      // that every thread gets about the same work, counted as nonzeros plus 8 per row (the
-      // vector updates' loads and stores).
-      const int unit = blocks ? 3 : 1;
-      const int units = n / unit;
-      const int* outer = A.outerIndexPtr();
-      auto first_row = [&](int k) {
-        if (k == team) return n;
-        const std::int64_t goal = (std::int64_t{outer[n]} + 8 * std::int64_t{n}) * k / team;
-        int lo = 0, hi = units;  // the first unit whose start reaches the goal
-        while (lo < hi) {
-          const int mid = lo + (hi - lo) / 2;
-          if (outer[unit * mid] + 8 * std::int64_t{unit} * mid < goal)
-            lo = mid + 1;
-          else
-            hi = mid;
-        }
-        return unit * lo;
-      };
-      const int begin = first_row(t);
-      const int end = first_row(t + 1);
-      auto slot = [&](int round, int thread) { return partials[(round & 1) * team + thread].sum; };
+      const int first_block = count * t / team, end_block = count * (t + 1) / team;
+      auto slot = [&](int round, int block) { return partials[(round & 1) * count + block].sum; };
       auto total = [&](int round, int which) {
         double sum = 0.0;
-        for (int k = 0; k < team; ++k) sum += slot(round, k)[which];
+        for (int k = 0; k < count; ++k) sum += slot(round, k)[which];
         return sum;
       };
       auto spmv_and_wz = [&](int round) {  // sweep (2): w = A z, partial (w, z)
-        if (blocks)
-          block_copy_.MultiplyNodes(pz, pw, begin / 3, end / 3);
-        else
-          SymmetricSpMVRows(A, pz, pw, begin, end);
-        double wz0 = 0.0, wz1 = 0.0;  // two chains: the adds' latency, not the loads, bound it
-        int i = begin;
-        for (; i + 2 <= end; i += 2) {
-          wz0 += pw[i] * pz[i];
-          wz1 += pw[i + 1] * pz[i + 1];
+        for (int k = first_block; k < end_block; ++k) {
+          const int begin = start[k], end = start[k + 1];
+          if (blocks)
+            block_copy_.MultiplyNodes(pz, pw, begin / 3, end / 3);
+          else
+            SymmetricSpMVRows(A, pz, pw, begin, end);
+          double wz0 = 0.0, wz1 = 0.0;  // two chains: the adds' latency, not the loads, bound it
+          int i = begin;
+          for (; i + 2 <= end; i += 2) {
+            wz0 += pw[i] * pz[i];
+            wz1 += pw[i + 1] * pz[i + 1];
+          }
+          if (i < end) wz0 += pw[i] * pz[i];
+          slot(round, k)[2] = wz0 + wz1;
         }
-        if (i < end) wz0 += pw[i] * pz[i];
-        const double wz = wz0 + wz1;
-        slot(round, t)[2] = wz;
       };
       // Start: z = M⁻¹ r, then w = A z, (r, z) and (w, z).
-      {
+      for (int k = first_block; k < end_block; ++k) {
         double rz = 0.0;
-        for (int i = begin; i < end; ++i) {
+        for (int i = start[k]; i < start[k + 1]; ++i) {
           pz[i] = inverse[i] * pr[i];
           rz += pr[i] * pz[i];
           pp[i] = 0.0;  // round 1 takes p = z, s = w (β = 0): no value left from an earlier
           ps[i] = 0.0;  // solve may survive, not even a non-finite one (0 · ∞ is NaN)
         }
-        slot(0, t)[1] = rz;
+        slot(0, k)[1] = rz;
       }
       barrier.Wait(team);
       spmv_and_wz(0);
@@ -420,25 +442,28 @@ class PcgSolver final : public LinearSolver {
           alpha = gamma / (delta - beta * gamma / alpha);
         }
         if (!(gamma > 0.0) || !(alpha > 0.0) || !std::isfinite(alpha)) break;  // not SPD, NaN
-        double rr[2] = {0.0, 0.0}, rz[2] = {0.0, 0.0};  // two chains each, as above
-        auto update = [&](int i, int chain) {
-          pp[i] = pz[i] + beta * pp[i];
-          ps[i] = pw[i] + beta * ps[i];
-          px[i] += alpha * pp[i];
-          pr[i] -= alpha * ps[i];
-          pz[i] = inverse[i] * pr[i];
-          rr[chain] += pr[i] * pr[i];
-          rz[chain] += pr[i] * pz[i];
-        };
-        int i = begin;
-        for (; i + 2 <= end; i += 2) {
-          update(i, 0);
-          update(i + 1, 1);
+        for (int k = first_block; k < end_block; ++k) {
+          double rr[2] = {0.0, 0.0}, rz[2] = {0.0, 0.0};  // two chains each, as above
+          auto update = [&](int i, int chain) {
+            pp[i] = pz[i] + beta * pp[i];
+            ps[i] = pw[i] + beta * ps[i];
+            px[i] += alpha * pp[i];
+            pr[i] -= alpha * ps[i];
+            pz[i] = inverse[i] * pr[i];
+            rr[chain] += pr[i] * pr[i];
+            rz[chain] += pr[i] * pz[i];
+          };
+          const int end = start[k + 1];
+          int i = start[k];
+          for (; i + 2 <= end; i += 2) {
+            update(i, 0);
+            update(i + 1, 1);
+          }
+          if (i < end) update(i, 0);
+          double* sums = slot(round, k);
+          sums[0] = rr[0] + rr[1];
+          sums[1] = rz[0] + rz[1];
         }
-        if (i < end) update(i, 0);
-        double* mine = slot(round, t);
-        mine[0] = rr[0] + rr[1];
-        mine[1] = rz[0] + rz[1];
         barrier.Wait(team);
         ++local;
         const double rr_total = total(round, 0);
@@ -518,6 +543,8 @@ class PcgSolver final : public LinearSolver {
     double sum[3] = {0.0, 0.0, 0.0};
   };
   std::vector<PartialSums> partials_;
+  std::vector<int> block_start_;  ///< IterateFused's row blocks (kSumBlocks + 1 starts, at most)
+  AdaptiveParallel team_choice_;  ///< a fused solve on the team or on the calling thread
   VecX inverse_diagonal_;
   std::vector<int> diagonal_index_;  ///< value index of each diagonal entry (−1: none)
   ReductionScratch scratch_;

@@ -1,10 +1,12 @@
 #pragma once
 /// @file
 /// OpenMP-parallel vector kernels for the iterative solvers, with deterministic reductions: the
-/// index range is split into one contiguous block per thread, each thread sums its block in
-/// index order, and the per-thread partial sums are added in thread order. The result is
-/// therefore the same bits on every run with the same thread count (unlike `reduction(+:)`,
-/// whose combination order OpenMP leaves unspecified). Small ranges run on one thread.
+/// index range is split into kSumBlocks contiguous blocks whatever the thread count, each
+/// block is summed in index order by whichever thread runs it, and the block sums are added in
+/// block order. The result is therefore the same bits on every run and for every thread count,
+/// one included (unlike `reduction(+:)`, whose combination order OpenMP leaves unspecified), so
+/// a solver may change its team from one call to the next (AdaptiveParallel). Small ranges run
+/// on one thread, as one block.
 
 #include <cstddef>
 #include <vector>
@@ -20,20 +22,18 @@ namespace gipsi {
 /// Ranges shorter than this run serially: a parallel region costs a few microseconds.
 inline constexpr Index kMinParallelLength = 8192;
 
-/// Scratch for deterministic reductions: one cache-line-padded partial sum per thread.
-/// Grows (allocates) only when the OpenMP thread count grows. Not thread-safe; movable.
+/// Blocks of a deterministic reduction: a multiple of every team size up to 4 (and of 6, 8, 12,
+/// 16 and 24), so that a team splits them evenly.
+inline constexpr int kSumBlocks = 48;
+
+/// Scratch for deterministic reductions: one cache-line-padded partial sum per block. Not
+/// thread-safe; movable.
 class ReductionScratch {
  public:
-  /// Sized for the current `omp_get_max_threads()`.
-  ReductionScratch() { Reserve(omp_get_max_threads()); }
+  ReductionScratch() : partials_(static_cast<std::size_t>(kSumBlocks) * kStride, 0.0) {}
 
-  /// Makes room for `threads` partial sums (allocates only if it grows).
-  void Reserve(int threads) {
-    const std::size_t need = static_cast<std::size_t>(threads) * kStride;
-    if (partials_.size() < need) partials_.assign(need, 0.0);
-  }
-  /// The slot of thread `t`.
-  double& slot(int t) { return partials_[static_cast<std::size_t>(t) * kStride]; }
+  /// The slot of block `b` (< kSumBlocks).
+  double& slot(int b) { return partials_[static_cast<std::size_t>(b) * kStride]; }
 
  private:
   static constexpr std::size_t kStride = 8;  // 64 bytes: no false sharing between slots
@@ -41,29 +41,20 @@ class ReductionScratch {
 };
 
 /// Σ over the blocks of [0, n) of `block_sum(begin, end)`, computed in parallel as described in
-/// the file comment; deterministic for a fixed thread count. `block_sum` may also write to
-/// the indices of its block (fused update + reduction).
+/// the file comment; the same bits for every thread count. `block_sum` may also write to the
+/// indices of its block (fused update + reduction).
 template <class BlockSum>
 double DeterministicParallelSum(Index n, ReductionScratch& scratch, BlockSum&& block_sum) {
   if (n < kMinParallelLength) return block_sum(Index{0}, n);
-  const int max_threads = omp_get_max_threads();
-  scratch.Reserve(max_threads);
-  int team = 1;
-#pragma omp parallel num_threads(max_threads)
-  {
-    const int t = omp_get_thread_num();
-    const int count = omp_get_num_threads();
-    const Index begin = n * t / count;
-    const Index end = n * (t + 1) / count;
-    scratch.slot(t) = block_sum(begin, end);
-    if (t == 0) team = count;
-  }
+#pragma omp parallel for schedule(static)
+  for (int b = 0; b < kSumBlocks; ++b)
+    scratch.slot(b) = block_sum(n * b / kSumBlocks, n * (b + 1) / kSumBlocks);
   double sum = 0.0;
-  for (int t = 0; t < team; ++t) sum += scratch.slot(t);
+  for (int b = 0; b < kSumBlocks; ++b) sum += scratch.slot(b);
   return sum;
 }
 
-/// a · b (deterministic for a fixed thread count). Sizes must match.
+/// a · b (the same bits for every thread count). Sizes must match.
 inline double ParallelDot(const VecX& a, const VecX& b, ReductionScratch& scratch) {
   const double* __restrict pa = a.data();
   const double* __restrict pb = b.data();
