@@ -20,8 +20,8 @@ bool AdaptiveParallel::Next() {
   bool parallel = prefer_parallel_;
   const double other = average_[parallel ? 0 : 1];
   ++calls_since_probe_;
-  const bool due = other < 0 ? calls_since_probe_ >= kFirstProbe
-                             : time_since_probe_ >= kProbeRatio * other;
+  const bool due =
+      other < 0 ? calls_since_probe_ >= kFirstProbe : time_since_probe_ >= kProbeRatio * other;
   if (due) {  // now and then, the other way once
     parallel = !parallel;
     calls_since_probe_ = 0;
