@@ -232,7 +232,8 @@ std::string ProfileTable(const gipsi::Kernel& kernel, double wall_seconds) {
         table += fmt::format("    {:<27} {:>10.3f} s {:>5.1f} %\n", entry.name, entry.value,
                              share(entry.value));
       else
-        table += fmt::format("    {:<27} {:>10.0f}\n", entry.name, entry.value);
+        table += fmt::format("    {:<27} {:>10.0f}{}\n", entry.name, entry.value,
+                             entry.unit.empty() ? "" : " " + entry.unit);
     }
   }
   for (std::size_t i = 0; i < coordinator.num_connectors(); ++i) {

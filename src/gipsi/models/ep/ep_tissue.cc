@@ -317,8 +317,8 @@ std::vector<SimObject::ProfileEntry> EpTissue::ProfileBreakdown() const {
           {"diffusion (assembly and solves)", profile_.diffusion, "s"},
           {"activation and APD tracking", profile_.tracking, "s"},
           {"diffusion solver iterations", static_cast<double>(profile_.cg_iterations), ""},
-          {"reaction loops run on the thread team", TeamShare(reaction_parallel_), "%"},
-          {"tracking loops run on the thread team", TeamShare(tracking_parallel_), "%"}};
+          {"reaction loops on the team", TeamShare(reaction_parallel_), "%"},
+          {"tracking loops on the team", TeamShare(tracking_parallel_), "%"}};
 }
 
 const double* EpTissue::DoFieldMemory(FieldId id) const {
