@@ -172,16 +172,18 @@ TEST(GipsiValidate, AcceptsTheDemoScenes) {
 }
 
 TEST(GipsiValidate, ListsEachConnectorsPortsAndOrderRules) {
-  // The heart's connectors live inside its aggregate and are listed under its name.
+  // The heart's connectors live inside its aggregate and are listed under its name; their
+  // ports name the parts by their full names, as the command line takes them.
   const Result r = Gipsi("validate " + Scene("heart.json"));
   ASSERT_EQ(r.code, 0) << r.output;
   for (const char* line : {
            "connector heart.cavity_coupling CavityCoupling",
-           "      reads muscle.lumen_volume [m^3] (wall)",
-           "      calls blood as lumped chambers (blood)",
-           "      writes blood.lv_pressure_input [Pa] (blood)",
-           "      fires after muscle steps, before blood steps, same time step, every macro step",
-           "      reads bioelectricity.V [mV] (from)",
+           "      reads heart.muscle.lumen_volume [m^3] (wall)",
+           "      calls heart.blood as lumped chambers (blood)",
+           "      writes heart.blood.lv_pressure_input [Pa] (blood)",
+           "      fires after heart.muscle steps, before heart.blood steps, same time step, every "
+           "macro step",
+           "      reads heart.bioelectricity.V [mV] (from)",
        })
     EXPECT_THAT(r.output, HasSubstr(line));
 }
