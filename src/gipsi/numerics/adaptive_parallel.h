@@ -20,7 +20,8 @@
 /// the faster team is noticed within that time.
 ///
 /// Use it only for loops whose results do not depend on the number of threads (each item
-/// written by one iteration, no reductions): switching must never change a result's bits.
+/// written by one iteration, or sums over fixed blocks added in block order, as in
+/// numerics/sparse/vector_ops.h): switching must never change a result's bits.
 
 #include <chrono>
 #include <cstdint>
