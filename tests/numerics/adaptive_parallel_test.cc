@@ -1,11 +1,14 @@
 // AdaptiveParallel's rule, driven with given call times (no clock): on a quiet machine the team
 // wins and serial probes cost under 1 %; beside a busy neighbour (a region waits for a time
 // slice) the calling thread wins at the first probe and parallel probes become rare; a change
-// of load during a run is followed.
+// of load during a run is followed. ForRange: a serial choice opens no OpenMP region.
 
 #include "gipsi/numerics/adaptive_parallel.h"
 
+#include <vector>
+
 #include <gtest/gtest.h>
+#include <omp.h>
 
 namespace gipsi {
 namespace {
@@ -70,6 +73,39 @@ TEST(AdaptiveParallel, ALoopTooShortForATeamRunsSeriallyAndIsNotTimed) {
   EXPECT_TRUE(loop.Begin(true));  // the first eligible call tries the team
   loop.End();
   EXPECT_EQ(loop.parallel_calls(), 1);
+}
+
+// A serial choice must not enter libgomp at all (its region end costs a system call even for
+// a team of one), and a parallel one must run every index exactly once on the team.
+TEST(ForRange, ASerialChoiceOpensNoRegionAndAParallelOneCoversEveryIndexOnce) {
+  const int n = 1000;
+  std::vector<int> level(n, -1), hits(n, 0);
+  ForRange(0, n, false, [&](int i) {
+    level[static_cast<std::size_t>(i)] = omp_get_level();
+    ++hits[static_cast<std::size_t>(i)];
+  });
+  for (int i = 0; i < n; ++i) {
+    ASSERT_EQ(level[static_cast<std::size_t>(i)], 0) << "index " << i << " ran inside a region";
+    ASSERT_EQ(hits[static_cast<std::size_t>(i)], 1);
+  }
+
+  std::vector<int> thread(n, -1);
+  hits.assign(n, 0);
+  ForRange(0, n, true, [&](int i) {
+    level[static_cast<std::size_t>(i)] = omp_get_level();
+    thread[static_cast<std::size_t>(i)] = omp_get_thread_num();
+    ++hits[static_cast<std::size_t>(i)];  // each index belongs to one thread: no race
+  });
+  for (int i = 0; i < n; ++i) {
+    ASSERT_EQ(level[static_cast<std::size_t>(i)], 1) << "index " << i << " ran outside a region";
+    ASSERT_EQ(hits[static_cast<std::size_t>(i)], 1) << "index " << i;
+  }
+  // A static schedule: the team's threads take contiguous, increasing ranges.
+  for (int i = 1; i < n; ++i)
+    ASSERT_GE(thread[static_cast<std::size_t>(i)], thread[static_cast<std::size_t>(i) - 1]);
+  // The empty range runs nothing either way.
+  ForRange(5, 5, true, [&](int) { ADD_FAILURE() << "ran an index of an empty range"; });
+  ForRange(5, 5, false, [&](int) { ADD_FAILURE() << "ran an index of an empty range"; });
 }
 
 }  // namespace

@@ -9,6 +9,7 @@
 #include <cmath>
 
 #include "gipsi/base/error.h"
+#include "gipsi/numerics/adaptive_parallel.h"
 
 namespace gipsi {
 namespace {
@@ -180,11 +181,10 @@ void EpTissue::ReactionSteps(double t0_ms, double length_ms) {
         stimulated ? std::span<const double>(i_stim_.data(), n) : std::span<const double>();
     const bool parallel = reaction_parallel_.Begin(static_cast<Index>(n) >= kMinParallelNodes &&
                                                    MaxTeamThreads() > 1);
-#pragma omp parallel for schedule(static) if (parallel)
-    for (std::ptrdiff_t c = 0; c < chunks; ++c) {
+    ForRange(std::ptrdiff_t{0}, chunks, parallel, [&](std::ptrdiff_t c) {
       const auto begin = static_cast<std::size_t>(c) * kReactionChunk;
       model.Step(view, begin, std::min(n, begin + kReactionChunk), h, stim);
-    }
+    });
     reaction_parallel_.End();
     ApplyClamps(ta + h);
   }
@@ -282,8 +282,7 @@ void EpTissue::TrackActivation(double t0_ms, double dt_ms) {
   const double fraction = params_.apd_repolarisation;
   const Index n = num_nodes();
   const bool parallel = tracking_parallel_.Begin(n >= kMinParallelNodes && MaxTeamThreads() > 1);
-#pragma omp parallel for schedule(static) if (parallel)
-  for (Index i = 0; i < n; ++i) {
+  ForRange(Index{0}, n, parallel, [&](Index i) {
     const double v0 = v_prev_[i];
     const double v1 = v[i];
     if (!state_.depolarised[static_cast<std::size_t>(i)]) {
@@ -307,7 +306,7 @@ void EpTissue::TrackActivation(double t0_ms, double dt_ms) {
         state_.v_min[i] = v1;
       }
     }
-  }
+  });
   tracking_parallel_.End();
   profile_.tracking += Seconds(start);
 }

@@ -12,6 +12,7 @@
 #include "gipsi/base/log.h"
 #include "gipsi/models/fem/fem_geometry.h"
 #include "gipsi/models/fem/surface_loads.h"
+#include "gipsi/numerics/adaptive_parallel.h"
 
 namespace gipsi {
 namespace {
@@ -136,8 +137,8 @@ bool FemSolid::AssembleElements(const double* u, VecX& f, double* k_values) cons
   f.setZero(3 * num_nodes());
   if (k_values) {
     const Index nnz = jac_.nonZeros();
-#pragma omp parallel for schedule(static) if (nnz >= 65536 && tangent_team_.prefers_parallel())
-    for (Index j = 0; j < nnz; ++j) k_values[j] = 0.0;
+    ForRange(Index{0}, nnz, nnz >= 65536 && tangent_team_.prefers_parallel(),
+             [=](Index j) { k_values[j] = 0.0; });
   }
   std::atomic<bool> any_invalid{false};
   double* fp = f.data();
@@ -376,11 +377,7 @@ bool FemSolid::IncrementResidualAndJacobian(double s, const VecX& d, VecX& r, Sp
   const double unit = diag_sum > 0 ? diag_sum / static_cast<double>(ncols) : 1.0;
   const std::uint8_t* constraint = constraint_.data();
   double max_row_sum = 0;
-  // (A maximum is exact in any order: the team's choice cannot change the bits.)
-#pragma omp parallel for schedule(static) \
-    reduction(max                         \
-              : max_row_sum) if (nnz >= 65536 && tangent_team_.prefers_parallel())
-  for (int c = 0; c < ncols; ++c) {
+  auto finish_column = [&](int c) {  // returns the column's absolute sum
     const bool fixed_col = constraint[c] != 0;
     double row_sum = 0;
     for (int j = outer[c]; j < outer[c + 1]; ++j) {
@@ -389,7 +386,15 @@ bool FemSolid::IncrementResidualAndJacobian(double s, const VecX& d, VecX& r, Sp
       jv[j] = v;
       row_sum += std::abs(v);
     }
-    max_row_sum = std::max(max_row_sum, row_sum);
+    return row_sum;
+  };
+  // (A maximum is exact in any order: the team's choice cannot change the bits. A serial
+  // choice opens no region; see ForRange.)
+  if (nnz >= 65536 && tangent_team_.prefers_parallel()) {
+#pragma omp parallel for schedule(static) reduction(max : max_row_sum)
+    for (int c = 0; c < ncols; ++c) max_row_sum = std::max(max_row_sum, finish_column(c));
+  } else {
+    for (int c = 0; c < ncols; ++c) max_row_sum = std::max(max_row_sum, finish_column(c));
   }
   state_.jacobian_norm = max_row_sum;
   FinishResidual(d, r);

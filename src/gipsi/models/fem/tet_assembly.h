@@ -99,13 +99,12 @@ class TetAssembly {
       const int begin = colour_start_[static_cast<std::size_t>(c)];
       const int end = colour_start_[static_cast<std::size_t>(c) + 1];
       const int elements = (end - begin) * kChunkElements;  // an upper bound
-#pragma omp parallel for schedule(static) if (parallel && end - begin >= 2 && \
-                                              elements >= kMinParallelElements)
-      for (int k = begin; k < end; ++k) {
-        const int first = colour_chunks_[static_cast<std::size_t>(k)] * kChunkElements;
-        const int last = std::min(first + kChunkElements, ne);
-        for (int e = first; e < last; ++e) fn(static_cast<Index>(e));
-      }
+      ForRange(begin, end, parallel && end - begin >= 2 && elements >= kMinParallelElements,
+               [&](int k) {
+                 const int first = colour_chunks_[static_cast<std::size_t>(k)] * kChunkElements;
+                 const int last = std::min(first + kChunkElements, ne);
+                 for (int e = first; e < last; ++e) fn(static_cast<Index>(e));
+               });
     }
     team.End();
   }
@@ -113,8 +112,7 @@ class TetAssembly {
   template <class Fn>
   void ForEachElement(Fn&& fn) const {
     const int n = static_cast<int>(num_elements());
-#pragma omp parallel for schedule(static) if (n >= kMinParallelElements)
-    for (int e = 0; e < n; ++e) fn(static_cast<Index>(e));
+    ForRange(0, n, n >= kMinParallelElements, [&](int e) { fn(static_cast<Index>(e)); });
   }
 
   /// Consistent mass matrix values (in MakePattern's layout) for density ρ [kg/m³]:

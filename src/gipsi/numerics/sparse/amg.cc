@@ -210,12 +210,11 @@ void RowSpMV(const Eigen::SparseMatrix<double, Eigen::RowMajor, int>& M, const V
   const double* __restrict values = M.valuePtr();
   const double* __restrict px = x.data();
   double* __restrict py = y.data();
-#pragma omp parallel for schedule(static) if (n >= kMinParallelLength)
-  for (int i = 0; i < n; ++i) {
+  ForRange(0, n, n >= kMinParallelLength, [=](int i) {
     double s = 0.0;
     for (int k = outer[i]; k < outer[i + 1]; ++k) s += values[k] * px[inner[k]];
     py[i] = accumulate ? py[i] + s : s;
-  }
+  });
 }
 
 }  // namespace
@@ -464,17 +463,16 @@ void SmoothedAggregationAmg::ApplyBlockInverse(const Level& level, const VecX& r
   if (level.blocked) {
     const int nodes = static_cast<int>(n / 3);
     const double* __restrict inverse = level.block_inverse.data();
-#pragma omp parallel for schedule(static) if (n >= kMinParallelLength)
-    for (int node = 0; node < nodes; ++node) {
+    ForRange(0, nodes, n >= kMinParallelLength, [=](int node) {
       const double s[3] = {weight * pr[3 * node], weight * pr[3 * node + 1],
                            weight * pr[3 * node + 2]};
       ApplyInverse(inverse + 9 * node, s, pz + 3 * node, add);
-    }
+    });
     return;
   }
   const double* __restrict inv = level.inverse_diagonal.data();
-#pragma omp parallel for schedule(static) if (n >= kMinParallelLength)
-  for (Index i = 0; i < n; ++i) pz[i] = (add ? pz[i] : 0.0) + weight * inv[i] * pr[i];
+  ForRange(Index{0}, n, n >= kMinParallelLength,
+           [=](Index i) { pz[i] = (add ? pz[i] : 0.0) + weight * inv[i] * pr[i]; });
 }
 
 void SmoothedAggregationAmg::LevelMultiply(const Level& level, const VecX& x, VecX& y) {

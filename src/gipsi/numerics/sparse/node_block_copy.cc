@@ -33,15 +33,14 @@ void NodeBlockCopy::CopyValues(const SparseMatrix& A) {
   double* blocks = values_.data();
   // Column 3I + a holds A(3J + i, 3I + a) = A(3I + a, 3J + i) (symmetry) at source + 3m + i
   // for the node's block m; the three columns of a node follow each other.
-#pragma omp parallel for schedule(static) if (3 * n >= kMinParallelLength)
-  for (int node = 0; node < n; ++node) {
+  ForRange(0, n, 3 * n >= kMinParallelLength, [=](int node) {
     const int count = start[node + 1] - start[node];
     const double* column = values + source[node];
     double* out = blocks + 9 * std::ptrdiff_t{start[node]};
     for (int a = 0; a < 3; ++a, column += 3 * count)
       for (int m = 0; m < count; ++m)
         for (int i = 0; i < 3; ++i) out[9 * m + 3 * a + i] = column[3 * m + i];
-  }
+  });
 }
 
 void NodeBlockCopy::MultiplyNodes(const double* x, double* y, int begin, int end) const {
@@ -70,8 +69,9 @@ void NodeBlockCopy::Multiply(const VecX& x, VecX& y) const {
   GIPSI_CHECK(x.size() == 3 * n && y.size() == 3 * n && x.data() != y.data(),
               "NodeBlockCopy::Multiply: sizes do not match or x and y alias");
   constexpr int kBatch = 64;
-#pragma omp parallel for schedule(static) if (3 * n >= kMinParallelLength)
-  for (int t = 0; t < n; t += kBatch) MultiplyNodes(x.data(), y.data(), t, std::min(t + kBatch, n));
+  ForRange(0, (n + kBatch - 1) / kBatch, 3 * n >= kMinParallelLength, [&](int b) {
+    MultiplyNodes(x.data(), y.data(), b * kBatch, std::min((b + 1) * kBatch, n));
+  });
 }
 
 }  // namespace gipsi

@@ -3,6 +3,7 @@
 // smoothed-aggregation AMG with a lagged hierarchy).
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -228,14 +229,15 @@ class PcgSolver final : public LinearSolver {
     const int* diagonal = diagonal_index_.data();
     const double* values = A.valuePtr();
     double* inverse = inverse_diagonal_.data();
-    bool positive = true;
-#pragma omp parallel for schedule(static) reduction(&& : positive) if (n >= kMinParallelLength)
-    for (int j = 0; j < n; ++j) {
+    // Whether every entry is positive, as a count of those that are not (one flag per entry,
+    // so no reduction: ForRange opens no region for a short one).
+    std::atomic<int> not_positive{0};
+    ForRange(0, n, n >= kMinParallelLength, [&](int j) {
       const double d = diagonal[j] >= 0 ? values[diagonal[j]] : 0.0;
-      positive = positive && d > 0.0;
+      if (!(d > 0.0)) not_positive.fetch_add(1, std::memory_order_relaxed);
       inverse[j] = d > 0.0 ? 1.0 / d : 0.0;
-    }
-    return positive;
+    });
+    return not_positive.load() == 0;
   }
 
   /// y = A x: from a block-row copy of A when there is one (the AMG hierarchy's finest level,

@@ -83,9 +83,11 @@ void SymmetricSpMV(const SparseMatrix& A, const VecX& x, VecX& y) {
   GIPSI_CHECK(x.data() != y.data() || x.size() == 0, "SymmetricSpMV: x and y alias");
 
   const int n = static_cast<int>(A.cols());
-#pragma omp parallel for schedule(static) if (n >= kMinParallelLength)
-  for (int t = 0; t < n; t += kSpMVRowBatch)
+  const int batches = (n + kSpMVRowBatch - 1) / kSpMVRowBatch;
+  ForRange(0, batches, n >= kMinParallelLength, [&](int b) {
+    const int t = b * kSpMVRowBatch;
     SymmetricSpMVRows(A, x.data(), y.data(), t, std::min(t + kSpMVRowBatch, n));
+  });
 }
 
 bool HasNodeBlockPattern(const SparseMatrix& A) {
@@ -122,9 +124,11 @@ void NodeBlockSpMV(const SparseMatrix& A, const VecX& x, VecX& y) {
               "NodeBlockSpMV: sizes do not match (A {}x{}, x {}, y {}) or x and y alias", A.rows(),
               A.cols(), x.size(), y.size());
   const int nodes = static_cast<int>(A.cols() / 3);
-#pragma omp parallel for schedule(static) if (3 * nodes >= kMinParallelLength)
-  for (int t = 0; t < nodes; t += kSpMVRowBatch)
+  const int batches = (nodes + kSpMVRowBatch - 1) / kSpMVRowBatch;
+  ForRange(0, batches, 3 * nodes >= kMinParallelLength, [&](int b) {
+    const int t = b * kSpMVRowBatch;
     NodeBlockSpMVNodes(A, x.data(), y.data(), t, std::min(t + kSpMVRowBatch, nodes));
+  });
 }
 
 }  // namespace gipsi

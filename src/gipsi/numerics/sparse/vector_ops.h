@@ -15,6 +15,7 @@
 
 #include "gipsi/base/export.h"
 #include "gipsi/base/math.h"
+#include "gipsi/numerics/adaptive_parallel.h"
 
 GIPSI_EXPORT_BEGIN
 namespace gipsi {
@@ -70,8 +71,7 @@ inline void ParallelXpby(const VecX& x, double beta, VecX& y) {
   const double* __restrict px = x.data();
   double* __restrict py = y.data();
   const Index n = y.size();
-#pragma omp parallel for schedule(static) if (n >= kMinParallelLength)
-  for (Index i = 0; i < n; ++i) py[i] = px[i] + beta * py[i];
+  ForRange(Index{0}, n, n >= kMinParallelLength, [=](Index i) { py[i] = px[i] + beta * py[i]; });
 }
 
 }  // namespace gipsi
