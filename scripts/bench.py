@@ -9,6 +9,7 @@ triad, CPU, core count and load average, so figures from different machines can 
   python3 scripts/bench.py            # builds what it needs (release preset), about 5 minutes
   python3 scripts/bench.py --quick    # one repetition, no 10-s haptic loop, no long scenes
   python3 scripts/bench.py --json out.json   # also the raw figures
+  python3 scripts/bench.py --busy     # also each figure beside a busy neighbour
 
 Rows:
   STREAM triad [GB/s]                      the machine's memory bandwidth (sparse_bench)
@@ -20,7 +21,9 @@ Rows:
   Heart real-time factor                   scenes/heart.json, 4 s (gipsi run; not --quick)
   Niederer slab 0.2 mm [s]                 scenes/slab_ep_0.2mm.json to its end (gipsi run; not --quick)
 Loads on a shared machine distort every row: the load average is printed, and the medians of
-several repetitions are reported, never the best.
+several repetitions are reported, never the best. With --busy every thread count is measured
+twice: alone, and beside a busy neighbour (one process spinning on one core for the whole
+measurement, as a user's other work would), where two threads should not lose to one.
 """
 import argparse
 import json
@@ -88,6 +91,23 @@ def run_scene(scene, threads, until=None):
     return float(wall.group(1)), float(rtf.group(1))
 
 
+class BusyNeighbour:
+    """One process spinning on one core while the `with` block lasts. It also stops by itself
+    if this script dies (it watches its parent), so it never outlives the measurement."""
+
+    CODE = ("import os\nparent = os.getppid()\n"
+            "while os.getppid() == parent:\n    for _ in range(200000): pass\n")
+
+    def __enter__(self):
+        self.proc = subprocess.Popen([sys.executable, "-c", self.CODE])
+        return self
+
+    def __exit__(self, *exc):
+        self.proc.kill()
+        self.proc.wait()
+        return False
+
+
 def measure(threads, repetitions, quick):
     r = {}
     triad = run_benchmark("sparse_bench", "BM_StreamTriad|BM_SymmetricSpMV/26/", threads,
@@ -139,6 +159,8 @@ def main():
     parser.add_argument("--no-build", action="store_true", help="use build/release as it is")
     parser.add_argument("--build-dir", help="a release build folder (implies --no-build)")
     parser.add_argument("--json", help="also write the figures to this file")
+    parser.add_argument("--busy", action="store_true",
+                        help="also measure each thread count beside a busy neighbour")
     args = parser.parse_args()
     global BUILD
     if args.build_dir:
@@ -153,22 +175,33 @@ def main():
     if not args.no_build:
         build()
     load_before = os.getloadavg()
-    results = {t: measure(t, repetitions, args.quick) for t in threads}
+    columns = [(t, False) for t in threads] + ([(t, True) for t in threads] if args.busy else [])
+    results = {}
+    for t, busy in columns:
+        if busy:
+            with BusyNeighbour():
+                results[(t, busy)] = measure(t, repetitions, args.quick)
+        else:
+            results[(t, busy)] = measure(t, repetitions, args.quick)
     load_after = os.getloadavg()
+
+    def title(t, busy):
+        return f"{t} thread{'s' if t > 1 else ''}" + (", busy neighbour" if busy else "")
 
     print(f"GiPSi benchmarks: {cpu_model()}, {os.cpu_count()} logical CPUs, "
           f"load average {load_before[0]:.2f} before and {load_after[0]:.2f} after, "
           f"medians of {repetitions}")
     print()
-    print("| figure | " + " | ".join(f"{t} thread{'s' if t > 1 else ''}" for t in threads) + " |")
-    print("|---|" + "---|" * len(threads))
-    for name in results[threads[0]]:
-        print(f"| {name} | " + " | ".join(f"{results[t][name]:.3g}" for t in threads) + " |")
+    print("| figure | " + " | ".join(title(*c) for c in columns) + " |")
+    print("|---|" + "---|" * len(columns))
+    for name in results[columns[0]]:
+        print(f"| {name} | " + " | ".join(f"{results[c][name]:.3g}" for c in columns) + " |")
     if args.json:
         with open(args.json, "w") as f:
             json.dump({"cpu": cpu_model(), "cpus": os.cpu_count(), "load_before": load_before,
                        "load_after": load_after, "repetitions": repetitions,
-                       "results": {str(t): results[t] for t in threads}}, f, indent=1)
+                       "results": {f"{t} busy" if busy else str(t): results[(t, busy)]
+                                   for t, busy in columns}}, f, indent=1)
     return 0
 
 
