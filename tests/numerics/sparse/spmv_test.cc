@@ -113,6 +113,9 @@ TEST(SymmetricSpMV, BitsDoNotDependOnThreadCount) {
       VecX parallel(A.rows());
       SymmetricSpMV(A, x, parallel);
       EXPECT_TRUE(SameBits(serial, parallel)) << threads << " threads";
+      VecX alone(A.rows());  // the caller's choice of its own thread (AdaptiveParallel's)
+      SymmetricSpMV(A, x, alone, /*team=*/false);
+      EXPECT_TRUE(SameBits(serial, alone)) << threads << " threads, team off";
     }
   }
 }
@@ -208,6 +211,13 @@ TEST(NodeBlockCopy, MatchesEigenProductAndFollowsNewValues) {
   for (int begin = 0; begin < nodes; begin += 997)  // an uneven split
     copy.MultiplyNodes(x.data(), pieces.data(), begin, std::min(begin + 997, nodes));
   EXPECT_TRUE(SameBits(serial, pieces));
+  // Copied on the calling thread alone (team false): the same blocks.
+  NodeBlockCopy alone;
+  alone.Assign(A);
+  alone.CopyValues(B, /*team=*/false);
+  VecX from_alone(B.rows());
+  alone.Multiply(x, from_alone);
+  EXPECT_TRUE(SameBits(serial, from_alone));
   for (int threads : {2, 3}) {
     omp_set_num_threads(threads);
     VecX parallel(B.rows());
@@ -228,6 +238,9 @@ TEST(ParallelDot, MatchesSerialDotAndRepeatsBitForBit) {
     const double again = ParallelDot(a, b, scratch);
     EXPECT_EQ(std::memcmp(&first, &again, sizeof(double)), 0) << "run " << run;
   }
+  // On the calling thread alone (team false) the same blocks are added in the same order.
+  const double alone = ParallelDot(a, b, scratch, /*team=*/false);
+  EXPECT_EQ(std::memcmp(&first, &alone, sizeof(double)), 0);
 }
 
 }  // namespace

@@ -239,12 +239,13 @@ void FemSolid::FinishResidual(const VecX& d, VecX& r) {
       for (Index i = 0; i < num_nodes(); ++i)
         r.segment<3>(3 * i) += lumped_mass_[i] * work_.segment<3>(3 * i);
     } else {
+      // The products follow the residual loop's team (beside a busy neighbour, alone).
       VecX& ma = f_int_;  // f_int_ is consumed above; reuse as a buffer
-      SymmetricSpMV(mass_, work_, ma);
+      SymmetricSpMV(mass_, work_, ma, residual_team_.prefers_parallel());
       r += ma;
     }
     if (params_.rayleigh_stiffness > 0) {
-      SymmetricSpMV(damping_k_, work2_, work_);
+      SymmetricSpMV(damping_k_, work2_, work_, residual_team_.prefers_parallel());
       r += params_.rayleigh_stiffness * work_;
     }
   }

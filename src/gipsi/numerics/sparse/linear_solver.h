@@ -34,8 +34,10 @@ using SparseMatrix = Eigen::SparseMatrix<double, Eigen::ColMajor, int>;
 /// static schedule: the same bits for the same thread count; in fact each y[j] is summed by one
 /// thread in a fixed order, so the bits do not depend on the thread count either). Preconditions
 /// (checked): A is square and compressed, x.size() == y.size() == A.rows() (y is not resized), x
-/// and y are distinct vectors. Allocates nothing.
-void SymmetricSpMV(const SparseMatrix& A, const VecX& x, VecX& y);
+/// and y are distinct vectors. Allocates nothing. `team` false runs it on the calling thread
+/// (a caller that follows an AdaptiveParallel's choice beside a busy neighbour); the bits are
+/// the same either way.
+void SymmetricSpMV(const SparseMatrix& A, const VecX& x, VecX& y, bool team = true);
 
 /// True if A (square, compressed) has the node-block pattern of a matrix assembled from 3×3
 /// node blocks: the row count is a multiple of 3, the three columns 3I, 3I + 1, 3I + 2 of every

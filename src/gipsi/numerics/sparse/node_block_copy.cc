@@ -23,7 +23,7 @@ void NodeBlockCopy::AssignPattern(const SparseMatrix& A) {
   values_.assign(static_cast<std::size_t>(A.nonZeros()), 0.0);
 }
 
-void NodeBlockCopy::CopyValues(const SparseMatrix& A) {
+void NodeBlockCopy::CopyValues(const SparseMatrix& A, bool team) {
   const int n = nodes();
   GIPSI_CHECK(A.cols() == 3 * n && A.nonZeros() == static_cast<Index>(values_.size()),
               "NodeBlockCopy::CopyValues: the matrix does not have the copied pattern");
@@ -33,7 +33,7 @@ void NodeBlockCopy::CopyValues(const SparseMatrix& A) {
   double* blocks = values_.data();
   // Column 3I + a holds A(3J + i, 3I + a) = A(3I + a, 3J + i) (symmetry) at source + 3m + i
   // for the node's block m; the three columns of a node follow each other.
-  ForRange(0, n, 3 * n >= kMinParallelLength, [=](int node) {
+  ForRange(0, n, team && 3 * n >= kMinParallelLength, [=](int node) {
     const int count = start[node + 1] - start[node];
     const double* column = values + source[node];
     double* out = blocks + 9 * std::ptrdiff_t{start[node]};

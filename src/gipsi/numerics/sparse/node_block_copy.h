@@ -30,8 +30,8 @@ class NodeBlockCopy {
     CopyValues(A);
   }
   /// Copies the values of A, which has the pattern of the last Assign (only the sizes are
-  /// checked). Parallel over nodes.
-  void CopyValues(const SparseMatrix& A);
+  /// checked). Parallel over nodes, unless `team` is false (then on the calling thread).
+  void CopyValues(const SparseMatrix& A, bool team = true);
   /// y = A x for the rows of nodes [begin, end) (rows 3·begin to 3·end); serial. Each entry is
   /// summed in a fixed order, so its bits do not depend on how callers split the nodes.
   void MultiplyNodes(const double* x, double* y, int begin, int end) const;

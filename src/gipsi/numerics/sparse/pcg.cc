@@ -141,7 +141,7 @@ class PcgSolver final : public LinearSolver {
         break;
     }
     if (node_blocks_ && fused()) {
-      block_copy_.CopyValues(A);
+      block_copy_.CopyValues(A, SetUpOnTeam());
       block_copy_ready_ = true;
     }
     matrix_ = &A;
@@ -157,7 +157,7 @@ class PcgSolver final : public LinearSolver {
     }
     GIPSI_CHECK(b.size() == rows_, "PCG Solve: b has size {}, matrix has {} rows", b.size(), rows_);
     if (x.size() != rows_) x.setZero(rows_);
-    const double b_norm = std::sqrt(ParallelDot(b, b, scratch_));
+    const double b_norm = std::sqrt(ParallelDot(b, b, scratch_, SetUpOnTeam()));
     if (b_norm == 0.0) {
       x.setZero();
       stats.converged = true;
@@ -214,6 +214,11 @@ class PcgSolver final : public LinearSolver {
   }
 
  private:
+  /// Whether the set-ups around a fused solve (Jacobi's diagonal, the block copy, the norm of
+  /// b) run on the team: as the fused solves have lately (team_choice_), so that beside a busy
+  /// neighbour they do not each wait for a descheduled thread. Other kinds: always.
+  [[nodiscard]] bool SetUpOnTeam() const { return !fused() || team_choice_.prefers_parallel(); }
+
   /// inverse_diagonal_ = 1 / diag(A); false if a diagonal entry is missing or ≤ 0 (not SPD).
   /// The diagonal's positions are found once per pattern (diagonal_index_).
   bool ComputeInverseDiagonal(const SparseMatrix& A) {
@@ -232,7 +237,7 @@ class PcgSolver final : public LinearSolver {
     // Whether every entry is positive, as a count of those that are not (one flag per entry,
     // so no reduction: ForRange opens no region for a short one).
     std::atomic<int> not_positive{0};
-    ForRange(0, n, n >= kMinParallelLength, [&](int j) {
+    ForRange(0, n, SetUpOnTeam() && n >= kMinParallelLength, [&](int j) {
       const double d = diagonal[j] >= 0 ? values[diagonal[j]] : 0.0;
       if (!(d > 0.0)) not_positive.fetch_add(1, std::memory_order_relaxed);
       inverse[j] = d > 0.0 ? 1.0 / d : 0.0;

@@ -73,7 +73,7 @@ void SymmetricSpMVRows(const SparseMatrix& A, const double* x, double* y, int be
   }
 }
 
-void SymmetricSpMV(const SparseMatrix& A, const VecX& x, VecX& y) {
+void SymmetricSpMV(const SparseMatrix& A, const VecX& x, VecX& y, bool team) {
   GIPSI_CHECK(A.rows() == A.cols(), "SymmetricSpMV: matrix is {}x{}, not square", A.rows(),
               A.cols());
   GIPSI_CHECK(x.size() == A.cols() && y.size() == A.rows(),
@@ -84,7 +84,7 @@ void SymmetricSpMV(const SparseMatrix& A, const VecX& x, VecX& y) {
 
   const int n = static_cast<int>(A.cols());
   const int batches = (n + kSpMVRowBatch - 1) / kSpMVRowBatch;
-  ForRange(0, batches, n >= kMinParallelLength, [&](int b) {
+  ForRange(0, batches, team && n >= kMinParallelLength, [&](int b) {
     const int t = b * kSpMVRowBatch;
     SymmetricSpMVRows(A, x.data(), y.data(), t, std::min(t + kSpMVRowBatch, n));
   });

@@ -43,10 +43,18 @@ class ReductionScratch {
 
 /// Σ over the blocks of [0, n) of `block_sum(begin, end)`, computed in parallel as described in
 /// the file comment; the same bits for every thread count. `block_sum` may also write to the
-/// indices of its block (fused update + reduction).
+/// indices of its block (fused update + reduction). `team` false sums the same blocks on the
+/// calling thread (a caller that follows an AdaptiveParallel's choice): the same bits again.
 template <class BlockSum>
-double DeterministicParallelSum(Index n, ReductionScratch& scratch, BlockSum&& block_sum) {
+double DeterministicParallelSum(Index n, ReductionScratch& scratch, BlockSum&& block_sum,
+                                bool team = true) {
   if (n < kMinParallelLength) return block_sum(Index{0}, n);
+  if (!team) {  // the same blocks in the same order on this thread: the same bits
+    double sum = 0.0;
+    for (int b = 0; b < kSumBlocks; ++b)
+      sum += block_sum(n * b / kSumBlocks, n * (b + 1) / kSumBlocks);
+    return sum;
+  }
 #pragma omp parallel for schedule(static)
   for (int b = 0; b < kSumBlocks; ++b)
     scratch.slot(b) = block_sum(n * b / kSumBlocks, n * (b + 1) / kSumBlocks);
@@ -55,15 +63,20 @@ double DeterministicParallelSum(Index n, ReductionScratch& scratch, BlockSum&& b
   return sum;
 }
 
-/// a · b (the same bits for every thread count). Sizes must match.
-inline double ParallelDot(const VecX& a, const VecX& b, ReductionScratch& scratch) {
+/// a · b (the same bits for every thread count, and with `team` false on this thread alone).
+/// Sizes must match.
+inline double ParallelDot(const VecX& a, const VecX& b, ReductionScratch& scratch,
+                          bool team = true) {
   const double* __restrict pa = a.data();
   const double* __restrict pb = b.data();
-  return DeterministicParallelSum(a.size(), scratch, [=](Index begin, Index end) {
-    double s = 0.0;
-    for (Index i = begin; i < end; ++i) s += pa[i] * pb[i];
-    return s;
-  });
+  return DeterministicParallelSum(
+      a.size(), scratch,
+      [=](Index begin, Index end) {
+        double s = 0.0;
+        for (Index i = begin; i < end; ++i) s += pa[i] * pb[i];
+        return s;
+      },
+      team);
 }
 
 /// y = x + beta * y, in parallel (no reduction).
