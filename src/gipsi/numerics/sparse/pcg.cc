@@ -234,8 +234,8 @@ class PcgSolver final : public LinearSolver {
     const int* diagonal = diagonal_index_.data();
     const double* values = A.valuePtr();
     double* inverse = inverse_diagonal_.data();
-    // Whether every entry is positive, as a count of those that are not (one flag per entry,
-    // so no reduction: ForRange opens no region for a short one).
+    // Counts the entries that are not positive (an atomic, touched only by a matrix that is
+    // not SPD; ForRange takes no reduction clause).
     std::atomic<int> not_positive{0};
     ForRange(0, n, SetUpOnTeam() && n >= kMinParallelLength, [&](int j) {
       const double d = diagonal[j] >= 0 ? values[diagonal[j]] : 0.0;
