@@ -49,15 +49,9 @@ template <class BlockSum>
 double DeterministicParallelSum(Index n, ReductionScratch& scratch, BlockSum&& block_sum,
                                 bool team = true) {
   if (n < kMinParallelLength) return block_sum(Index{0}, n);
-  if (!team) {  // the same blocks in the same order on this thread: the same bits
-    double sum = 0.0;
-    for (int b = 0; b < kSumBlocks; ++b)
-      sum += block_sum(n * b / kSumBlocks, n * (b + 1) / kSumBlocks);
-    return sum;
-  }
-#pragma omp parallel for schedule(static)
-  for (int b = 0; b < kSumBlocks; ++b)
+  ForRange(0, kSumBlocks, team, [&](int b) {
     scratch.slot(b) = block_sum(n * b / kSumBlocks, n * (b + 1) / kSumBlocks);
+  });
   double sum = 0.0;
   for (int b = 0; b < kSumBlocks; ++b) sum += scratch.slot(b);
   return sum;
