@@ -182,7 +182,7 @@ class PcgSolver final : public LinearSolver {
           break;
         }
         if (stats.iterations >= options_.max_iterations || stuck) break;
-        stuck = fused() ? !IterateFused(target, stats.iterations, x)
+        stuck = fused() ? !IterateFused(target, stats.iterations, x, team)
                         : !Iterate(target, stats.iterations, x);
         r_norm = TrueResidual(b, x);
       }
@@ -345,7 +345,7 @@ class PcgSolver final : public LinearSolver {
   /// thread, and one thread is faster. In exact arithmetic the iterates are those of Iterate; the
   /// recurred s can drift from A p in floating point, which Solve's true-residual check catches (it
   /// restarts CG from the true residual).
-  bool IterateFused(double target, int& iterations, VecX& x) {
+  bool IterateFused(double target, int& iterations, VecX& x, bool on_team) {
     const int n = static_cast<int>(rows_);
     const SparseMatrix& A = *matrix_;
     const bool blocks = block_copy_ready_;
@@ -372,9 +372,10 @@ class PcgSolver final : public LinearSolver {
       }
       block_start_[static_cast<std::size_t>(k)] = unit * lo;
     }
-    // On one thread below kMinFusedParallelRows, or when Solve chose this thread alone (its
-    // SerialOpenMp makes the region inactive).
-    const int threads = n >= kMinFusedParallelRows ? omp_get_max_threads() : 1;
+    // On one thread below kMinFusedParallelRows, or when Solve chose this thread alone: then
+    // without an OpenMP region (even an inactive one costs a futex call; EP on a small mesh
+    // solves 10,000 times per simulated second).
+    const int threads = on_team && n >= kMinFusedParallelRows ? omp_get_max_threads() : 1;
     // Per block and round parity: (r, r), (r, z), (w, z), padded to a cache line. Two rounds
     // alternate, so a thread that runs ahead never overwrites sums another is still reading.
     partials_.assign(static_cast<std::size_t>(2 * count), PartialSums{});
@@ -390,10 +391,7 @@ class PcgSolver final : public LinearSolver {
     PartialSums* partials = partials_.data();
     int done = iterations;
     bool ok = false;
-#pragma omp parallel num_threads(threads) if (threads > 1)
-    {
-      const int team = omp_get_num_threads();
-      const int t = omp_get_thread_num();
+    auto sweep = [&](const int team, const int t) {
       const int first_block = count * t / team, end_block = count * (t + 1) / team;
       auto slot = [&](int round, int block) { return partials[(round & 1) * count + block].sum; };
       auto total = [&](int round, int which) {
@@ -487,6 +485,12 @@ class PcgSolver final : public LinearSolver {
         done = local;
         ok = converged;
       }
+    };
+    if (threads > 1) {
+#pragma omp parallel num_threads(threads)
+      sweep(omp_get_num_threads(), omp_get_thread_num());
+    } else {
+      sweep(1, 0);
     }
     iterations = done;
     return ok;
