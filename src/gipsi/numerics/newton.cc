@@ -15,8 +15,13 @@ NewtonSolver::NewtonSolver(NewtonOptions options, std::unique_ptr<LinearSolver> 
   GIPSI_CHECK(linear_ != nullptr && options_.max_iterations >= 1);
 }
 
-void NewtonSolver::Prepare(const SparseMatrix& pattern) {
-  const Index n = pattern.rows();
+void NewtonSolver::Prepare(const SparseMatrix& pattern, int bordered) {
+  GIPSI_CHECK(bordered >= 0 && bordered <= kMaxLowRankTerms);
+  sparse_size_ = pattern.rows();
+  const Index n = sparse_size_ + bordered;
+  bordered_rhs_.setZero(bordered > 0 ? sparse_size_ : 0);
+  bordered_x_.setZero(bordered > 0 ? sparse_size_ : 0);
+  low_rank_kept_ = false;
   r_.setZero(n);
   r_trial_.setZero(n);
   delta_.setZero(n);
@@ -72,7 +77,11 @@ NewtonStats NewtonSolver::Solve(NonlinearSystem& system, VecX& d, SparseMatrix& 
     stats.inadmissible = true;
     return stats;
   }
-  double norm = r_.norm();
+  GIPSI_CHECK(d.size() == sparse_size_ + system.num_bordered() && r_.size() == d.size(),
+              "Newton: an iterate of {} unknowns for a solver prepared for {}", d.size(),
+              r_.size());
+  double merit = 0;
+  double norm = Norms(system, r_, merit);
   stats.initial_residual = norm;
   stats.final_residual = norm;
   stats.residual_history[0] = norm;
@@ -90,7 +99,7 @@ NewtonStats NewtonSolver::Solve(NonlinearSystem& system, VecX& d, SparseMatrix& 
   // A stale factorisation that fails is replaced by a fresh Jacobian once per iteration.
   auto refresh = [&]() {
     if (!system.CalcResidualAndJacobian(d, r_, J)) return false;
-    norm = r_.norm();
+    norm = Norms(system, r_, merit);
     need_factor = true;
     factor_valid_ = false;  // J now differs from the factorised matrix
     return true;
@@ -113,6 +122,7 @@ NewtonStats NewtonSolver::Solve(NonlinearSystem& system, VecX& d, SparseMatrix& 
     bool fresh = need_factor;
     if (need_factor) {
       factor_valid_ = false;
+      low_rank_kept_ = false;
       if (!FactorizeTangent(J, stats)) {
         stats.linear_failure = true;
         return stats;
@@ -120,19 +130,14 @@ NewtonStats NewtonSolver::Solve(NonlinearSystem& system, VecX& d, SparseMatrix& 
       factor_valid_ = true;
       need_factor = false;
     }
-    rhs_ = -r_;
     // Warm start: the first correction of a solve resembles the previous solve's (consecutive
     // time steps), later ones shrink towards zero.
-    if (it == 1 && options_.warm_start && warm_valid_)
-      delta_ = warm_;
-    else
-      delta_.setZero();
-    const LinearSolveStats ls = linear_->Solve(rhs_, delta_);
-    stats.linear_iterations += ls.iterations;
+    LinearSolveStats ls;
+    const bool solved =
+        SolveCorrection(system, stats, it == 1 && options_.warm_start && warm_valid_, ls);
     // `refactorized` describes the last Factorize, so count it only in the iteration that called
     // it.
     stats.refactorizations += fresh && ls.refactorized ? 1 : 0;
-    const bool solved = ls.converged && delta_.allFinite() && ApplyLowRank(system, stats, delta_);
     if (!solved && !fresh) {
       if (!refresh()) {
         stats.inadmissible = true;
@@ -161,6 +166,7 @@ NewtonStats NewtonSolver::Solve(NonlinearSystem& system, VecX& d, SparseMatrix& 
     bool accepted = false;
     bool by_monotonicity = false;
     double trial_norm = 0;
+    double trial_merit = 0;
     const int tries = options_.line_search ? options_.max_line_search_steps : 1;
     for (int ls_step = 0; ls_step < tries; ++ls_step, alpha *= 0.5) {
       if (ls_step > 0) {
@@ -172,9 +178,12 @@ NewtonStats NewtonSolver::Solve(NonlinearSystem& system, VecX& d, SparseMatrix& 
       }
       d_trial_ = d + alpha * delta_;
       if (!system.CalcResidual(d_trial_, r_trial_)) continue;
-      trial_norm = r_trial_.norm();
+      trial_norm = Norms(system, r_trial_, trial_merit);
       if (!std::isfinite(trial_norm)) continue;
-      if (!options_.line_search || trial_norm <= (1 - 1e-4 * alpha) * norm) {
+      // With bordered unknowns either measure may show the progress (a filter): ‖r_u‖, or the
+      // convergence norm when the step mainly repairs the bordered residuals r_q.
+      const double armijo = 1 - 1e-4 * alpha;
+      if (!options_.line_search || trial_merit <= armijo * merit || trial_norm <= armijo * norm) {
         accepted = true;
         break;
       }
@@ -204,7 +213,7 @@ NewtonStats NewtonSolver::Solve(NonlinearSystem& system, VecX& d, SparseMatrix& 
         stats.inadmissible = true;
         return stats;
       }
-      trial_norm = r_trial_.norm();
+      trial_norm = Norms(system, r_trial_, trial_merit);
     }
     d.swap(d_trial_);
     const double ratio = norm > 0 ? trial_norm / norm : 0;
@@ -214,6 +223,7 @@ NewtonStats NewtonSolver::Solve(NonlinearSystem& system, VecX& d, SparseMatrix& 
                      : by_monotonicity      ? simplified_.norm() / delta_.norm()
                                             : ratio;
     norm = trial_norm;
+    merit = trial_merit;
     stats.final_residual = norm;
     if (it < NewtonStats::kHistory) stats.residual_history[static_cast<std::size_t>(it)] = norm;
     const double step = delta_.lpNorm<Eigen::Infinity>();  // the full Newton correction
@@ -247,12 +257,99 @@ NewtonStats NewtonSolver::Solve(NonlinearSystem& system, VecX& d, SparseMatrix& 
   return stats;
 }
 
-bool NewtonSolver::ApplyLowRank(NonlinearSystem& system, NewtonStats& stats, VecX& x) {
+double NewtonSolver::Norms(const NonlinearSystem& system, const VecX& r, double& merit) const {
+  const int m = system.num_bordered();
+  if (m == 0) return merit = r.norm();
+  merit = r.head(sparse_size_).norm();
+  double sum = merit * merit;
+  for (int k = 0; k < m; ++k) {
+    const VecX* b = nullptr;
+    double w = 0;
+    system.LowRankTerm(k, b, w);
+    const double equivalent = w * b->norm() * r[sparse_size_ + k];
+    sum += equivalent * equivalent;
+  }
+  return std::sqrt(sum);
+}
+
+bool NewtonSolver::SolveCorrection(NonlinearSystem& system, NewtonStats& stats, bool warm,
+                                   LinearSolveStats& ls) {
+  const int m = system.num_bordered();
+  if (m == 0) {
+    rhs_ = -r_;
+    if (warm)
+      delta_ = warm_;
+    else
+      delta_.setZero();
+    ls = linear_->Solve(rhs_, delta_);
+    stats.linear_iterations += ls.iterations;
+    return ls.converged && delta_.allFinite() && ApplyLowRank(system, stats, delta_);
+  }
+  // Eliminate the bordered unknowns (NonlinearSystem::num_bordered) with the b_k kept with the
+  // factorisation (KeepLowRank).
+  if (!low_rank_kept_ && !KeepLowRank(system, stats)) return false;
+  const Index n = sparse_size_;
+  bordered_rhs_ = -r_.head(n);
+  for (int k = 0; k < m; ++k) {
+    const double w = LowRankWeight(system, k);
+    if (w > 0) bordered_rhs_ -= (w * r_[n + k]) * low_rank_b_[static_cast<std::size_t>(k)];
+  }
+  if (warm)
+    bordered_x_ = warm_.head(n);
+  else
+    bordered_x_.setZero();
+  ls = linear_->Solve(bordered_rhs_, bordered_x_);
+  stats.linear_iterations += ls.iterations;
+  if (!ls.converged || !bordered_x_.allFinite() || !ApplyLowRank(system, stats, bordered_x_, true))
+    return false;
+  delta_.head(n) = bordered_x_;
+  for (int k = 0; k < m; ++k) {
+    const double w = LowRankWeight(system, k);
+    delta_[n + k] =
+        w > 0 ? -w * (r_[n + k] + low_rank_b_[static_cast<std::size_t>(k)].dot(bordered_x_)) : 0.0;
+  }
+  return delta_.allFinite();
+}
+
+double NewtonSolver::LowRankWeight(const NonlinearSystem& system, int k) {
+  const VecX* b = nullptr;
+  double w = 0;
+  system.LowRankTerm(k, b, w);
+  return w;
+}
+
+bool NewtonSolver::KeepLowRank(NonlinearSystem& system, NewtonStats& stats) {
+  const int k = system.num_low_rank_terms();
+  GIPSI_CHECK(k <= kMaxLowRankTerms);
+  low_rank_b_.resize(static_cast<std::size_t>(k));
+  if (static_cast<int>(low_rank_z_.size()) < k) low_rank_z_.resize(static_cast<std::size_t>(k));
+  for (int i = 0; i < k; ++i) {
+    const auto ui = static_cast<std::size_t>(i);
+    const VecX* b = nullptr;
+    double w = 0;
+    system.LowRankTerm(i, b, w);
+    low_rank_b_[ui] = *b;
+    if (!SolveLowRankZ(low_rank_b_[ui], low_rank_z_[ui], stats)) return false;
+  }
+  low_rank_kept_ = true;
+  return true;
+}
+
+bool NewtonSolver::SolveLowRankZ(const VecX& b, VecX& z, NewtonStats& stats) {
+  if (z.size() != b.size()) z.setZero(b.size());
+  const LinearSolveStats ls = linear_->Solve(b, z);  // warm-started from the last z
+  stats.linear_iterations += ls.iterations;
+  return ls.converged && z.allFinite();
+}
+
+bool NewtonSolver::ApplyLowRank(NonlinearSystem& system, NewtonStats& stats, VecX& x, bool kept) {
   const int k = system.num_low_rank_terms();
   if (k == 0) return true;
   GIPSI_CHECK(k <= kMaxLowRankTerms);
   // (J + B W Bᵀ)⁻¹ r = y − Z (W⁻¹ + Bᵀ Z)⁻¹ Bᵀ y with y = J⁻¹ r (in x) and Z = J⁻¹ B.
-  // Terms with w = 0 drop out and are skipped.
+  // Terms with w = 0 drop out and are skipped. `kept`: B and Z are those kept with the
+  // factorisation (KeepLowRank), W is the current one.
+  GIPSI_CHECK(!kept || (low_rank_kept_ && static_cast<int>(low_rank_b_.size()) == k));
   if (static_cast<int>(low_rank_z_.size()) < k) low_rank_z_.resize(static_cast<std::size_t>(k));
   std::array<const VecX*, kMaxLowRankTerms> b{};
   std::array<double, kMaxLowRankTerms> w{};
@@ -262,11 +359,10 @@ bool NewtonSolver::ApplyLowRank(NonlinearSystem& system, NewtonStats& stats, Vec
     const auto ui = static_cast<std::size_t>(i);
     system.LowRankTerm(i, b[ui], w[ui]);
     if (!(w[ui] > 0)) continue;
-    VecX& z = low_rank_z_[ui];
-    if (z.size() != b[ui]->size()) z.setZero(b[ui]->size());
-    const LinearSolveStats ls = linear_->Solve(*b[ui], z);  // warm-started from the last z
-    stats.linear_iterations += ls.iterations;
-    if (!ls.converged || !z.allFinite()) return false;
+    if (kept)
+      b[ui] = &low_rank_b_[ui];
+    else if (!SolveLowRankZ(*b[ui], low_rank_z_[ui], stats))
+      return false;
     active[static_cast<std::size_t>(m++)] = i;
   }
   if (m == 0) return true;

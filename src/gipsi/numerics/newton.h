@@ -66,8 +66,23 @@ class NonlinearSystem {
   /// Newton solves with it by the Sherman–Morrison–Woodbury formula (one extra solve with J per
   /// term). Default: none.
   [[nodiscard]] virtual int num_low_rank_terms() const { return 0; }
-  /// Term k (k < 8): sets `b` (size of the system, zero on constrained unknowns) and `w`.
+  /// Term k (k < 8): sets `b` (size of the sparse system, zero on constrained unknowns) and
+  /// `w`.
   virtual void LowRankTerm(int /*k*/, const VecX*& /*b*/, double& /*w*/) const {}
+  /// Bordered scalar unknowns (e.g. cavity pressures solved with the wall), one per low-rank
+  /// term when not 0: the iterate is then (u, q) with q_k appended after the n sparse unknowns,
+  /// and the residual (r_u, r_q) with
+  ///   ∂r_u/∂u = J,  ∂r_u/∂q_k = −b_k,  ∂r_q,k/∂u = b_kᵀ,  ∂r_q,k/∂q_k = 1/w_k  (w_k > 0).
+  /// Newton eliminates q: (J + Σ w_k b_k b_kᵀ) Δu = −r_u − Σ w_k r_q,k b_k (the low-rank terms
+  /// above, by Woodbury), then Δq_k = −w_k (r_q,k + b_kᵀ Δu). Unlike a q(u) solved inside the
+  /// residual (a penalty with weight w_k), a stiff w_k then does not amplify the quadratic
+  /// error of a step in r_q into r_u, so Newton keeps its quadratic convergence however stiff
+  /// the coupling. Convergence is tested on ‖(r_u, w_k ‖b_k‖ r_q,k)‖, the residual r_u would
+  /// have with each q_k moved to zero r_q,k; the line search accepts a step that reduces that
+  /// norm or ‖r_u‖ (a step that repairs r_q may raise r_u, and a step that reduces r_u may leave
+  /// a volume error that w_k magnifies).
+  /// Must not change between Prepare and Solve.
+  [[nodiscard]] virtual int num_bordered() const { return 0; }
 };
 
 /// Options. Plain struct. The defaults are the stated defaults of the scene key "newton".
@@ -169,8 +184,9 @@ class NewtonSolver {
   NewtonSolver(const NewtonSolver&) = delete;
   NewtonSolver& operator=(const NewtonSolver&) = delete;
 
-  /// Sizes work vectors and analyses J's pattern once.
-  void Prepare(const SparseMatrix& pattern);
+  /// Sizes work vectors and analyses J's pattern once; `bordered`: the system's
+  /// num_bordered() (the iterate has pattern.rows() + bordered entries).
+  void Prepare(const SparseMatrix& pattern, int bordered = 0);
   /// Solves r(d) = 0 starting from d (in: initial guess; out: the last accepted iterate).
   /// `J` is the matrix the system assembles into (the pattern given to Prepare).
   /// Polls `stop` at the start of every iteration and before every line-search trial: when a
@@ -195,21 +211,41 @@ class NewtonSolver {
   void ForgetHandOver() {
     warm_valid_ = false;
     factor_valid_ = false;
+    low_rank_kept_ = false;
   }
 
  private:
   NewtonOptions options_;
   std::unique_ptr<LinearSolver> linear_;
   VecX r_, r_trial_, delta_, d_trial_, rhs_, simplified_;
-  VecX warm_;  // first correction of the last solve
+  Index sparse_size_ = 0;           // n: the iterate's unknowns in J (then num_bordered() scalars)
+  VecX bordered_rhs_, bordered_x_;  // the sparse part of a bordered system's correction
+  VecX warm_;                       // first correction of the last solve
   bool warm_valid_ = false;
   bool factor_valid_ = false;  // the linear solver holds a factorisation of the current J
   bool indefinite_ = false;    // the linear solver was switched to its indefinite mode
   static constexpr int kMaxLowRankTerms = 8;
   std::vector<VecX> low_rank_z_;  // J⁻¹ b_k of the low-rank terms (sized on first use)
+  // With bordered unknowns the b_k are kept with the factorisation, like J: a kept
+  // factorisation then costs one solve per iteration instead of 1 + num_low_rank_terms (the
+  // residual stays exact, so Newton converges to the same solution).
+  std::vector<VecX> low_rank_b_;
+  bool low_rank_kept_ = false;  // low_rank_b_ and low_rank_z_ belong to the factorisation
 
-  /// Applies the low-rank terms to x = J⁻¹ rhs (Woodbury); false if a solve fails.
-  bool ApplyLowRank(NonlinearSystem& system, NewtonStats& stats, VecX& x);
+  /// The correction delta_ = −J⁻¹ r_ with the low-rank terms and bordered unknowns, started
+  /// from warm_ if `warm`; false if the linear solve fails (`ls` tells how).
+  bool SolveCorrection(NonlinearSystem& system, NewtonStats& stats, bool warm,
+                       LinearSolveStats& ls);
+  /// ‖r_u‖ (the line search's merit) and the convergence norm of r (the same without
+  /// bordered unknowns; see NonlinearSystem::num_bordered).
+  [[nodiscard]] double Norms(const NonlinearSystem& system, const VecX& r, double& merit) const;
+  /// Applies the low-rank terms to x = J⁻¹ rhs (Woodbury); false if a solve fails. `kept`:
+  /// with the b_k and J⁻¹ b_k kept with the factorisation (KeepLowRank).
+  bool ApplyLowRank(NonlinearSystem& system, NewtonStats& stats, VecX& x, bool kept = false);
+  /// Keeps the system's current b_k and solves J⁻¹ b_k with the current factorisation.
+  bool KeepLowRank(NonlinearSystem& system, NewtonStats& stats);
+  bool SolveLowRankZ(const VecX& b, VecX& z, NewtonStats& stats);
+  static double LowRankWeight(const NonlinearSystem& system, int k);
   /// The natural monotonicity test of trial step α: true if ‖J⁻¹ r_trial_‖ ≤ (1 − α/4) ‖Δ‖.
   bool Monotone(NonlinearSystem& system, NewtonStats& stats, double alpha);
   /// Factorises J; on failure of an SPD-only direct solver, switches it to its indefinite

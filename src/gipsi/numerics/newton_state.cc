@@ -12,6 +12,7 @@
 /// original, and gives the same factors.
 
 #include <algorithm>
+#include <cstdint>
 #include <span>
 #include <vector>
 
@@ -21,21 +22,29 @@
 namespace gipsi {
 
 void NewtonSolver::SaveState(StateWriter& out, const SparseMatrix& J) const {
-  out.BeginSection("NewtonSolver", 2);
+  out.BeginSection("NewtonSolver", 3);
   out.WriteBool(warm_valid_);
   out.WriteMatrix(warm_);
   const bool keep = options_.reuse_factorization && factor_valid_;
   out.WriteBool(keep);
-  if (keep)
+  if (keep) {
     out.WriteArray(std::span<const double>(J.valuePtr(), static_cast<std::size_t>(J.nonZeros())));
+    // The low-rank vectors kept with it (bordered unknowns); J⁻¹ b is solved again on restore.
+    out.WriteBool(low_rank_kept_);
+    if (low_rank_kept_) {
+      out.WriteInt(static_cast<std::int64_t>(low_rank_b_.size()));
+      for (const VecX& b : low_rank_b_) out.WriteMatrix(b);
+    }
+  }
   out.EndSection();
 }
 
 void NewtonSolver::RestoreState(StateReader& in, SparseMatrix& J) {
-  in.BeginSection("NewtonSolver", 2);
+  in.BeginSection("NewtonSolver", 3);
   warm_valid_ = in.ReadBool();
-  in.ReadMatrix(warm_);
+  in.ReadMatrixExact(warm_, "the warm start of the Newton solver");
   factor_valid_ = false;
+  low_rank_kept_ = false;
   if (in.ReadBool()) {
     if (!options_.reuse_factorization)
       in.Fail("the checkpoint keeps a Newton factorisation but this scene does not reuse them");
@@ -46,6 +55,21 @@ void NewtonSolver::RestoreState(StateReader& in, SparseMatrix& J) {
     NewtonStats stats;
     if (!FactorizeTangent(J, stats)) in.Fail("the saved Newton matrix cannot be factorised again");
     factor_valid_ = true;
+    if (in.ReadBool()) {
+      const std::int64_t terms = in.ReadInt();
+      if (terms < 0 || terms > kMaxLowRankTerms)
+        in.Fail("more low-rank terms than a Newton solver takes");
+      const auto count = static_cast<std::size_t>(terms);
+      low_rank_b_.resize(count);
+      if (low_rank_z_.size() < count) low_rank_z_.resize(count);
+      for (std::size_t k = 0; k < count; ++k) {
+        low_rank_b_[k].setZero(sparse_size_);
+        in.ReadMatrixExact(low_rank_b_[k], "a low-rank vector of the Newton solver");
+        if (!SolveLowRankZ(low_rank_b_[k], low_rank_z_[k], stats))
+          in.Fail("the saved Newton low-rank vectors cannot be solved again");
+      }
+      low_rank_kept_ = true;
+    }
   }
   in.EndSection();
 }

@@ -1,14 +1,19 @@
 // FemSolid's cavities coupled to blood through a CavityLaw (cavity_law.h).
 //
 // For each coupled cavity the step's unknowns are the displacements u and the pressure p, with
-//   f_int(u) − p ∂V/∂x(u) − … = 0     (the pressure acts as a follower load, p ∂V/∂x)
-//   V(u) = V_b(p)                      (the wall encloses what the blood fills at the end)
-// where V_b is the law's end volume, non-increasing in p. For given u the second equation has
-// one root p(u) (V − V_b is increasing in p), found here by a bracketed secant iteration, so
-// Newton sees a residual in u alone. Differentiating p(u): ∂p/∂u = ∂V/∂x / C with
-// C = −dV_b/dp > 0 (the blood's compressibility keeps it positive when the valves are closed),
-// which adds the rank-one term (1/C) ∂V/∂x ⊗ ∂V/∂x to the tangent, solved by Newton with the
+//   r_u = f_int(u) − p ∂V/∂x(u) − … = 0   (the pressure acts as a follower load, p ∂V/∂x)
+//   r_p = V(u) − V_b(p) = 0               (the wall encloses what the blood fills at the end)
+// where V_b is the law's end volume, non-increasing in p. Newton solves for (u, p) together:
+// p is a bordered unknown (NonlinearSystem::num_bordered) with ∂r_p/∂p = C = −dV_b/dp > 0 (the
+// blood's compressibility keeps it positive when the valves are closed). Eliminating Δp adds
+// the rank-one term (1/C) ∂V/∂x ⊗ ∂V/∂x to the tangent, solved by Newton with the
 // Sherman–Morrison–Woodbury formula instead of filling the sparse matrix.
+//
+// Solving p(u) from r_p = 0 inside the residual instead (as this file did until stop 38) makes
+// the coupling a penalty of weight 1/C: with the valves closed (C of a few 1e-12 m³/Pa) the
+// quadratic volume error of every Newton step reappears in r_u multiplied by 1/C, the line
+// search cuts the steps, and Newton needed 6–13 iterations with several factorisations at each
+// isovolumetric phase of the heart. As a bordered unknown p absorbs that error linearly.
 
 #include <algorithm>
 #include <cmath>
@@ -18,28 +23,17 @@
 #include "gipsi/base/error.h"
 #include "gipsi/base/log.h"
 #include "gipsi/models/fem/fem_solid.h"
-#include "gipsi/numerics/bracketed_root.h"
 
 namespace gipsi {
 namespace {
 
-/// Root of h(p) = v − law(p) (increasing in p) near `guess`; false if the law fails or no root
-/// is bracketed. `stiffness` estimates −dp/dV_b [Pa/m³] (0: unknown) for the first step.
-bool SolvePressure(CavityLaw& law, double t, double dt, double v, double guess, double stiffness,
-                   double& p) {
-  auto h = [&](double q, double& out) {
-    double vb = 0;
-    if (!law.EndVolume(t, dt, q, vb) || !std::isfinite(vb)) return false;
-    out = v - vb;
-    return true;
-  };
-  // Step away from the guess in the direction that reduces |h|.
-  auto first_step = [&](double h0) {
-    const double first = stiffness > 0 ? std::max(2 * std::abs(h0) * stiffness, 1e-3)
-                                       : std::max(1.0, 0.01 * std::abs(guess));
-    return h0 > 0 ? -first : first;
-  };
-  return SolveIncreasingRoot(h, guess, first_step, 1e-13 * std::abs(v), p);
+/// −dp/dV_b of the law at p [Pa/m³] by a one-sided difference of 1e-6 of the pressure (at least
+/// 1 mPa), given V_b(p) = vb; 0 if the law fails there or is not decreasing.
+double LawStiffness(CavityLaw& law, double t, double dt, double p, double vb) {
+  const double dp = std::max(1e-3, 1e-6 * std::abs(p));
+  double v1 = 0;
+  if (law.EndVolume(t, dt, p + dp, v1) && std::isfinite(v1) && vb > v1) return dp / (vb - v1);
+  return 0;
 }
 
 }  // namespace
@@ -57,6 +51,13 @@ void FemSolid::AttachCavityLaw(std::string_view cavity, CavityLaw* law) {
         "with the wall; '{}' cannot",
         path(), cavity, ode_integrator_->name()));
   cavities_[i].law = law;
+  // Newton's iterate gains the cavity's pressure.
+  bordered_ = num_low_rank_terms();
+  const Index n = jac_.rows();
+  newton_x_.setZero(n + bordered_);
+  bordered_d_.setZero(n);
+  bordered_r_.setZero(n);
+  newton_->Prepare(jac_, bordered_);
   cavity_follower_tangent_ = newton_->linear_solver().AcceptIndefinite();
   if (!cavity_follower_tangent_)
     Log().warn(
@@ -83,12 +84,21 @@ bool FemSolid::AddCoupledCavityLoads(const double* u) {
           rest_.segment<3>(3 * node) + Eigen::Map<const Vec3>(u + 3 * node);
     }
     const double v = cavity.volume.Compute(cavity.positions, &cavity.local_gradient);
-    double p = cs.pressure;
-    if (!SolvePressure(*cavity.law, step_time_, step_dt_, v, cs.pressure, cs.stiffness, p)) {
+    const double p = cs.pressure;  // the iterate's (FemSolid::Increment sets it)
+    double vb = 0;
+    if (!cavity.law->EndVolume(step_time_, step_dt_, p, vb) || !std::isfinite(vb)) {
       failed_cavity_ = static_cast<int>(c);
       return false;
     }
-    cs.pressure = p;
+    cavity.volume_residual = v - vb;
+    // Evaluated with every residual (two law evaluations): the Woodbury solve and the
+    // elimination of Δp then use the stiffness at the current pressure even while a
+    // factorisation of an older tangent is kept, e.g. when a valve has just closed.
+    cs.stiffness = LawStiffness(*cavity.law, step_time_, step_dt_, p, vb);
+    if (!(cs.stiffness > 0)) {  // p would not be determined by the volume
+      failed_cavity_ = static_cast<int>(c);
+      return false;
+    }
     cavity.gradient.setZero();
     for (std::size_t k = 0; k < cavity.nodes.size(); ++k) {
       const auto node = static_cast<Index>(cavity.nodes[k]);
@@ -103,7 +113,7 @@ bool FemSolid::AddCoupledCavityLoads(const double* u) {
 void FemSolid::AddCoupledCavityTangent(const double* u, double* jv) {
   for (std::size_t c = 0; c < cavities_.size(); ++c) {
     const Cavity& cavity = cavities_[c];
-    FemCavityState& cs = state_.cavities[c];
+    const FemCavityState& cs = state_.cavities[c];
     if (cavity.law == nullptr) continue;
     // The follower part p ∂²V/∂x² is the faces' pressure tangent (the cap of an open rim moves
     // only with the rim; its curvature terms are left out, exact when the rim is held). It can
@@ -111,14 +121,7 @@ void FemSolid::AddCoupledCavityTangent(const double* u, double* jv) {
     // out for solvers that need SPD matrices: Newton then converges linearly.
     if (cavity_follower_tangent_)
       for (int f : cavity.faces) AddFaceLoadTangent(f, u, cs.pressure, Vec3::Zero(), jv);
-    // C = −dV_b/dp by a one-sided difference of 1e-6 of the pressure (at least 1 mPa).
-    const double p = cs.pressure;
-    const double dp = std::max(1e-3, 1e-6 * std::abs(p));
-    double v0 = 0, v1 = 0;
-    cs.stiffness = 0;
-    if (cavity.law->EndVolume(step_time_, step_dt_, p, v0) &&
-        cavity.law->EndVolume(step_time_, step_dt_, p + dp, v1) && v0 > v1)
-      cs.stiffness = dp / (v0 - v1);
+    // The rank-one weight cs.stiffness was set with the residual (AddCoupledCavityLoads).
   }
 }
 

@@ -271,12 +271,27 @@ class FemSolid::Increment final : public NonlinearSystem {
         damping_pending_(solid.params_.rayleigh_stiffness > 0) {}
 
   bool CalcResidual(const VecX& d, VecX& r) override {
-    const bool ok = solid_.IncrementResidual(s_, d, r);
-    if (ok) TakeLoadScale();
+    if (solid_.bordered_ == 0) {
+      const bool ok = solid_.IncrementResidual(s_, d, r);
+      if (ok) TakeLoadScale();
+      return ok;
+    }
+    const bool ok = solid_.IncrementResidual(s_, solid_.TakeIterate(d), solid_.bordered_r_);
+    if (ok) {
+      solid_.GiveResidual(r);
+      TakeLoadScale();
+    }
     return ok;
   }
   bool CalcResidualAndJacobian(const VecX& d, VecX& r, SparseMatrix& J) override {
-    const bool ok = solid_.IncrementResidualAndJacobian(s_, d, r, J, damping_pending_);
+    bool ok = false;
+    if (solid_.bordered_ == 0) {
+      ok = solid_.IncrementResidualAndJacobian(s_, d, r, J, damping_pending_);
+    } else {
+      ok = solid_.IncrementResidualAndJacobian(s_, solid_.TakeIterate(d), solid_.bordered_r_, J,
+                                               damping_pending_);
+      if (ok) solid_.GiveResidual(r);
+    }
     if (ok) {
       TakeLoadScale();
       damping_pending_ = false;
@@ -287,6 +302,7 @@ class FemSolid::Increment final : public NonlinearSystem {
   [[nodiscard]] double residual_floor() const override { return solid_.residual_floor_; }
   [[nodiscard]] int num_low_rank_terms() const override { return solid_.num_low_rank_terms(); }
   void LowRankTerm(int k, const VecX*& b, double& w) const override { solid_.LowRankTerm(k, b, w); }
+  [[nodiscard]] int num_bordered() const override { return solid_.bordered_; }
 
  private:
   void TakeLoadScale() {
@@ -301,6 +317,23 @@ class FemSolid::Increment final : public NonlinearSystem {
   bool damping_pending_;
   bool scale_pending_ = true;
 };
+
+const VecX& FemSolid::TakeIterate(const VecX& x) {
+  const Index n = bordered_d_.size();
+  bordered_d_ = x.head(n);
+  Index k = n;
+  for (std::size_t c = 0; c < cavities_.size(); ++c)
+    if (cavities_[c].law != nullptr) state_.cavities[c].pressure = x[k++];
+  return bordered_d_;
+}
+
+void FemSolid::GiveResidual(VecX& r) const {
+  const Index n = bordered_r_.size();
+  r.head(n) = bordered_r_;
+  Index k = n;
+  for (const Cavity& cavity : cavities_)
+    if (cavity.law != nullptr) r[k++] = cavity.volume_residual;
+}
 
 bool FemSolid::IncrementResidual(double s, const VecX& d, VecX& r) {
   const auto start = Clock::now();
@@ -511,12 +544,20 @@ StepStatus FemSolid::Advance(double s0, double s1, double dt, int depth) {
   if (stop_token().stop_requested()) return StepStatus::Stopped();
   saved_scheme_ = state_.scheme;
   state_.scheme.Begin((s1 - s0) * dt);
-  const bool predict = params_.predict_velocity && params_.scheme != ImplicitSchemeKind::kStatic;
+  const bool predict = params_.predictor != FemParams::Predictor::kNone &&
+                       params_.scheme != ImplicitSchemeKind::kStatic;
   auto solve = [&](bool predicted) {
-    if (predicted)
-      d_ = ((s1 - s0) * dt) * state_.scheme.v();
-    else
+    if (!predicted) {
       d_.setZero();
+    } else if (params_.predictor == FemParams::Predictor::kConstantVelocity) {
+      d_ = ((s1 - s0) * dt) * state_.scheme.v();
+    } else {
+      const double h = (s1 - s0) * dt;
+      const VecX& v = state_.scheme.v();
+      const VecX& a = state_.scheme.a();
+      for (Index i = 0; i < d_.size(); ++i)
+        d_[i] = state_.scheme.IncrementForVelocity(i, v[i] + h * a[i]);
+    }
     const VecX& xn = state_.scheme.x();
     for (int dof : constrained_dofs_) {
       if (constraint_[static_cast<std::size_t>(dof)] == 1)
@@ -526,7 +567,18 @@ StepStatus FemSolid::Advance(double s0, double s1, double dt, int depth) {
     }
     Increment increment(*this, s1,
                         (state_.f_nodal_prev + s1 * (f_nodal_new_ - state_.f_nodal_prev)).norm());
-    state_.last_newton = newton_->Solve(increment, d_, jac_, stop_token());
+    if (bordered_ == 0) {
+      state_.last_newton = newton_->Solve(increment, d_, jac_, stop_token());
+    } else {
+      // The iterate (d, p) starts from the step's first pressures (those of the last step).
+      const Index n = d_.size();
+      newton_x_.head(n) = d_;
+      Index k = n;
+      for (std::size_t c = 0; c < cavities_.size(); ++c)
+        if (cavities_[c].law != nullptr) newton_x_[k++] = state_.cavities[c].pressure;
+      state_.last_newton = newton_->Solve(increment, newton_x_, jac_, stop_token());
+      d_ = TakeIterate(newton_x_);  // the last residual may have been a rejected trial's
+    }
     load_scale_ = increment.force_scale();
     if (state_.last_newton.switched_to_indefinite)  // once per run: the switch is for good
       Log().warn(
@@ -561,8 +613,9 @@ StepStatus FemSolid::Advance(double s0, double s1, double dt, int depth) {
   failure_detail_ = Describe(state_.last_newton, params_.newton, newton_->linear_solver().name());
   if (failed_cavity_ >= 0)
     failure_detail_ += fmt::format(
-        "; the blood coupled to cavity '{}' found no pressure for the wall's volume (is the blood "
-        "object stepped right after this one?)",
+        "; the blood coupled to cavity '{}' could not give its volume at the wall's pressure, or "
+        "its volume does not fall as the pressure rises (is the blood object stepped right after "
+        "this one?)",
         params_.cavities[static_cast<std::size_t>(failed_cavity_)].name);
   if (state_.last_newton.inadmissible && first_invalid_ >= 0)
     failure_detail_ += fmt::format("; {} is outside its law's domain (det F <= 0?)",

@@ -132,9 +132,14 @@ void RegisterFemSolid(TypeRegistry& registry) {
         if (auto solver = p.Find("linear_solver"))
           params.linear_solver = ParseLinearSolverOptions(*solver);
         ParseLoadStepping(p, params.load_steps, params.max_bisections);
-        if (auto predictor = p.Find("predictor"))
-          params.predict_velocity =
-              predictor->AsChoice({"none", "constant_velocity"}) == "constant_velocity";
+        if (auto predictor = p.Find("predictor")) {
+          const std::string choice =
+              predictor->AsChoice({"none", "constant_velocity", "constant_acceleration"});
+          params.predictor = choice == "constant_velocity" ? FemParams::Predictor::kConstantVelocity
+                             : choice == "constant_acceleration"
+                                 ? FemParams::Predictor::kConstantAcceleration
+                                 : FemParams::Predictor::kNone;
+        }
         std::optional<TransmuralFibreRule> fibre_rule;
         if (auto fibres = p.Find("fibres"); fibres && fibres->Has("rule")) {
           fibre_rule = ParseTransmuralFibreRule(*fibres);

@@ -36,7 +36,7 @@ constexpr const char* kHeartDefaults = R"({
                    "bulk_modulus": 50000},
       "fibres": {"rule": "transmural", "endo": {"group": "endo"}, "epi": {"group": "epi"},
                  "axis": [0, 0, 1], "endo_angle": 60, "epi_angle": -60},
-      "integrator": "BackwardEuler", "predictor": "constant_velocity", "density": 1060,
+      "integrator": "BackwardEuler", "predictor": "constant_acceleration", "density": 1060,
       "gravity": [0, 0, 0],
       "linear_solver": {"type": "cholmod"},
       "newton": {"tolerance": 1e-6, "max_iterations": 40, "reuse_factorization": true},
