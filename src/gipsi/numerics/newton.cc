@@ -68,6 +68,9 @@ bool NewtonSolver::Monotone(NonlinearSystem& system, NewtonStats& stats, double 
 
 NewtonStats NewtonSolver::Solve(NonlinearSystem& system, VecX& d, SparseMatrix& J, StopToken stop) {
   NewtonStats stats;
+  GIPSI_CHECK(d.size() == sparse_size_ + system.num_bordered() && r_.size() == d.size(),
+              "Newton: an iterate of {} unknowns for a solver prepared for {}", d.size(),
+              r_.size());
   const bool reuse = options_.reuse_factorization && !options_.fixed_iterations;
   // With reuse, the previous Solve's factorisation is tried first (only the residual is new).
   bool need_factor = !(reuse && factor_valid_);
@@ -77,9 +80,6 @@ NewtonStats NewtonSolver::Solve(NonlinearSystem& system, VecX& d, SparseMatrix& 
     stats.inadmissible = true;
     return stats;
   }
-  GIPSI_CHECK(d.size() == sparse_size_ + system.num_bordered() && r_.size() == d.size(),
-              "Newton: an iterate of {} unknowns for a solver prepared for {}", d.size(),
-              r_.size());
   double merit = 0;
   double norm = Norms(system, r_, merit);
   stats.initial_residual = norm;
@@ -292,7 +292,8 @@ bool NewtonSolver::SolveCorrection(NonlinearSystem& system, NewtonStats& stats, 
   bordered_rhs_ = -r_.head(n);
   for (int k = 0; k < m; ++k) {
     const double w = LowRankWeight(system, k);
-    if (w > 0) bordered_rhs_ -= (w * r_[n + k]) * low_rank_b_[static_cast<std::size_t>(k)];
+    if (!(w > 0)) return false;  // q_k would not be determined (NonlinearSystem::num_bordered)
+    bordered_rhs_ -= (w * r_[n + k]) * low_rank_b_[static_cast<std::size_t>(k)];
   }
   if (warm)
     bordered_x_ = warm_.head(n);
@@ -304,9 +305,8 @@ bool NewtonSolver::SolveCorrection(NonlinearSystem& system, NewtonStats& stats, 
     return false;
   delta_.head(n) = bordered_x_;
   for (int k = 0; k < m; ++k) {
-    const double w = LowRankWeight(system, k);
-    delta_[n + k] =
-        w > 0 ? -w * (r_[n + k] + low_rank_b_[static_cast<std::size_t>(k)].dot(bordered_x_)) : 0.0;
+    delta_[n + k] = -LowRankWeight(system, k) *
+                    (r_[n + k] + low_rank_b_[static_cast<std::size_t>(k)].dot(bordered_x_));
   }
   return delta_.allFinite();
 }

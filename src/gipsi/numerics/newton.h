@@ -81,7 +81,8 @@ class NonlinearSystem {
   /// have with each q_k moved to zero r_q,k; the line search accepts a step that reduces that
   /// norm or ‖r_u‖ (a step that repairs r_q may raise r_u, and a step that reduces r_u may leave
   /// a volume error that w_k magnifies).
-  /// Must not change between Prepare and Solve.
+  /// Must not change between Prepare and Solve; a term with w_k ≤ 0 (q_k not determined) fails
+  /// the iteration's linear solve.
   [[nodiscard]] virtual int num_bordered() const { return 0; }
 };
 
