@@ -327,6 +327,14 @@ const VecX& FemSolid::TakeIterate(const VecX& x) {
   return bordered_d_;
 }
 
+void FemSolid::GiveIterate(VecX& x) const {
+  const Index n = d_.size();
+  x.head(n) = d_;
+  Index k = n;
+  for (std::size_t c = 0; c < cavities_.size(); ++c)
+    if (cavities_[c].law != nullptr) x[k++] = state_.cavities[c].pressure;
+}
+
 void FemSolid::GiveResidual(VecX& r) const {
   const Index n = bordered_r_.size();
   r.head(n) = bordered_r_;
@@ -571,11 +579,7 @@ StepStatus FemSolid::Advance(double s0, double s1, double dt, int depth) {
       state_.last_newton = newton_->Solve(increment, d_, jac_, stop_token());
     } else {
       // The iterate (d, p) starts from the step's first pressures (those of the last step).
-      const Index n = d_.size();
-      newton_x_.head(n) = d_;
-      Index k = n;
-      for (std::size_t c = 0; c < cavities_.size(); ++c)
-        if (cavities_[c].law != nullptr) newton_x_[k++] = state_.cavities[c].pressure;
+      GiveIterate(newton_x_);
       state_.last_newton = newton_->Solve(increment, newton_x_, jac_, stop_token());
       d_ = TakeIterate(newton_x_);  // the last residual may have been a rejected trial's
     }

@@ -191,6 +191,8 @@ class FemSolid final : public SimObject, public CavityWall {
                                     bool damping_tangent);
   /// Newton's iterate (d, p) → d in bordered_d_ and the coupled cavities' pressures.
   const VecX& TakeIterate(const VecX& x);
+  /// d_ and the coupled cavities' pressures → Newton's iterate (d, p).
+  void GiveIterate(VecX& x) const;
   /// The residual r_u in bordered_r_ and the cavities' volume residuals → Newton's r.
   void GiveResidual(VecX& r) const;
   [[nodiscard]] int num_low_rank_terms() const;
