@@ -4,6 +4,10 @@
 #include <string>
 #include <vector>
 
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 #include <Eigen/Geometry>
@@ -141,6 +145,21 @@ TEST(CylinderShell, LeavesTheProcessLocaleUnchanged) {
   const std::string before = std::setlocale(LC_ALL, nullptr);
   MakeCylinderShell(1, 2, 1, 0.8);
   EXPECT_EQ(std::setlocale(LC_ALL, nullptr), before);
+}
+
+// gmsh::initialize sets the calling thread's OpenMP team size to one and gmsh::finalize leaves it
+// there: every scene that generated a mesh then ran GiPSi's parallel loops on one thread.
+TEST(CylinderShell, LeavesTheOpenMpTeamSizeUnchanged) {
+#ifdef _OPENMP
+  const int before = omp_get_max_threads();
+  omp_set_num_threads(3);  // not Gmsh's 1, whatever the machine
+  MakeCylinderShell(1, 2, 1, 0.8);
+  const int after = omp_get_max_threads();
+  omp_set_num_threads(before);
+  EXPECT_EQ(after, 3);
+#else
+  GTEST_SKIP() << "built without OpenMP";
+#endif
 }
 
 TEST(CylinderShell, RejectsInnerRadiusNotBelowOuter) {

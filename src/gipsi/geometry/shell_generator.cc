@@ -9,8 +9,16 @@
 ///
 /// Gmsh keeps global state, so every use goes through `GmshSession`: a process-wide mutex held
 /// from `gmsh::initialize` to `gmsh::finalize`.
+///
+/// `gmsh::initialize` sets the calling thread's OpenMP team size to its General.NumThreads (1)
+/// with `omp_set_num_threads`, and `gmsh::finalize` leaves it there: before the session restored
+/// it, every scene that generated a mesh (the heart demo among them) then ran all of GiPSi's
+/// parallel loops on one thread, whatever OMP_NUM_THREADS said.
 
 #include <gmsh.h>
+#ifdef _OPENMP
+#include <omp.h>
+#endif
 
 #include <clocale>
 #include <cmath>
@@ -44,12 +52,16 @@ std::mutex& GmshMutex() {
 
 /// One Gmsh API session: holds the Gmsh mutex, initialises Gmsh quietly (no terminal output,
 /// no configuration files, one thread for reproducible meshes) and finalises it on exit, also
-/// when an exception leaves the scope. Gmsh sets the process locale from the environment; the
-/// session restores the previous one. Neither copyable nor movable.
+/// when an exception leaves the scope. Gmsh sets the process locale from the environment and
+/// the calling thread's OpenMP team size to one; the session restores both. Neither copyable
+/// nor movable.
 class GmshSession {
  public:
   GmshSession() : lock_(GmshMutex()) {
     if (const char* locale = std::setlocale(LC_ALL, nullptr)) saved_locale_ = locale;
+#ifdef _OPENMP
+    saved_threads_ = omp_get_max_threads();
+#endif
     gmsh::initialize(0, nullptr, /*readConfigFiles=*/false);
     gmsh::option::setNumber("General.Terminal", 0);
     gmsh::option::setNumber("General.Verbosity", 0);
@@ -61,6 +73,9 @@ class GmshSession {
     } catch (...) {  // nothing sensible to do in a destructor
     }
     if (!saved_locale_.empty()) std::setlocale(LC_ALL, saved_locale_.c_str());
+#ifdef _OPENMP
+    omp_set_num_threads(saved_threads_);
+#endif
   }
   GmshSession(const GmshSession&) = delete;
   GmshSession& operator=(const GmshSession&) = delete;
@@ -68,6 +83,7 @@ class GmshSession {
  private:
   std::lock_guard<std::mutex> lock_;
   std::string saved_locale_;
+  int saved_threads_ = 1;
 };
 
 std::string LastGmshError() {
