@@ -94,6 +94,37 @@ TEST(EllipsoidShell, HasPositiveTetsNamedSurfacesAndTheAnalyticVolume) {
   EXPECT_NEAR(MeanAlignment(mesh, "base", [](const Vec3&) { return Vec3(0, 0, 1); }), 1, 1e-12);
 }
 
+/// Mean distance between consecutive columns of `points`.
+double MeanStep(const Points& points) {
+  double sum = 0;
+  for (Index i = 1; i < points.cols(); ++i) sum += (points.col(i) - points.col(i - 1)).norm();
+  return sum / double(points.cols() - 1);
+}
+
+// Gmsh numbers a volume's tets in no spatial order; read back, nodes and tets follow a Z-order
+// curve, so that consecutive ones are neighbours in space (the FEM assembly colours runs of
+// consecutive tets and runs them in parallel; with Gmsh's order every run touched every other).
+TEST(EllipsoidShell, NumbersNodesAndTetsAlongTheDomain) {
+  EllipsoidShellSpec spec;
+  spec.mesh_size = 1.5;
+  const Mesh mesh = MakeEllipsoidShell(spec);
+  Points centroids(3, mesh.num_tets());
+  for (Index e = 0; e < mesh.num_tets(); ++e) {
+    centroids.col(e).setZero();
+    for (int a = 0; a < 4; ++a) centroids.col(e) += 0.25 * mesh.nodes.col(mesh.tets(a, e));
+  }
+  const double diagonal =
+      (mesh.nodes.rowwise().maxCoeff() - mesh.nodes.rowwise().minCoeff()).norm();
+  std::cout << "[ info     ] " << mesh.num_tets() << " tets; mean step between consecutive tets "
+            << MeanStep(centroids) / spec.mesh_size << " mesh sizes, nodes "
+            << MeanStep(mesh.nodes) / spec.mesh_size << ", diagonal " << diagonal / spec.mesh_size
+            << "\n";
+  // Random order: about half the diagonal (> 10 mesh sizes here); along the curve: about one
+  // mesh size, with a few long jumps between the curve's blocks.
+  EXPECT_LT(MeanStep(centroids), 2 * spec.mesh_size);
+  EXPECT_LT(MeanStep(mesh.nodes), 2 * spec.mesh_size);
+}
+
 TEST(EllipsoidShell, RejectsInconsistentDimensions) {
   EllipsoidShellSpec inside_out;
   inside_out.endo_short = 12;
