@@ -164,7 +164,8 @@ TEST(GipsiValidate, AcceptsTheDemoScenes) {
        {"hanging_sheet.json", "hanging_liver.json", "plugin_oscillator.json", "coupled_blocks.json",
         "cantilever.json", "indentation.json", "hanging_liver_fem.json", "slab_ep_0.5mm.json",
         "slab_ep_0.2mm.json", "slab_ep_grid_0.5mm.json", "slab_ep_grid_0.2mm.json",
-        "spiral_wave.json", "lv_activation.json", "heart.json", "heart_mass_spring.json"}) {
+        "spiral_wave.json", "lv_activation.json", "heart.json", "heart_mass_spring.json",
+        "heart_fine.json"}) {
     Result r = Gipsi("validate " + Scene(scene));
     EXPECT_EQ(r.code, 0) << scene << "\n" << r.output;
     EXPECT_THAT(r.output, HasSubstr("valid scene"));
