@@ -165,8 +165,9 @@ class CholmodSolver final : public DirectSolver {
     // 1,326-row tangent that overhead was half the factorisation. Relaxed amalgamation (more
     // explicit zeros in bigger supernodes; CHOLMOD's defaults are nrelax 4/16/48, zrelax
     // 0.8/0.1/0.05) cut it from 88 to 37 supernodes and the factorisation from 2.2 to 1.4 ms
-    // here; the 216k-row lattice of bench/sparse_bench factorised 5–8 % slower with it, hence
-    // the limit.
+    // here. Larger matrices gain nothing from it: the 216k-row lattice of bench/sparse_bench
+    // factorised 5–8 % slower with it, and the fine heart's 8,529-row tangent (METIS-ordered)
+    // 3 % slower (muscle linear solves, three alternating runs), hence the limit.
     cholmod_common& c = llt_.cholmod();
     const bool small = A.rows() <= kSmallRows;
     c.nrelax[0] = small ? 16 : 4;
@@ -216,7 +217,7 @@ class CholmodSolver final : public DirectSolver {
   }
 
  private:
-  static constexpr Index kSmallRows = 20000;  ///< relaxed supernodes up to this size
+  static constexpr Index kSmallRows = 5000;  ///< relaxed supernodes up to this size
   Eigen::CholmodSupernodalLLT<SparseMatrix, Eigen::Lower> llt_;
   Eigen::SimplicialLDLT<SparseMatrix, Eigen::Lower, Eigen::AMDOrdering<int>> ldlt_;
   bool indefinite_ = false;
