@@ -19,6 +19,7 @@ Rows:
   Collision query [ms]                     two 224x224 sheets, 50 % overlap (collision_bench)
   Haptic loop p99 period error [us]        1 kHz beside a physics thread (haptics_bench; not --quick)
   Heart real-time factor                   scenes/heart.json, 4 s (gipsi run; not --quick)
+  Heart 10.9k tets real-time factor        scenes/heart_fine.json, 1.6 s (gipsi run; not --quick)
   Niederer slab 0.2 mm [s]                 scenes/slab_ep_0.2mm.json to its end (gipsi run; not --quick)
 Loads on a shared machine distort every row: the load average is printed, and the medians of
 several repetitions are reported, never the best. With --busy every thread count is measured
@@ -132,6 +133,8 @@ def measure(threads, repetitions, quick):
         r["Haptic loop p99 period error [us]"] = row["error_p99_us"]
         wall, rtf = run_scene("heart.json", threads, until=4)
         r["Heart real-time factor"] = rtf
+        wall, rtf = run_scene("heart_fine.json", threads, until=1.6)
+        r["Heart 10.9k tets real-time factor"] = rtf
         wall, _ = run_scene("slab_ep_0.2mm.json", threads)
         r["Niederer slab 0.2 mm [s]"] = wall
     return r
