@@ -6,7 +6,7 @@ CLI's own timing of two shipped scenes, and prints one Markdown table with the m
 triad, CPU, core count and load average, so figures from different machines can be compared
 (per core: run it with --threads 1; the default runs at 1 and at 2 threads, OMP_NUM_THREADS).
 
-  python3 scripts/bench.py            # builds what it needs (release preset), about 5 minutes
+  python3 scripts/bench.py            # builds what it needs (release preset), about 6 minutes
   python3 scripts/bench.py --quick    # one repetition, no 10-s haptic loop, no long scenes
   python3 scripts/bench.py --json out.json   # also the raw figures
   python3 scripts/bench.py --busy     # also each figure beside a busy neighbour
