@@ -9,6 +9,7 @@
 #include <charconv>
 #include <cmath>
 #include <cstdint>
+#include <cstdlib>
 #include <string>
 #include <system_error>
 
@@ -53,6 +54,17 @@ inline CLI::Validator IntegerIn(std::int64_t lo, std::int64_t hi, std::string ex
         return ok ? std::string() : fmt::format("expected {}, got '{}'", expected, text);
       },
       "", "");
+}
+
+/// True when this process was started by an MPI launcher with more than one rank: mpirun or
+/// mpiexec of Open MPI or MPICH (and Intel MPI), or a Slurm job step (srun; not sbatch alone).
+/// Reads the launchers' environment variables only: the tool does not initialise MPI.
+inline bool LaunchedWithSeveralRanks() {
+  for (const char* name : {"OMPI_COMM_WORLD_SIZE", "PMI_SIZE", "SLURM_STEP_NUM_TASKS"}) {
+    const char* value = std::getenv(name);
+    if (value != nullptr && std::atoi(value) > 1) return true;
+  }
+  return false;
 }
 
 }  // namespace gipsi::apps

@@ -758,6 +758,13 @@ int main(int argc, char** argv) {
   gipsi::Log().set_level(quiet     ? spdlog::level::warn
                          : verbose ? spdlog::level::debug
                                    : spdlog::level::info);
+  if (*run && gipsi::apps::LaunchedWithSeveralRanks()) {
+    // Every rank would run the whole scene and write the same files.
+    std::cerr << "gipsi: error: command line: 'gipsi run' was started on several MPI ranks; "
+                 "distributed scene runs are not available yet (docs/scale-out.md says what "
+                 "is). Run it without mpirun.\n";
+    return 2;
+  }
   try {
     if (*run)
       return Run(scene_file, out_dir, until, quiet, no_vtu, profile, overwrite, plugins,

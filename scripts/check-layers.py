@@ -4,7 +4,7 @@
 Each folder under src/gipsi/ is a layer and a CMake library (src/CMakeLists.txt); a file may
 include its own layer and the layers below it, never one above or beside it:
 
-    base -> geometry -> numerics -> core -> {models, collision, haptics} -> io -> viz
+    base -> geometry -> numerics -> core -> {models, collision, haptics} -> io -> {viz, parallel}
 
 (models, collision and haptics sit side by side above core: none includes another). Every
 `#include "gipsi/<layer>/..."` in src/ is checked. The few upward includes that remain from before
@@ -28,6 +28,7 @@ BELOW = {
     "haptics": {"base", "geometry", "numerics", "core"},
     "io": {"base", "geometry", "numerics", "core", "models", "collision", "haptics"},
     "viz": {"base", "geometry", "numerics", "core", "models", "collision", "haptics", "io"},
+    "parallel": {"base", "geometry", "numerics", "core", "models", "collision", "haptics", "io"},
 }
 
 # Upward includes still to be removed (issue 18): (file, included layer) -> why it is there.

@@ -1,7 +1,14 @@
 #!/usr/bin/env bash
 # Installs every Debian 12 package GiPSi needs to build, test and run. Idempotent; run as root
 # (or through sudo). Nothing else is required on a fresh machine.
+#   bash scripts/install-deps.sh --mpi   adds PETSc and Open MPI (about 110 packages, 1 GB):
+#                                        distributed runs (docs/scale-out.md). The test command
+#                                        installs them; the demo does not need them.
 set -euo pipefail
+case "${1:-}" in
+  "" | --mpi) ;;
+  *) echo "install-deps: unknown option '$1' (expected --mpi or nothing)" >&2; exit 2 ;;
+esac
 
 packages=(
   build-essential cmake ninja-build ccache pkg-config git
@@ -29,6 +36,10 @@ packages=(
   python3-pytest python3-matplotlib  # its tests, and the plots of examples/python/
   clang-format clang-tidy
 )
+if [ "${1:-}" = "--mpi" ]; then
+  # PETSc 3.18 (with PT-Scotch, hypre and MUMPS) over Open MPI: src/gipsi/parallel/.
+  packages+=(petsc-dev libopenmpi-dev openmpi-bin)
+fi
 
 missing=()
 for p in "${packages[@]}"; do

@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # The core without the optional parts (docs/install.md, "Optional parts"): configures
-# build/minimal with GIPSI_WITH_GMSH=OFF and GIPSI_WITH_OPENIGTLINK=OFF and otherwise the release
+# build/minimal with GIPSI_WITH_GMSH, GIPSI_WITH_OPENIGTLINK and GIPSI_WITH_PETSC OFF and otherwise the release
 # flags (so ccache serves every file but the few that differ), builds the gipsi tool, and checks:
-#  - no library of it links Gmsh or OpenIGTLink;
+#  - no library of it links Gmsh, OpenIGTLink, MPI or PETSc;
 #  - `gipsi --version` and `gipsi types` say what was left out;
 #  - a scene that needs neither runs;
 #  - a scene that generates a mesh with Gmsh is refused at the mesh's JSON path (exit 1);
@@ -12,7 +12,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 build=build/minimal
 cmake -S . -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release -DGIPSI_WERROR="${GIPSI_WERROR:-OFF}" \
-  -DGIPSI_WITH_GMSH=OFF -DGIPSI_WITH_OPENIGTLINK=OFF \
+  -DGIPSI_WITH_GMSH=OFF -DGIPSI_WITH_OPENIGTLINK=OFF -DGIPSI_WITH_PETSC=OFF \
   -DGIPSI_BUILD_TESTS=OFF -DGIPSI_BUILD_BENCH=OFF -DGIPSI_BUILD_PYTHON=OFF > /dev/null
 cmake --build "$build" --target gipsi_cli
 gipsi="$build/bin/gipsi"
@@ -20,8 +20,8 @@ work=$(mktemp -d "${TMPDIR:-/tmp}/gipsi-minimal.XXXXXX")
 trap 'rm -rf "$work"' EXIT
 fail() { echo "minimal-test: $*" >&2; exit 1; }
 
-if ldd "$gipsi" "$build"/src/libgipsi_*.so | grep -Ei "libgmsh|libOpenIGTLink"; then
-  fail "a library of the minimal build links Gmsh or OpenIGTLink"
+if ldd "$gipsi" "$build"/src/libgipsi_*.so | grep -Ei "libgmsh|libOpenIGTLink|libmpi|libpetsc"; then
+  fail "a library of the minimal build links Gmsh, OpenIGTLink, MPI or PETSc"
 fi
 "$gipsi" --version | tee "$work/version"
 grep -q "without Gmsh, OpenIGTLink" "$work/version" || fail "--version does not say what was left out"

@@ -14,7 +14,7 @@ case "${1:-}" in
   "" | --full) ;;
   *) echo "test.sh: unknown option '$1' (expected --full or nothing)" >&2; exit 2 ;;
 esac
-bash scripts/install-deps.sh
+bash scripts/install-deps.sh --mpi
 
 # ccache keys on paths relative to the checkout (the CMake launcher sets its base folder and
 # leaves the working folder out of -g builds), so fresh clones reuse earlier builds.

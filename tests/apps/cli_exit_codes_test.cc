@@ -96,6 +96,25 @@ TEST(GipsiExitCodes, BadCommandLineExits2ForEverySubcommand) {
   }
 }
 
+// Under mpirun each rank would run the whole scene and write the same files: refused until
+// scenes run distributed (docs/scale-out.md). Launchers are recognised by their environment.
+TEST(GipsiExitCodes, RunOnSeveralMpiRanksIsRefusedUntilScenesRunDistributed) {
+  const std::string sheet = Scene("hanging_sheet.json");
+  for (const char* launcher : {"OMPI_COMM_WORLD_SIZE=2", "PMI_SIZE=4", "SLURM_STEP_NUM_TASKS=8"}) {
+    const Result r =
+        Gipsi("run " + sheet + " --until 0.01", std::string("export ") + launcher + ";");
+    EXPECT_EQ(r.code, 2) << launcher << "\n" << r.output;
+    EXPECT_THAT(r.output, HasSubstr("started on several MPI ranks")) << launcher;
+    EXPECT_THAT(r.output, HasSubstr("docs/scale-out.md")) << launcher;
+  }
+  // One rank is a serial run.
+  const fs::path dir = testing::TestTempDir();
+  const Result one =
+      Gipsi("run " + sheet + " --until 0.01 --no-vtu -q -o " + (dir / "out").string(),
+            "export OMPI_COMM_WORLD_SIZE=1;");
+  EXPECT_EQ(one.code, 0) << one.output;
+}
+
 TEST(GipsiExitCodes, BadInputExits1ForEverySubcommand) {
   const fs::path dir = testing::TestTempDir();
   const std::string sheet = Scene("hanging_sheet.json");

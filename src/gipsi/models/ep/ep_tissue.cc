@@ -95,7 +95,7 @@ EpTissue::EpTissue(std::string name, EpTissueParams params)
   BindState(state_);
 }
 
-void EpTissue::InitTissue() {
+void EpTissue::InitTissue(TissueSetup setup) {
   const CellModel& model = *params_.cell;
   const auto n = static_cast<std::size_t>(domain().num_nodes());
   state_.cells = CellStates(model, n);
@@ -104,12 +104,12 @@ void EpTissue::InitTissue() {
   i_stim_ = VecX::Zero(static_cast<Index>(n));
   for (const StimulusSpec& s : params_.stimuli) {
     stim_nodes_.push_back(SelectNodes(s.region, domain()));
-    if (stim_nodes_.back().empty())
+    if (setup.require_region_nodes && stim_nodes_.back().empty())
       throw InputError(fmt::format("stimulus '{}' selects no node of the domain", s.name));
   }
   for (const ClampSpec& c : params_.clamps) {
     clamp_nodes_.push_back(SelectNodes(c.region, domain()));
-    if (clamp_nodes_.back().empty())
+    if (setup.require_region_nodes && clamp_nodes_.back().empty())
       throw InputError(fmt::format("clamp '{}' selects no node of the domain", c.name));
   }
   const Index count = static_cast<Index>(n);
@@ -120,7 +120,7 @@ void EpTissue::InitTissue() {
   state_.v_min = v_prev_;
   state_.v_peak = v_prev_;
   state_.depolarised.assign(n, 0);
-  solver_ = MakeLinearSolver(params_.linear);
+  if (setup.serial_solver) solver_ = MakeLinearSolver(params_.linear);
   // Tables for the reaction sub-step now, so the first step does not build them (with no
   // reaction dt the sub-step is the object's dt, known at the first step).
   if (params_.reaction_dt > 0) model.Prepare(1e3 * params_.reaction_dt);
@@ -218,6 +218,16 @@ void EpTissue::ApplyClamps(double t) {
 
 StepStatus EpTissue::Diffuse(double dt_ms) {
   const auto start = Clock::now();
+  int iterations = 0;
+  const StepStatus status = SolveDiffusion(dt_ms, v_data(), iterations, failure_detail_);
+  state_.last_iterations = iterations;
+  profile_.cg_iterations += iterations;
+  profile_.diffusion += Seconds(start);
+  return status;
+}
+
+StepStatus EpTissue::SolveDiffusion(double dt_ms, double* v_ptr, int& iterations,
+                                    std::string& detail) {
   const double theta = params_.theta;
   if (dt_ms != system_dt_) {
     system_ = theta * dt_ms * stiffness_;
@@ -232,7 +242,7 @@ StepStatus EpTissue::Diffuse(double dt_ms) {
       return StepStatus::Failed("the diffusion matrix M + theta dt K is not positive definite");
     system_dt_ = dt_ms;
   }
-  Eigen::Map<VecX> v(v_data(), num_nodes());
+  Eigen::Map<VecX> v(v_ptr, num_nodes());
   if (params_.lumped_mass) {
     rhs_ = lumped_mass_.cwiseProduct(v);
   } else {
@@ -248,13 +258,10 @@ StepStatus EpTissue::Diffuse(double dt_ms) {
   }
   solution_ = v;  // warm start
   const LinearSolveStats stats = solver_->Solve(rhs_, solution_);
-  state_.last_iterations = stats.iterations;
-  profile_.cg_iterations += stats.iterations;
-  profile_.diffusion += Seconds(start);
+  iterations = stats.iterations;
   if (!stats.converged) {
-    failure_detail_ =
-        fmt::format("{} reached a relative residual of {:.3g} (tolerance {:.3g})", solver_->name(),
-                    stats.relative_residual, params_.linear.tolerance);
+    detail = fmt::format("{} reached a relative residual of {:.3g} (tolerance {:.3g})",
+                         solver_->name(), stats.relative_residual, params_.linear.tolerance);
     return StepStatus::Failed("the diffusion solve did not converge", -1, stats.relative_residual);
   }
   v = solution_;

@@ -155,10 +155,20 @@ class EpTissue : public SimObject {
  protected:
   EpTissue(std::string name, EpTissueParams params);
 
+  /// How InitTissue sets a tissue up. Plain struct.
+  struct TissueSetup {
+    /// Refuse a stimulus or clamp region that selects no node of `domain()`. A distributed
+    /// object's part of the mesh may hold none of a region's nodes; it checks the whole mesh.
+    bool require_region_nodes = true;
+    /// Create the serial diffusion solver from params().linear (a subclass that overrides
+    /// SolveDiffusion with a solver of its own does not need it).
+    bool serial_solver = true;
+  };
   /// Call once from the subclass constructor after SetGeometry: sizes the cell states and
   /// selects the stimulus and clamp nodes on `domain()` (throws InputError for a region that
-  /// selects nothing).
-  void InitTissue();
+  /// selects nothing, unless `setup` says otherwise, and for bad solver options).
+  void InitTissue(TissueSetup setup);
+  void InitTissue() { InitTissue(TissueSetup{}); }
   /// Sets the diffusion operator (internal units, see the file comment). `stiffness` is
   /// symmetric with both triangles stored and rows summing to zero; `mass` is the lumped mass
   /// per node [mm³] and `consistent_mass`, if the parameters ask for it, has K's pattern.
@@ -168,6 +178,12 @@ class EpTissue : public SimObject {
   [[nodiscard]] virtual Vec3 NodePositionMm(Index node) const;
 
   StepStatus DoStep(double t, double dt) override;
+  /// One diffusion solve (M + θΔt K) V⁺ = (M − (1 − θ)Δt K) V of length `dt_ms`, in place on
+  /// the num_nodes() voltages `v`; sets `iterations` (the solver's) and, on failure, `detail`
+  /// (what the solver reached, for failure_detail()). The default assembles and factorises the
+  /// system from SetDiffusionOperator's matrices whenever Δt changes and solves with
+  /// params().linear; a distributed object solves its global system instead.
+  virtual StepStatus SolveDiffusion(double dt_ms, double* v, int& iterations, std::string& detail);
   /// The diffusion factorisation depends on the step size only: a snapshot restore keeps it; a
   /// checkpoint holds none, so its restore refactorises at the next step (the same factors).
   void RestoreStateCache(StateReader& /*in*/) override { system_dt_ = -1; }
