@@ -6,6 +6,7 @@
 /// command line; 3 the run stopped because an object diverged or failed; 4 writing outputs
 /// failed; 130 interrupted.
 
+#include <dlfcn.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -19,6 +20,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
+#include <functional>
 #include <iostream>
 #include <mutex>
 #include <optional>
@@ -45,6 +47,7 @@
 #include "gipsi/io/scene.h"
 #include "gipsi/models/ep/cell_models.h"
 #include "gipsi/models/ep/single_cell.h"
+#include "gipsi/parallel/distributed_run.h"
 #include "gipsi/viz/render/plot.h"
 #include "run_progress.h"
 #include "viz_commands.h"
@@ -194,10 +197,26 @@ class BuildProgress {
 };
 
 /// Loads the scene with its build progress (unless `quiet`).
+/// The ranks of a distributed run (`mpirun -np N gipsi run`; docs/scale-out.md): every rank
+/// loads and runs the same scene, the distributed types split their objects over the ranks,
+/// and rank 0 alone writes files and prints. One rank (size 1) is a serial run.
+struct Ranks {
+  int rank = 0;
+  int size = 1;
+  /// Replaces the registry's factories of the distributed types (empty for a serial run).
+  std::function<void(gipsi::TypeRegistry&)> register_types;
+  /// Ends every rank with `code` (a rank that stops alone would leave the others waiting).
+  std::function<void(int)> abort;
+  std::vector<std::string> type_names;  ///< of the distributed types
+  [[nodiscard]] bool distributed() const { return size > 1; }
+};
+
 gipsi::Scene Load(const std::string& file, const std::vector<std::string>& plugins,
-                  gipsi::TypeRegistry& registry, const gipsi::SceneLimits& limits, bool quiet) {
+                  gipsi::TypeRegistry& registry, const gipsi::SceneLimits& limits, bool quiet,
+                  const Ranks& ranks = {}) {
   gipsi::RegisterBuiltins(registry);
   for (const auto& plugin : plugins) registry.LoadPlugin(gipsi::ResolvePlugin(plugin, "."));
+  if (ranks.register_types) ranks.register_types(registry);
   BuildProgress progress(quiet);
   return gipsi::LoadScene(file, registry, limits, progress.Callback());
 }
@@ -323,10 +342,19 @@ struct CheckpointOptions {
 
 int Run(const std::string& file, const std::string& out_dir, double until, bool quiet, bool no_vtu,
         bool profile, bool overwrite, const std::vector<std::string>& plugins,
-        const CheckpointOptions& checkpoints, const gipsi::SceneLimits& limits) {
+        const CheckpointOptions& checkpoints, const gipsi::SceneLimits& limits,
+        const Ranks& ranks = {}) {
   StopSignals signals;  // while building: exit 130 at once; then: stop the run cleanly
+  if (ranks.distributed() && (checkpoints.every > 0 || !checkpoints.resume.empty()))
+    gipsi::ThrowInputError(
+        "command line", checkpoints.every > 0 ? "--checkpoint-every" : "--resume",
+        fmt::format("checkpoints of a distributed run ({} ranks) are not available yet "
+                    "(docs/scale-out.md); run without them",
+                    ranks.size));
+  const bool lead = ranks.rank == 0;  // writes files and prints
+  if (!lead) quiet = true;
   gipsi::TypeRegistry registry;
-  gipsi::Scene scene = Load(file, plugins, registry, limits, quiet);
+  gipsi::Scene scene = Load(file, plugins, registry, limits, quiet, ranks);
   if (until > 0) scene.end_time = until;
   if (no_vtu) scene.vtu.enabled = false;
   std::filesystem::path out =
@@ -364,8 +392,12 @@ int Run(const std::string& file, const std::string& out_dir, double until, bool 
                              fmt::format("this scene cannot be checkpointed: {}", e.what()));
     }
   }
-  PrepareOutputDirectory(scene, out, !checkpoints.resume.empty(), overwrite);
-  gipsi::AttachOutputs(scene, out, !checkpoints.resume.empty());
+  if (ranks.distributed() && !gipsi::RealtimeProbes(kernel).empty())
+    gipsi::ThrowInputError("command line", "mpirun",
+                           "a scene with a real-time HapticProbe cannot run on several ranks");
+  if (lead) PrepareOutputDirectory(scene, out, !checkpoints.resume.empty(), overwrite);
+  gipsi::AttachOutputs(scene, out, !checkpoints.resume.empty(),
+                       lead ? gipsi::OutputFiles::kWrite : gipsi::OutputFiles::kReadOnly);
   if (!checkpoints.resume.empty()) {
     kernel.ReadCheckpoint(checkpoints.resume);
     const double tolerance = 1e-9 * kernel.macro_dt();
@@ -393,11 +425,23 @@ int Run(const std::string& file, const std::string& out_dir, double until, bool 
       kernel.Run(scene.end_time, [&](double t, double end) { progress.Update(t, end); });
   haptics.Stop();  // logs each loop's period percentiles
   progress.Done();
+  if (ranks.distributed() && (result.outcome == gipsi::RunResult::Outcome::kStopped ||
+                              result.outcome == gipsi::RunResult::Outcome::kOutputFailed)) {
+    // Not agreed between the ranks (a signal, or a write on rank 0): the others may be inside
+    // the next step's collectives. What was written is flushed; end every rank.
+    std::cerr << "gipsi: " << (lead ? "" : fmt::format("rank {}: ", ranks.rank))
+              << result.diagnostic << "\n";
+    ranks.abort(result.outcome == gipsi::RunResult::Outcome::kStopped ? 130 : 4);
+  }
+  if (!lead) return result.ok() ? 0 : 3;  // an agreed divergence: rank 0 reports it
 
   std::string summary;
   summary += fmt::format("simulated time:   {:.6g} s (from {:.6g} s)\n",
                          result.end_time - result.start_time, result.start_time);
   summary += fmt::format("wall time:        {:.3f} s\n", result.wall_seconds);
+  if (ranks.distributed())
+    summary += fmt::format("MPI ranks:        {} (distributed: {})\n", ranks.size,
+                           fmt::join(ranks.type_names, ", "));
   summary += fmt::format("real-time factor: {:.3g}\n", result.real_time_factor());
   summary +=
       fmt::format("macro steps:      {} of {:.6g} s\n", result.macro_steps, kernel.macro_dt());
@@ -758,17 +802,53 @@ int main(int argc, char** argv) {
   gipsi::Log().set_level(quiet     ? spdlog::level::warn
                          : verbose ? spdlog::level::debug
                                    : spdlog::level::info);
+  Ranks ranks;
+  // Under an MPI launcher with several ranks: PETSc and MPI for the whole run, loaded only then
+  // (serial runs never load them), the distributed types, rank 0 printing and writing.
+  std::unique_ptr<gipsi::DistributedRun> mpi;
   if (*run && gipsi::apps::LaunchedWithSeveralRanks()) {
+#ifdef GIPSI_PARALLEL_LIBRARY
+    void* library = dlopen(GIPSI_PARALLEL_LIBRARY, RTLD_NOW | RTLD_GLOBAL);
+    const char* why = library == nullptr ? dlerror() : nullptr;
+    const auto start = library == nullptr ? nullptr
+                                          : reinterpret_cast<gipsi::ParallelStartFunction>(
+                                                dlsym(library, gipsi::kParallelStartSymbol));
+    if (start == nullptr) {
+      std::cerr << "gipsi: error: 'gipsi run' was started on several MPI ranks, and the "
+                   "distributed runs' library could not be loaded: "
+                << (why != nullptr ? why : dlerror()) << "\n";
+      return 1;
+    }
+    try {
+      mpi.reset(start());
+    } catch (const std::exception& e) {
+      std::cerr << "gipsi: error: starting MPI: " << e.what() << "\n";
+      return 1;
+    }
+    ranks.rank = mpi->rank();
+    ranks.size = mpi->size();
+    ranks.register_types = [&mpi](gipsi::TypeRegistry& r) { mpi->RegisterTypes(r); };
+    ranks.type_names = mpi->type_names();
+    ranks.abort = [&mpi](int code) { mpi->Abort(code); };
+    if (ranks.rank != 0) gipsi::Log().set_level(spdlog::level::err);
+#else
     // Every rank would run the whole scene and write the same files.
-    std::cerr << "gipsi: error: command line: 'gipsi run' was started on several MPI ranks; "
-                 "distributed scene runs are not available yet (docs/scale-out.md says what "
-                 "is). Run it without mpirun.\n";
+    std::cerr << "gipsi: error: command line: 'gipsi run' was started on several MPI ranks, "
+                 "and this gipsi was built without PETSc (docs/scale-out.md: install petsc-dev "
+                 "and configure with -DGIPSI_WITH_PETSC=ON). Run it without mpirun.\n";
     return 2;
+#endif
   }
+  // A rank that fails alone must not leave the others waiting in a collective.
+  auto fail = [&ranks](int code) {
+    if (ranks.distributed()) ranks.abort(code);
+    return code;
+  };
+  const std::string rank_prefix = ranks.rank > 0 ? fmt::format("rank {}: ", ranks.rank) : "";
   try {
     if (*run)
       return Run(scene_file, out_dir, until, quiet, no_vtu, profile, overwrite, plugins,
-                 checkpoints, limits);
+                 checkpoints, limits, ranks);
     if (*validate) {
       StopSignals signals;  // Ctrl-C while building: exit 130 at once
       return Validate(scene_file, plugins, limits);
@@ -778,19 +858,19 @@ int main(int argc, char** argv) {
     if (*cell) return Cell(cell_options, plugins);
     if (auto code = viz_commands.Dispatch()) return *code;
   } catch (const gipsi::InputError& e) {
-    std::cerr << "gipsi: error: " << e.what() << "\n";
-    return 1;
+    std::cerr << "gipsi: error: " << rank_prefix << e.what() << "\n";
+    return fail(1);
   } catch (const gipsi::OutputError& e) {
-    std::cerr << "gipsi: error: " << e.what() << "\n";
-    return 4;
+    std::cerr << "gipsi: error: " << rank_prefix << e.what() << "\n";
+    return fail(4);
   } catch (const std::filesystem::filesystem_error& e) {
     // Creating the output directory or files (the readers report their own errors as
     // InputError): a write failure.
-    std::cerr << "gipsi: error: " << gipsi::DescribeFilesystemError(e) << "\n";
-    return 4;
+    std::cerr << "gipsi: error: " << rank_prefix << gipsi::DescribeFilesystemError(e) << "\n";
+    return fail(4);
   } catch (const std::exception& e) {
-    std::cerr << "gipsi: error: " << e.what() << "\n";
-    return 1;
+    std::cerr << "gipsi: error: " << rank_prefix << e.what() << "\n";
+    return fail(1);
   }
   return 0;
 }

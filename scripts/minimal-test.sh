@@ -6,7 +6,8 @@
 #  - `gipsi --version` and `gipsi types` say what was left out;
 #  - a scene that needs neither runs;
 #  - a scene that generates a mesh with Gmsh is refused at the mesh's JSON path (exit 1);
-#  - a scene with an OpenIGTLink device is refused at the device's JSON path (exit 1).
+#  - a scene with an OpenIGTLink device is refused at the device's JSON path (exit 1);
+#  - `gipsi run` under an MPI launcher with several ranks is refused (exit 2).
 # Run by scripts/test.sh after the package stage (about 2 minutes with a warm ccache).
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -52,4 +53,12 @@ json.dump(scene, open(sys.argv[1], "w"))
 PY
 expect_refusal "$work/igtl.json" \
   "objects.probe.device: an OpenIGTLink device needs OpenIGTLink, which this GiPSi was built without (configure with -DGIPSI_WITH_OPENIGTLINK=ON)"
+# Under an MPI launcher with several ranks (its environment is enough): refused, exit 2.
+code=0
+OMPI_COMM_WORLD_SIZE=2 "$gipsi" run scenes/hanging_sheet.json --until 0.05 --out "$work/mpi" -q \
+  > "$work/out" 2>&1 || code=$?
+[ "$code" -eq 2 ] && grep -qF "this gipsi was built without PETSc" "$work/out" ||
+  { cat "$work/out" >&2; fail "a run on several MPI ranks: expected exit 2, got exit $code"; }
+[ ! -e "$work/mpi" ] || fail "the refused run on several MPI ranks wrote $work/mpi"
+echo "refused as expected: $(head -c 120 "$work/out")"
 echo "minimal-test: passed"

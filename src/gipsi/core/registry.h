@@ -116,6 +116,16 @@ class FactoryTable {
     GIPSI_CHECK(!Contains(name), "{} '{}' registered twice", kind_, name);
     table_.emplace(name, Entry{std::move(factory), std::move(description)});
   }
+  /// Replaces the factory registered under `name`, keeping its description unless one is given:
+  /// a build that runs the type another way (a distributed run, gipsi/parallel/). Aborts
+  /// (programmer error) if `name` is not registered.
+  void Replace(const std::string& name, Factory factory, std::string description = {}) {
+    auto it = table_.find(name);
+    GIPSI_CHECK(it != table_.end() && factory, "{} '{}' replaced before it was registered", kind_,
+                name);
+    it->second.factory = std::move(factory);
+    if (!description.empty()) it->second.description = std::move(description);
+  }
   [[nodiscard]] bool Contains(std::string_view name) const { return table_.count(name) > 0; }
   /// The factory for `name`; throws InputError at `where` listing the known names.
   [[nodiscard]] const Factory& Get(std::string_view name, const JsonNode& where) const {

@@ -14,20 +14,21 @@ namespace gipsi {
 
 VtuSeriesWriter::VtuSeriesWriter(std::vector<const SimObject*> objects,
                                  const std::filesystem::path& directory, double every, bool display,
-                                 bool resume)
-    : directory_(directory), every_(every) {
-  std::filesystem::create_directories(directory);
+                                 bool resume, OutputFiles files)
+    : directory_(directory), every_(every), write_(files == OutputFiles::kWrite) {
+  if (write_) std::filesystem::create_directories(directory);
   for (const SimObject* object : objects) {
     const Mesh& mesh = object->domain();
     if (mesh.num_tets() == 0 && mesh.num_triangles() == 0 &&
         object->boundary().num_triangles() == 0)
       continue;  // nothing drawable (a point object)
-    std::filesystem::create_directories(directory / object->name());
-    Series series{object, PvdWriter(directory / (object->name() + ".pvd"), !resume), nullptr};
+    if (write_) std::filesystem::create_directories(directory / object->name());
+    Series series{object, PvdWriter(directory / (object->name() + ".pvd"), write_ && !resume),
+                  nullptr};
     if (display && object->display().map) {
-      std::filesystem::create_directories(directory / (object->name() + "_display"));
-      series.display =
-          std::make_unique<PvdWriter>(directory / (object->name() + "_display.pvd"), !resume);
+      if (write_) std::filesystem::create_directories(directory / (object->name() + "_display"));
+      series.display = std::make_unique<PvdWriter>(directory / (object->name() + "_display.pvd"),
+                                                   write_ && !resume);
     }
     series_.push_back(std::move(series));
   }
@@ -48,6 +49,7 @@ void VtuSeriesWriter::WriteFrame(Series& series, double t) {
     (info.location == FieldLocation::kNode ? fields.point_data : fields.cell_data)
         .push_back(std::move(array));
   }
+  if (!write_) return;  // the fields are read (collective for a distributed object), not written
   const std::string name = object.name();
   const std::string file = fmt::format("{}/{}_{:06d}.vtu", name, name, frame_);
   if (mesh.num_tets() > 0) {
@@ -274,7 +276,8 @@ OutputEstimate EstimateOutputs(const Scene& scene) {
   return estimate;
 }
 
-void AttachOutputs(Scene& scene, const std::filesystem::path& directory, bool resume) {
+void AttachOutputs(Scene& scene, const std::filesystem::path& directory, bool resume,
+                   OutputFiles files) {
   Kernel& kernel = *scene.kernel;
   if (scene.limits.max_output_bytes > 0) {
     const OutputEstimate estimate = EstimateOutputs(scene);
@@ -297,9 +300,10 @@ void AttachOutputs(Scene& scene, const std::filesystem::path& directory, bool re
   }
   if (scene.vtu.enabled)
     kernel.AddObserver(std::make_unique<VtuSeriesWriter>(
-        VtuObjects(scene), directory, scene.vtu.every, scene.vtu.display, resume));
+        VtuObjects(scene), directory, scene.vtu.every, scene.vtu.display, resume, files));
   if (!scene.probes.empty())
-    kernel.AddObserver(std::make_unique<ProbeRecorder>(scene.probes, directory / "probes", resume));
+    kernel.AddObserver(std::make_unique<ProbeRecorder>(scene.probes, directory / "probes", resume,
+                                                       files == OutputFiles::kReadOnly));
 }
 
 }  // namespace gipsi

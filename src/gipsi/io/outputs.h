@@ -23,14 +23,22 @@
 GIPSI_EXPORT_BEGIN
 namespace gipsi {
 
+/// Whether the outputs attached in this process write their files. Every rank of a distributed
+/// run (gipsi/parallel/) attaches the scene's outputs and reads every field at the same times,
+/// because a distributed object's reads are collective; only rank 0 writes (kWrite), the others
+/// read and write nothing (kReadOnly).
+enum class OutputFiles { kWrite, kReadOnly };
+
 /// Writes VTU frames and keeps the PVD collections current after every frame, so a run that
 /// stops early leaves a valid series up to its last frame.
 class VtuSeriesWriter final : public Observer {
  public:
   /// Creates `directory` and one collection per object; throws std::exception on I/O errors.
-  /// With `resume`, existing collections are left untouched until CommitRestore.
+  /// With `resume`, existing collections are left untouched until CommitRestore. With
+  /// OutputFiles::kReadOnly it reads the fields of every frame and touches no file.
   VtuSeriesWriter(std::vector<const SimObject*> objects, const std::filesystem::path& directory,
-                  double every, bool display, bool resume = false);
+                  double every, bool display, bool resume = false,
+                  OutputFiles files = OutputFiles::kWrite);
   void Observe(const Kernel& kernel, double t) override;
   /// Checkpoints: next output time, frame number and the frames of every collection
   /// (RestoreState only reads and checks them; CommitRestore rewrites the collections).
@@ -48,6 +56,7 @@ class VtuSeriesWriter final : public Observer {
 
   std::filesystem::path directory_;
   double every_;
+  bool write_ = true;
   double next_ = 0;
   std::int64_t frame_ = 0;
   std::vector<double> frame_times_;  // of every frame so far (all series share them)
@@ -76,8 +85,11 @@ OutputEstimate EstimateOutputs(const Scene& scene);
 /// the directory or files cannot be created. With
 /// `resume`, no existing file is changed until the kernel has read and checked the whole
 /// checkpoint (Kernel::RestoreState); then every file is cut back to its state at the
-/// checkpoint. A refused checkpoint leaves the outputs as they were.
-void AttachOutputs(Scene& scene, const std::filesystem::path& directory, bool resume = false);
+/// checkpoint. A refused checkpoint leaves the outputs as they were. With
+/// OutputFiles::kReadOnly (the ranks of a distributed run but the first) the outputs sample
+/// their fields as usual and create or write no file.
+void AttachOutputs(Scene& scene, const std::filesystem::path& directory, bool resume = false,
+                   OutputFiles files = OutputFiles::kWrite);
 
 }  // namespace gipsi
 GIPSI_EXPORT_END

@@ -248,12 +248,13 @@ Probe ParseProbe(const std::string& name, const JsonNode& node, const Kernel& ke
 }
 
 ProbeRecorder::ProbeRecorder(std::vector<Probe> probes, const std::filesystem::path& directory,
-                             bool resume) {
-  std::filesystem::create_directories(directory);
+                             bool resume, bool read_only)
+    : write_(!read_only) {
+  if (write_) std::filesystem::create_directories(directory);
   for (auto& probe : probes) {
     auto path = directory / (probe.name + ".csv");
     Stream stream{std::move(probe), {}, 0, 0, path};
-    if (!resume) {  // a resumed run opens its files once the checkpoint is restored
+    if (write_ && !resume) {  // a resumed run opens its files once the checkpoint is restored
       stream.file.open(path, std::ios::out | std::ios::trunc);
       if (!stream.file)
         throw OutputError(
@@ -267,6 +268,7 @@ ProbeRecorder::ProbeRecorder(std::vector<Probe> probes, const std::filesystem::p
 
 void ProbeRecorder::Write(Stream& s, double t) {
   s.probe.Sample(row_);
+  if (!write_) return;  // sampled (collective for a distributed object), not written
   const std::size_t width = ProbeWidth(s.probe);
   for (std::size_t start = 0; start < row_.size(); start += width) {  // line probes: n rows
     s.file << t;
@@ -302,7 +304,7 @@ void ProbeRecorder::Finish(const Kernel& kernel) {
       Write(s, kernel.time());  // once, at the end of the run
       s.next_at = 1;
     }
-    s.file.flush();
+    if (write_) s.file.flush();
   }
 }
 

@@ -75,8 +75,10 @@ class ProbeRecorder final : public Observer {
   /// Opens the files (throws std::runtime_error naming the file if one cannot be created).
   /// With `resume`, the files are neither created nor opened here: RestoreState checks them
   /// against the checkpoint, CommitRestore cuts them to the checkpoint's length and opens them.
+  /// With `read_only` (the ranks of a distributed run but the first, outputs.h) it samples
+  /// every probe at the same times and creates or writes no file.
   ProbeRecorder(std::vector<Probe> probes, const std::filesystem::path& directory,
-                bool resume = false);
+                bool resume = false, bool read_only = false);
   void Observe(const Kernel& kernel, double t) override;
   void Finish(const Kernel& kernel) override;
   /// Checkpoints: next sample time and length of every file (defined in outputs.cc).
@@ -96,6 +98,7 @@ class ProbeRecorder final : public Observer {
   void Write(Stream& s, double t);
   std::vector<Stream> streams_;
   std::vector<double> row_;
+  bool write_ = true;
 };
 
 }  // namespace gipsi

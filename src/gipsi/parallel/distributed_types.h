@@ -1,0 +1,27 @@
+#pragma once
+/// @file
+/// The object types a distributed scene run splits over the ranks (`mpirun -np N gipsi run
+/// SCENE`, docs/scale-out.md). Today: "Monodomain" (a DistributedMonodomain behind a
+/// WholeDomainView). Every other object of the scene runs whole on every rank, each rank
+/// computing the same steps, so connectors, events and outputs see the same values everywhere.
+
+#include <mpi.h>
+
+#include <string>
+#include <vector>
+
+#include "gipsi/base/export.h"
+#include "gipsi/core/registry.h"
+
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
+
+/// Replaces the factories of the types that run distributed over `comm` in `registry` (after
+/// RegisterBuiltins). Their scene keys are the serial types' own.
+void RegisterDistributedTypes(TypeRegistry& registry, MPI_Comm comm);
+
+/// The type names RegisterDistributedTypes replaces.
+[[nodiscard]] std::vector<std::string> DistributedTypeNames();
+
+}  // namespace gipsi
+GIPSI_EXPORT_END

@@ -1,0 +1,104 @@
+/// @file
+/// A distributed object's part seen as one object on the whole mesh.
+
+#include "gipsi/parallel/whole_domain_view.h"
+
+#include <numeric>
+
+#include "gipsi/geometry/boundary.h"
+
+namespace gipsi {
+
+WholeDomainView::Layout WholeDomainView::MakeLayout(const std::vector<int>& whole_of_local,
+                                                    std::int64_t owned, MPI_Comm comm) {
+  int size = 1;
+  MPI_Comm_size(comm, &size);
+  Layout layout;
+  layout.counts.resize(static_cast<std::size_t>(size));
+  layout.offsets.assign(static_cast<std::size_t>(size), 0);
+  const int mine = static_cast<int>(owned);
+  MPI_Allgather(&mine, 1, MPI_INT, layout.counts.data(), 1, MPI_INT, comm);
+  std::partial_sum(layout.counts.begin(), layout.counts.end() - 1, layout.offsets.begin() + 1);
+  layout.whole.resize(static_cast<std::size_t>(layout.offsets.back() + layout.counts.back()));
+  MPI_Allgatherv(whole_of_local.data(), mine, MPI_INT, layout.whole.data(), layout.counts.data(),
+                 layout.offsets.data(), MPI_INT, comm);
+  layout.local.resize(static_cast<std::size_t>(mine));
+  std::iota(layout.local.begin(), layout.local.end(), 0);
+  return layout;
+}
+
+WholeDomainView::WholeDomainView(std::unique_ptr<SimObject> part, const MeshPart& mesh_part,
+                                 std::shared_ptr<const Mesh> whole, MPI_Comm comm)
+    : SimObject(std::string(part->name())),
+      part_(std::move(part)),
+      mesh_part_(mesh_part),
+      comm_(comm) {
+  SetGeometry(whole, MakeBoundary(*whole));
+  for (std::size_t f = 0; f < part_->fields().size(); ++f) {
+    const FieldInfo& info = part_->fields()[f];
+    if (info.location == FieldLocation::kBoundaryVertex ||
+        info.location == FieldLocation::kBoundaryFace)
+      continue;
+    DeclareField(info);
+    part_field_.emplace_back(static_cast<std::int64_t>(f));
+  }
+  nodes_ = MakeLayout(mesh_part_.whole_node, mesh_part_.num_owned, comm_);
+  // Every local tet is this rank's own (tets are not shared).
+  elements_ = MakeLayout(mesh_part_.whole_tet,
+                         static_cast<std::int64_t>(mesh_part_.whole_tet.size()), comm_);
+}
+
+void WholeDomainView::BeginMacroStep() {
+  SimObject::BeginMacroStep();
+  part_->BeginMacroStep();
+}
+
+StepStatus WholeDomainView::DoStep(double t, double dt) {
+  part_->SetTime(t);  // the view's clock is the kernel's
+  return part_->Step(dt);
+}
+
+void WholeDomainView::DoReadField(FieldId id, Eigen::Ref<Eigen::MatrixXd> out) const {
+  const FieldId part_id = part_field_[static_cast<std::size_t>(id.value())];
+  const FieldInfo& info = part_->field_info(part_id);
+  if (info.location == FieldLocation::kGlobal) {
+    part_->ReadField(part_id, out);
+    return;
+  }
+  const Layout& layout = info.location == FieldLocation::kNode ? nodes_ : elements_;
+  const int c = info.components;
+  local_.resize(c, part_->FieldCount(part_id));
+  part_->ReadField(part_id, local_);
+  send_.resize(layout.local.size() * static_cast<std::size_t>(c));
+  for (std::size_t i = 0; i < layout.local.size(); ++i)
+    for (int k = 0; k < c; ++k)
+      send_[i * static_cast<std::size_t>(c) + static_cast<std::size_t>(k)] =
+          local_(k, layout.local[i]);
+  std::vector<int> counts(layout.counts), offsets(layout.offsets);
+  for (int& n : counts) n *= c;
+  for (int& o : offsets) o *= c;
+  receive_.resize(layout.whole.size() * static_cast<std::size_t>(c));
+  MPI_Allgatherv(send_.data(), static_cast<int>(send_.size()), MPI_DOUBLE, receive_.data(),
+                 counts.data(), offsets.data(), MPI_DOUBLE, comm_);
+  for (std::size_t i = 0; i < layout.whole.size(); ++i)
+    for (int k = 0; k < c; ++k)
+      out(k, layout.whole[i]) =
+          receive_[i * static_cast<std::size_t>(c) + static_cast<std::size_t>(k)];
+}
+
+void WholeDomainView::DoWriteField(FieldId id, const Eigen::Ref<const Eigen::MatrixXd>& in) {
+  const FieldId part_id = part_field_[static_cast<std::size_t>(id.value())];
+  const FieldInfo& info = part_->field_info(part_id);
+  if (info.location == FieldLocation::kGlobal) {
+    part_->WriteField(part_id, in);
+    return;
+  }
+  const std::vector<int>& whole_of_local =
+      info.location == FieldLocation::kNode ? mesh_part_.whole_node : mesh_part_.whole_tet;
+  local_.resize(info.components, static_cast<Index>(whole_of_local.size()));
+  for (std::size_t i = 0; i < whole_of_local.size(); ++i)
+    local_.col(static_cast<Index>(i)) = in.col(whole_of_local[i]);
+  part_->WriteField(part_id, local_);
+}
+
+}  // namespace gipsi

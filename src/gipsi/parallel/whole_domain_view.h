@@ -1,0 +1,75 @@
+#pragma once
+/// @file
+/// `WholeDomainView`: a distributed object's part (one rank's share of the mesh, e.g. a
+/// DistributedMonodomain) presented as one object on the whole mesh, so that everything built
+/// for serial objects (connectors, probes, VTU series, the kernel's retries) runs unchanged on
+/// every rank of a distributed scene run. The view's domain is the whole mesh; reading a node
+/// or element field gathers every rank's owned values into the whole mesh's order on every
+/// rank (MPI_Allgatherv: collective, and O(whole mesh) per rank per read), writing one keeps
+/// this rank's entries; global fields are the part's (its own reductions). Boundary fields are
+/// not offered. Steps, stop requests, profiles and failure details go to the part; the part's
+/// state is the view's (checkpoints and step retries serialise it per rank).
+///
+/// Every rank must make the same calls in the same order (they do when every rank runs the
+/// same kernel on the same scene). The gathers make this the simple path, not the scalable one:
+/// per-rank VTU pieces and owner-computed probes are to replace it (docs/scale-out.md).
+
+#include <mpi.h>
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "gipsi/base/export.h"
+#include "gipsi/core/sim_object.h"
+#include "gipsi/parallel/mesh_partition.h"
+
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
+
+/// Not copyable or movable (a SimObject).
+class WholeDomainView final : public SimObject {
+ public:
+  /// `part` is this rank's object on `mesh_part.mesh` (`mesh_part` must outlive the view: the
+  /// part usually owns it), `whole` the mesh it was cut from. Collective.
+  WholeDomainView(std::unique_ptr<SimObject> part, const MeshPart& mesh_part,
+                  std::shared_ptr<const Mesh> whole, MPI_Comm comm);
+
+  [[nodiscard]] std::string_view type_name() const override { return part_->type_name(); }
+  [[nodiscard]] const Points& domain_positions() const override { return domain().nodes; }
+  [[nodiscard]] std::string failure_detail() const override { return part_->failure_detail(); }
+  [[nodiscard]] std::vector<ProfileEntry> ProfileBreakdown() const override {
+    return part_->ProfileBreakdown();
+  }
+  void SaveObjectState(StateWriter& out) const override { part_->SaveState(out); }
+  void RestoreObjectState(StateReader& in) override { part_->RestoreState(in); }
+  void BeginMacroStep() override;
+  [[nodiscard]] const SimObject& part() const { return *part_; }
+
+ protected:
+  StepStatus DoStep(double t, double dt) override;
+  void DoReadField(FieldId id, Eigen::Ref<Eigen::MatrixXd> out) const override;
+  void DoWriteField(FieldId id, const Eigen::Ref<const Eigen::MatrixXd>& in) override;
+  void DoSetStopToken(StopToken token) override { part_->SetStopToken(token); }
+
+ private:
+  // How the owned items of every rank line up in an Allgatherv, and where they go.
+  struct Layout {
+    std::vector<int> counts, offsets;  // items per rank and where each rank's start
+    std::vector<int> whole;            // the whole-mesh index of every gathered item
+    std::vector<int> local;            // this rank's items (local indices) in gathered order
+  };
+  static Layout MakeLayout(const std::vector<int>& whole_of_local, std::int64_t owned,
+                           MPI_Comm comm);
+
+  std::unique_ptr<SimObject> part_;
+  const MeshPart& mesh_part_;
+  MPI_Comm comm_;
+  std::vector<FieldId> part_field_;  // the part's field behind each of the view's
+  Layout nodes_, elements_;
+  mutable std::vector<double> send_, receive_;
+  mutable Eigen::MatrixXd local_;
+};
+
+}  // namespace gipsi
+GIPSI_EXPORT_END
