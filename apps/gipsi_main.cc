@@ -207,6 +207,7 @@ struct Ranks {
   std::function<void(gipsi::TypeRegistry&)> register_types;
   /// Ends every rank with `code` (a rank that stops alone would leave the others waiting).
   std::function<void(int)> abort;
+  std::function<void()> barrier;
   std::vector<std::string> type_names;  ///< of the distributed types
   [[nodiscard]] bool distributed() const { return size > 1; }
 };
@@ -272,15 +273,21 @@ std::vector<std::filesystem::path> FrameFiles(const std::filesystem::path& out,
   std::error_code error;
   const std::filesystem::path dir = out / series;
   if (!std::filesystem::is_directory(dir, error)) return frames;
+  auto digits = [](std::string_view text) {
+    return !text.empty() &&
+           std::all_of(text.begin(), text.end(), [](char c) { return c >= '0' && c <= '9'; });
+  };
   for (const auto& entry : std::filesystem::directory_iterator(dir, error)) {
     const std::string name = entry.path().filename().string();
     const std::string prefix = series + "_";
-    if (!entry.is_regular_file(error) || !name.starts_with(prefix) || !name.ends_with(".vtu") ||
-        name.size() != prefix.size() + 6 + 4)
+    if (!entry.is_regular_file(error) || !name.starts_with(prefix) ||
+        name.size() < prefix.size() + 6 + 4 || !digits(name.substr(prefix.size(), 6)))
       continue;
-    const std::string digits = name.substr(prefix.size(), 6);
-    if (std::all_of(digits.begin(), digits.end(), [](char c) { return c >= '0' && c <= '9'; }))
-      frames.push_back(entry.path());
+    // <series>_NNNNNN.vtu, or a distributed run's <series>_NNNNNN.pvtu and _NNNNNN_p<rank>.vtu.
+    const std::string_view rest = std::string_view(name).substr(prefix.size() + 6);
+    const bool piece =
+        rest.starts_with("_p") && rest.ends_with(".vtu") && digits(rest.substr(2, rest.size() - 6));
+    if (rest == ".vtu" || rest == ".pvtu" || piece) frames.push_back(entry.path());
   }
   return frames;
 }
@@ -289,7 +296,8 @@ std::vector<std::filesystem::path> FrameFiles(const std::filesystem::path& out,
 /// from an earlier run there would keep frames the new, perhaps shorter, run's `.pvd` no longer
 /// lists. Refuses (InputError naming the directory) unless `overwrite`; with it, deletes the
 /// earlier series' frames and collections — only files of the form GiPSi writes
-/// (`<out>/<series>.pvd`, `<out>/<series>/<series>_NNNNNN.vtu`), nothing else.
+/// (`<out>/<series>.pvd`, `<out>/<series>/<series>_NNNNNN.vtu`, and a distributed run's
+/// `_NNNNNN.pvtu` and `_NNNNNN_p<rank>.vtu`), nothing else.
 void PrepareOutputDirectory(const gipsi::Scene& scene, const std::filesystem::path& out,
                             bool resume, bool overwrite) {
   if (resume || !scene.vtu.enabled) return;
@@ -396,6 +404,9 @@ int Run(const std::string& file, const std::string& out_dir, double until, bool 
     gipsi::ThrowInputError("command line", "mpirun",
                            "a scene with a real-time HapticProbe cannot run on several ranks");
   if (lead) PrepareOutputDirectory(scene, out, !checkpoints.resume.empty(), overwrite);
+  // Every rank writes its pieces of distributed objects' frames: not before rank 0 has
+  // prepared (and with --overwrite cleared) the folder.
+  if (ranks.distributed()) ranks.barrier();
   gipsi::AttachOutputs(scene, out, !checkpoints.resume.empty(),
                        lead ? gipsi::OutputFiles::kWrite : gipsi::OutputFiles::kReadOnly);
   if (!checkpoints.resume.empty()) {
@@ -830,6 +841,7 @@ int main(int argc, char** argv) {
     ranks.register_types = [&mpi](gipsi::TypeRegistry& r) { mpi->RegisterTypes(r); };
     ranks.type_names = mpi->type_names();
     ranks.abort = [&mpi](int code) { mpi->Abort(code); };
+    ranks.barrier = [&mpi] { mpi->Barrier(); };
     if (ranks.rank != 0) gipsi::Log().set_level(spdlog::level::err);
 #else
     // Every rank would run the whole scene and write the same files.

@@ -3,7 +3,9 @@
 
 Runs the N-version benchmark slab (scenes/slab_ep_0.5mm.json, its first 30 ms) serially and on
 2 and 4 ranks (4 oversubscribed: more ranks than cores), and checks that
-  - the distributed runs write the same files as the serial one, from rank 0 only;
+  - the distributed runs write the serial run's files, except that each VTU frame of the split
+    object is a `.pvtu` joining one `.vtu` piece per rank; the pieces of a frame hold every tet
+    once and every node (shared ones in several pieces) with the serial frame's values;
   - every probe (a point probe of V and activation time, the activated fraction, the line probe
     of activation times along the diagonal) has the serial run's rows and times, and values
     within what the diffusion solver's tolerance allows: both solve with CG + Jacobi to a
@@ -15,15 +17,22 @@ Runs the N-version benchmark slab (scenes/slab_ep_0.5mm.json, its first 30 ms) s
     and its muscle and circulation whole on every rank, gives the serial PV loop and beat
     summary within 1e-4 relative (activation times within 2e-3 ms shift the active tension by
     that; at the steepest pressure rise, ~200 kPa/s, that is 0.4 Pa of ~10 kPa); measured 3e-14;
+  - an earlier run's pieces are refused, or deleted with --overwrite;
+  - a divergence on one rank's part (a 5 V clamp at the far corner from 5 ms) stops every rank
+    at the serial run's step, exit 3, with the probe rows recorded until then;
   - what a distributed run refuses (checkpoints) and a bad scene exit with the serial codes.
 
 Usage: distributed_scene_test.py GIPSI MPIEXEC SOURCE_DIR
 """
+import base64
 import csv
 import os
+import re
+import struct
 import subprocess
 import sys
 import tempfile
+import xml.etree.ElementTree as ET
 
 GIPSI, MPIEXEC, SOURCE = sys.argv[1], sys.argv[2], sys.argv[3]
 SCENE = os.path.join(SOURCE, "scenes", "slab_ep_0.5mm.json")
@@ -50,6 +59,64 @@ def files(folder):
                   for d, _, names in os.walk(folder) for f in names)
 
 
+def expected_files(serial_files, ranks):
+    """The serial file list with each frame of the split object as a .pvtu and its pieces."""
+    out = []
+    for f in serial_files:
+        m = re.fullmatch(r"(tissue/tissue_\d{6})\.vtu", f)
+        if m:
+            out.append(m.group(1) + ".pvtu")
+            out += [f"{m.group(1)}_p{k}.vtu" for k in range(ranks)]
+        else:
+            out.append(f)
+    return sorted(out)
+
+
+def vtu_arrays(path):
+    """Point count, cell count and the Float64 arrays of a .vtu GiPSi wrote (inline base64: a
+    12-character UInt64 byte count, then the data)."""
+    piece = ET.parse(path).getroot().find("UnstructuredGrid/Piece")
+    arrays = {}
+    for array in piece.iter("DataArray"):
+        if array.get("type") != "Float64":
+            continue
+        data = base64.b64decode(array.text.strip()[12:])
+        values = struct.unpack(f"<{len(data) // 8}d", data)
+        arrays[array.get("Name")] = values
+    return int(piece.get("NumberOfPoints")), int(piece.get("NumberOfCells")), arrays
+
+
+def compare_frame(serial_vtu, pvtu, ranks, label):
+    n, cells, reference = vtu_arrays(serial_vtu)
+    points = reference["Points"]
+    index = {tuple(round(c, 12) for c in points[3 * i:3 * i + 3]): i for i in range(n)}
+    root = ET.parse(pvtu).getroot()
+    sources = [p.get("Source") for p in root.iter("Piece")]
+    check(len(sources) == ranks, f"{label}: {len(sources)} pieces in {pvtu}")
+    names = {a.get("Name") for a in root.find("PUnstructuredGrid/PPointData")}
+    check({"V", "activation_time"} <= names, f"{label}: point arrays {names}")
+    seen, piece_cells, worst = set(), 0, 0.0
+    for source in sources:
+        m, c, arrays = vtu_arrays(os.path.join(os.path.dirname(pvtu), source))
+        piece_cells += c
+        for i in range(m):
+            key = tuple(round(x, 12) for x in arrays["Points"][3 * i:3 * i + 3])
+            j = index.get(key)
+            if j is None:
+                check(False, f"{label}: {source} point {i} at {key} is not a node of the mesh")
+                break
+            seen.add(j)
+            for name in ("V", "activation_time"):
+                diff = abs(arrays[name][i] - reference[name][j])
+                worst = max(worst, diff)
+                if diff > BOUNDS[name]:
+                    check(False, f"{label}: {source} {name} at node {j}: {arrays[name][i]} vs "
+                          f"serial {reference[name][j]}")
+    check(piece_cells == cells, f"{label}: the pieces hold {piece_cells} cells, serial {cells}")
+    check(len(seen) == n, f"{label}: the pieces hold {len(seen)} of the {n} nodes")
+    print(f"{label}: {len(sources)} pieces, {piece_cells} cells, largest difference {worst:.3g}")
+
+
 def rows(path):
     with open(path, newline="") as f:
         return list(csv.reader(f))
@@ -66,8 +133,17 @@ with tempfile.TemporaryDirectory() as work:
         check(f"MPI ranks:        {ranks} (distributed: Monodomain)" in text,
               f"{ranks} ranks: the summary does not name the ranks:\n{text}")
         check(text.count("simulated time:") == 1, f"{ranks} ranks: more than one rank printed")
-        check(files(out) == files(serial),
-              f"{ranks} ranks: files differ: {set(files(out)) ^ set(files(serial))}")
+        expected = expected_files(files(serial), ranks)
+        check(files(out) == expected,
+              f"{ranks} ranks: files differ: {set(files(out)) ^ set(expected)}")
+        with open(os.path.join(out, "tissue.pvd")) as pvd:
+            listed = re.findall(r'file="([^"]+)"', pvd.read())
+        check(listed and all(f.endswith(".pvtu") for f in listed),
+              f"{ranks} ranks: tissue.pvd lists {listed[:3]}")
+        last = sorted(f for f in files(serial) if f.endswith(".vtu"))[-1]
+        compare_frame(os.path.join(serial, last),
+                      os.path.join(out, last[:-len(".vtu")] + ".pvtu"), ranks,
+                      f"{ranks} ranks, frame {last}")
         for name in ("far_corner", "activated", "diagonal"):
             a = rows(os.path.join(serial, "probes", name + ".csv"))
             b = rows(os.path.join(out, "probes", name + ".csv"))
@@ -83,6 +159,17 @@ with tempfile.TemporaryDirectory() as work:
                         check(False, f"{ranks} ranks, {name}.{column}: {y} vs serial {x}")
                         break
             print(f"{ranks} ranks, {name}: largest differences {worst}")
+    # An earlier distributed run's series (4 pieces per frame) is refused, or with --overwrite
+    # cleared (pieces and .pvtu files included) before a run on 2 ranks writes its own.
+    again = os.path.join(work, "ranks4")
+    result = subprocess.run([MPIEXEC, "-np", "2", GIPSI, "run", SCENE, "--until", "0.01", "-o",
+                             again, "-q"], capture_output=True, text=True, timeout=120)
+    check(result.returncode == 1 and "holds VTU series of an earlier run" in result.stderr,
+          f"no --overwrite over an earlier series: exit {result.returncode}: {result.stderr}")
+    code, text = run(2, again)
+    check(code == 0 and files(again) == expected_files(files(serial), 2),
+          f"--overwrite over 4 ranks' series: exit {code}, stale files "
+          f"{set(files(again)) - set(expected_files(files(serial), 2))}")
     heart = os.path.join(SOURCE, "scenes", "heart.json")
     heart_runs = {}
     for ranks in (1, 2):
@@ -100,7 +187,7 @@ with tempfile.TemporaryDirectory() as work:
         check(a[0] == b[0] and len(a) == len(b) and len(a) > 1,
               f"heart, {name}: {len(b)} rows with {b[0]}, serial {len(a)} with {a[0]}")
         worst = 0.0
-        for ra, rb in zip(a[1:], b[1:]):
+        for ra, rb in zip(a[1:], b[1:]):  # the same numbers to within 1e-4 relative
             for column, x, y in zip(a[0], ra, rb):
                 diff = abs(float(x) - float(y))
                 scale = max(abs(float(x)), 1e-300)
@@ -108,6 +195,29 @@ with tempfile.TemporaryDirectory() as work:
                 check(diff <= 1e-4 * abs(float(x)) or diff == 0,
                       f"heart, {name}.{column}: {y} vs serial {x}")
         print(f"heart on 2 ranks, {name}: largest relative difference {worst:.3g}")
+    # A divergence on one rank's part stops every rank, at the serial run's step.
+    import json
+    with open(SCENE) as f:
+        scene = json.load(f)
+    scene["objects"]["tissue"]["clamps"] = {"bad": {
+        "region": {"box": {"min": [0.0195, 0.0065, 0.0025], "max": [0.0201, 0.0071, 0.0031]}},
+        "voltage": "5 V", "start": "5 ms", "duration": "1 ms"}}
+    bad = os.path.join(work, "diverging.json")
+    with open(bad, "w") as f:
+        json.dump(scene, f)
+    diverged = {}
+    for ranks in (1, 2):
+        out = os.path.join(work, f"diverged{ranks}")
+        command = [GIPSI, "run", bad, "--until", "0.01", "-o", out, "--overwrite", "-q"]
+        if ranks > 1:
+            command = [MPIEXEC, "-np", str(ranks)] + command
+        result = subprocess.run(command, capture_output=True, text=True, timeout=120)
+        check(result.returncode == 3 and "diverged" in result.stderr,
+              f"diverging clamp on {ranks} ranks: exit {result.returncode}: {result.stderr}")
+        diverged[ranks] = rows(os.path.join(out, "probes", "far_corner.csv"))
+    times = {ranks: [row[0] for row in table] for ranks, table in diverged.items()}
+    check(times[1] == times[2] and len(times[1]) > 5,
+          f"diverging clamp: probe rows at {times[2][-3:]} on 2 ranks, {times[1][-3:]} serially")
     # Refusals keep the serial exit codes, on every rank.
     code, text = run(2, os.path.join(work, "refused"), "--checkpoint-every", "0.01")
     check(code == 1 and "checkpoints of a distributed run (2 ranks) are not available yet" in text,

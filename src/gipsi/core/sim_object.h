@@ -132,6 +132,16 @@ class SimObject {
   void SetTime(double t) { time_ = t; }
   /// Number of successful steps taken.
   [[nodiscard]] std::int64_t step_count() const { return step_count_; }
+  /// What a VTU series writes of this object in this process. Plain struct.
+  struct OutputPiece {
+    const SimObject* object = nullptr;  ///< whose domain and node/element fields are written
+    int index = 0;                      ///< this process's piece
+    int count = 1;                      ///< pieces in all (more than one: a `.pvtu` indexes them)
+  };
+  /// The object itself, whole; a distributed object (gipsi/parallel/) gives this rank's part as
+  /// one piece of as many as there are ranks: each rank writes its piece and the first rank
+  /// the `.pvtu` that joins them (io/outputs.h).
+  [[nodiscard]] virtual OutputPiece output_piece() const { return {this, 0, 1}; }
   /// Leaf objects for output (an aggregate returns its parts; a plain object returns itself).
   virtual void CollectLeaves(std::vector<const SimObject*>& out) const { out.push_back(this); }
   /// A part of an aggregate by (possibly dotted) name; plain objects have none (nullptr).

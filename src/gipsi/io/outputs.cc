@@ -22,7 +22,9 @@ VtuSeriesWriter::VtuSeriesWriter(std::vector<const SimObject*> objects,
     if (mesh.num_tets() == 0 && mesh.num_triangles() == 0 &&
         object->boundary().num_triangles() == 0)
       continue;  // nothing drawable (a point object)
-    if (write_) std::filesystem::create_directories(directory / object->name());
+    // A distributed object's pieces are written by every rank (output_piece).
+    if (write_ || object->output_piece().count > 1)
+      std::filesystem::create_directories(directory / object->name());
     Series series{object, PvdWriter(directory / (object->name() + ".pvd"), write_ && !resume),
                   nullptr};
     if (display && object->display().map) {
@@ -35,7 +37,10 @@ VtuSeriesWriter::VtuSeriesWriter(std::vector<const SimObject*> objects,
 }
 
 void VtuSeriesWriter::WriteFrame(Series& series, double t) {
-  const SimObject& object = *series.object;
+  // A distributed object: this rank's part, one piece of the frame (output_piece).
+  const SimObject::OutputPiece piece = series.object->output_piece();
+  if (piece.count == 1 && !write_) return;  // whole objects: written by the first rank alone
+  const SimObject& object = *piece.object;
   const Mesh& mesh = object.domain();
   VtuFields fields;
   for (std::size_t f = 0; f < object.fields().size(); ++f) {
@@ -49,7 +54,22 @@ void VtuSeriesWriter::WriteFrame(Series& series, double t) {
     (info.location == FieldLocation::kNode ? fields.point_data : fields.cell_data)
         .push_back(std::move(array));
   }
-  if (!write_) return;  // the fields are read (collective for a distributed object), not written
+  if (piece.count > 1) {
+    // Every rank writes its piece; the first also the .pvtu that joins them and the .pvd.
+    const std::string name = series.object->name();
+    const std::string stem = fmt::format("{}_{:06d}", name, frame_);
+    WriteVtu(directory_ / name / fmt::format("{}_p{}.vtu", stem, piece.index),
+             object.domain_positions(), mesh.tets, Triangles(3, 0), fields);
+    if (!write_) return;
+    std::vector<std::string> pieces;
+    for (int k = 0; k < piece.count; ++k) pieces.push_back(fmt::format("{}_p{}.vtu", stem, k));
+    std::vector<VtuArrayShape> point_shapes, cell_shapes;
+    for (const NamedArray& a : fields.point_data) point_shapes.push_back({a.name, a.components});
+    for (const NamedArray& a : fields.cell_data) cell_shapes.push_back({a.name, a.components});
+    WritePvtu(directory_ / name / (stem + ".pvtu"), pieces, point_shapes, cell_shapes);
+    series.domain.AddFrame(t, name + "/" + stem + ".pvtu");
+    return;
+  }
   const std::string name = object.name();
   const std::string file = fmt::format("{}/{}_{:06d}.vtu", name, name, frame_);
   if (mesh.num_tets() > 0) {

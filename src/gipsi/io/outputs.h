@@ -5,7 +5,8 @@
 ///
 /// Layout of an output directory:
 ///   <out>/<object>.pvd                 ParaView collection (open this one)
-///   <out>/<object>/<object>_NNNNNN.vtu one frame per output time
+///   <out>/<object>/<object>_NNNNNN.vtu one frame per output time (a distributed object:
+///                                      <object>_NNNNNN.pvtu and one _p<rank>.vtu per rank)
 ///   <out>/<object>_display.pvd, <out>/<object>_display/...   display surface (if embedded)
 ///   <out>/probes/<probe>.csv           one row per sample: time, values
 
@@ -24,9 +25,10 @@ GIPSI_EXPORT_BEGIN
 namespace gipsi {
 
 /// Whether the outputs attached in this process write their files. Every rank of a distributed
-/// run (gipsi/parallel/) attaches the scene's outputs and reads every field at the same times,
+/// run (gipsi/parallel/) attaches the scene's outputs and samples the probes at the same times,
 /// because a distributed object's reads are collective; only rank 0 writes (kWrite), the others
-/// read and write nothing (kReadOnly).
+/// (kReadOnly) write nothing but their own piece of each distributed object's VTU frames
+/// (SimObject::output_piece).
 enum class OutputFiles { kWrite, kReadOnly };
 
 /// Writes VTU frames and keeps the PVD collections current after every frame, so a run that
@@ -34,8 +36,10 @@ enum class OutputFiles { kWrite, kReadOnly };
 class VtuSeriesWriter final : public Observer {
  public:
   /// Creates `directory` and one collection per object; throws std::exception on I/O errors.
-  /// With `resume`, existing collections are left untouched until CommitRestore. With
-  /// OutputFiles::kReadOnly it reads the fields of every frame and touches no file.
+  /// With `resume`, existing collections are left untouched until CommitRestore. A distributed
+  /// object (SimObject::output_piece) is written as one `.vtu` piece per rank, by each rank, in
+  /// `<object>/<object>_NNNNNN_p<rank>.vtu`, joined by `<object>_NNNNNN.pvtu`, which the `.pvd`
+  /// lists. With OutputFiles::kReadOnly only those pieces are written.
   VtuSeriesWriter(std::vector<const SimObject*> objects, const std::filesystem::path& directory,
                   double every, bool display, bool resume = false,
                   OutputFiles files = OutputFiles::kWrite);

@@ -167,6 +167,33 @@ std::uintmax_t VtuFileBytes(Index num_nodes, Index num_tets, Index num_triangles
   return total + kPieceClosing.size();
 }
 
+void WritePvtu(const std::filesystem::path& path, const std::vector<std::string>& pieces,
+               const std::vector<VtuArrayShape>& point_data,
+               const std::vector<VtuArrayShape>& cell_data) {
+  std::string xml = "<?xml version=\"1.0\"?>\n";
+  xml += fmt::format(
+      "<VTKFile type=\"PUnstructuredGrid\" version=\"1.0\" byte_order=\"{}\" "
+      "header_type=\"UInt64\">\n  <PUnstructuredGrid GhostLevel=\"0\">\n",
+      internal::HostIsLittleEndian() ? "LittleEndian" : "BigEndian");
+  auto arrays = [&](std::string_view tag, const std::vector<VtuArrayShape>& shapes) {
+    xml += fmt::format("    <{}>\n", tag);
+    for (const VtuArrayShape& a : shapes)
+      xml += fmt::format(
+          "      <PDataArray type=\"Float64\" Name=\"{}\" NumberOfComponents=\"{}\"/>\n",
+          EscapeXml(a.name), a.components);
+    xml += fmt::format("    </{}>\n", tag);
+  };
+  arrays("PPointData", point_data);
+  arrays("PCellData", cell_data);
+  xml +=
+      "    <PPoints>\n      <PDataArray type=\"Float64\" NumberOfComponents=\"3\"/>\n"
+      "    </PPoints>\n";
+  for (const std::string& piece : pieces)
+    xml += fmt::format("    <Piece Source=\"{}\"/>\n", EscapeXml(piece));
+  xml += "  </PUnstructuredGrid>\n</VTKFile>\n";
+  internal::WriteFileBytes(path, xml);
+}
+
 void WriteVtu(const std::filesystem::path& path, const Mesh& mesh, const VtuFields& fields) {
   WriteVtu(path, mesh.nodes, mesh.tets, mesh.triangles, fields);
 }

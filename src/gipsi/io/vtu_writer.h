@@ -58,6 +58,14 @@ std::uintmax_t VtuFileBytes(Index num_nodes, Index num_tets, Index num_triangles
                             const std::vector<VtuArrayShape>& point_data,
                             const std::vector<VtuArrayShape>& cell_data);
 
+/// Writes a parallel unstructured grid (`.pvtu`): the index of `pieces` (`.vtu` paths relative
+/// to the `.pvtu`'s folder, as ParaView resolves them), each written by WriteVtu with these
+/// point and cell arrays (all Float64), which ParaView opens as one dataset. Throws InputError
+/// if the file cannot be written.
+void WritePvtu(const std::filesystem::path& path, const std::vector<std::string>& pieces,
+               const std::vector<VtuArrayShape>& point_data,
+               const std::vector<VtuArrayShape>& cell_data);
+
 /// `WriteVtu(path, mesh.nodes, mesh.tets, mesh.triangles, fields)`.
 void WriteVtu(const std::filesystem::path& path, const Mesh& mesh, const VtuFields& fields = {});
 

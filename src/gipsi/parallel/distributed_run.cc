@@ -22,6 +22,7 @@ class PetscRun final : public DistributedRun {
   [[nodiscard]] std::vector<std::string> type_names() const override {
     return DistributedTypeNames();
   }
+  void Barrier() const override { MPI_Barrier(world()); }
   [[noreturn]] void Abort(int code) const override {
     MPI_Abort(world(), code);
     std::abort();  // MPI_Abort does not return

@@ -25,6 +25,8 @@ class DistributedRun {
   virtual void RegisterTypes(TypeRegistry& registry) const = 0;
   /// The type names RegisterTypes replaces.
   [[nodiscard]] virtual std::vector<std::string> type_names() const = 0;
+  /// Waits until every rank has called it.
+  virtual void Barrier() const = 0;
   /// Ends every rank with `code` (MPI_Abort): for a failure one rank meets alone.
   [[noreturn]] virtual void Abort(int code) const = 0;
 };

@@ -12,7 +12,8 @@
 ///
 /// Every rank must make the same calls in the same order (they do when every rank runs the
 /// same kernel on the same scene). The gathers make this the simple path, not the scalable one:
-/// per-rank VTU pieces and owner-computed probes are to replace it (docs/scale-out.md).
+/// VTU series write the part as one piece per rank instead (output_piece), and owner-computed
+/// probes are to replace the gathers for probes (docs/scale-out.md).
 
 #include <mpi.h>
 
@@ -44,6 +45,10 @@ class WholeDomainView final : public SimObject {
   void SaveObjectState(StateWriter& out) const override { part_->SaveState(out); }
   void RestoreObjectState(StateReader& in) override { part_->RestoreState(in); }
   void BeginMacroStep() override;
+  /// VTU series write the part, one piece per rank.
+  [[nodiscard]] OutputPiece output_piece() const override {
+    return {part_.get(), mesh_part_.rank, mesh_part_.size};
+  }
   [[nodiscard]] const SimObject& part() const { return *part_; }
 
  protected:
