@@ -26,6 +26,7 @@ Usage: distributed_scene_test.py GIPSI MPIEXEC SOURCE_DIR
 """
 import base64
 import csv
+import json
 import os
 import re
 import struct
@@ -46,8 +47,8 @@ def check(condition, message):
         print("FAIL:", message)
 
 
-def run(ranks, out, *extra):
-    command = [GIPSI, "run", SCENE, "--until", "0.03", "-o", out, "--overwrite", *extra]
+def run(ranks, out, *extra, scene=SCENE, until="0.03"):
+    command = [GIPSI, "run", scene, "--until", until, "-o", out, "--overwrite", *extra]
     if ranks > 1:
         command = [MPIEXEC, "-np", str(ranks)] + (["--oversubscribe"] if ranks > 2 else []) + command
     result = subprocess.run(command, capture_output=True, text=True, timeout=240)
@@ -174,12 +175,8 @@ with tempfile.TemporaryDirectory() as work:
     heart_runs = {}
     for ranks in (1, 2):
         out = os.path.join(work, f"heart{ranks}")
-        command = [GIPSI, "run", heart, "--until", "0.8", "-o", out, "--overwrite", "-q"]
-        if ranks > 1:
-            command = [MPIEXEC, "-np", str(ranks)] + command
-        result = subprocess.run(command, capture_output=True, text=True, timeout=240)
-        check(result.returncode == 0, f"heart on {ranks} ranks: exit {result.returncode}: "
-              f"{result.stdout}{result.stderr}")
+        code, text = run(ranks, out, "-q", scene=heart, until="0.8")
+        check(code == 0, f"heart on {ranks} ranks: exit {code}: {text}")
         heart_runs[ranks] = out
     for name in ("pv", "summary"):
         a = rows(os.path.join(heart_runs[1], "probes", name + ".csv"))
@@ -196,7 +193,6 @@ with tempfile.TemporaryDirectory() as work:
                       f"heart, {name}.{column}: {y} vs serial {x}")
         print(f"heart on 2 ranks, {name}: largest relative difference {worst:.3g}")
     # A divergence on one rank's part stops every rank, at the serial run's step.
-    import json
     with open(SCENE) as f:
         scene = json.load(f)
     scene["objects"]["tissue"]["clamps"] = {"bad": {
@@ -208,12 +204,8 @@ with tempfile.TemporaryDirectory() as work:
     diverged = {}
     for ranks in (1, 2):
         out = os.path.join(work, f"diverged{ranks}")
-        command = [GIPSI, "run", bad, "--until", "0.01", "-o", out, "--overwrite", "-q"]
-        if ranks > 1:
-            command = [MPIEXEC, "-np", str(ranks)] + command
-        result = subprocess.run(command, capture_output=True, text=True, timeout=120)
-        check(result.returncode == 3 and "diverged" in result.stderr,
-              f"diverging clamp on {ranks} ranks: exit {result.returncode}: {result.stderr}")
+        code, text = run(ranks, out, "-q", scene=bad, until="0.01")
+        check(code == 3 and "diverged" in text, f"diverging clamp on {ranks} ranks: exit {code}: {text}")
         diverged[ranks] = rows(os.path.join(out, "probes", "far_corner.csv"))
     times = {ranks: [row[0] for row in table] for ranks, table in diverged.items()}
     check(times[1] == times[2] and len(times[1]) > 5,

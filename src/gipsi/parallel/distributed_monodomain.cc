@@ -11,7 +11,7 @@
 
 #include "gipsi/base/error.h"
 #include "gipsi/geometry/boundary.h"
-#include "gipsi/numerics/p1_scalar.h"
+#include "gipsi/models/ep/monodomain.h"
 #include "gipsi/parallel/petsc_check.h"
 
 namespace gipsi {
@@ -124,16 +124,7 @@ DistributedMonodomain::DistributedMonodomain(std::string name, const Mesh& whole
 DistributedMonodomain::~DistributedMonodomain() = default;
 
 void DistributedMonodomain::Assemble() {
-  const Mesh& mesh = domain();
-  const double dl = params_.diffusivity_longitudinal();
-  const double dt = params_.diffusivity_transverse();
-  P1ScalarOperators ops = AssembleP1Scalar(
-      mesh.nodes, mesh.tets, 1e3,  // m → mm
-      [&](Index e) -> Mat3 {
-        const Vec3 f = fibres_.col(e);
-        return dt * Mat3::Identity() + (dl - dt) * f * f.transpose();
-      },
-      !params_.lumped_mass);
+  P1ScalarOperators ops = AssembleMonodomainOperators(domain(), fibres_, params_);
   Petsc& p = *petsc_;
   const SparseMatrix& k = ops.stiffness;
   const auto entries = static_cast<std::size_t>(k.nonZeros());

@@ -8,7 +8,6 @@
 #include "gipsi/base/error.h"
 #include "gipsi/geometry/boundary.h"
 #include "gipsi/models/ep/ep_tissue_json.h"
-#include "gipsi/numerics/p1_scalar.h"
 
 namespace gipsi {
 
@@ -30,17 +29,21 @@ Monodomain::Monodomain(std::string name, std::shared_ptr<const Mesh> mesh, EpTis
   Assemble();
 }
 
-void Monodomain::Assemble() {
-  const Mesh& mesh = domain();
-  const double dl = params_.diffusivity_longitudinal();
-  const double dt = params_.diffusivity_transverse();
-  P1ScalarOperators ops = AssembleP1Scalar(
+P1ScalarOperators AssembleMonodomainOperators(const Mesh& mesh, const Points& fibres,
+                                              const EpTissueParams& params) {
+  const double dl = params.diffusivity_longitudinal();
+  const double dt = params.diffusivity_transverse();
+  return AssembleP1Scalar(
       mesh.nodes, mesh.tets, 1e3,  // m → mm
       [&](Index e) -> Mat3 {
-        const Vec3 f = fibres_.col(e);
+        const Vec3 f = fibres.col(e);
         return dt * Mat3::Identity() + (dl - dt) * f * f.transpose();
       },
-      !params_.lumped_mass);
+      !params.lumped_mass);
+}
+
+void Monodomain::Assemble() {
+  P1ScalarOperators ops = AssembleMonodomainOperators(domain(), fibres_, params_);
   SetDiffusionOperator(std::move(ops.stiffness), std::move(ops.lumped_mass),
                        std::move(ops.consistent_mass));
 }

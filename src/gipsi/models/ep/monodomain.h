@@ -14,6 +14,7 @@
 #include "gipsi/base/export.h"
 #include "gipsi/core/registry.h"
 #include "gipsi/models/ep/ep_tissue.h"
+#include "gipsi/numerics/p1_scalar.h"
 
 GIPSI_EXPORT_BEGIN
 namespace gipsi {
@@ -40,6 +41,13 @@ class Monodomain final : public EpTissue {
   Points fibres_;
   FieldId f_fibre_;
 };
+
+/// The P1 monodomain operators of `mesh` (coordinates in m, operators in mm) with the fibre
+/// direction `fibres` per element (3 by E, unit) and the diffusivities of `params`; the
+/// consistent mass too unless `params.lumped_mass`. Shared by Monodomain and the distributed
+/// object (gipsi/parallel/). Throws InputError naming a degenerate tet.
+P1ScalarOperators AssembleMonodomainOperators(const Mesh& mesh, const Points& fibres,
+                                              const EpTissueParams& params);
 
 /// Registers "Monodomain" (keys in docs/scene-format.md).
 void RegisterMonodomain(TypeRegistry& registry);
