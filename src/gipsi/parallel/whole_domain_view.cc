@@ -74,12 +74,15 @@ void WholeDomainView::DoReadField(FieldId id, Eigen::Ref<Eigen::MatrixXd> out) c
     for (int k = 0; k < c; ++k)
       send_[i * static_cast<std::size_t>(c) + static_cast<std::size_t>(k)] =
           local_(k, layout.local[i]);
-  std::vector<int> counts(layout.counts), offsets(layout.offsets);
-  for (int& n : counts) n *= c;
-  for (int& o : offsets) o *= c;
+  counts_.resize(layout.counts.size());
+  offsets_.resize(layout.offsets.size());
+  for (std::size_t r = 0; r < counts_.size(); ++r) {
+    counts_[r] = c * layout.counts[r];
+    offsets_[r] = c * layout.offsets[r];
+  }
   receive_.resize(layout.whole.size() * static_cast<std::size_t>(c));
   MPI_Allgatherv(send_.data(), static_cast<int>(send_.size()), MPI_DOUBLE, receive_.data(),
-                 counts.data(), offsets.data(), MPI_DOUBLE, comm_);
+                 counts_.data(), offsets_.data(), MPI_DOUBLE, comm_);
   for (std::size_t i = 0; i < layout.whole.size(); ++i)
     for (int k = 0; k < c; ++k)
       out(k, layout.whole[i]) =

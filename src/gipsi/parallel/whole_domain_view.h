@@ -72,7 +72,9 @@ class WholeDomainView final : public SimObject {
   MPI_Comm comm_;
   std::vector<FieldId> part_field_;  // the part's field behind each of the view's
   Layout nodes_, elements_;
+  // Buffers of the gathers, kept between reads (no allocation once sized).
   mutable std::vector<double> send_, receive_;
+  mutable std::vector<int> counts_, offsets_;
   mutable Eigen::MatrixXd local_;
 };
 
