@@ -20,6 +20,16 @@ namespace {
 
 using Face = std::array<int, 3>;
 
+// The face of tet e opposite its corner `skip`, nodes sorted.
+Face SortedFace(const Tets& tets, Index e, int skip) {
+  Face f{};
+  int k = 0;
+  for (int a = 0; a < 4; ++a)
+    if (a != skip) f[static_cast<std::size_t>(k++)] = tets(a, e);
+  std::sort(f.begin(), f.end());
+  return f;
+}
+
 // The face-adjacency (dual) graph's neighbours of every tet: up to four tets each.
 std::vector<std::array<int, 4>> FaceNeighbours(const Tets& tets) {
   const Index count = tets.cols();
@@ -30,14 +40,8 @@ std::vector<std::array<int, 4>> FaceNeighbours(const Tets& tets) {
   std::vector<Entry> faces;
   faces.reserve(static_cast<std::size_t>(4 * count));
   for (Index e = 0; e < count; ++e)
-    for (int skip = 0; skip < 4; ++skip) {
-      Face f{};
-      int k = 0;
-      for (int a = 0; a < 4; ++a)
-        if (a != skip) f[static_cast<std::size_t>(k++)] = tets(a, e);
-      std::sort(f.begin(), f.end());
-      faces.push_back({f, static_cast<int>(e)});
-    }
+    for (int skip = 0; skip < 4; ++skip)
+      faces.push_back({SortedFace(tets, e, skip), static_cast<int>(e)});
   std::sort(faces.begin(), faces.end(), [](const Entry& a, const Entry& b) {
     return a.face != b.face ? a.face < b.face : a.tet < b.tet;
   });
@@ -180,14 +184,7 @@ MeshPart PartitionMesh(const Mesh& whole, MPI_Comm comm) {
   // Triangles that are a face of a local tet.
   std::vector<Face> local_faces;
   for (Index e = 0; e < mesh->num_tets(); ++e)
-    for (int skip = 0; skip < 4; ++skip) {
-      Face f{};
-      int k = 0;
-      for (int a = 0; a < 4; ++a)
-        if (a != skip) f[static_cast<std::size_t>(k++)] = mesh->tets(a, e);
-      std::sort(f.begin(), f.end());
-      local_faces.push_back(f);
-    }
+    for (int skip = 0; skip < 4; ++skip) local_faces.push_back(SortedFace(mesh->tets, e, skip));
   std::sort(local_faces.begin(), local_faces.end());
   std::vector<int> local_triangle(static_cast<std::size_t>(whole.num_triangles()), -1);
   std::vector<int> kept;

@@ -22,8 +22,7 @@ WholeDomainView::Layout WholeDomainView::MakeLayout(const std::vector<int>& whol
   layout.whole.resize(static_cast<std::size_t>(layout.offsets.back() + layout.counts.back()));
   MPI_Allgatherv(whole_of_local.data(), mine, MPI_INT, layout.whole.data(), layout.counts.data(),
                  layout.offsets.data(), MPI_INT, comm);
-  layout.local.resize(static_cast<std::size_t>(mine));
-  std::iota(layout.local.begin(), layout.local.end(), 0);
+  layout.owned = mine;
   return layout;
 }
 
@@ -69,11 +68,6 @@ void WholeDomainView::DoReadField(FieldId id, Eigen::Ref<Eigen::MatrixXd> out) c
   const int c = info.components;
   local_.resize(c, part_->FieldCount(part_id));
   part_->ReadField(part_id, local_);
-  send_.resize(layout.local.size() * static_cast<std::size_t>(c));
-  for (std::size_t i = 0; i < layout.local.size(); ++i)
-    for (int k = 0; k < c; ++k)
-      send_[i * static_cast<std::size_t>(c) + static_cast<std::size_t>(k)] =
-          local_(k, layout.local[i]);
   counts_.resize(layout.counts.size());
   offsets_.resize(layout.offsets.size());
   for (std::size_t r = 0; r < counts_.size(); ++r) {
@@ -81,8 +75,9 @@ void WholeDomainView::DoReadField(FieldId id, Eigen::Ref<Eigen::MatrixXd> out) c
     offsets_[r] = c * layout.offsets[r];
   }
   receive_.resize(layout.whole.size() * static_cast<std::size_t>(c));
-  MPI_Allgatherv(send_.data(), static_cast<int>(send_.size()), MPI_DOUBLE, receive_.data(),
-                 counts_.data(), offsets_.data(), MPI_DOUBLE, comm_);
+  // The owned items are the first local ones: their values are the first columns of local_.
+  MPI_Allgatherv(local_.data(), c * layout.owned, MPI_DOUBLE, receive_.data(), counts_.data(),
+                 offsets_.data(), MPI_DOUBLE, comm_);
   for (std::size_t i = 0; i < layout.whole.size(); ++i)
     for (int k = 0; k < c; ++k)
       out(k, layout.whole[i]) =

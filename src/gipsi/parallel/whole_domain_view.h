@@ -62,7 +62,7 @@ class WholeDomainView final : public SimObject {
   struct Layout {
     std::vector<int> counts, offsets;  // items per rank and where each rank's start
     std::vector<int> whole;            // the whole-mesh index of every gathered item
-    std::vector<int> local;            // this rank's items (local indices) in gathered order
+    int owned = 0;                     // this rank's items: the local ones [0, owned)
   };
   static Layout MakeLayout(const std::vector<int>& whole_of_local, std::int64_t owned,
                            MPI_Comm comm);
@@ -73,7 +73,7 @@ class WholeDomainView final : public SimObject {
   std::vector<FieldId> part_field_;  // the part's field behind each of the view's
   Layout nodes_, elements_;
   // Buffers of the gathers, kept between reads (no allocation once sized).
-  mutable std::vector<double> send_, receive_;
+  mutable std::vector<double> receive_;
   mutable std::vector<int> counts_, offsets_;
   mutable Eigen::MatrixXd local_;
 };
