@@ -341,6 +341,49 @@ void PrepareOutputDirectory(const gipsi::Scene& scene, const std::filesystem::pa
                     out.string());
 }
 
+/// A distributed run's checkpoint `file` as each rank writes it: `<stem>_p<rank><extension>`
+/// (checkpoint.gck: checkpoint_p0.gck, checkpoint_p1.gck, ...; docs/scale-out.md).
+std::filesystem::path RankFile(const std::filesystem::path& file, int rank) {
+  std::filesystem::path name = file.stem();
+  name += fmt::format("_p{}", rank);
+  name += file.extension();
+  return file.parent_path() / name;
+}
+
+/// Before a resume: a serial run's checkpoint named for a distributed run, or the reverse,
+/// gets a message that says which run wrote it (a missing file is left to the reader).
+void CheckResumeFiles(const std::filesystem::path& resume, const Ranks& ranks) {
+  std::error_code error;
+  int pieces = 0;  // the files _p0, _p1, ... that exist
+  while (std::filesystem::exists(RankFile(resume, pieces), error)) ++pieces;
+  if (ranks.distributed()) {
+    // Every rank looks at the same files and refuses alike (a rank whose file exists would
+    // otherwise wait for the others; more files than ranks are refused by their contents).
+    if (pieces >= ranks.size) return;
+    if (pieces == 0 && std::filesystem::is_regular_file(resume, error))
+      gipsi::ThrowInputError(
+          "command line", "--resume",
+          fmt::format("{} is the checkpoint of a run on one process, and this run has {} ranks "
+                      "(which would read {}): resume it without mpirun",
+                      resume.string(), ranks.size, RankFile(resume, ranks.rank).string()));
+    if (pieces > 0)
+      gipsi::ThrowInputError(
+          "command line", "--resume",
+          fmt::format("{} to {} are the checkpoint of a run on {} MPI ranks, and this run has {} "
+                      "(which would also read {}): resume it with mpirun -np {}",
+                      RankFile(resume, 0).string(), RankFile(resume, pieces - 1).string(), pieces,
+                      ranks.size, RankFile(resume, ranks.size - 1).string(), pieces));
+    return;
+  }
+  if (std::filesystem::exists(resume, error) || pieces == 0) return;
+  gipsi::ThrowInputError(
+      "command line", "--resume",
+      fmt::format("{} does not exist, and {} to {} are the checkpoint of a run on {} MPI ranks: "
+                  "resume it with mpirun -np {} (docs/scale-out.md)",
+                  resume.string(), RankFile(resume, 0).string(),
+                  RankFile(resume, pieces - 1).string(), pieces, pieces));
+}
+
 /// Options of `gipsi run` about checkpoints.
 struct CheckpointOptions {
   double every = 0;    ///< simulated seconds between checkpoints; 0: none
@@ -353,12 +396,7 @@ int Run(const std::string& file, const std::string& out_dir, double until, bool 
         const CheckpointOptions& checkpoints, const gipsi::SceneLimits& limits,
         const Ranks& ranks = {}) {
   StopSignals signals;  // while building: exit 130 at once; then: stop the run cleanly
-  if (ranks.distributed() && (checkpoints.every > 0 || !checkpoints.resume.empty()))
-    gipsi::ThrowInputError(
-        "command line", checkpoints.every > 0 ? "--checkpoint-every" : "--resume",
-        fmt::format("checkpoints of a distributed run ({} ranks) are not available yet "
-                    "(docs/scale-out.md); run without them",
-                    ranks.size));
+  if (!checkpoints.resume.empty()) CheckResumeFiles(checkpoints.resume, ranks);
   const bool lead = ranks.rank == 0;  // writes files and prints
   if (!lead) quiet = true;
   gipsi::TypeRegistry registry;
@@ -387,9 +425,9 @@ int Run(const std::string& file, const std::string& out_dir, double until, bool 
       gipsi::ThrowInputError("command line", "--checkpoint-every",
                              fmt::format("{} s is not a whole number of macro steps of {} s",
                                          checkpoints.every, kernel.macro_dt()));
-    kernel.SetCheckpointing(
-        checkpoints.file.empty() ? out / "checkpoint.gck" : std::filesystem::path(checkpoints.file),
-        every);
+    const std::filesystem::path file =
+        checkpoints.file.empty() ? out / "checkpoint.gck" : std::filesystem::path(checkpoints.file);
+    kernel.SetCheckpointing(ranks.distributed() ? RankFile(file, ranks.rank) : file, every);
     // Refuse now, not at the first checkpoint after minutes of running, if some object or
     // connector cannot save its state (a trial save into memory; no outputs exist yet).
     try {
@@ -410,7 +448,8 @@ int Run(const std::string& file, const std::string& out_dir, double until, bool 
   gipsi::AttachOutputs(scene, out, !checkpoints.resume.empty(),
                        lead ? gipsi::OutputFiles::kWrite : gipsi::OutputFiles::kReadOnly);
   if (!checkpoints.resume.empty()) {
-    kernel.ReadCheckpoint(checkpoints.resume);
+    kernel.ReadCheckpoint(ranks.distributed() ? RankFile(checkpoints.resume, ranks.rank)
+                                              : std::filesystem::path(checkpoints.resume));
     const double tolerance = 1e-9 * kernel.macro_dt();
     if (scene.end_time <= kernel.time() + tolerance)
       gipsi::ThrowInputError(
@@ -738,11 +777,13 @@ int main(int argc, char** argv) {
                   "steps), and when stopped by SIGINT/SIGTERM")
       ->check(gipsi::apps::PositiveNumber("a positive number of seconds"));
   run->add_option("--checkpoint", checkpoints.file,
-                  "Checkpoint file to write (default: <out>/checkpoint.gck)");
+                  "Checkpoint file to write (default: <out>/checkpoint.gck; under mpirun each "
+                  "rank writes its own, <stem>_p<rank>.gck)");
   run->add_option("--resume", checkpoints.resume,
                   "Continue from a checkpoint of the same scene, appending to the outputs in the "
                   "output directory (continued outputs are bitwise identical to an "
-                  "uninterrupted run with the same thread count)");
+                  "uninterrupted run with the same thread count; a distributed run's checkpoint "
+                  "resumes on the same number of ranks, named as it was written)");
 
   auto* validate = app.add_subcommand("validate", "Check a scene without running it");
   validate->add_option("SCENE", scene_file, "Scene file (JSON)")->required();

@@ -20,7 +20,10 @@ Runs the N-version benchmark slab (scenes/slab_ep_0.5mm.json, its first 30 ms) s
   - an earlier run's pieces are refused, or deleted with --overwrite;
   - a divergence on one rank's part (a 5 V clamp at the far corner from 5 ms) stops every rank
     at the serial run's step, exit 3, with the probe rows recorded until then;
-  - what a distributed run refuses (checkpoints) and a bad scene exit with the serial codes.
+  - checkpoints: written per rank, and a run resumed from them on 2 ranks writes the
+    uninterrupted run's files byte for byte; a checkpoint on another rank count, or a set of
+    files from two checkpoints, is refused with the way out;
+  - a bad scene exits with the serial code.
 
 Usage: distributed_scene_test.py GIPSI MPIEXEC SOURCE_DIR
 """
@@ -210,10 +213,43 @@ with tempfile.TemporaryDirectory() as work:
     times = {ranks: [row[0] for row in table] for ranks, table in diverged.items()}
     check(times[1] == times[2] and len(times[1]) > 5,
           f"diverging clamp: probe rows at {times[2][-3:]} on 2 ranks, {times[1][-3:]} serially")
+    # Checkpoints: each rank writes its own file; a run stopped at 20 ms and resumed to 30 ms
+    # on 2 ranks writes the uninterrupted run's files, every byte (frames, pieces, probes).
+    resumed = os.path.join(work, "resumed")
+    code, text = run(2, resumed, "--checkpoint-every", "0.01", until="0.02")
+    check(code == 0, f"2 ranks with checkpoints: exit {code}: {text}")
+    early = {}
+    for k in (0, 1):
+        with open(os.path.join(resumed, f"checkpoint_p{k}.gck"), "rb") as f:
+            early[k] = f.read()
+    code, text = run(2, resumed, "--resume", os.path.join(resumed, "checkpoint.gck"),
+                     "--checkpoint-every", "0.01")
+    check(code == 0, f"2 ranks resumed: exit {code}: {text}")
+    uninterrupted = os.path.join(work, "ranks2")
+    for f in files(uninterrupted):
+        with open(os.path.join(uninterrupted, f), "rb") as a, open(os.path.join(resumed, f), "rb") as b:
+            check(a.read() == b.read(), f"resumed on 2 ranks: {f} differs from the uninterrupted run")
+    check(set(files(resumed)) - set(files(uninterrupted)) ==
+          {"checkpoint_p0.gck", "checkpoint_p1.gck"},
+          f"resumed on 2 ranks: files {set(files(resumed)) ^ set(files(uninterrupted))}")
+    # A checkpoint resumes only on the rank count that wrote it, and the ranks' files only as
+    # the set written together; the refusals name the files and the way out.
+    checkpoint = os.path.join(resumed, "checkpoint.gck")
+    code, text = run(4, resumed, "--resume", checkpoint)
+    check(code == 1 and "are the checkpoint of a run on 2 MPI ranks, and this run has 4" in text
+          and "mpirun -np 2" in text, f"a 2-rank checkpoint on 4 ranks: exit {code}: {text}")
+    code, text = run(1, resumed, "--resume", checkpoint)
+    check(code == 1 and "are the checkpoint of a run on 2 MPI ranks" in text,
+          f"a 2-rank checkpoint serially: exit {code}: {text}")
+    with open(os.path.join(resumed, "checkpoint_p1.gck"), "wb") as f:
+        f.write(early[1])  # rank 1's file of the checkpoint at 20 ms, rank 0's at 30 ms
+    before = rows(os.path.join(resumed, "probes", "far_corner.csv"))
+    code, text = run(2, resumed, "--resume", checkpoint, until="0.04")
+    check(code == 1 and "the ranks' checkpoint files are from different checkpoints" in text,
+          f"a mixed set of checkpoint files: exit {code}: {text}")
+    check(rows(os.path.join(resumed, "probes", "far_corner.csv")) == before,
+          "a refused checkpoint changed the outputs")
     # Refusals keep the serial exit codes, on every rank.
-    code, text = run(2, os.path.join(work, "refused"), "--checkpoint-every", "0.01")
-    check(code == 1 and "checkpoints of a distributed run (2 ranks) are not available yet" in text,
-          f"checkpoints under MPI: exit {code}: {text}")
     missing = os.path.join(work, "no-such-scene.json")
     result = subprocess.run([MPIEXEC, "-np", "2", GIPSI, "run", missing], capture_output=True,
                             text=True, timeout=120)

@@ -105,9 +105,10 @@ void VtuSeriesWriter::Observe(const Kernel& kernel, double t) {
 }
 
 namespace {
-std::string FrameFile(const std::string& name, std::int64_t frame, bool display) {
+/// The file a collection lists for a frame: a distributed object's frame is its `.pvtu`.
+std::string FrameFile(const std::string& name, std::int64_t frame, bool display, bool pieces) {
   return display ? fmt::format("{}_display/{}_display_{:06d}.vtu", name, name, frame)
-                 : fmt::format("{}/{}_{:06d}.vtu", name, name, frame);
+                 : fmt::format("{}/{}_{:06d}.{}", name, name, frame, pieces ? "pvtu" : "vtu");
 }
 }  // namespace
 
@@ -138,12 +139,14 @@ void VtuSeriesWriter::RestoreState(StateReader& in) {
 }
 
 void VtuSeriesWriter::CommitRestore() {
+  if (!write_) return;  // the collections are the first rank's
   for (Series& series : series_) {
+    const bool pieces = series.object->output_piece().count > 1;
     std::vector<std::pair<double, std::string>> frames, display;
     for (std::int64_t k = 0; k < frame_; ++k) {
       const double t = frame_times_[static_cast<std::size_t>(k)];
-      frames.emplace_back(t, FrameFile(series.object->name(), k, false));
-      display.emplace_back(t, FrameFile(series.object->name(), k, true));
+      frames.emplace_back(t, FrameFile(series.object->name(), k, false, pieces));
+      display.emplace_back(t, FrameFile(series.object->name(), k, true, false));
     }
     series.domain.SetFrames(frames);
     if (series.display) series.display->SetFrames(display);
@@ -154,10 +157,14 @@ void ProbeRecorder::SaveState(StateWriter& out) {
   out.BeginSection("ProbeRecorder", 2);
   out.WriteInt(static_cast<std::int64_t>(streams_.size()));
   for (auto& s : streams_) {
-    s.file.flush();
-    const auto length = static_cast<std::int64_t>(s.file.tellp());
-    if (!s.file || length < 0)
-      throw std::runtime_error(fmt::format("{}: cannot tell the file length", s.path.string()));
+    // A rank that does not write (OutputFiles::kReadOnly) has no file: length 0.
+    std::int64_t length = 0;
+    if (write_) {
+      s.file.flush();
+      length = static_cast<std::int64_t>(s.file.tellp());
+      if (!s.file || length < 0)
+        throw std::runtime_error(fmt::format("{}: cannot tell the file length", s.path.string()));
+    }
     out.WriteString(s.probe.name);
     out.WriteDouble(s.next);
     out.WriteInt(static_cast<std::int64_t>(s.next_at));
@@ -175,6 +182,7 @@ void ProbeRecorder::RestoreState(StateReader& in) {
     s.next = in.ReadDouble();
     s.next_at = static_cast<std::size_t>(in.ReadInt());
     const std::int64_t length = in.ReadInt();
+    if (!write_) continue;  // the files are the first rank's to check and cut
     std::error_code error;
     const auto size = std::filesystem::file_size(s.path, error);
     if (error || length < 0 || static_cast<std::uintmax_t>(length) > size)
@@ -188,6 +196,7 @@ void ProbeRecorder::RestoreState(StateReader& in) {
 }
 
 void ProbeRecorder::CommitRestore() {
+  if (!write_) return;
   for (auto& s : streams_) {
     s.file.close();
     std::filesystem::resize_file(s.path, s.resume_length);

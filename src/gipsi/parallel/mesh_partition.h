@@ -1,11 +1,13 @@
 #pragma once
 /// @file
 /// Splitting a tetrahedral mesh over the ranks of an MPI communicator. The tets are cut by
-/// PT-Scotch (through PETSc's MatPartitioning; Debian's PETSc has PT-Scotch, not ParMETIS,
-/// whose licence keeps it out of Debian main) on the mesh's dual graph (tets joined across
-/// shared faces), balanced by tet count. Each rank keeps its tets and every node they use;
-/// a node used by several ranks is owned by the lowest of them, and each rank's owned nodes
-/// take a contiguous block of the global (PETSc) numbering, in the whole mesh's order.
+/// PT-Scotch (the partitioner Debian's PETSc comes with; ParMETIS's licence keeps it out of
+/// Debian main) on the mesh's dual graph (tets joined across shared faces), balanced by tet
+/// count, in Scotch's deterministic mode with a fixed seed: the same mesh on the same rank
+/// count is cut the same way in every run (checkpoints of a distributed run rely on it). Each rank
+/// keeps its tets and every node they use; a node used by several ranks is owned by the lowest of
+/// them, and each rank's owned nodes take a contiguous block of the global (PETSc) numbering, in
+/// the whole mesh's order.
 ///
 /// Every rank reads the whole mesh first (the scene loader does), so the peak memory per rank
 /// is the whole mesh plus its part: about 100 bytes per tet for the mesh and 60 for the
@@ -48,7 +50,7 @@ struct MeshPart {
 
 /// Splits `whole` (identical on every rank of `comm`) over the ranks (see the file comment).
 /// Collective. On one rank the part is the whole mesh in its own order. Throws InputError if
-/// the mesh has fewer tets than there are ranks, and PetscError if the partitioner fails.
+/// the mesh has fewer tets than there are ranks, and std::runtime_error if PT-Scotch fails.
 MeshPart PartitionMesh(const Mesh& whole, MPI_Comm comm);
 
 /// Every rank's owned values of a node field, gathered on rank 0 in the whole mesh's node order

@@ -8,7 +8,12 @@
 /// rank (MPI_Allgatherv: collective, and O(whole mesh) per rank per read), writing one keeps
 /// this rank's entries; global fields are the part's (its own reductions). Boundary fields are
 /// not offered. Steps, stop requests, profiles and failure details go to the part; the part's
-/// state is the view's (checkpoints and step retries serialise it per rank).
+/// state is the view's. Step retries take the part's own snapshots (no communication). A
+/// checkpoint holds this rank's part after the rank count, the rank and a fingerprint of the
+/// partition (every rank writes its own file, docs/scale-out.md); a restore checks them on
+/// every rank together and, once read, that every rank's part is at the same time and step,
+/// so a checkpoint restores only on the rank count and partition that wrote it, and a set of
+/// files from different checkpoints (a run stopped while writing them) is refused.
 ///
 /// Every rank must make the same calls in the same order (they do when every rank runs the
 /// same kernel on the same scene). The gathers make this the simple path, not the scalable one:
@@ -17,6 +22,7 @@
 
 #include <mpi.h>
 
+#include <cstdint>
 #include <memory>
 #include <string>
 #include <vector>
@@ -42,8 +48,14 @@ class WholeDomainView final : public SimObject {
   [[nodiscard]] std::vector<ProfileEntry> ProfileBreakdown() const override {
     return part_->ProfileBreakdown();
   }
-  void SaveObjectState(StateWriter& out) const override { part_->SaveState(out); }
-  void RestoreObjectState(StateReader& in) override { part_->RestoreState(in); }
+  void SaveObjectState(StateWriter& out) const override;
+  /// Collective: every rank must restore its own rank's file.
+  void RestoreObjectState(StateReader& in) override;
+  [[nodiscard]] std::unique_ptr<ObjectState> NewObjectState() const override {
+    return part_->NewSnapshot();
+  }
+  void CopyObjectState(ObjectState& into) const override { part_->TakeSnapshot(into); }
+  void SetObjectState(const ObjectState& from) override { part_->RestoreSnapshot(from); }
   void BeginMacroStep() override;
   /// VTU series write the part, one piece per rank.
   [[nodiscard]] OutputPiece output_piece() const override {
@@ -72,6 +84,7 @@ class WholeDomainView final : public SimObject {
   MPI_Comm comm_;
   std::vector<FieldId> part_field_;  // the part's field behind each of the view's
   Layout nodes_, elements_;
+  std::uint64_t partition_fingerprint_ = 0;  // of the whole-mesh indices of the local nodes/tets
   // Buffers of the gathers, kept between reads (no allocation once sized).
   mutable std::vector<double> receive_;
   mutable std::vector<int> counts_, offsets_;
