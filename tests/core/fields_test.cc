@@ -45,11 +45,32 @@ TEST(Fields, UnknownNameListsTheFieldsAndSuggests) {
   }
 }
 
+// What probes read: the asked items (in any order, repeated) are ReadField's columns, bitwise,
+// for a field stored in the object (FieldMemory) and for one computed on request.
+TEST(Fields, ReadingItemsGivesThoseColumnsOfTheWholeField) {
+  auto cube = Cube();
+  cube->WriteField(cube->FindField("velocity"),
+                   Eigen::MatrixXd::Random(3, cube->FieldCount(cube->FindField("velocity"))));
+  const std::vector<int> items = {26, 3, 3, 0, 13};
+  for (const char* name : {"position", "velocity", "displacement"}) {
+    const FieldId id = cube->FindField(name);
+    Eigen::MatrixXd whole(3, cube->FieldCount(id)), some(3, 5);
+    cube->ReadField(id, whole);
+    cube->ReadFieldItems(id, items, some);
+    for (std::size_t k = 0; k < items.size(); ++k)
+      EXPECT_EQ(some.col(static_cast<Index>(k)), whole.col(items[k])) << name << " item " << k;
+  }
+}
+
 TEST(FieldsDeathTest, WrongSizeIsAProgrammerErrorThatAborts) {
   auto cube = Cube();
   Eigen::MatrixXd wrong(3, 5);
   EXPECT_DEATH(cube->ReadField(cube->FindField("position"), wrong), "is 3 by 27, buffer is 3 by 5");
   EXPECT_DEATH(cube->WriteField(cube->FindField("displacement"), wrong), "read-only");
+  const std::vector<int> outside = {27};
+  Eigen::MatrixXd one(3, 1);
+  EXPECT_DEATH(cube->ReadFieldItems(cube->FindField("position"), outside, one),
+               "has 27 items, asked for item 27");
 }
 
 TEST(BoundaryConditions, FixThenReleaseFreesTheAxes) {

@@ -168,6 +168,37 @@ void SimObject::ReadField(FieldId id, Eigen::Ref<Eigen::MatrixXd> out) const {
   DoReadField(id, out);
 }
 
+void SimObject::ReadFieldItems(FieldId id, std::span<const int> items,
+                               Eigen::Ref<Eigen::MatrixXd> out) const {
+  const FieldInfo& info = field_info(id);
+  GIPSI_CHECK(info.readable(), "field '{}' of '{}' is write-only", info.name, name_);
+  GIPSI_CHECK(info.location != FieldLocation::kGlobal, "field '{}' of '{}' has no items", info.name,
+              name_);
+  GIPSI_CHECK(out.rows() == info.components && out.cols() == static_cast<Index>(items.size()),
+              "field '{}' of '{}': {} items of {} components, buffer is {} by {}", info.name, name_,
+              items.size(), info.components, out.rows(), out.cols());
+  const Index count = FieldCount(id);
+  for (const int i : items)
+    GIPSI_CHECK(i >= 0 && i < count, "field '{}' of '{}' has {} items, asked for item {}",
+                info.name, name_, count, i);
+  DoReadFieldItems(id, items, out);
+}
+
+void SimObject::DoReadFieldItems(FieldId id, std::span<const int> items,
+                                 Eigen::Ref<Eigen::MatrixXd> out) const {
+  const FieldInfo& info = field_info(id);
+  const Index count = FieldCount(id);
+  Eigen::MatrixXd whole;
+  const double* values = DoFieldMemory(id);
+  if (values == nullptr) {
+    whole.resize(info.components, count);
+    DoReadField(id, whole);
+    values = whole.data();
+  }
+  const Eigen::Map<const Eigen::MatrixXd> all(values, info.components, count);
+  for (std::size_t k = 0; k < items.size(); ++k) out.col(static_cast<Index>(k)) = all.col(items[k]);
+}
+
 const double* SimObject::FieldMemory(FieldId id) const {
   return field_info(id).readable() ? DoFieldMemory(id) : nullptr;
 }

@@ -113,6 +113,14 @@ class SimObject {
   /// Copies the field into `out` (components by count). Preconditions (checked, abort): the
   /// field is readable and `out` has the right shape. Allocates nothing.
   void ReadField(FieldId id, Eigen::Ref<Eigen::MatrixXd> out) const;
+  /// Copies the listed items of a node, element or boundary field (indices in [0, count),
+  /// repeats allowed) into `out` (components by items.size()): what ReadField gives in those
+  /// columns, bitwise. Probes read through it, so an object whose fields are not all in one
+  /// process (a distributed object's view, gipsi/parallel/) sends only the items asked for.
+  /// Preconditions as ReadField (checked, abort), and a field with items. Collective where
+  /// ReadField is.
+  void ReadFieldItems(FieldId id, std::span<const int> items,
+                      Eigen::Ref<Eigen::MatrixXd> out) const;
   /// Sets the field from `in` (components by count). Preconditions as ReadField, for writing.
   void WriteField(FieldId id, const Eigen::Ref<const Eigen::MatrixXd>& in);
   /// Where a readable field's values are stored, if they are rather than computed on request:
@@ -263,6 +271,10 @@ class SimObject {
   /// Hook of SetStopToken (an aggregate forwards the token to its parts). Default: nothing.
   virtual void DoSetStopToken(StopToken /*token*/) {}
   virtual void DoReadField(FieldId id, Eigen::Ref<Eigen::MatrixXd> out) const = 0;
+  /// Hook of ReadFieldItems (items checked). Default: the columns of FieldMemory, else of a
+  /// ReadField into a buffer.
+  virtual void DoReadFieldItems(FieldId id, std::span<const int> items,
+                                Eigen::Ref<Eigen::MatrixXd> out) const;
   /// Hook of FieldMemory (readable fields only); default nullptr: every field computed.
   [[nodiscard]] virtual const double* DoFieldMemory(FieldId /*id*/) const { return nullptr; }
   virtual void DoWriteField(FieldId id, const Eigen::Ref<const Eigen::MatrixXd>& in) = 0;

@@ -33,6 +33,24 @@ void Interpolate(const PointMap& map, const FieldInfo& info, const Eigen::Matrix
     map.Apply(values, out);
 }
 
+/// The probe's point map rewritten over the nodes it uses (sorted, into probe.items): a sample
+/// then reads those nodes only. Every slot keeps its node, the unused ones (weight 0) too, so
+/// the interpolation adds the same numbers as over the whole field.
+void UseOnlyTheMappedNodes(Probe& probe) {
+  const PointMap& map = *probe.point;
+  const Eigen::Matrix4Xi& nodes = map.indices();
+  probe.items.assign(nodes.data(), nodes.data() + nodes.size());
+  std::sort(probe.items.begin(), probe.items.end());
+  probe.items.erase(std::unique(probe.items.begin(), probe.items.end()), probe.items.end());
+  Eigen::Matrix4Xi columns(4, nodes.cols());
+  for (Index j = 0; j < nodes.cols(); ++j)
+    for (int k = 0; k < 4; ++k)
+      columns(k, j) =
+          static_cast<int>(std::lower_bound(probe.items.begin(), probe.items.end(), nodes(k, j)) -
+                           probe.items.begin());
+  probe.point = PointMap::FromWeights(std::move(columns), map.weights(), map.max_distance());
+}
+
 }  // namespace
 
 std::string Probe::Header() const {
@@ -65,8 +83,8 @@ void Probe::Sample(std::vector<double>& out) const {
     std::size_t column = 4;
     for (FieldId id : fields) {
       const FieldInfo& info = object->field_info(id);
-      Eigen::MatrixXd values(info.components, object->FieldCount(id));
-      object->ReadField(id, values);
+      Eigen::MatrixXd values(info.components, static_cast<Index>(items.size()));
+      object->ReadFieldItems(id, items, values);
       Eigen::MatrixXd at_points(info.components, n);
       Interpolate(*point, info, values, at_points);
       for (Index j = 0; j < n; ++j)
@@ -78,9 +96,13 @@ void Probe::Sample(std::vector<double>& out) const {
   }
   for (FieldId id : fields) {
     const FieldInfo& info = object->field_info(id);
-    Eigen::MatrixXd values(info.components, object->FieldCount(id));
-    object->ReadField(id, values);
-    if (info.location == FieldLocation::kGlobal) {
+    const bool global = info.location == FieldLocation::kGlobal;
+    Eigen::MatrixXd values(info.components, global ? 1 : static_cast<Index>(items.size()));
+    if (global)
+      object->ReadField(id, values);
+    else
+      object->ReadFieldItems(id, items, values);
+    if (global) {
       for (int c = 0; c < info.components; ++c) out.push_back(values(c, 0));
     } else if (point) {
       Eigen::MatrixXd at(info.components, 1);
@@ -92,8 +114,8 @@ void Probe::Sample(std::vector<double>& out) const {
                      : reduce == Reduce::kMax ? -std::numeric_limits<double>::infinity()
                                               : 0.0;
         std::size_t counted = 0;
-        for (int i : items) {
-          double v = values(c, i);
+        for (Index i = 0; i < values.cols(); ++i) {
+          const double v = values(c, i);
           if (info.no_data && v == *info.no_data) continue;
           ++counted;
           if (reduce == Reduce::kMin)
@@ -179,6 +201,7 @@ Probe ParseProbe(const std::string& name, const JsonNode& node, const Kernel& ke
     if (probe.point->max_distance() > 1e-6 * diag)
       p->Fail(fmt::format("the point lies {:.4g} outside the domain of '{}'",
                           probe.point->max_distance(), object.path()));
+    UseOnlyTheMappedNodes(probe);
   } else if (auto l = node.Find("line")) {
     if (location != FieldLocation::kNode || !needs_location)
       node.At(node.Has("field") ? "field" : "fields")
@@ -208,6 +231,7 @@ Probe ParseProbe(const std::string& name, const JsonNode& node, const Kernel& ke
     if (probe.point->max_distance() > 1e-6 * diag)
       l->Fail(fmt::format("the line leaves the domain of '{}' (a point lies {:.4g} outside it)",
                           object.path(), probe.point->max_distance()));
+    UseOnlyTheMappedNodes(probe);
     if (auto at = node.Find("at")) {
       if (at->is_array()) {
         for (const auto& item : at->Items())

@@ -44,13 +44,15 @@ struct Probe {
   std::string name;
   const SimObject* object = nullptr;
   std::vector<FieldId> fields;
-  std::optional<PointMap> point;  ///< point and line probes: interpolation weights
+  /// Point and line probes: interpolation weights, over the columns of `items` (the nodes the
+  /// points need, sorted): a sample reads those items only (SimObject::ReadFieldItems).
+  std::optional<PointMap> point;
   /// Line probes: the sample points (3 by n, rest coordinates) and distances from the first.
   Points line = Points(3, 0);
   std::vector<double> distance;
   /// Line probes: sample times [s], ascending; empty = once, at the end of the run.
   std::vector<double> at;
-  std::vector<int> items;  ///< region probes: node or boundary-vertex ids
+  std::vector<int> items;  ///< node or boundary-vertex ids read by each sample
   bool region = false;
   Reduce reduce = Reduce::kMean;
   double every = 0;

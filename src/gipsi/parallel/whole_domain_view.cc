@@ -8,6 +8,7 @@
 #include <array>
 #include <numeric>
 
+#include "gipsi/base/error.h"
 #include "gipsi/base/state.h"
 #include "gipsi/geometry/boundary.h"
 
@@ -27,6 +28,9 @@ WholeDomainView::Layout WholeDomainView::MakeLayout(const std::vector<int>& whol
   MPI_Allgatherv(whole_of_local.data(), mine, MPI_INT, layout.whole.data(), layout.counts.data(),
                  layout.offsets.data(), MPI_INT, comm);
   layout.owned = mine;
+  layout.owned_local.assign(layout.whole.size(), -1);
+  for (int i = 0; i < mine; ++i)
+    layout.owned_local[static_cast<std::size_t>(whole_of_local[static_cast<std::size_t>(i)])] = i;
   return layout;
 }
 
@@ -149,6 +153,47 @@ void WholeDomainView::DoReadField(FieldId id, Eigen::Ref<Eigen::MatrixXd> out) c
     for (int k = 0; k < c; ++k)
       out(k, layout.whole[i]) =
           receive_[i * static_cast<std::size_t>(c) + static_cast<std::size_t>(k)];
+}
+
+void WholeDomainView::DoReadFieldItems(FieldId id, std::span<const int> items,
+                                       Eigen::Ref<Eigen::MatrixXd> out) const {
+  const FieldId part_id = part_field_[static_cast<std::size_t>(id.value())];
+  const FieldInfo& info = part_->field_info(part_id);
+  const Layout& layout = info.location == FieldLocation::kNode ? nodes_ : elements_;
+  const int c = info.components;
+  local_.resize(c, part_->FieldCount(part_id));
+  part_->ReadField(part_id, local_);
+  // The asked items this rank owns: their positions in `items` and their values.
+  sent_items_.clear();
+  sent_values_.clear();
+  for (std::size_t k = 0; k < items.size(); ++k) {
+    const int local = layout.owned_local[static_cast<std::size_t>(items[k])];
+    if (local < 0) continue;
+    sent_items_.push_back(static_cast<int>(k));
+    for (int j = 0; j < c; ++j) sent_values_.push_back(local_(j, local));
+  }
+  const int size = static_cast<int>(layout.counts.size());
+  counts_.resize(static_cast<std::size_t>(size));
+  offsets_.assign(static_cast<std::size_t>(size), 0);
+  const int mine = static_cast<int>(sent_items_.size());
+  MPI_Allgather(&mine, 1, MPI_INT, counts_.data(), 1, MPI_INT, comm_);
+  std::partial_sum(counts_.begin(), counts_.end() - 1, offsets_.begin() + 1);
+  received_items_.resize(static_cast<std::size_t>(offsets_.back() + counts_.back()));
+  GIPSI_CHECK(received_items_.size() == items.size(), "'{}': {} of {} items owned by some rank",
+              name(), received_items_.size(), items.size());
+  MPI_Allgatherv(sent_items_.data(), mine, MPI_INT, received_items_.data(), counts_.data(),
+                 offsets_.data(), MPI_INT, comm_);
+  for (int r = 0; r < size; ++r) {
+    counts_[static_cast<std::size_t>(r)] *= c;
+    offsets_[static_cast<std::size_t>(r)] *= c;
+  }
+  receive_.resize(items.size() * static_cast<std::size_t>(c));
+  MPI_Allgatherv(sent_values_.data(), c * mine, MPI_DOUBLE, receive_.data(), counts_.data(),
+                 offsets_.data(), MPI_DOUBLE, comm_);
+  for (std::size_t i = 0; i < received_items_.size(); ++i)
+    for (int j = 0; j < c; ++j)
+      out(j, received_items_[i]) =
+          receive_[i * static_cast<std::size_t>(c) + static_cast<std::size_t>(j)];
 }
 
 void WholeDomainView::DoWriteField(FieldId id, const Eigen::Ref<const Eigen::MatrixXd>& in) {

@@ -16,9 +16,10 @@
 /// files from different checkpoints (a run stopped while writing them) is refused.
 ///
 /// Every rank must make the same calls in the same order (they do when every rank runs the
-/// same kernel on the same scene). The gathers make this the simple path, not the scalable one:
-/// VTU series write the part as one piece per rank instead (output_piece), and owner-computed
-/// probes are to replace the gathers for probes (docs/scale-out.md).
+/// same kernel on the same scene). The whole-field gathers make ReadField the simple path, not
+/// the scalable one: VTU series write the part as one piece per rank instead (output_piece),
+/// and probes read only the items they need (ReadFieldItems), each sent by the rank that owns
+/// it. Connectors still read whole fields (docs/scale-out.md).
 
 #include <mpi.h>
 
@@ -66,6 +67,10 @@ class WholeDomainView final : public SimObject {
  protected:
   StepStatus DoStep(double t, double dt) override;
   void DoReadField(FieldId id, Eigen::Ref<Eigen::MatrixXd> out) const override;
+  /// Each rank sends the asked items it owns, to every rank (MPI_Allgatherv of O(items)):
+  /// how probes read the part.
+  void DoReadFieldItems(FieldId id, std::span<const int> items,
+                        Eigen::Ref<Eigen::MatrixXd> out) const override;
   void DoWriteField(FieldId id, const Eigen::Ref<const Eigen::MatrixXd>& in) override;
   void DoSetStopToken(StopToken token) override { part_->SetStopToken(token); }
 
@@ -75,6 +80,7 @@ class WholeDomainView final : public SimObject {
     std::vector<int> counts, offsets;  // items per rank and where each rank's start
     std::vector<int> whole;            // the whole-mesh index of every gathered item
     int owned = 0;                     // this rank's items: the local ones [0, owned)
+    std::vector<int> owned_local;      // per whole-mesh item: its local index if owned, else -1
   };
   static Layout MakeLayout(const std::vector<int>& whole_of_local, std::int64_t owned,
                            MPI_Comm comm);
@@ -89,6 +95,8 @@ class WholeDomainView final : public SimObject {
   mutable std::vector<double> receive_;
   mutable std::vector<int> counts_, offsets_;
   mutable Eigen::MatrixXd local_;
+  mutable std::vector<int> sent_items_, received_items_;
+  mutable std::vector<double> sent_values_;
 };
 
 }  // namespace gipsi
