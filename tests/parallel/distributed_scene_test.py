@@ -23,6 +23,8 @@ Runs the N-version benchmark slab (scenes/slab_ep_0.5mm.json, its first 30 ms) s
   - checkpoints: written per rank, and a run resumed from them on 2 ranks writes the
     uninterrupted run's files byte for byte; a checkpoint on another rank count, or a set of
     files from two checkpoints, is refused with the way out;
+  - the object's "parallel" block chooses the distributed diffusion solver (BoomerAMG: one CG
+    iteration per step, fewer in all than Jacobi's one or two);
   - a bad scene exits with the serial code.
 
 Usage: distributed_scene_test.py GIPSI MPIEXEC SOURCE_DIR
@@ -213,6 +215,37 @@ with tempfile.TemporaryDirectory() as work:
     times = {ranks: [row[0] for row in table] for ranks, table in diverged.items()}
     check(times[1] == times[2] and len(times[1]) > 5,
           f"diverging clamp: probe rows at {times[2][-3:]} on 2 ranks, {times[1][-3:]} serially")
+    # The object's "parallel" block chooses the distributed diffusion solver: BoomerAMG needs
+    # one CG iteration per step, and fewer in all than the default Jacobi; the activated fraction
+    # stays the serial one within one node of the 4,305 (the solves agree to their tolerance).
+    with open(SCENE) as f:
+        scene = json.load(f)
+    scene["probes"]["iterations"] = {"object": "tissue", "field": "diffusion_iterations"}
+    counted = os.path.join(work, "counted.json")
+    with open(counted, "w") as f:
+        json.dump(scene, f)
+    scene["objects"]["tissue"]["parallel"] = {"linear_solver": {"preconditioner": "hypre"}}
+    hypre = os.path.join(work, "hypre.json")
+    with open(hypre, "w") as f:
+        json.dump(scene, f)
+    iterations = {}
+    for label, scene_file in (("jacobi", counted), ("hypre", hypre)):
+        out = os.path.join(work, label)
+        code, text = run(2, out, "-q", scene=scene_file, until="0.01")
+        check(code == 0, f"the parallel block ({label}): exit {code}: {text}")
+        iterations[label] = [int(r[1]) for r in rows(os.path.join(out, "probes", "iterations.csv"))[2:]]
+        fractions = rows(os.path.join(out, "probes", "activated.csv"))[1:]
+        serial_fractions = rows(os.path.join(serial, "probes", "activated.csv"))[1:len(fractions) + 1]
+        for a, b in zip(serial_fractions, fractions):
+            check(a[0] == b[0] and abs(float(a[1]) - float(b[1])) <= 1 / 4305 + 1e-12,
+                  f"the parallel block ({label}): activated fraction {b} vs serial {a}")
+    check(iterations["hypre"] and max(iterations["hypre"]) == 1 and
+          sum(iterations["jacobi"]) > sum(iterations["hypre"]),
+          f"the parallel block: CG iterations per step with hypre {sorted(set(iterations['hypre']))} "
+          f"({sum(iterations['hypre'])} in all), Jacobi {sorted(set(iterations['jacobi']))} "
+          f"({sum(iterations['jacobi'])})")
+    print(f"the parallel block: {sum(iterations['hypre'])} CG iterations with hypre, "
+          f"{sum(iterations['jacobi'])} with Jacobi")
     # Checkpoints: each rank writes its own file; a run stopped at 20 ms and resumed to 30 ms
     # on 2 ranks writes the uninterrupted run's files, every byte (frames, pieces, probes).
     resumed = os.path.join(work, "resumed")

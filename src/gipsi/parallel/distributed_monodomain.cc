@@ -52,6 +52,12 @@ void LocaliseRegions(EpTissueParams& params, const Mesh& whole, const MeshPart& 
   for (ClampSpec& c : params.clamps) localise(c.region, fmt::format("clamp '{}'", c.name));
 }
 
+// The object's "parallel" solver, where the scene gives one, replaces the serial one.
+EpTissueParams UseDistributedSolver(EpTissueParams params) {
+  if (params.distributed_linear) params.linear = *params.distributed_linear;
+  return params;
+}
+
 }  // namespace
 
 struct DistributedMonodomain::Petsc {
@@ -82,7 +88,7 @@ struct DistributedMonodomain::Petsc {
 
 DistributedMonodomain::DistributedMonodomain(std::string name, const Mesh& whole,
                                              EpTissueParams params, MPI_Comm comm)
-    : EpTissue(std::move(name), std::move(params)), comm_(comm) {
+    : EpTissue(std::move(name), UseDistributedSolver(std::move(params))), comm_(comm) {
   if (whole.tets.cols() == 0)
     throw InputError("the Monodomain object needs a tetrahedral domain mesh (this one has none)");
   if (params_.anisotropic() && !params_.fibre && !params_.fibre_rule)

@@ -38,8 +38,9 @@ class DistributedMonodomain final : public EpTissue {
  public:
   /// Collective: partitions `whole` (identical on every rank) over `comm`. Regions select
   /// nodes of the whole mesh, then each rank keeps its own; fibre rules are evaluated on the
-  /// whole mesh. Throws InputError as Monodomain does (a region that selects no node of the
-  /// whole mesh, on every rank), PetscError if PETSc fails.
+  /// whole mesh. The diffusion solver is `params.distributed_linear` where set (the scene's
+  /// "parallel" block), else `params.linear`. Throws InputError as Monodomain does (a region
+  /// that selects no node of the whole mesh, on every rank), PetscError if PETSc fails.
   DistributedMonodomain(std::string name, const Mesh& whole, EpTissueParams params, MPI_Comm comm);
   ~DistributedMonodomain() override;
 

@@ -13,7 +13,7 @@ namespace gipsi {
 void RegisterDistributedTypes(TypeRegistry& registry, MPI_Comm comm) {
   registry.objects.Replace(
       "Monodomain", [comm](const ObjectBuildContext& ctx) -> std::unique_ptr<SimObject> {
-        CheckEpTissueKeys(ctx);
+        CheckEpTissueKeys(ctx, {"parallel"});
         EpTissueParams params = ParseEpTissueParams(ctx);
         std::shared_ptr<const Mesh> whole = ctx.DomainMesh();
         try {

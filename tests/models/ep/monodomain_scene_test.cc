@@ -68,6 +68,36 @@ TEST(MonodomainScene, ReadsQuantitiesWithUnitsAndTheHarmonicMean) {
   EXPECT_NEAR(scene.kernel->macro_dt(), 1e-5, 1e-20);
 }
 
+// The "parallel" block chooses the diffusion solver of a distributed run: a serial run reads
+// and checks it, keeps its own solver, and the keys the block leaves out follow "diffusion".
+TEST(MonodomainScene, TheParallelBlockIsCheckedAndKeptForDistributedRuns) {
+  TypeRegistry registry;
+  RegisterBuiltins(registry);
+  Scene scene = LoadSceneFromString(SceneText(kCell + R"("conductivity": 0.1,
+      "diffusion": {"linear_solver": {"preconditioner": "ic", "tolerance": 1e-10}},
+      "parallel": {"linear_solver": {"preconditioner": "hypre"}})"),
+                                    "scene.json", ".", registry);
+  const auto& tissue = dynamic_cast<const Monodomain&>(scene.kernel->FindObject("tissue"));
+  const EpTissueParams& p = tissue.params();
+  EXPECT_EQ(p.linear.preconditioner, "ic");
+  ASSERT_TRUE(p.distributed_linear.has_value());
+  EXPECT_EQ(p.distributed_linear->type, "cg");
+  EXPECT_EQ(p.distributed_linear->preconditioner, "hypre");
+  EXPECT_EQ(p.distributed_linear->tolerance, 1e-10);
+  EXPECT_THAT(LoadError(SceneText(kCell + R"("conductivity": 0.1,
+      "parallel": {"linear_solver": {"preconditioner": "ic"}})")),
+              HasSubstr("objects.tissue.parallel.linear_solver.preconditioner"));
+  EXPECT_THAT(LoadError(SceneText(kCell + R"("conductivity": 0.1,
+      "parallel": {"linear_solver": {"type": "umfpack"}})")),
+              HasSubstr("objects.tissue.parallel.linear_solver.type"));
+  EXPECT_THAT(LoadError(SceneText(kCell + R"("conductivity": 0.1,
+      "parallel": {"linear_solver": {"max_iterations": 0}})")),
+              HasSubstr("objects.tissue.parallel.linear_solver.max_iterations: expected a number "
+                        "of iterations in [1, 1000000]"));
+  EXPECT_THAT(LoadError(SceneText(kCell + R"("conductivity": 0.1, "parallel": {"ranks": 4})")),
+              HasSubstr("objects.tissue.parallel"));
+}
+
 TEST(MonodomainScene, BadInputGetsAClearError) {
   EXPECT_THAT(LoadError(SceneText(kCell + R"("conductivity": -0.1)")),
               HasSubstr("objects.tissue.conductivity: expected a positive quantity"));

@@ -84,6 +84,9 @@ struct EpTissueParams {
   bool lumped_mass = true;     ///< else consistent mass
   double reaction_dt = 0;      ///< largest reaction sub-step [s]; 0: the object's step
   LinearSolverOptions linear;  ///< diffusion solver (default CG + Jacobi, 1e-8)
+  /// The diffusion solver of a run split over MPI ranks (gipsi/parallel/), where it differs
+  /// from `linear`: the object's "parallel" block (a Monodomain's only). Serial runs ignore it.
+  std::optional<LinearSolverOptions> distributed_linear;
   std::vector<StimulusSpec> stimuli;
   std::vector<ClampSpec> clamps;
   double activation_threshold = 0;    ///< mV: activation when V rises through it

@@ -118,6 +118,26 @@ EpTissueParams ParseEpTissueParams(const ObjectBuildContext& ctx) {
       params.linear = parsed;
     }
   }
+  // "parallel": {"linear_solver": {...}}: the diffusion solver when the object is split over
+  // MPI ranks (PETSc's: "hypre" is BoomerAMG, "cholmod" and "ldlt" MUMPS's Cholesky); keys it
+  // leaves out keep the diffusion's. Checked in every run, used only in distributed ones.
+  if (auto parallel = p.Find("parallel")) {
+    parallel->CheckKeys({"linear_solver"});
+    const JsonNode solver = parallel->At("linear_solver");
+    solver.CheckKeys({"type", "preconditioner", "tolerance", "max_iterations"});
+    LinearSolverOptions distributed = params.linear;
+    if (auto type = solver.Find("type"))
+      distributed.type = type->AsChoice({"cg", "cholmod", "ldlt"});
+    if (auto preconditioner = solver.Find("preconditioner"))
+      distributed.preconditioner = preconditioner->AsChoice({"none", "jacobi", "amg", "hypre"});
+    distributed.tolerance = solver.Positive("tolerance", distributed.tolerance);
+    if (auto max_iterations = solver.Find("max_iterations")) {
+      const std::int64_t n = max_iterations->AsInt();
+      if (n < 1 || n > 1000000) max_iterations->Expected("a number of iterations in [1, 1000000]");
+      distributed.max_iterations = static_cast<int>(n);
+    }
+    params.distributed_linear = distributed;
+  }
   if (auto reaction = p.Find("reaction")) {
     reaction->CheckKeys({"dt"});
     params.reaction_dt = ReadPositiveQuantity(reaction->At("dt"), "s");

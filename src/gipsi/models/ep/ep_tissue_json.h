@@ -17,7 +17,8 @@ namespace gipsi {
 void CheckEpTissueKeys(const ObjectBuildContext& ctx, const std::vector<std::string>& extra = {});
 
 /// Reads cell, conductivity, fibres, surface_to_volume, capacitance, splitting, diffusion,
-/// reaction, stimuli, clamps and activation. Throws InputError naming the JSON path.
+/// reaction, stimuli, clamps, activation and (if the keys allow it: Monodomain) parallel.
+/// Throws InputError naming the JSON path.
 EpTissueParams ParseEpTissueParams(const ObjectBuildContext& ctx);
 
 }  // namespace gipsi

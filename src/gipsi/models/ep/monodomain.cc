@@ -74,7 +74,7 @@ void RegisterMonodomain(TypeRegistry& registry) {
   registry.objects.Register(
       "Monodomain",
       [](const ObjectBuildContext& ctx) -> std::unique_ptr<SimObject> {
-        CheckEpTissueKeys(ctx);
+        CheckEpTissueKeys(ctx, {"parallel"});
         EpTissueParams params = ParseEpTissueParams(ctx);
         try {
           return std::make_unique<Monodomain>(ctx.name, ctx.DomainMesh(), std::move(params));
