@@ -96,8 +96,8 @@ double TimePerCall(const Options& o, MPI_Comm comm, Call call) {
 
 }  // namespace
 
-int main(int argc, char** argv) {
-  gipsi::ParallelSession session(&argc, &argv);
+namespace {
+int Main(int argc, char** argv) {
   const Options o = Parse(argc, argv);
   const MPI_Comm world = gipsi::ParallelSession::world();
   const int rank = gipsi::ParallelSession::rank(world);
@@ -191,4 +191,18 @@ int main(int argc, char** argv) {
         "%.2f us  2 doubles %.2f us\n",
         size, 1e6 * halo, high[1], 8e-3 * high[1], 1e6 * reduce1, 1e6 * reduce2);
   return 0;
+}
+}  // namespace
+
+// A bad size (a mesh past the generator's limit, more ranks than tets) is reported by every
+// rank and ends all of them, rather than terminate's core dump.
+int main(int argc, char** argv) {
+  gipsi::ParallelSession session(&argc, &argv);  // MPI_Abort below needs MPI alive
+  try {
+    return Main(argc, argv);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "%s: %s\n", "comm_bench", e.what());
+    MPI_Abort(MPI_COMM_WORLD, 1);
+    return 1;
+  }
 }

@@ -118,8 +118,8 @@ gipsi::EpTissueParams SlabParams(const Options& o) {
 
 }  // namespace
 
-int main(int argc, char** argv) {
-  gipsi::ParallelSession session(&argc, &argv);
+namespace {
+int Main(int argc, char** argv) {
   const Options o = Parse(argc, argv);
   const MPI_Comm world = gipsi::ParallelSession::world();
   const int rank = gipsi::ParallelSession::rank(world);
@@ -188,4 +188,18 @@ int main(int argc, char** argv) {
   }
   tissue.reset();  // before PETSc finalises
   return 0;
+}
+}  // namespace
+
+// A bad size (a mesh past the generator's limit, more ranks than tets) is reported by every
+// rank and ends all of them, rather than terminate's core dump.
+int main(int argc, char** argv) {
+  gipsi::ParallelSession session(&argc, &argv);  // MPI_Abort below needs MPI alive
+  try {
+    return Main(argc, argv);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "%s: %s\n", "ep_scaling_bench", e.what());
+    MPI_Abort(MPI_COMM_WORLD, 1);
+    return 1;
+  }
 }
