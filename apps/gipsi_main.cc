@@ -196,7 +196,11 @@ class BuildProgress {
   bool finished_ = false, drawn_ = false, announced_ = false;
 };
 
-/// Loads the scene with its build progress (unless `quiet`).
+/// How long a rank that met an error waits for the others to report one too before it ends
+/// them all (Ranks::agree_on_failure): they read the same scene, so a bad one fails every rank
+/// within this; a rank that fails alone costs this much more before the abort.
+constexpr double kFailureAgreementSeconds = 5.0;
+
 /// The ranks of a distributed run (`mpirun -np N gipsi run`; docs/scale-out.md): every rank
 /// loads and runs the same scene, the distributed types split their objects over the ranks,
 /// and rank 0 alone writes files and prints. One rank (size 1) is a serial run.
@@ -208,10 +212,13 @@ struct Ranks {
   /// Ends every rank with `code` (a rank that stops alone would leave the others waiting).
   std::function<void(int)> abort;
   std::function<void()> barrier;
+  /// DistributedRun::AgreeOnFailure.
+  std::function<std::optional<std::string>(const std::string&)> agree_on_failure;
   std::vector<std::string> type_names;  ///< of the distributed types
   [[nodiscard]] bool distributed() const { return size > 1; }
 };
 
+/// Loads the scene with its build progress (unless `quiet`).
 gipsi::Scene Load(const std::string& file, const std::vector<std::string>& plugins,
                   gipsi::TypeRegistry& registry, const gipsi::SceneLimits& limits, bool quiet,
                   const Ranks& ranks = {}) {
@@ -883,6 +890,9 @@ int main(int argc, char** argv) {
     ranks.type_names = mpi->type_names();
     ranks.abort = [&mpi](int code) { mpi->Abort(code); };
     ranks.barrier = [&mpi] { mpi->Barrier(); };
+    ranks.agree_on_failure = [&mpi](const std::string& message) {
+      return mpi->AgreeOnFailure(message, kFailureAgreementSeconds);
+    };
     if (ranks.rank != 0) gipsi::Log().set_level(spdlog::level::err);
 #else
     // Every rank would run the whole scene and write the same files.
@@ -892,12 +902,22 @@ int main(int argc, char** argv) {
     return 2;
 #endif
   }
-  // A rank that fails alone must not leave the others waiting in a collective.
-  auto fail = [&ranks](int code) {
-    if (ranks.distributed()) ranks.abort(code);
+  // An error: printed, with the exit code. On several ranks, an error every rank meets (a bad
+  // scene, a refused checkpoint) is printed once, by rank 0, and by the others only where their
+  // message differs; a rank that fails alone must not leave the others waiting in a collective,
+  // so it ends every rank.
+  auto fail = [&ranks](int code, const std::string& message) {
+    if (!ranks.distributed()) {
+      std::cerr << "gipsi: error: " << message << "\n";
+      return code;
+    }
+    const std::optional<std::string> first = ranks.agree_on_failure(message);
+    if (ranks.rank == 0 || !first || *first != message)
+      std::cerr << "gipsi: error: " << (ranks.rank > 0 ? fmt::format("rank {}: ", ranks.rank) : "")
+                << message << "\n";
+    if (!first) ranks.abort(code);
     return code;
   };
-  const std::string rank_prefix = ranks.rank > 0 ? fmt::format("rank {}: ", ranks.rank) : "";
   try {
     if (*run)
       return Run(scene_file, out_dir, until, quiet, no_vtu, profile, overwrite, plugins,
@@ -911,19 +931,15 @@ int main(int argc, char** argv) {
     if (*cell) return Cell(cell_options, plugins);
     if (auto code = viz_commands.Dispatch()) return *code;
   } catch (const gipsi::InputError& e) {
-    std::cerr << "gipsi: error: " << rank_prefix << e.what() << "\n";
-    return fail(1);
+    return fail(1, e.what());
   } catch (const gipsi::OutputError& e) {
-    std::cerr << "gipsi: error: " << rank_prefix << e.what() << "\n";
-    return fail(4);
+    return fail(4, e.what());
   } catch (const std::filesystem::filesystem_error& e) {
     // Creating the output directory or files (the readers report their own errors as
     // InputError): a write failure.
-    std::cerr << "gipsi: error: " << rank_prefix << gipsi::DescribeFilesystemError(e) << "\n";
-    return fail(4);
+    return fail(4, gipsi::DescribeFilesystemError(e));
   } catch (const std::exception& e) {
-    std::cerr << "gipsi: error: " << rank_prefix << e.what() << "\n";
-    return fail(1);
+    return fail(1, e.what());
   }
   return 0;
 }

@@ -25,7 +25,7 @@ Runs the N-version benchmark slab (scenes/slab_ep_0.5mm.json, its first 30 ms) s
     files from two checkpoints, is refused with the way out;
   - the object's "parallel" block chooses the distributed diffusion solver (BoomerAMG: one CG
     iteration per step, fewer in all than Jacobi's one or two);
-  - a bad scene exits with the serial code.
+  - a bad scene exits with the serial code, its error printed once (not once per rank).
 
 Usage: distributed_scene_test.py GIPSI MPIEXEC SOURCE_DIR
 """
@@ -288,6 +288,9 @@ with tempfile.TemporaryDirectory() as work:
                             text=True, timeout=120)
     check(result.returncode == 1 and "no-such-scene.json" in result.stderr,
           f"a missing scene under MPI: exit {result.returncode}: {result.stderr}")
+    # An error every rank meets is printed once (rank 0's), not once per rank.
+    errors = [line for line in result.stderr.splitlines() if line.startswith("gipsi: error:")]
+    check(len(errors) == 1, f"a missing scene under MPI: {len(errors)} error lines: {errors}")
 
 print("FAILED" if failures else "PASSED", f"({len(failures)} failures)")
 sys.exit(1 if failures else 0)

@@ -5,6 +5,9 @@
 
 #include <mpi.h>
 
+#include <chrono>
+#include <thread>
+
 #include "gipsi/parallel/distributed_types.h"
 #include "gipsi/parallel/parallel_session.h"
 
@@ -13,7 +16,10 @@ namespace {
 
 class PetscRun final : public DistributedRun {
  public:
-  PetscRun() : session_(nullptr, nullptr) {}
+  PetscRun() : session_(nullptr, nullptr) { MPI_Comm_dup(world(), &failures_); }
+  ~PetscRun() override { MPI_Comm_free(&failures_); }
+  PetscRun(const PetscRun&) = delete;
+  PetscRun& operator=(const PetscRun&) = delete;
   [[nodiscard]] int rank() const override { return ParallelSession::rank(world()); }
   [[nodiscard]] int size() const override { return ParallelSession::size(world()); }
   void RegisterTypes(TypeRegistry& registry) const override {
@@ -27,10 +33,28 @@ class PetscRun final : public DistributedRun {
     MPI_Abort(world(), code);
     std::abort();  // MPI_Abort does not return
   }
+  [[nodiscard]] std::optional<std::string> AgreeOnFailure(const std::string& message,
+                                                          double seconds) const override {
+    MPI_Request arrived = MPI_REQUEST_NULL;
+    MPI_Ibarrier(failures_, &arrived);
+    const double start = MPI_Wtime();
+    for (int done = 0; done == 0;) {
+      MPI_Test(&arrived, &done, MPI_STATUS_IGNORE);
+      if (done == 0 && MPI_Wtime() - start > seconds) return std::nullopt;  // Abort follows
+      if (done == 0) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    }
+    // Every rank failed and is here: rank 0's message to all.
+    int length = static_cast<int>(message.size());
+    MPI_Bcast(&length, 1, MPI_INT, 0, failures_);
+    std::string first = rank() == 0 ? message : std::string(static_cast<std::size_t>(length), ' ');
+    MPI_Bcast(first.data(), length, MPI_CHAR, 0, failures_);
+    return first;
+  }
 
  private:
   static MPI_Comm world() { return ParallelSession::world(); }
   ParallelSession session_;
+  MPI_Comm failures_ = MPI_COMM_NULL;  // AgreeOnFailure's alone
 };
 
 }  // namespace

@@ -5,6 +5,7 @@
 /// every build neither load nor start MPI (linking PETSc made every start of the tool 0.12 s
 /// and 22 MB heavier). This header names no MPI type.
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -29,6 +30,13 @@ class DistributedRun {
   virtual void Barrier() const = 0;
   /// Ends every rank with `code` (MPI_Abort): for a failure one rank meets alone.
   [[noreturn]] virtual void Abort(int code) const = 0;
+  /// After an error on this rank (`message`): waits up to `seconds` for every rank to report
+  /// one too (on a communicator of its own, so no collective of the run can match it), and
+  /// returns rank 0's message if they all did (every rank read the same bad scene: the caller
+  /// prints it once and exits normally), or nothing if some rank did not (it is waiting in the
+  /// run: the caller aborts).
+  [[nodiscard]] virtual std::optional<std::string> AgreeOnFailure(const std::string& message,
+                                                                  double seconds) const = 0;
 };
 
 /// The name dlopen looks gipsi_parallel_start up by.
