@@ -19,6 +19,8 @@
 #include <mpi.h>
 #include <petscmat.h>
 
+#include <CLI/CLI.hpp>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -40,36 +42,26 @@ struct Options {
   bool partition_only = false;
 };
 
+// Exits 2 with CLI11's message on a bad command line.
 Options Parse(int argc, char** argv) {
   Options o;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    auto next = [&]() -> const char* {
-      if (i + 1 >= argc) {
-        std::fprintf(stderr, "comm_bench: %s needs a value\n", a.c_str());
-        std::exit(2);
-      }
-      return argv[++i];
-    };
-    if (a == "--cells") {
-      o.nx = std::atoi(next());
-      o.ny = std::atoi(next());
-      o.nz = std::atoi(next());
-    } else if (a == "--batches") {
-      o.batches = std::atoi(next());
-    } else if (a == "--reps") {
-      o.reps = std::atoi(next());
-    } else if (a == "--partition-only") {
-      o.partition_only = true;
-    } else {
-      std::fprintf(stderr, "comm_bench: unknown option %s\n", a.c_str());
-      std::exit(2);
-    }
+  std::vector<int> cells = {o.nx, o.ny, o.nz};
+  CLI::App app{"What the distributed monodomain's step communicates"};
+  app.add_option("--cells", cells, "Hexahedra along the slab (6 tets each)")
+      ->expected(3)
+      ->check(CLI::Range(1, 100000));
+  app.add_option("--batches", o.batches, "Timed batches")->check(CLI::Range(1, 100000000));
+  app.add_option("--reps", o.reps, "Calls per batch")->check(CLI::Range(1, 100000000));
+  app.add_flag("--partition-only", o.partition_only, "The surface figures alone");
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int code = app.exit(e);  // prints the message (or the help)
+    std::exit(code == 0 ? 0 : 2);
   }
-  if (o.nx < 1 || o.ny < 1 || o.nz < 1 || o.batches < 1 || o.reps < 1) {
-    std::fprintf(stderr, "comm_bench: cells, batches and reps must be positive\n");
-    std::exit(2);
-  }
+  o.nx = cells[0];
+  o.ny = cells[1];
+  o.nz = cells[2];
   return o;
 }
 
