@@ -19,9 +19,8 @@
 #include <mpi.h>
 #include <petscmat.h>
 
-#include <CLI/CLI.hpp>
-
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -33,6 +32,7 @@
 #include "gipsi/parallel/mesh_partition.h"
 #include "gipsi/parallel/parallel_session.h"
 #include "gipsi/parallel/petsc_check.h"
+#include "slab_cli.h"
 
 namespace {
 
@@ -45,20 +45,13 @@ struct Options {
 // Exits 2 with CLI11's message on a bad command line.
 Options Parse(int argc, char** argv) {
   Options o;
-  std::vector<int> cells = {o.nx, o.ny, o.nz};
+  std::array<int, 3> cells = {o.nx, o.ny, o.nz};
   CLI::App app{"What the distributed monodomain's step communicates"};
-  app.add_option("--cells", cells, "Hexahedra along the slab (6 tets each)")
-      ->expected(3)
-      ->check(CLI::Range(1, 100000));
+  gipsi::bench::AddSlabCells(app, cells);
   app.add_option("--batches", o.batches, "Timed batches")->check(CLI::Range(1, 100000000));
   app.add_option("--reps", o.reps, "Calls per batch")->check(CLI::Range(1, 100000000));
   app.add_flag("--partition-only", o.partition_only, "The surface figures alone");
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    const int code = app.exit(e);  // prints the message (or the help)
-    std::exit(code == 0 ? 0 : 2);
-  }
+  gipsi::bench::ParseOrExit(app, argc, argv);
   o.nx = cells[0];
   o.ny = cells[1];
   o.nz = cells[2];

@@ -17,9 +17,8 @@
 
 #include <mpi.h>
 
-#include <CLI/CLI.hpp>
-
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -34,6 +33,7 @@
 #include "gipsi/models/ep/ten_tusscher_panfilov_2006.h"
 #include "gipsi/parallel/distributed_monodomain.h"
 #include "gipsi/parallel/parallel_session.h"
+#include "slab_cli.h"
 
 namespace {
 
@@ -65,23 +65,16 @@ struct Options {
 // through as extras: PETSc reads them).
 Options Parse(int argc, char** argv) {
   Options o;
-  std::vector<int> cells = {o.nx, o.ny, o.nz};
+  std::array<int, 3> cells = {o.nx, o.ny, o.nz};
   CLI::App app{"Strong scaling of the distributed monodomain on the N-version slab"};
   app.allow_extras();
-  app.add_option("--cells", cells, "Hexahedra along the slab (6 tets each)")
-      ->expected(3)
-      ->check(CLI::Range(1, 100000));
+  gipsi::bench::AddSlabCells(app, cells);
   app.add_option("--steps", o.steps, "Timed steps")->check(CLI::Range(1, 100000000));
   app.add_option("--warmup", o.warmup, "Untimed steps first")->check(CLI::NonNegativeNumber);
   app.add_option("--pc", o.pc, "Preconditioner")->check(CLI::IsMember({"jacobi", "amg", "hypre"}));
   app.add_option("--tolerance", o.tolerance, "CG's relative residual")->check(CLI::PositiveNumber);
   app.add_flag("--serial", o.serial, "The serial Monodomain instead (one rank)");
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    const int code = app.exit(e);  // prints the message (or the help)
-    std::exit(code == 0 ? 0 : 2);
-  }
+  gipsi::bench::ParseOrExit(app, argc, argv);
   o.nx = cells[0];
   o.ny = cells[1];
   o.nz = cells[2];
