@@ -196,11 +196,6 @@ class BuildProgress {
   bool finished_ = false, drawn_ = false, announced_ = false;
 };
 
-/// How long a rank that met an error waits for the others to report one too before it ends
-/// them all (Ranks::agree_on_failure): they read the same scene, so a bad one fails every rank
-/// within this; a rank that fails alone costs this much more before the abort.
-constexpr double kFailureAgreementSeconds = 5.0;
-
 /// The ranks of a distributed run (`mpirun -np N gipsi run`; docs/scale-out.md): every rank
 /// loads and runs the same scene, the distributed types split their objects over the ranks,
 /// and rank 0 alone writes files and prints. One rank (size 1) is a serial run.
@@ -890,7 +885,11 @@ int main(int argc, char** argv) {
     ranks.type_names = mpi->type_names();
     ranks.abort = [&mpi](int code) { mpi->Abort(code); };
     ranks.barrier = [&mpi] { mpi->Barrier(); };
+    // How long a rank that met an error waits for the others to report one too before it
+    // ends them all: they read the same scene, so a bad one fails every rank within this; a
+    // rank that fails alone costs this much more before the abort.
     ranks.agree_on_failure = [&mpi](const std::string& message) {
+      constexpr double kFailureAgreementSeconds = 5.0;
       return mpi->AgreeOnFailure(message, kFailureAgreementSeconds);
     };
     if (ranks.rank != 0) gipsi::Log().set_level(spdlog::level::err);
