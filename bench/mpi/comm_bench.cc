@@ -179,15 +179,4 @@ int Main(int argc, char** argv) {
 }
 }  // namespace
 
-// A bad size (a mesh past the generator's limit, more ranks than tets) is reported by every
-// rank and ends all of them, rather than terminate's core dump.
-int main(int argc, char** argv) {
-  gipsi::ParallelSession session(&argc, &argv);  // MPI_Abort below needs MPI alive
-  try {
-    return Main(argc, argv);
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "%s: %s\n", "comm_bench", e.what());
-    MPI_Abort(MPI_COMM_WORLD, 1);
-    return 1;
-  }
-}
+int main(int argc, char** argv) { return gipsi::bench::RunBench("comm_bench", argc, argv, Main); }

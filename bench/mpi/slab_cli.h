@@ -1,11 +1,18 @@
 #pragma once
-// The MPI benches' shared command line: the slab's size in hexahedra (--cells NX NY NZ) and a
-// parse that exits 2 with CLI11's message on a bad command line (0 after --help).
+// What the MPI benches share: the slab's size in hexahedra (--cells NX NY NZ), a parse that
+// exits 2 with CLI11's message on a bad command line (0 after --help), and a main that reports
+// an error on every rank and ends them all.
 
 #include <CLI/CLI.hpp>
 
+#include <mpi.h>
+
 #include <array>
+#include <cstdio>
 #include <cstdlib>
+#include <exception>
+
+#include "gipsi/parallel/parallel_session.h"
 
 namespace gipsi::bench {
 
@@ -21,6 +28,21 @@ inline void ParseOrExit(CLI::App& app, int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     const int code = app.exit(e);  // prints the message (or the help)
     std::exit(code == 0 ? 0 : 2);
+  }
+}
+
+// Runs `run(argc, argv)` with MPI and PETSc started. A bad size (a mesh past the generator's
+// limit, more ranks than tets) is reported by every rank and ends all of them, rather than
+// terminate's core dump.
+template <class Run>
+int RunBench(const char* name, int argc, char** argv, Run run) {
+  ParallelSession session(&argc, &argv);  // MPI_Abort below needs MPI alive
+  try {
+    return run(argc, argv);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "%s: %s\n", name, e.what());
+    MPI_Abort(MPI_COMM_WORLD, 1);
+    return 1;
   }
 }
 
