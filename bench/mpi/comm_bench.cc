@@ -79,16 +79,12 @@ double TimePerCall(const Options& o, MPI_Comm comm, Call call) {
   return Median(batches);
 }
 
-}  // namespace
-
-namespace {
 int Main(int argc, char** argv) {
   const Options o = Parse(argc, argv);
   const MPI_Comm world = gipsi::ParallelSession::world();
   const int rank = gipsi::ParallelSession::rank(world);
   const int size = gipsi::ParallelSession::size(world);
-  const gipsi::Mesh whole =
-      gipsi::MakeTetBox(gipsi::Vec3::Zero(), gipsi::Vec3(0.020, 0.007, 0.003), {o.nx, o.ny, o.nz});
+  const gipsi::Mesh whole = gipsi::bench::SlabMesh(o.nx, o.ny, o.nz);
   const gipsi::MeshPart part = gipsi::PartitionMesh(whole, world);
 
   // The surface: ghosts (local nodes owned by another rank) and the ranks that own them.

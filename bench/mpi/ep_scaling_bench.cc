@@ -100,9 +100,6 @@ gipsi::EpTissueParams SlabParams(const Options& o) {
   return p;
 }
 
-}  // namespace
-
-namespace {
 int Main(int argc, char** argv) {
   const Options o = Parse(argc, argv);
   const MPI_Comm world = gipsi::ParallelSession::world();
@@ -113,8 +110,7 @@ int Main(int argc, char** argv) {
     return 2;
   }
   const double t0 = MPI_Wtime();
-  const auto whole = std::make_shared<gipsi::Mesh>(
-      gipsi::MakeTetBox(gipsi::Vec3::Zero(), gipsi::Vec3(0.020, 0.007, 0.003), {o.nx, o.ny, o.nz}));
+  const auto whole = std::make_shared<gipsi::Mesh>(gipsi::bench::SlabMesh(o.nx, o.ny, o.nz));
   const double t_mesh = MPI_Wtime() - t0;
   std::unique_ptr<gipsi::EpTissue> tissue;
   std::string solver = "serial " + o.pc;

@@ -1,5 +1,6 @@
 #pragma once
-// What the MPI benches share: the slab's size in hexahedra (--cells NX NY NZ), a parse that
+// What the MPI benches share: the N-version slab (20 × 7 × 3 mm) and its size in hexahedra
+// (--cells NX NY NZ), a parse that
 // exits 2 with CLI11's message on a bad command line (0 after --help), and a main that reports
 // an error on every rank and ends them all.
 
@@ -12,6 +13,7 @@
 #include <cstdlib>
 #include <exception>
 
+#include "gipsi/geometry/generators.h"
 #include "gipsi/parallel/parallel_session.h"
 
 namespace gipsi::bench {
@@ -20,6 +22,11 @@ namespace gipsi::bench {
 inline void AddSlabCells(CLI::App& app, std::array<int, 3>& cells) {
   app.add_option("--cells", cells, "Hexahedra along the slab (6 tets each)")
       ->check(CLI::Range(1, 100000));
+}
+
+// The slab cut into nx × ny × nz hexahedra of 6 tets each.
+inline Mesh SlabMesh(int nx, int ny, int nz) {
+  return MakeTetBox(Vec3::Zero(), Vec3(0.020, 0.007, 0.003), {nx, ny, nz});
 }
 
 inline void ParseOrExit(CLI::App& app, int argc, char** argv) {
