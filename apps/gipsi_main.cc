@@ -47,6 +47,7 @@
 #include "gipsi/io/scene.h"
 #include "gipsi/models/ep/cell_models.h"
 #include "gipsi/models/ep/single_cell.h"
+#include "gipsi/numerics/simd.h"
 #include "gipsi/parallel/distributed_run.h"
 #include "gipsi/viz/render/plot.h"
 #include "run_progress.h"
@@ -746,7 +747,9 @@ int main(int argc, char** argv) {
   CLI::App app{"GiPSi: an open-architecture framework for organ-level and surgical simulation"};
   app.set_version_flag("--version", "gipsi " GIPSI_VERSION_STRING " (plugin interface " +
                                         std::to_string(GIPSI_PLUGIN_INTERFACE) + "; " +
-                                        gipsi::BuildFeatureSummary() + ")");
+                                        gipsi::BuildFeatureSummary() + "; " +
+                                        gipsi::SimdKernelsName(gipsi::ActiveSimdKernels()) +
+                                        " kernels)");
   app.require_subcommand(1);
   std::string scene_file, out_dir, mesh_file;
   double until = 0;

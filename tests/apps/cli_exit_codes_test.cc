@@ -21,6 +21,7 @@
 #include "apps/cli_test_util.h"
 #include "gipsi/base/version.h"
 #include "gipsi/core/registry.h"
+#include "gipsi/numerics/simd.h"
 #include "test_paths.h"
 
 extern char** environ;
@@ -54,7 +55,8 @@ TEST(GipsiExitCodes, VersionNamesThePackageAndPluginInterfaceVersionsAndTheOptio
   const Result r = Gipsi("--version");
   EXPECT_EQ(r.code, 0) << r.output;
   EXPECT_EQ(r.output, "gipsi " GIPSI_VERSION_STRING " (plugin interface " +
-                          std::to_string(GIPSI_PLUGIN_INTERFACE) + "; with Gmsh, OpenIGTLink)\n");
+                          std::to_string(GIPSI_PLUGIN_INTERFACE) + "; with Gmsh, OpenIGTLink; " +
+                          SimdKernelsName(ActiveSimdKernels()) + " kernels)\n");
 }
 
 TEST(GipsiExitCodes, BadCommandLineExits2ForEverySubcommand) {

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 #include <omp.h>
 
+#include "gipsi/numerics/simd.h"
 #include "gipsi/numerics/sparse/linear_solver.h"
 #include "gipsi/numerics/sparse/model_problems.h"
 #include "gipsi/numerics/sparse/node_block_copy.h"
@@ -224,6 +225,30 @@ TEST(NodeBlockCopy, MatchesEigenProductAndFollowsNewValues) {
     copy.Multiply(x, parallel);
     EXPECT_TRUE(SameBits(serial, parallel)) << threads << " threads";
   }
+}
+
+// The AVX kernel (chosen when the processor has AVX) and the generic one give the same bits:
+// the machine changes the speed of a product, not its result. Also on a matrix whose values
+// span many magnitudes and signs, where a fused multiply-add or another order would round
+// differently.
+TEST(NodeBlockCopy, AvxAndGenericKernelsGiveTheSameBits) {
+  SparseMatrix A = MakeSpringLattice3D(9, 1e-2, [](const Vec3& p) { return 1.0 + p.x(); });
+  const VecX noise = RandomVector(A.nonZeros(), 5);
+  for (Index k = 0; k < A.nonZeros(); ++k)  // symmetric: scale by a function of (row, col) sums
+    A.valuePtr()[k] *= 1.0 + 1e3 * std::abs(noise[k % 7]);
+  SparseMatrix symmetric = SparseMatrix(A.transpose()) + A;
+  NodeBlockCopy copy;
+  copy.Assign(symmetric);
+  const VecX x = RandomVector(symmetric.cols(), 29) * 1e5;
+  VecX active(symmetric.rows()), generic(symmetric.rows());
+  copy.MultiplyNodes(x.data(), active.data(), 0, copy.nodes());
+  const SimdKernels before = LimitSimdKernels(SimdKernels::kGeneric);
+  ASSERT_EQ(ActiveSimdKernels(), SimdKernels::kGeneric);
+  copy.MultiplyNodes(x.data(), generic.data(), 0, copy.nodes());
+  LimitSimdKernels(before);
+  EXPECT_TRUE(SameBits(active, generic)) << "kernels: " << SimdKernelsName(ActiveSimdKernels());
+  const VecX expected = symmetric * x;
+  EXPECT_LE((generic - expected).norm(), 1e-14 * expected.norm());
 }
 
 TEST(ParallelDot, MatchesSerialDotAndRepeatsBitForBit) {

@@ -33,7 +33,8 @@ class NodeBlockCopy {
   /// checked). Parallel over nodes, unless `team` is false (then on the calling thread).
   void CopyValues(const SparseMatrix& A, bool team = true);
   /// y = A x for the rows of nodes [begin, end) (rows 3·begin to 3·end); serial. Each entry is
-  /// summed in a fixed order, so its bits do not depend on how callers split the nodes.
+  /// summed in a fixed order, so its bits do not depend on how callers split the nodes, nor on
+  /// whether the AVX kernel runs (numerics/simd.h).
   void MultiplyNodes(const double* x, double* y, int begin, int end) const;
   /// y = A x, parallel over nodes (OpenMP). x and y must have 3·nodes() entries.
   void Multiply(const VecX& x, VecX& y) const;
@@ -45,10 +46,11 @@ class NodeBlockCopy {
   [[nodiscard]] const std::vector<int>& block_start() const { return start_; }
 
  private:
-  std::vector<int> start_;      ///< first block of each node, then the block count
-  std::vector<int> column_;     ///< 3 × the neighbour node J of each block (its first row)
-  std::vector<double> values_;  ///< block m of node I: A(3I + a, 3J + i) at 9m + 3a + i
-  std::vector<int> source_;     ///< per node: where its first column starts in A's values
+  std::vector<int> start_;   ///< first block of each node, then the block count
+  std::vector<int> column_;  ///< 3 × the neighbour node J of each block (its first row)
+  /// block m of node I: A(3I + a, 3J + i) at 9m + 3i + a (column-major blocks), then zeros
+  std::vector<double> values_;
+  std::vector<int> source_;  ///< per node: where its first column starts in A's values
 };
 
 }  // namespace gipsi
