@@ -2,6 +2,10 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cstdlib>
+#include <string_view>
+
+#include "gipsi/base/log.h"
 
 namespace gipsi {
 namespace {
@@ -16,8 +20,20 @@ SimdKernels Supported() {
   return SimdKernels::kGeneric;
 }
 
+// GIPSI_SIMD=generic in the environment limits the kernels from the start (to compare
+// machines or speeds; the bits are the same either way).
+SimdKernels LimitFromEnvironment() {
+  const char* value = std::getenv("GIPSI_SIMD");
+  if (!value || !*value) return SimdKernels::kAvx;
+  const std::string_view text(value);
+  if (text == "generic") return SimdKernels::kGeneric;
+  if (text != "avx")
+    Log().warn("GIPSI_SIMD='{}' ignored: expected 'generic' or 'avx' (the vector kernels)", text);
+  return SimdKernels::kAvx;
+}
+
 std::atomic<SimdKernels>& Limit() {
-  static std::atomic<SimdKernels> limit{SimdKernels::kAvx};
+  static std::atomic<SimdKernels> limit{LimitFromEnvironment()};
   return limit;
 }
 

@@ -19,7 +19,8 @@ enum class SimdKernels {
   kAvx,      ///< 256-bit AVX (x86-64 with AVX, OS support checked), no FMA
 };
 
-/// The kernels in use: the best the machine supports, unless limited by LimitSimdKernels.
+/// The kernels in use: the best the machine supports, unless limited by LimitSimdKernels or
+/// by the environment variable GIPSI_SIMD=generic (read once, at the first call).
 [[nodiscard]] SimdKernels ActiveSimdKernels();
 /// Uses at most `limit` (e.g. kGeneric to compare bits in tests, or to rule the AVX kernels
 /// out when debugging); returns the previous limit. Not meant to change while kernels run.

@@ -18,6 +18,7 @@
 #include "gipsi/base/error.h"
 #include "gipsi/numerics/adaptive_parallel.h"
 #include "gipsi/numerics/sparse/amg.h"
+#include "gipsi/numerics/sparse/cg_kernels.h"
 #include "gipsi/numerics/sparse/node_block_copy.h"
 #include "gipsi/numerics/sparse/serial_openmp.h"
 #include "gipsi/numerics/sparse/solvers.h"
@@ -406,14 +407,7 @@ class PcgSolver final : public LinearSolver {
             block_copy_.MultiplyNodes(pz, pw, begin / 3, end / 3);
           else
             SymmetricSpMVRows(A, pz, pw, begin, end);
-          double wz0 = 0.0, wz1 = 0.0;  // two chains: the adds' latency, not the loads, bound it
-          int i = begin;
-          for (; i + 2 <= end; i += 2) {
-            wz0 += pw[i] * pz[i];
-            wz1 += pw[i + 1] * pz[i + 1];
-          }
-          if (i < end) wz0 += pw[i] * pz[i];
-          slot(round, k)[2] = wz0 + wz1;
+          slot(round, k)[2] = DotRows(pw, pz, begin, end);
         }
       };
       // Start: z = M⁻¹ r, then w = A z, (r, z) and (w, z).
@@ -448,26 +442,10 @@ class PcgSolver final : public LinearSolver {
         }
         if (!(gamma > 0.0) || !(alpha > 0.0) || !std::isfinite(alpha)) break;  // not SPD, NaN
         for (int k = first_block; k < end_block; ++k) {
-          double rr[2] = {0.0, 0.0}, rz[2] = {0.0, 0.0};  // two chains each, as above
-          auto update = [&](int i, int chain) {
-            pp[i] = pz[i] + beta * pp[i];
-            ps[i] = pw[i] + beta * ps[i];
-            px[i] += alpha * pp[i];
-            pr[i] -= alpha * ps[i];
-            pz[i] = inverse[i] * pr[i];
-            rr[chain] += pr[i] * pr[i];
-            rz[chain] += pr[i] * pz[i];
-          };
-          const int end = start[k + 1];
-          int i = start[k];
-          for (; i + 2 <= end; i += 2) {
-            update(i, 0);
-            update(i + 1, 1);
-          }
-          if (i < end) update(i, 0);
-          double* sums = slot(round, k);
-          sums[0] = rr[0] + rr[1];
-          sums[1] = rz[0] + rz[1];
+          const CgUpdateSums sums =
+              CgUpdateRows(alpha, beta, inverse, pw, px, pr, pz, pp, ps, start[k], start[k + 1]);
+          slot(round, k)[0] = sums.rr;
+          slot(round, k)[1] = sums.rz;
         }
         barrier.Wait(team);
         ++local;

@@ -1,0 +1,86 @@
+#include "gipsi/numerics/sparse/cg_kernels.h"
+
+#include <cmath>
+#include <cstring>
+
+#include <gtest/gtest.h>
+
+#include "gipsi/numerics/simd.h"
+#include "numerics/sparse/sparse_test_util.h"
+
+namespace gipsi {
+namespace {
+
+using testing::RandomVector;
+
+bool SameBits(const VecX& a, const VecX& b) {
+  return a.size() == b.size() &&
+         std::memcmp(a.data(), b.data(), sizeof(double) * static_cast<std::size_t>(a.size())) == 0;
+}
+
+struct CgVectors {
+  VecX d, w, x, r, z, p, s;
+  explicit CgVectors(Index n)
+      : d(RandomVector(n, 1).cwiseAbs()),
+        w(RandomVector(n, 2) * 1e3),
+        x(RandomVector(n, 3)),
+        r(RandomVector(n, 4) * 1e-4),
+        z(RandomVector(n, 5)),
+        p(RandomVector(n, 6) * 1e2),
+        s(RandomVector(n, 7)) {}
+};
+
+// The update sweep does what its contract says (against a plain loop, to round-off), and the
+// AVX and generic versions give the same bits, for ranges of every length mod 4 and any start.
+TEST(CgKernels, UpdateSweepFollowsTheRecurrencesWithTheSameBitsOnEveryKernel) {
+  const Index n = 1003;
+  const double alpha = 0.37, beta = 1.9;
+  for (const auto& [begin, end] : {std::pair{0, 1003}, std::pair{1, 1000}, std::pair{5, 7}}) {
+    CgVectors plain(n), active(n), generic(n);
+    double rr = 0, rz = 0;
+    for (int i = begin; i < end; ++i) {
+      plain.p[i] = plain.z[i] + beta * plain.p[i];
+      plain.s[i] = plain.w[i] + beta * plain.s[i];
+      plain.x[i] += alpha * plain.p[i];
+      plain.r[i] -= alpha * plain.s[i];
+      plain.z[i] = plain.d[i] * plain.r[i];
+      rr += plain.r[i] * plain.r[i];
+      rz += plain.r[i] * plain.z[i];
+    }
+    auto run = [&](CgVectors& v) {
+      return CgUpdateRows(alpha, beta, v.d.data(), v.w.data(), v.x.data(), v.r.data(), v.z.data(),
+                          v.p.data(), v.s.data(), begin, end);
+    };
+    const CgUpdateSums a = run(active);
+    const SimdKernels before = LimitSimdKernels(SimdKernels::kGeneric);
+    const CgUpdateSums g = run(generic);
+    LimitSimdKernels(before);
+    // Element-wise updates: the same operations as the plain loop, so the same bits.
+    for (VecX CgVectors::*v :
+         {&CgVectors::x, &CgVectors::r, &CgVectors::z, &CgVectors::p, &CgVectors::s}) {
+      EXPECT_TRUE(SameBits(plain.*v, active.*v)) << begin << ".." << end;
+      EXPECT_TRUE(SameBits(plain.*v, generic.*v)) << begin << ".." << end;
+    }
+    // The sums in four chains: another order than the plain loop's, the same on both kernels.
+    EXPECT_EQ(std::memcmp(&a.rr, &g.rr, sizeof a.rr), 0);
+    EXPECT_EQ(std::memcmp(&a.rz, &g.rz, sizeof a.rz), 0);
+    EXPECT_NEAR(a.rr, rr, 1e-15 * rr * (end - begin));
+    EXPECT_NEAR(a.rz, rz, 1e-15 * std::abs(rz) * (end - begin) + 1e-300);
+  }
+}
+
+TEST(CgKernels, DotIsTheSameOnEveryKernel) {
+  const VecX a = RandomVector(777, 8), b = RandomVector(777, 9) * 1e7;
+  for (const auto& [begin, end] : {std::pair{0, 777}, std::pair{3, 774}, std::pair{2, 3}}) {
+    const double active = DotRows(a.data(), b.data(), begin, end);
+    const SimdKernels before = LimitSimdKernels(SimdKernels::kGeneric);
+    const double generic = DotRows(a.data(), b.data(), begin, end);
+    LimitSimdKernels(before);
+    EXPECT_EQ(std::memcmp(&active, &generic, sizeof active), 0);
+    const double plain = a.segment(begin, end - begin).dot(b.segment(begin, end - begin));
+    EXPECT_NEAR(active, plain, 1e-14 * b.norm() * a.norm());
+  }
+}
+
+}  // namespace
+}  // namespace gipsi
