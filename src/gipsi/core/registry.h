@@ -32,8 +32,8 @@
 /// Connector::failure_detail, and the ABI version tied to the package version; 12: state value
 /// types for connectors (Connector::BindState, BindNoState) and aggregates
 /// (AggregateObject::BindAggregateState, replacing SaveAggregateState), the HapticEndpoint
-/// capability.
-#define GIPSI_PLUGIN_INTERFACE 12
+/// capability; 13: SolidMaterial::ElementStressAndStiffnessBatch (a new virtual).
+#define GIPSI_PLUGIN_INTERFACE 13
 /// What a plugin's gipsi_plugin_abi_version() returns and the loader requires: the package's
 /// major and minor version with the plugin interface, MAJOR·10⁶ + MINOR·10³ + INTERFACE. A
 /// plugin thus loads only into the release line it was built against (0.1.x, as the CMake

@@ -142,41 +142,65 @@ bool FemSolid::AssembleElements(const double* u, VecX& f, double* k_values) cons
   }
   std::atomic<bool> any_invalid{false};
   double* fp = f.data();
-  assembly_.ForEachElementColoured(
-      [&](Index e) {
-        const TetGradients g = assembly_.gradients(e);
-        const Mat3 F = assembly_.DeformationGradient(e, u);
-        const MaterialPoint mp = PointOf(e);
-        const double vol = assembly_.volume(e);
-        Mat3 P;
-        Mat12 K;
-        const bool ok = k_values ? law_->ElementStressAndStiffness(F, mp, g, vol, P, K)
-                                 : law_->Stress(F, mp, P);
-        invalid_[static_cast<std::size_t>(e)] = ok ? 0 : 1;
-        element_force_sum_[e] = 0;
-        if (!ok) {
-          any_invalid.store(true, std::memory_order_relaxed);
-          return;
+  // Element e's force (and, with k_values, stiffness) from its stress P and stiffness K,
+  // scattered into f and the tangent.
+  const auto scatter = [&](Index e, bool ok, const Mat3& P, const auto& K) {
+    invalid_[static_cast<std::size_t>(e)] = ok ? 0 : 1;
+    element_force_sum_[e] = 0;
+    if (!ok) {
+      any_invalid.store(true, std::memory_order_relaxed);
+      return;
+    }
+    const Eigen::Matrix<double, 3, 4> fe = assembly_.volume(e) * P * assembly_.gradients(e);
+    element_force_sum_[e] = fe.cwiseAbs().sum();
+    for (int a = 0; a < 4; ++a) {
+      double* fa = fp + 3 * assembly_.tets()(a, e);
+      fa[0] += fe(0, a);
+      fa[1] += fe(1, a);
+      fa[2] += fe(2, a);
+    }
+    if (!k_values) return;
+    for (int b = 0; b < 4; ++b)
+      for (int a = 0; a < 4; ++a)
+        for (int k = 0; k < 3; ++k) {
+          double* col = k_values + assembly_.ValueIndex(e, a, b, 0, k);
+          col[0] += K(3 * a, 3 * b + k);
+          col[1] += K(3 * a + 1, 3 * b + k);
+          col[2] += K(3 * a + 2, 3 * b + k);
         }
-        const Eigen::Matrix<double, 3, 4> fe = vol * P * g;
-        element_force_sum_[e] = fe.cwiseAbs().sum();
-        for (int a = 0; a < 4; ++a) {
-          double* fa = fp + 3 * assembly_.tets()(a, e);
-          fa[0] += fe(0, a);
-          fa[1] += fe(1, a);
-          fa[2] += fe(2, a);
-        }
-        if (!k_values) return;
-        for (int b = 0; b < 4; ++b)
-          for (int a = 0; a < 4; ++a)
-            for (int k = 0; k < 3; ++k) {
-              double* col = k_values + assembly_.ValueIndex(e, a, b, 0, k);
-              col[0] += K(3 * a, 3 * b + k);
-              col[1] += K(3 * a + 1, 3 * b + k);
-              col[2] += K(3 * a + 2, 3 * b + k);
+  };
+  if (!k_values) {
+    assembly_.ForEachElementColoured(
+        [&](Index e) {
+          Mat3 P;
+          const bool ok = law_->Stress(assembly_.DeformationGradient(e, u), PointOf(e), P);
+          scatter(e, ok, P, Mat12());
+        },
+        residual_team_);
+  } else {
+    // Tangents in batches of ElementBatch::kLanes consecutive elements (the corotational law
+    // evaluates a batch in vector lanes), scattered in element order: the same sums in the
+    // same order as element by element.
+    assembly_.ForEachChunkColoured(
+        [&](Index first, Index last) {
+          ElementBatch batch;
+          for (Index begin = first; begin < last; begin += ElementBatch::kLanes) {
+            batch.count = static_cast<int>(std::min<Index>(ElementBatch::kLanes, last - begin));
+            for (int l = 0; l < batch.count; ++l) {
+              const Index e = begin + l;
+              batch.SetInput(l, assembly_.DeformationGradient(e, u), assembly_.gradients(e),
+                             assembly_.volume(e), PointOf(e));
             }
-      },
-      k_values ? tangent_team_ : residual_team_);
+            law_->ElementStressAndStiffnessBatch(batch);
+            for (int l = 0; l < batch.count; ++l) {
+              // K(r, c) of lane l, read in place.
+              const auto K = [&batch, l](int r, int c) { return batch.K[r + 12 * c][l]; };
+              scatter(begin + l, batch.ok[l], batch.OutputP(l), K);
+            }
+          }
+        },
+        tangent_team_);
+  }
   // Assembling contributions of magnitude |f| into a residual loses ~ε|f| each, and forces
   // evaluated at a displacement u carry ~ε ‖K‖ ‖u‖: 100 ε times their sum bounds what any
   // iterate's residual can be told apart from zero (still ~1e-14 of the element forces).

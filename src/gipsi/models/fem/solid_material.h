@@ -34,6 +34,34 @@ struct MaterialPoint {
   double active_tension = 0;
 };
 
+/// Up to kLanes elements that SolidMaterial::ElementStressAndStiffnessBatch evaluates together,
+/// stored lane-interleaved (entry k of element l at [k][l]) for vector code. The caller fills
+/// count and the inputs of lanes 0..count−1; the law writes P, K and ok of those lanes (and may
+/// compute unused lanes on copies of lane 0).
+struct ElementBatch {
+  static constexpr int kLanes = 4;
+  int count = 0;  ///< elements in the batch, 1..kLanes
+  // Inputs.
+  alignas(32) double F[9][kLanes];   ///< deformation gradient, F(i, j) at [i + 3j]
+  alignas(32) double g[12][kLanes];  ///< shape-function gradients, g(j, a) at [j + 3a]
+  alignas(32) double volume[kLanes];
+  MaterialPoint mp[kLanes];
+  // Outputs.
+  alignas(32) double P[9][kLanes];    ///< first Piola–Kirchhoff stress, P(i, j) at [i + 3j]
+  alignas(32) double K[144][kLanes];  ///< element stiffness, K(r, c) at [r + 12c]
+  bool ok[kLanes] = {};               ///< false where F is outside the law's domain
+
+  /// Writes element `lane`'s inputs.
+  void SetInput(int lane, const Mat3& f, const TetGradients& grad, double vol,
+                const MaterialPoint& point);
+  [[nodiscard]] Mat3 InputF(int lane) const;
+  [[nodiscard]] TetGradients InputGradients(int lane) const;
+  /// Writes element `lane`'s outputs.
+  void SetOutput(int lane, bool success, const Mat3& stress, const Mat12& stiffness);
+  [[nodiscard]] Mat3 OutputP(int lane) const;
+  [[nodiscard]] Mat12 OutputK(int lane) const;
+};
+
 /// Base class of solid laws. Immutable after construction, shared by all elements; all methods
 /// are const, thread-safe and allocation-free.
 class SolidMaterial : public Material {
@@ -57,6 +85,12 @@ class SolidMaterial : public Material {
   [[nodiscard]] virtual bool ElementStressAndStiffness(const Mat3& F, const MaterialPoint& mp,
                                                        const TetGradients& g, double volume,
                                                        Mat3& P, Mat12& K) const;
+
+  /// ElementStressAndStiffness for the `batch.count` elements of a batch (the FEM assembly's
+  /// path for tangents): ok[l] = ElementStressAndStiffness(F_l, mp_l, g_l, V_l, P_l, K_l). The
+  /// default evaluates the elements one by one; a law may evaluate them together in vector lanes
+  /// (CorotationalSolid), with the same results up to round-off.
+  virtual void ElementStressAndStiffnessBatch(ElementBatch& batch) const;
 
   /// κ [Pa] if the law's energy is W(F) = W̃(F) + κ/2 (ln J)² with that volumetric term split
   /// off (NeoHookean: κ = λ; Guccione: its bulk modulus), else 0. The mixed displacement–

@@ -101,12 +101,23 @@ class TetAssembly {
   /// wait would be for a descheduled thread (AdaptiveParallel).
   template <class Fn>
   void ForEachElementColoured(Fn&& fn, AdaptiveParallel& team) const {
+    ForEachChunkColoured(
+        [&](Index first, Index last) {
+          for (Index e = first; e < last; ++e) fn(e);
+        },
+        team);
+  }
+  /// ForEachElementColoured by chunks: `fn(first, last)` must handle elements [first, last) in
+  /// order (it may evaluate several of them together, e.g. in vector lanes, as long as it
+  /// scatters them in element order).
+  template <class Fn>
+  void ForEachChunkColoured(Fn&& fn, AdaptiveParallel& team) const {
     const int ne = static_cast<int>(num_elements());
     // The k-th chunk in colour order (colours are runs of colour_chunks_).
     const auto run_chunk = [&](int k) {
       const int first = colour_chunks_[static_cast<std::size_t>(k)] * kChunkElements;
       const int last = std::min(first + kChunkElements, ne);
-      for (int e = first; e < last; ++e) fn(static_cast<Index>(e));
+      fn(static_cast<Index>(first), static_cast<Index>(last));
     };
     const bool parallel = team.Begin(ne >= kMinParallelElements && MaxTeamThreads() > 1 &&
                                      num_colours() < static_cast<int>(colour_chunks_.size()));

@@ -1,28 +1,20 @@
 #include "gipsi/numerics/sparse/cg_kernels.h"
 
-#include <cstring>
-
 #include "gipsi/numerics/simd.h"
+#include "gipsi/numerics/simd_v4.h"
 
 namespace gipsi {
 namespace {
 
-// Four doubles as one value (a GCC/Clang vector extension). In a function compiled for AVX
-// its operations are single 256-bit instructions; elsewhere the compiler splits them into SSE2
-// pairs. Either way every lane is one IEEE operation, in the written order, with no fused
-// multiply-add (the AVX target below is "avx" alone): the same bits.
-typedef double V4 __attribute__((vector_size(32)));
+using simd::Load;
+using simd::Store;
+using V4 = simd::V4d;
 
-#define GIPSI_ALWAYS_INLINE inline __attribute__((always_inline))
-
-GIPSI_ALWAYS_INLINE void Load(V4& v, const double* p) { std::memcpy(&v, p, sizeof v); }
-GIPSI_ALWAYS_INLINE void Store(double* p, const V4& v) { std::memcpy(p, &v, sizeof v); }
-
-GIPSI_ALWAYS_INLINE CgUpdateSums UpdateBody(double alpha, double beta, const double* __restrict d,
-                                            const double* __restrict w, double* __restrict x,
-                                            double* __restrict r, double* __restrict z,
-                                            double* __restrict p, double* __restrict s, int begin,
-                                            int end) {
+GIPSI_SIMD_INLINE CgUpdateSums UpdateBody(double alpha, double beta, const double* __restrict d,
+                                          const double* __restrict w, double* __restrict x,
+                                          double* __restrict r, double* __restrict z,
+                                          double* __restrict p, double* __restrict s, int begin,
+                                          int end) {
   V4 rr = {0.0, 0.0, 0.0, 0.0}, rz = rr;
   const V4 a = {alpha, alpha, alpha, alpha}, b = {beta, beta, beta, beta};
   int i = begin;
@@ -64,8 +56,8 @@ GIPSI_ALWAYS_INLINE CgUpdateSums UpdateBody(double alpha, double beta, const dou
           (chain_rz[0] + chain_rz[1]) + (chain_rz[2] + chain_rz[3])};
 }
 
-GIPSI_ALWAYS_INLINE double DotBody(const double* __restrict a, const double* __restrict b,
-                                   int begin, int end) {
+GIPSI_SIMD_INLINE double DotBody(const double* __restrict a, const double* __restrict b, int begin,
+                                 int end) {
   V4 sum = {0.0, 0.0, 0.0, 0.0};
   int i = begin;
   for (; i + 4 <= end; i += 4) {

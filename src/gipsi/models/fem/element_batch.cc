@@ -1,0 +1,301 @@
+// ElementBatch, the element-wise default of SolidMaterial::ElementStressAndStiffnessBatch, and
+// CorotationalSolid's vector-lane version of its closed-form element stiffness (solid_laws.h).
+
+#include <cmath>
+#include <cstdint>
+
+#include "gipsi/models/fem/solid_laws.h"
+#include "gipsi/numerics/simd.h"
+#include "gipsi/numerics/simd_v4.h"
+
+namespace gipsi {
+
+void ElementBatch::SetInput(int lane, const Mat3& f, const TetGradients& grad, double vol,
+                            const MaterialPoint& point) {
+  for (int k = 0; k < 9; ++k) F[k][lane] = f.data()[k];
+  for (int k = 0; k < 12; ++k) g[k][lane] = grad.data()[k];
+  volume[lane] = vol;
+  mp[lane] = point;
+}
+
+Mat3 ElementBatch::InputF(int lane) const {
+  Mat3 f;
+  for (int k = 0; k < 9; ++k) f.data()[k] = F[k][lane];
+  return f;
+}
+
+TetGradients ElementBatch::InputGradients(int lane) const {
+  TetGradients grad;
+  for (int k = 0; k < 12; ++k) grad.data()[k] = g[k][lane];
+  return grad;
+}
+
+void ElementBatch::SetOutput(int lane, bool success, const Mat3& stress, const Mat12& stiffness) {
+  ok[lane] = success;
+  for (int k = 0; k < 9; ++k) P[k][lane] = stress.data()[k];
+  for (int k = 0; k < 144; ++k) K[k][lane] = stiffness.data()[k];
+}
+
+Mat3 ElementBatch::OutputP(int lane) const {
+  Mat3 stress;
+  for (int k = 0; k < 9; ++k) stress.data()[k] = P[k][lane];
+  return stress;
+}
+
+Mat12 ElementBatch::OutputK(int lane) const {
+  Mat12 stiffness;
+  for (int k = 0; k < 144; ++k) stiffness.data()[k] = K[k][lane];
+  return stiffness;
+}
+
+namespace {
+
+void ElementWise(const SolidMaterial& law, ElementBatch& batch, int lane) {
+  Mat3 P;
+  Mat12 K;
+  const bool ok = law.ElementStressAndStiffness(
+      batch.InputF(lane), batch.mp[lane], batch.InputGradients(lane), batch.volume[lane], P, K);
+  batch.SetOutput(lane, ok, P, K);
+}
+
+}  // namespace
+
+void SolidMaterial::ElementStressAndStiffnessBatch(ElementBatch& batch) const {
+  for (int lane = 0; lane < batch.count; ++lane) ElementWise(*this, batch, lane);
+}
+
+namespace {
+
+using simd::Load;
+using simd::Store;
+using simd::V4d;
+using simd::V4i;
+
+/// A 3×3 matrix of lanes, column-major: (i, j) at m[i + 3j].
+struct M3 {
+  V4d m[9];
+};
+
+GIPSI_SIMD_INLINE void Splat(V4d& v, double x) { v = V4d{x, x, x, x}; }
+
+// det = det(a) and t = cof(a) = det(a) a⁻ᵀ (cofactors), lane by lane.
+GIPSI_SIMD_INLINE void Cofactors(const M3& a, M3& t, V4d& det) {
+  const V4d* m = a.m;
+  t.m[0] = m[4] * m[8] - m[7] * m[5];
+  t.m[1] = m[6] * m[5] - m[3] * m[8];
+  t.m[2] = m[3] * m[7] - m[6] * m[4];
+  t.m[3] = m[7] * m[2] - m[1] * m[8];
+  t.m[4] = m[0] * m[8] - m[6] * m[2];
+  t.m[5] = m[6] * m[1] - m[0] * m[7];
+  t.m[6] = m[1] * m[5] - m[4] * m[2];
+  t.m[7] = m[3] * m[2] - m[0] * m[5];
+  t.m[8] = m[0] * m[4] - m[3] * m[1];
+  det = m[0] * t.m[0] + m[1] * t.m[1] + m[2] * t.m[2];
+}
+
+GIPSI_SIMD_INLINE void SquaredNorm(const M3& a, V4d& sum) {
+  sum = a.m[0] * a.m[0];
+  for (int k = 1; k < 9; ++k) sum += a.m[k] * a.m[k];
+}
+
+GIPSI_SIMD_INLINE void Abs(const V4d& x, V4d& out) {
+  const V4i sign = {INT64_MIN, INT64_MIN, INT64_MIN, INT64_MIN};
+  out = (V4d)((V4i)x & ~sign);
+}
+
+// The element-wise path's scaled Newton polar iteration (solid_laws.cc, FastPolar) in the lanes:
+// R ← ½(γR + γ⁻¹R⁻ᵀ), γ = (‖R⁻¹‖_F / ‖R‖_F)^½ for the first four steps, until a step changes R
+// by ≤ 1e-8 (max norm). A lane that has converged keeps its iterate (bitwise select) while the
+// others go on. Returns a mask of the converged lanes (all ones) after at most 30 steps.
+GIPSI_SIMD_INLINE void PolarLanes(const M3& F, M3& R, V4i& converged) {
+  R = F;
+  converged = V4i{0, 0, 0, 0};
+  V4d half, tolerance;
+  Splat(half, 0.5);
+  Splat(tolerance, 1e-8);
+  for (int it = 0; it < 30; ++it) {
+    M3 inverse_t;
+    V4d det;
+    Cofactors(R, inverse_t, det);
+    const V4d inv_det = 1.0 / det;
+    for (V4d& v : inverse_t.m) v *= inv_det;
+    V4d gamma, inv_gamma;
+    if (it < 4) {
+      V4d num, den;
+      SquaredNorm(inverse_t, num);
+      SquaredNorm(R, den);
+      double ratio[4];
+      Store(ratio, num / den);
+      for (double& r : ratio) r = std::sqrt(std::sqrt(r));
+      Load(gamma, ratio);
+      inv_gamma = 1.0 / gamma;
+    } else {
+      Splat(gamma, 1.0);
+      Splat(inv_gamma, 1.0);
+    }
+    V4d change = V4d{0.0, 0.0, 0.0, 0.0};
+    M3 next;
+    for (int k = 0; k < 9; ++k) {
+      next.m[k] = half * (gamma * R.m[k] + inverse_t.m[k] * inv_gamma);
+      V4d delta;
+      Abs(next.m[k] - R.m[k], delta);
+      const V4i larger = (V4i)(delta > change);
+      change = (V4d)(((V4i)delta & larger) | ((V4i)change & ~larger));
+    }
+    // Lanes still iterating take the new iterate.
+    for (int k = 0; k < 9; ++k)
+      R.m[k] = (V4d)(((V4i)next.m[k] & ~converged) | ((V4i)R.m[k] & converged));
+    converged |= (V4i)(change <= tolerance);
+    bool all = true;
+    for (int l = 0; l < 4; ++l) all = all && converged[l] != 0;
+    if (all) return;
+  }
+}
+
+GIPSI_SIMD_INLINE void CorotationalLanes(double lambda_value, double mu_value, ElementBatch& batch,
+                                         V4i& fast) {
+  M3 F, R;
+  for (int k = 0; k < 9; ++k) Load(F.m[k], batch.F[k]);
+  PolarLanes(F, R, fast);
+  // S = sym(RᵀF), its trace, and M = (tr(S) I − S)⁻¹.
+  M3 S;
+  for (int j = 0; j < 3; ++j)
+    for (int i = 0; i < 3; ++i)
+      S.m[i + 3 * j] = R.m[3 * i] * F.m[3 * j] + R.m[3 * i + 1] * F.m[3 * j + 1] +
+                       R.m[3 * i + 2] * F.m[3 * j + 2];
+  V4d half;
+  Splat(half, 0.5);
+  for (int j = 0; j < 3; ++j)
+    for (int i = 0; i < j; ++i) {
+      const V4d v = half * (S.m[i + 3 * j] + S.m[j + 3 * i]);
+      S.m[i + 3 * j] = v;
+      S.m[j + 3 * i] = v;
+    }
+  const V4d trace_s = S.m[0] + S.m[4] + S.m[8];
+  M3 A, M;
+  for (int k = 0; k < 9; ++k) A.m[k] = -S.m[k];
+  for (int i = 0; i < 3; ++i) A.m[4 * i] += trace_s;
+  V4d det;
+  Cofactors(A, M, det);  // A is symmetric: cof(A) = det(A) A⁻¹
+  const V4d inv_det = 1.0 / det;
+  for (V4d& v : M.m) v *= inv_det;
+
+  V4d lambda, two_mu, three;
+  Splat(lambda, lambda_value);
+  Splat(two_mu, 2 * mu_value);
+  Splat(three, 3.0);
+  const V4d tr = trace_s - three;
+  // P = 2μ (F − R) + λ tr(S − I) R.
+  const V4d lambda_tr = lambda * tr;
+  for (int k = 0; k < 9; ++k) {
+    const V4d p = two_mu * (F.m[k] - R.m[k]) + lambda_tr * R.m[k];
+    Store(batch.P[k], p);
+  }
+  V4d volume;
+  Load(volume, batch.volume);
+  const V4d c = volume * (lambda_tr - two_mu);
+  const V4d v_lambda = volume * lambda;
+  const V4d v_two_mu = volume * two_mu;
+  // q_a = R g_a, X_a = R [g_a]×, Y_a = c X_a M.
+  V4d g[4][3], q[4][3];
+  M3 X[4], Y[4];
+  for (int a = 0; a < 4; ++a) {
+    for (int j = 0; j < 3; ++j) Load(g[a][j], batch.g[j + 3 * a]);
+    for (int i = 0; i < 3; ++i)
+      q[a][i] = R.m[i] * g[a][0] + R.m[i + 3] * g[a][1] + R.m[i + 6] * g[a][2];
+    for (int i = 0; i < 3; ++i) {
+      X[a].m[i] = R.m[i + 6] * g[a][1] - R.m[i + 3] * g[a][2];
+      X[a].m[i + 3] = R.m[i] * g[a][2] - R.m[i + 6] * g[a][0];
+      X[a].m[i + 6] = R.m[i + 3] * g[a][0] - R.m[i] * g[a][1];
+    }
+    for (int j = 0; j < 3; ++j)
+      for (int i = 0; i < 3; ++i)
+        Y[a].m[i + 3 * j] = c * (X[a].m[i] * M.m[3 * j] + X[a].m[i + 3] * M.m[3 * j + 1] +
+                                 X[a].m[i + 6] * M.m[3 * j + 2]);
+  }
+  // K_ab = Y_a X_bᵀ + Vλ q_a q_bᵀ + 2μV (g_a·g_b) I, a ≤ b, mirrored.
+  for (int b = 0; b < 4; ++b)
+    for (int a = 0; a <= b; ++a) {
+      const V4d gg = v_two_mu * (g[a][0] * g[b][0] + g[a][1] * g[b][1] + g[a][2] * g[b][2]);
+      for (int k = 0; k < 3; ++k)
+        for (int i = 0; i < 3; ++i) {
+          V4d v = Y[a].m[i] * X[b].m[k] + Y[a].m[i + 3] * X[b].m[k + 3] +
+                  Y[a].m[i + 6] * X[b].m[k + 6] + v_lambda * q[a][i] * q[b][k];
+          if (i == k) v += gg;
+          Store(batch.K[(3 * a + i) + 12 * (3 * b + k)], v);
+          if (a != b) Store(batch.K[(3 * b + k) + 12 * (3 * a + i)], v);
+        }
+    }
+}
+
+void CorotationalGeneric(double lambda, double mu, ElementBatch& batch, V4i& fast) {
+  CorotationalLanes(lambda, mu, batch, fast);
+}
+
+#if defined(__x86_64__)
+__attribute__((target("avx"))) void CorotationalAvx(double lambda, double mu, ElementBatch& batch,
+                                                    V4i& fast) {
+  CorotationalLanes(lambda, mu, batch, fast);
+}
+#endif
+
+bool AllFinite(const double (*values)[ElementBatch::kLanes], int count, int lane) {
+  for (int k = 0; k < count; ++k)
+    if (!std::isfinite(values[k][lane])) return false;
+  return true;
+}
+
+}  // namespace
+
+void CorotationalSolid::ElementStressAndStiffnessBatch(ElementBatch& batch) const {
+  constexpr int kLanes = ElementBatch::kLanes;
+  // Lanes for the vector path: a finite F comfortably away from inversion (the element-wise
+  // FastPolar's test) and no active tension. Unused lanes and the others compute on lane 0's
+  // or the identity's F, and are then replaced.
+  bool vector_lane[kLanes] = {};
+  int vector_lanes = 0;
+  for (int l = 0; l < batch.count; ++l) {
+    if (batch.mp[l].active_tension != 0) continue;
+    const Mat3 F = batch.InputF(l);
+    if (!F.allFinite()) continue;
+    const double det = F.determinant();
+    if (!(det > 1e-6 * F.squaredNorm() * F.norm())) continue;
+    vector_lane[l] = true;
+    ++vector_lanes;
+  }
+  if (vector_lanes < 2) {  // not worth the lanes: element-wise
+    SolidMaterial::ElementStressAndStiffnessBatch(batch);
+    return;
+  }
+  // The lanes left out compute on F = I (their F kept aside); unused lanes on lane 0's
+  // gradients and volume.
+  Mat3 kept_F[kLanes];
+  for (int l = 0; l < kLanes; ++l) {
+    if (l < batch.count && vector_lane[l]) continue;
+    if (l < batch.count) {
+      kept_F[l] = batch.InputF(l);
+    } else {
+      for (int k = 0; k < 12; ++k) batch.g[k][l] = batch.g[k][0];
+      batch.volume[l] = batch.volume[0];
+    }
+    for (int k = 0; k < 9; ++k) batch.F[k][l] = (k % 4 == 0) ? 1.0 : 0.0;
+  }
+  V4i fast;
+#if defined(__x86_64__)
+  if (ActiveSimdKernels() == SimdKernels::kAvx)
+    CorotationalAvx(lame_.lambda, lame_.mu, batch, fast);
+  else
+#endif
+    CorotationalGeneric(lame_.lambda, lame_.mu, batch, fast);
+  for (int l = 0; l < batch.count; ++l) {
+    if (vector_lane[l] && fast[l] != 0) {
+      batch.ok[l] = AllFinite(batch.P, 9, l) && AllFinite(batch.K, 144, l);
+    } else {
+      if (!vector_lane[l])
+        for (int k = 0; k < 9; ++k) batch.F[k][l] = kept_F[l].data()[k];
+      ElementWise(*this, batch, l);
+    }
+  }
+}
+
+}  // namespace gipsi
