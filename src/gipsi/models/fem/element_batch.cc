@@ -152,11 +152,40 @@ GIPSI_SIMD_INLINE void PolarLanes(const M3& F, M3& R, V4i& converged) {
   }
 }
 
+GIPSI_SIMD_INLINE void Select(const V4i& mask, const V4d& yes, const V4d& no, V4d& out) {
+  out = (V4d)(((V4i)yes & mask) | ((V4i)no & ~mask));
+}
+
+// `fast` comes in as the lanes to try (all ones) and goes out as those the vector path
+// evaluated in full: F finite and comfortably away from inversion (the element-wise FastPolar's
+// test, det F > 1e-6 ‖F‖³), the polar iteration converged, P and K finite. The others are
+// computed on F = I, to be replaced by the caller.
 GIPSI_SIMD_INLINE void CorotationalLanes(double lambda_value, double mu_value, ElementBatch& batch,
                                          V4i& fast) {
   M3 F, R;
   for (int k = 0; k < 9; ++k) Load(F.m[k], batch.F[k]);
-  PolarLanes(F, R, fast);
+  {
+    M3 cofactors;
+    V4d det, norm2;
+    Cofactors(F, cofactors, det);
+    SquaredNorm(F, norm2);
+    double norm[4];
+    Store(norm, norm2);
+    for (double& n : norm) n = std::sqrt(n);
+    V4d norm_v;
+    Load(norm_v, norm);
+    fast &= (V4i)(det > 1e-6 * norm2 * norm_v);  // false for a non-finite F
+    V4d one, zero;
+    Splat(one, 1.0);
+    Splat(zero, 0.0);
+    for (int k = 0; k < 9; ++k) Select(fast, F.m[k], k % 4 == 0 ? one : zero, F.m[k]);
+  }
+  V4i converged;
+  PolarLanes(F, R, converged);
+  fast &= converged;
+  // x · 0 is 0 for a finite x and NaN otherwise: one sum tells whether a lane's P and K are.
+  V4d finite_check;
+  Splat(finite_check, 0.0);
   // S = sym(RᵀF), its trace, and M = (tr(S) I − S)⁻¹.
   M3 S;
   for (int j = 0; j < 3; ++j)
@@ -189,6 +218,7 @@ GIPSI_SIMD_INLINE void CorotationalLanes(double lambda_value, double mu_value, E
   const V4d lambda_tr = lambda * tr;
   for (int k = 0; k < 9; ++k) {
     const V4d p = two_mu * (F.m[k] - R.m[k]) + lambda_tr * R.m[k];
+    finite_check += p * 0.0;
     Store(batch.P[k], p);
   }
   V4d volume;
@@ -222,10 +252,12 @@ GIPSI_SIMD_INLINE void CorotationalLanes(double lambda_value, double mu_value, E
           V4d v = Y[a].m[i] * X[b].m[k] + Y[a].m[i + 3] * X[b].m[k + 3] +
                   Y[a].m[i + 6] * X[b].m[k + 6] + v_lambda * q[a][i] * q[b][k];
           if (i == k) v += gg;
+          finite_check += v * 0.0;
           Store(batch.K[(3 * a + i) + 12 * (3 * b + k)], v);
           if (a != b) Store(batch.K[(3 * b + k) + 12 * (3 * a + i)], v);
         }
     }
+  fast &= (V4i)(finite_check == finite_check);
 }
 
 void CorotationalGeneric(double lambda, double mu, ElementBatch& batch, V4i& fast) {
@@ -239,48 +271,22 @@ __attribute__((target("avx"))) void CorotationalAvx(double lambda, double mu, El
 }
 #endif
 
-bool AllFinite(const double (*values)[ElementBatch::kLanes], int count, int lane) {
-  for (int k = 0; k < count; ++k)
-    if (!std::isfinite(values[k][lane])) return false;
-  return true;
-}
-
 }  // namespace
 
 void CorotationalSolid::ElementStressAndStiffnessBatch(ElementBatch& batch) const {
   constexpr int kLanes = ElementBatch::kLanes;
-  // Lanes for the vector path: a finite F comfortably away from inversion (the element-wise
-  // FastPolar's test) and no active tension. Unused lanes and the others compute on lane 0's
-  // or the identity's F, and are then replaced.
-  bool vector_lane[kLanes] = {};
-  int vector_lanes = 0;
-  for (int l = 0; l < batch.count; ++l) {
-    if (batch.mp[l].active_tension != 0) continue;
-    const Mat3 F = batch.InputF(l);
-    if (!F.allFinite()) continue;
-    const double det = F.determinant();
-    if (!(det > 1e-6 * F.squaredNorm() * F.norm())) continue;
-    vector_lane[l] = true;
-    ++vector_lanes;
-  }
-  if (vector_lanes < 2) {  // not worth the lanes: element-wise
-    SolidMaterial::ElementStressAndStiffnessBatch(batch);
-    return;
-  }
-  // The lanes left out compute on F = I (their F kept aside); unused lanes on lane 0's
-  // gradients and volume.
-  Mat3 kept_F[kLanes];
+  // The vector path tries every used lane without an active tension; unused lanes compute on
+  // lane 0's gradients and volume (and F = I).
+  V4i fast = {0, 0, 0, 0};
   for (int l = 0; l < kLanes; ++l) {
-    if (l < batch.count && vector_lane[l]) continue;
     if (l < batch.count) {
-      kept_F[l] = batch.InputF(l);
+      if (batch.mp[l].active_tension == 0) fast[l] = -1;
     } else {
       for (int k = 0; k < 12; ++k) batch.g[k][l] = batch.g[k][0];
       batch.volume[l] = batch.volume[0];
+      for (int k = 0; k < 9; ++k) batch.F[k][l] = batch.F[k][0];
     }
-    for (int k = 0; k < 9; ++k) batch.F[k][l] = (k % 4 == 0) ? 1.0 : 0.0;
   }
-  V4i fast;
 #if defined(__x86_64__)
   if (ActiveSimdKernels() == SimdKernels::kAvx)
     CorotationalAvx(lame_.lambda, lame_.mu, batch, fast);
@@ -288,13 +294,10 @@ void CorotationalSolid::ElementStressAndStiffnessBatch(ElementBatch& batch) cons
 #endif
     CorotationalGeneric(lame_.lambda, lame_.mu, batch, fast);
   for (int l = 0; l < batch.count; ++l) {
-    if (vector_lane[l] && fast[l] != 0) {
-      batch.ok[l] = AllFinite(batch.P, 9, l) && AllFinite(batch.K, 144, l);
-    } else {
-      if (!vector_lane[l])
-        for (int k = 0; k < 9; ++k) batch.F[k][l] = kept_F[l].data()[k];
-      ElementWise(*this, batch, l);
-    }
+    if (fast[l] != 0)
+      batch.ok[l] = true;
+    else
+      ElementWise(*this, batch, l);  // its F is unchanged in the batch
   }
 }
 
