@@ -174,9 +174,20 @@ bool FemSolid::AssembleElements(const double* u, VecX& f, double* k_values) cons
         [&](Index e) {
           Mat3 P;
           const bool ok = law_->Stress(assembly_.DeformationGradient(e, u), PointOf(e), P);
-          scatter(e, ok, P, Mat12());
+          scatter(e, ok, P, [](int, int) { return 0.0; });  // no tangent
         },
         residual_team_);
+  } else if (!law_->has_batch_kernel()) {
+    assembly_.ForEachElementColoured(
+        [&](Index e) {
+          Mat3 P;
+          Mat12 K;
+          const bool ok =
+              law_->ElementStressAndStiffness(assembly_.DeformationGradient(e, u), PointOf(e),
+                                              assembly_.gradients(e), assembly_.volume(e), P, K);
+          scatter(e, ok, P, K);
+        },
+        tangent_team_);
   } else {
     // Tangents in batches of ElementBatch::kLanes consecutive elements (the corotational law
     // evaluates a batch in vector lanes), scattered in element order: the same sums in the

@@ -133,6 +133,7 @@ class CorotationalSolid final : public IsotropicSolid {
   /// does not cover (a nearly inverted or non-finite F, a polar iteration that does not
   /// converge, an active tension) are evaluated element-wise.
   void ElementStressAndStiffnessBatch(ElementBatch& batch) const override;
+  [[nodiscard]] bool has_batch_kernel() const override { return true; }
 
  private:
   /// R of the polar decomposition, tr(S) − 3 and M = (tr(S) I − S)⁻¹ (clamped); false for a

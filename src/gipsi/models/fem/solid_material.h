@@ -91,6 +91,9 @@ class SolidMaterial : public Material {
   /// default evaluates the elements one by one; a law may evaluate them together in vector lanes
   /// (CorotationalSolid), with the same results up to round-off.
   virtual void ElementStressAndStiffnessBatch(ElementBatch& batch) const;
+  /// True if ElementStressAndStiffnessBatch is faster than the elements one by one (the law
+  /// overrides it); the assembly then uses batches, otherwise it skips the batch's copies.
+  [[nodiscard]] virtual bool has_batch_kernel() const { return false; }
 
   /// κ [Pa] if the law's energy is W(F) = W̃(F) + κ/2 (ln J)² with that volumetric term split
   /// off (NeoHookean: κ = λ; Guccione: its bulk modulus), else 0. The mixed displacement–
