@@ -3,7 +3,7 @@
 
 Runs the release build's benchmarks (Google Benchmark, medians of --repetitions runs) and the
 CLI's own timing of two shipped scenes, and prints one Markdown table with the machine's STREAM
-triad, CPU, core count and load average, so figures from different machines can be compared
+triad, CPU, vector kernels, core count and load average, so figures from different machines can be compared
 (per core: run it with --threads 1; the default runs at 1 and at 2 threads, OMP_NUM_THREADS).
 
   python3 scripts/bench.py            # builds what it needs (release preset), about 6 minutes
@@ -13,7 +13,7 @@ triad, CPU, core count and load average, so figures from different machines can 
 
 Rows:
   STREAM triad [GB/s]                      the machine's memory bandwidth (sparse_bench)
-  FEM step 5k / 20k tets [ms]              corotational, backward Euler, Jacobi-CG (fem_bench)
+  FEM step 5k / 20k / 78k tets [ms]        corotational, backward Euler, Jacobi-CG (fem_bench)
   SpMV 26^3 lattice [GB/s, % of triad]     symmetric sparse matrix-vector product (sparse_bench)
   TTP06 cell model [M node-steps/s]        ten Tusscher-Panfilov 2006, 10^5 cells (cell_models_bench)
   Collision query [ms]                     two 224x224 sheets, 50 % overlap (collision_bench)
@@ -117,10 +117,11 @@ def measure(threads, repetitions, quick):
     spmv = triad["BM_SymmetricSpMV/26/real_time"]["bytes_per_second"] / 1e9
     r["SpMV 26^3 lattice [GB/s]"] = spmv
     r["SpMV / triad [%]"] = 100 * spmv / r["STREAM triad [GB/s]"]
-    fem = run_benchmark("fem_bench", "BM_ImplicitStep/corotational/(10|16)/0/", threads,
+    fem = run_benchmark("fem_bench", "BM_ImplicitStep/corotational/(10|16|25)/0/", threads,
                         repetitions)
     r["FEM step 5k tets [ms]"] = ms(fem["BM_ImplicitStep/corotational/10/0/real_time"])
     r["FEM step 20k tets [ms]"] = ms(fem["BM_ImplicitStep/corotational/16/0/real_time"])
+    r["FEM step 78k tets [ms]"] = ms(fem["BM_ImplicitStep/corotational/25/0/real_time"])
     cells = run_benchmark("cell_models_bench", "BM_CellModelStep/TenTusscherPanfilov2006/100000$",
                           threads, repetitions)
     r["TTP06 [M node-steps/s]"] = 1e5 / ms(
@@ -149,6 +150,17 @@ def cpu_model():
     except OSError:
         pass
     return platform.processor() or "unknown"
+
+
+def simd_kernels():
+    """The vector kernels the build runs here ("avx" or "generic"), from `gipsi --version`."""
+    try:
+        out = subprocess.run([os.path.join(BUILD, "bin", "gipsi"), "--version"],
+                             capture_output=True, text=True, check=True).stdout
+    except (OSError, subprocess.CalledProcessError):
+        return "unknown"
+    m = re.search(r"(\w+) kernels\)", out)
+    return m.group(1) if m else "unknown"
 
 
 def main():
@@ -191,7 +203,8 @@ def main():
     def title(t, busy):
         return f"{t} thread{'s' if t > 1 else ''}" + (", busy neighbour" if busy else "")
 
-    print(f"GiPSi benchmarks: {cpu_model()}, {os.cpu_count()} logical CPUs, "
+    print(f"GiPSi benchmarks: {cpu_model()}, {simd_kernels()} kernels, "
+          f"{os.cpu_count()} logical CPUs, "
           f"load average {load_before[0]:.2f} before and {load_after[0]:.2f} after, "
           f"medians of {repetitions}")
     print()
@@ -201,7 +214,8 @@ def main():
         print(f"| {name} | " + " | ".join(f"{results[c][name]:.3g}" for c in columns) + " |")
     if args.json:
         with open(args.json, "w") as f:
-            json.dump({"cpu": cpu_model(), "cpus": os.cpu_count(), "load_before": load_before,
+            json.dump({"cpu": cpu_model(), "kernels": simd_kernels(), "cpus": os.cpu_count(),
+                       "load_before": load_before,
                        "load_after": load_after, "repetitions": repetitions,
                        "results": {f"{t} busy" if busy else str(t): results[(t, busy)]
                                    for t, busy in columns}}, f, indent=1)
