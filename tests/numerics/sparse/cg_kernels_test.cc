@@ -12,11 +12,7 @@ namespace gipsi {
 namespace {
 
 using testing::RandomVector;
-
-bool SameBits(const VecX& a, const VecX& b) {
-  return a.size() == b.size() &&
-         std::memcmp(a.data(), b.data(), sizeof(double) * static_cast<std::size_t>(a.size())) == 0;
-}
+using testing::SameBits;
 
 struct CgVectors {
   VecX d, w, x, r, z, p, s;

@@ -4,6 +4,7 @@
 /// residual check (Eigen's own product, not SymmetricSpMV).
 
 #include <cstdint>
+#include <cstring>
 #include <random>
 
 #include "gipsi/numerics/sparse/linear_solver.h"
@@ -18,6 +19,12 @@ inline VecX RandomVector(Index size, std::uint32_t seed) {
   VecX v(size);
   for (Index i = 0; i < size; ++i) v[i] = uniform(engine);
   return v;
+}
+
+/// True if a and b hold the same bits (not just equal values).
+inline bool SameBits(const VecX& a, const VecX& b) {
+  return a.size() == b.size() &&
+         std::memcmp(a.data(), b.data(), sizeof(double) * static_cast<std::size_t>(a.size())) == 0;
 }
 
 /// A x_true = b with a random x_true; b is computed with SymmetricSpMV, so x_true has a

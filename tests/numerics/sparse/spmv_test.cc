@@ -16,12 +16,7 @@ namespace gipsi {
 namespace {
 
 using testing::RandomVector;
-
-/// True if a and b hold the same bits (not just equal values).
-bool SameBits(const VecX& a, const VecX& b) {
-  return a.size() == b.size() &&
-         std::memcmp(a.data(), b.data(), sizeof(double) * static_cast<std::size_t>(a.size())) == 0;
-}
+using testing::SameBits;
 
 /// Restores the OpenMP thread count when a test changed it.
 class ThreadCountGuard {

@@ -190,8 +190,8 @@ bool FemSolid::AssembleElements(const double* u, VecX& f, double* k_values) cons
         tangent_team_);
   } else {
     // Tangents in batches of ElementBatch::kLanes consecutive elements (the corotational law
-    // evaluates a batch in vector lanes), scattered in element order: the same sums in the
-    // same order as element by element.
+    // evaluates a batch in vector lanes), scattered in element order: every entry receives its
+    // element contributions in the same order as element by element.
     assembly_.ForEachChunkColoured(
         [&](Index first, Index last) {
           ElementBatch batch;
