@@ -416,14 +416,13 @@ TEST(CorotationalLaw, ClosedFormElementStiffnessMatchesTheContractedTangent) {
   }
 }
 
-// The batched corotational kernel (four elements in vector lanes) against the element-wise
-// closed form, lane by lane: large rotations and stretches on the vector path; an inverted, a
-// non-finite and an actively tensed element that the batch hands to the element-wise path;
-// batches of 1 to 4 elements. The same formula evaluated in another association (its own 3×3
-// inverses and products), so agreement to 1e-12 relative, as above; the AVX and generic
-// kernels give the same bits.
-TEST(CorotationalLaw, BatchedLanesMatchTheElementWiseStiffness) {
-  const CorotationalSolid law(kYoung, kPoisson);
+// A law's batched kernel (four elements in vector lanes) against its element-wise closed form,
+// lane by lane: large rotations and stretches on the vector path; an inverted, a non-finite
+// and an actively tensed element that the batch hands to the element-wise path; batches of 1 to
+// 4 elements. The same formula evaluated in another association (its own 3×3 inverses and
+// products), so agreement to 1e-12 relative, as above; the AVX and generic kernels give the
+// same bits.
+void ExpectBatchMatchesElementWise(const SolidMaterial& law) {
   std::mt19937 engine(11);
   std::uniform_real_distribution<double> uniform(-1.0, 1.0);
   auto random_tet = [&](TetGradients& g, double& volume) {
@@ -488,6 +487,53 @@ TEST(CorotationalLaw, BatchedLanesMatchTheElementWiseStiffness) {
     }
   }
   EXPECT_GE(vector_lanes, 40);  // most lanes took the vector path
+}
+
+TEST(CorotationalLaw, BatchedLanesMatchTheElementWiseStiffness) {
+  const CorotationalSolid law(kYoung, kPoisson);
+  ASSERT_TRUE(law.has_batch_kernel());
+  ExpectBatchMatchesElementWise(law);
+}
+
+TEST(NeoHookeanLaw, BatchedLanesMatchTheElementWiseStiffness) {
+  const NeoHookeanSolid law(kYoung, kPoisson);
+  ASSERT_TRUE(law.has_batch_kernel());
+  ExpectBatchMatchesElementWise(law);
+}
+
+// The neo-Hookean closed-form element stiffness is the generic contraction of its
+// (finite-difference checked) 9×9 tangent, stretched and rotated, with and without an active
+// tension (which takes the contraction).
+TEST(NeoHookeanLaw, ClosedFormElementStiffnessMatchesTheContractedTangent) {
+  const NeoHookeanSolid law(kYoung, kPoisson);
+  Mat3 X;
+  X << 0.10, 0.02, -0.01, 0.00, 0.08, 0.03, 0.01, -0.02, 0.12;
+  const Mat3 inverse = X.inverse();
+  TetGradients g;
+  for (int a = 0; a < 3; ++a) g.col(a + 1) = inverse.row(a).transpose();
+  g.col(0) = -(g.col(1) + g.col(2) + g.col(3));
+  const double volume = X.determinant() / 6;
+  Mat3 large;
+  large << 1.2, 0.15, 0.0, -0.1, 0.9, 0.2, 0.05, 0.0, 1.1;
+  const Mat3 rotation = Eigen::AngleAxisd(0.8, Vec3(1, -2, 0.5).normalized()).toRotationMatrix();
+  for (const Mat3& F : {Mat3(rotation * large), Mat3(large.transpose() * 0.7)}) {
+    for (double active : {0.0, kActive}) {
+      MaterialPoint mp;
+      mp.axes = Eigen::AngleAxisd(0.4, Vec3(0, 1, 1).normalized()).toRotationMatrix();
+      mp.active_tension = active;
+      Mat3 p_fast, p_generic;
+      Mat12 k_fast, k_generic;
+      ASSERT_TRUE(law.ElementStressAndStiffness(F, mp, g, volume, p_fast, k_fast));
+      ASSERT_TRUE(
+          law.SolidMaterial::ElementStressAndStiffness(F, mp, g, volume, p_generic, k_generic));
+      EXPECT_LE((p_fast - p_generic).norm(), 1e-12 * p_generic.norm()) << "active " << active;
+      EXPECT_LE((k_fast - k_generic).norm(), 1e-12 * k_generic.norm()) << "active " << active;
+      EXPECT_LE((k_fast - k_fast.transpose()).norm(), 1e-12 * k_fast.norm());
+    }
+  }
+  Mat3 P;
+  Mat12 K;
+  EXPECT_FALSE(law.ElementStressAndStiffness(InvertedF(), {}, g, volume, P, K));
 }
 
 /// Inverted, flat and non-finite deformations.

@@ -1,5 +1,6 @@
 // ElementBatch, the element-wise default of SolidMaterial::ElementStressAndStiffnessBatch, and
-// CorotationalSolid's vector-lane version of its closed-form element stiffness (solid_laws.h).
+// the vector-lane versions of CorotationalSolid's and NeoHookeanSolid's closed-form element
+// stiffnesses (solid_laws.h).
 
 #include <cmath>
 #include <cstdint>
@@ -260,6 +261,78 @@ GIPSI_SIMD_INLINE void CorotationalLanes(double lambda_value, double mu_value, E
   fast &= (V4i)(finite_check == finite_check);
 }
 
+// NeoHookeanSolid's closed form in the lanes. `fast` as for CorotationalLanes: J > kMinJacobian
+// (false for a non-finite F) and P, K finite; the other lanes compute on F = I.
+GIPSI_SIMD_INLINE void NeoHookeanLanes(double lambda_value, double mu_value, ElementBatch& batch,
+                                       V4i& fast) {
+  M3 F, H;
+  for (int k = 0; k < 9; ++k) Load(F.m[k], batch.F[k]);
+  V4d J;
+  Cofactors(F, H, J);
+  V4d min_j;
+  Splat(min_j, kMinJacobian);
+  fast &= (V4i)(J > min_j);
+  V4d one, zero;
+  Splat(one, 1.0);
+  Splat(zero, 0.0);
+  for (int k = 0; k < 9; ++k) Select(fast, F.m[k], k % 4 == 0 ? one : zero, F.m[k]);
+  Cofactors(F, H, J);  // again for the lanes just set to I: H = cof(F) / J = F⁻ᵀ
+  const V4d inv_j = 1.0 / J;
+  for (V4d& v : H.m) v *= inv_j;
+  double logs[4];
+  Store(logs, J);
+  for (double& v : logs) v = std::log(v);
+  V4d log_j;
+  Load(log_j, logs);
+  V4d lambda, mu;
+  Splat(lambda, lambda_value);
+  Splat(mu, mu_value);
+  V4d finite_check = zero;
+  // P = μ F + (λ ln J − μ) H.
+  const V4d ph = lambda * log_j - mu;
+  for (int k = 0; k < 9; ++k) {
+    const V4d p = mu * F.m[k] + ph * H.m[k];
+    finite_check += p * 0.0;
+    Store(batch.P[k], p);
+  }
+  V4d volume;
+  Load(volume, batch.volume);
+  const V4d c = volume * (mu - lambda * log_j);
+  const V4d v_lambda = volume * lambda;
+  const V4d v_mu = volume * mu;
+  V4d g[4][3], h[4][3];
+  for (int a = 0; a < 4; ++a) {
+    for (int j = 0; j < 3; ++j) Load(g[a][j], batch.g[j + 3 * a]);
+    for (int i = 0; i < 3; ++i)
+      h[a][i] = H.m[i] * g[a][0] + H.m[i + 3] * g[a][1] + H.m[i + 6] * g[a][2];
+  }
+  // K_ab = V [μ (g_a·g_b) I + c h_b h_aᵀ + λ h_a h_bᵀ], a ≤ b, mirrored.
+  for (int b = 0; b < 4; ++b)
+    for (int a = 0; a <= b; ++a) {
+      const V4d gg = v_mu * (g[a][0] * g[b][0] + g[a][1] * g[b][1] + g[a][2] * g[b][2]);
+      for (int k = 0; k < 3; ++k)
+        for (int i = 0; i < 3; ++i) {
+          V4d v = c * (h[b][i] * h[a][k]) + v_lambda * (h[a][i] * h[b][k]);
+          if (i == k) v += gg;
+          finite_check += v * 0.0;
+          Store(batch.K[(3 * a + i) + 12 * (3 * b + k)], v);
+          if (a != b) Store(batch.K[(3 * b + k) + 12 * (3 * a + i)], v);
+        }
+    }
+  fast &= (V4i)(finite_check == finite_check);
+}
+
+void NeoHookeanGeneric(double lambda, double mu, ElementBatch& batch, V4i& fast) {
+  NeoHookeanLanes(lambda, mu, batch, fast);
+}
+
+#if defined(__x86_64__)
+__attribute__((target("avx"))) void NeoHookeanAvx(double lambda, double mu, ElementBatch& batch,
+                                                  V4i& fast) {
+  NeoHookeanLanes(lambda, mu, batch, fast);
+}
+#endif
+
 void CorotationalGeneric(double lambda, double mu, ElementBatch& batch, V4i& fast) {
   CorotationalLanes(lambda, mu, batch, fast);
 }
@@ -273,10 +346,16 @@ __attribute__((target("avx"))) void CorotationalAvx(double lambda, double mu, El
 
 }  // namespace
 
-void CorotationalSolid::ElementStressAndStiffnessBatch(ElementBatch& batch) const {
+namespace {
+
+using LanesKernel = void (*)(double lambda, double mu, ElementBatch& batch, V4i& fast);
+
+// Runs a law's lanes kernel (AVX or generic) on a batch: every used lane without an active
+// tension is tried, unused lanes compute on lane 0's inputs; the lanes the kernel leaves out
+// are evaluated element-wise, from their inputs as given.
+void RunLanes(const SolidMaterial& law, double lambda, double mu, LanesKernel avx,
+              LanesKernel generic, ElementBatch& batch) {
   constexpr int kLanes = ElementBatch::kLanes;
-  // The vector path tries every used lane without an active tension; unused lanes compute on
-  // lane 0's gradients and volume (and F = I).
   V4i fast = {0, 0, 0, 0};
   for (int l = 0; l < kLanes; ++l) {
     if (l < batch.count) {
@@ -287,18 +366,31 @@ void CorotationalSolid::ElementStressAndStiffnessBatch(ElementBatch& batch) cons
       for (int k = 0; k < 9; ++k) batch.F[k][l] = batch.F[k][0];
     }
   }
-#if defined(__x86_64__)
-  if (ActiveSimdKernels() == SimdKernels::kAvx)
-    CorotationalAvx(lame_.lambda, lame_.mu, batch, fast);
-  else
-#endif
-    CorotationalGeneric(lame_.lambda, lame_.mu, batch, fast);
+  (ActiveSimdKernels() == SimdKernels::kAvx && avx ? avx : generic)(lambda, mu, batch, fast);
   for (int l = 0; l < batch.count; ++l) {
     if (fast[l] != 0)
       batch.ok[l] = true;
     else
-      ElementWise(*this, batch, l);  // its F is unchanged in the batch
+      ElementWise(law, batch, l);  // its F is unchanged in the batch
   }
+}
+
+#if defined(__x86_64__)
+constexpr LanesKernel kCorotationalAvx = CorotationalAvx;
+constexpr LanesKernel kNeoHookeanAvx = NeoHookeanAvx;
+#else
+constexpr LanesKernel kCorotationalAvx = nullptr;
+constexpr LanesKernel kNeoHookeanAvx = nullptr;
+#endif
+
+}  // namespace
+
+void CorotationalSolid::ElementStressAndStiffnessBatch(ElementBatch& batch) const {
+  RunLanes(*this, lame_.lambda, lame_.mu, kCorotationalAvx, CorotationalGeneric, batch);
+}
+
+void NeoHookeanSolid::ElementStressAndStiffnessBatch(ElementBatch& batch) const {
+  RunLanes(*this, lame_.lambda, lame_.mu, kNeoHookeanAvx, NeoHookeanGeneric, batch);
 }
 
 }  // namespace gipsi

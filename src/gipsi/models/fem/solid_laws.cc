@@ -428,6 +428,31 @@ bool NeoHookeanSolid::StressAndTangent(const Mat3& F, const MaterialPoint& mp, M
   return P.allFinite() && dPdF.allFinite();
 }
 
+bool NeoHookeanSolid::ElementStressAndStiffness(const Mat3& F, const MaterialPoint& mp,
+                                                const TetGradients& g, double volume, Mat3& P,
+                                                Mat12& K) const {
+  if (mp.active_tension != 0)
+    return SolidMaterial::ElementStressAndStiffness(F, mp, g, volume, P, K);
+  const double J = F.determinant();
+  if (!(J > kMinJacobian)) return false;
+  const double log_j = std::log(J);
+  const Mat3 H = F.inverse().transpose();
+  P = lame_.mu * F + (lame_.lambda * log_j - lame_.mu) * H;
+  const Eigen::Matrix<double, 3, 4> h = H * g;
+  const double c = volume * (lame_.mu - lame_.lambda * log_j);
+  const double lambda = volume * lame_.lambda;
+  const double mu = volume * lame_.mu;
+  for (int b = 0; b < 4; ++b)
+    for (int a = 0; a <= b; ++a) {
+      Mat3 block =
+          c * (h.col(b) * h.col(a).transpose()) + lambda * (h.col(a) * h.col(b).transpose());
+      block.diagonal().array() += mu * g.col(a).dot(g.col(b));
+      K.block<3, 3>(3 * a, 3 * b) = block;
+      if (a != b) K.block<3, 3>(3 * b, 3 * a) = block.transpose();
+    }
+  return P.allFinite() && K.allFinite();
+}
+
 // ---------------------------------------------------------------------------------------------
 // Guccione
 

@@ -169,6 +169,16 @@ class NeoHookeanSolid final : public IsotropicSolid {
   [[nodiscard]] bool Stress(const Mat3& F, const MaterialPoint& mp, Mat3& P) const override;
   [[nodiscard]] bool StressAndTangent(const Mat3& F, const MaterialPoint& mp, Mat3& P,
                                       Mat9& dPdF) const override;
+  /// Closed form of the element stiffness: with h_a = H g_a (the current gradients),
+  ///   K_ab = V [μ (g_a·g_b) I + (μ − λ ln J) h_b h_aᵀ + λ h_a h_bᵀ]
+  /// (an active tension adds its geometric term through the generic contraction).
+  [[nodiscard]] bool ElementStressAndStiffness(const Mat3& F, const MaterialPoint& mp,
+                                               const TetGradients& g, double volume, Mat3& P,
+                                               Mat12& K) const override;
+  /// The same closed form for four elements in vector lanes (see CorotationalSolid's); lanes
+  /// with J ≤ kMinJacobian, a non-finite result or an active tension go element-wise.
+  void ElementStressAndStiffnessBatch(ElementBatch& batch) const override;
+  [[nodiscard]] bool has_batch_kernel() const override { return true; }
 };
 
 /// Parameters of the Guccione law.
