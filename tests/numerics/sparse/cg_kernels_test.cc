@@ -31,7 +31,8 @@ struct CgVectors {
 TEST(CgKernels, UpdateSweepFollowsTheRecurrencesWithTheSameBitsOnEveryKernel) {
   const Index n = 1003;
   const double alpha = 0.37, beta = 1.9;
-  for (const auto& [begin, end] : {std::pair{0, 1003}, std::pair{1, 1000}, std::pair{5, 7}}) {
+  for (const auto& range : {std::pair{0, 1003}, std::pair{1, 1000}, std::pair{5, 7}}) {
+    const int begin = range.first, end = range.second;  // (lambdas below use them)
     CgVectors plain(n), active(n), generic(n);
     double rr = 0, rz = 0;
     for (int i = begin; i < end; ++i) {
