@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <cstring>
+#include <limits>
 
 #include <gtest/gtest.h>
 
@@ -76,6 +77,28 @@ TEST(CgKernels, DotIsTheSameOnEveryKernel) {
     EXPECT_EQ(std::memcmp(&active, &generic, sizeof active), 0);
     const double plain = a.segment(begin, end - begin).dot(b.segment(begin, end - begin));
     EXPECT_NEAR(active, plain, 1e-14 * b.norm() * a.norm());
+  }
+}
+
+// A NaN or an infinity anywhere, in the four-lane part or the tail, is found by both kernels;
+// large finite values (whose squares would overflow) and negative zeros are finite.
+TEST(CgKernels, AllFiniteFindsEveryNonFiniteValue) {
+  VecX v = RandomVector(103, 10) * 1e300;
+  v[7] = -0.0;
+  for (const SimdKernels kernels : {SimdKernels::kAvx, SimdKernels::kGeneric}) {
+    const SimdKernels before = LimitSimdKernels(kernels);
+    EXPECT_TRUE(AllFiniteValues(v.data(), v.size()));
+    EXPECT_TRUE(AllFiniteValues(v.data(), 0));
+    for (const Index at : {Index{0}, Index{50}, Index{101}, Index{102}})
+      for (const double bad :
+           {std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::infinity(),
+            -std::numeric_limits<double>::infinity()}) {
+        VecX w = v;
+        w[at] = bad;
+        EXPECT_FALSE(AllFiniteValues(w.data(), w.size())) << "at " << at << ": " << bad;
+        EXPECT_TRUE(AllFiniteValues(w.data(), at)) << "the values before " << at;
+      }
+    LimitSimdKernels(before);
   }
 }
 

@@ -72,6 +72,25 @@ GIPSI_SIMD_INLINE double DotBody(const double* __restrict a, const double* __res
   return (chain[0] + chain[1]) + (chain[2] + chain[3]);
 }
 
+// x · 0 is 0 for a finite x and NaN otherwise, so one sum of them is NaN iff a value is not
+// finite (then its comparison with itself fails).
+GIPSI_SIMD_INLINE bool AllFiniteBody(const double* __restrict values, std::ptrdiff_t n) {
+  V4 sum = {0.0, 0.0, 0.0, 0.0};
+  std::ptrdiff_t i = 0;
+  for (; i + 4 <= n; i += 4) {
+    V4 v;
+    Load(v, values + i);
+    sum += v * 0.0;
+  }
+  double lanes[4];
+  Store(lanes, sum);
+  double total = (lanes[0] + lanes[1]) + (lanes[2] + lanes[3]);
+  for (; i < n; ++i) total += values[i] * 0.0;
+  return total == total;
+}
+
+bool AllFiniteGeneric(const double* values, std::ptrdiff_t n) { return AllFiniteBody(values, n); }
+
 CgUpdateSums UpdateGeneric(double alpha, double beta, const double* d, const double* w, double* x,
                            double* r, double* z, double* p, double* s, int begin, int end) {
   return UpdateBody(alpha, beta, d, w, x, r, z, p, s, begin, end);
@@ -87,6 +106,10 @@ __attribute__((target("avx"))) CgUpdateSums UpdateAvx(double alpha, double beta,
                                                       double* z, double* p, double* s, int begin,
                                                       int end) {
   return UpdateBody(alpha, beta, d, w, x, r, z, p, s, begin, end);
+}
+
+__attribute__((target("avx"))) bool AllFiniteAvx(const double* values, std::ptrdiff_t n) {
+  return AllFiniteBody(values, n);
 }
 
 __attribute__((target("avx"))) double DotAvx(const double* a, const double* b, int begin, int end) {
@@ -110,6 +133,13 @@ double DotRows(const double* a, const double* b, int begin, int end) {
   if (ActiveSimdKernels() == SimdKernels::kAvx) return DotAvx(a, b, begin, end);
 #endif
   return DotGeneric(a, b, begin, end);
+}
+
+bool AllFiniteValues(const double* values, std::ptrdiff_t n) {
+#if defined(__x86_64__)
+  if (ActiveSimdKernels() == SimdKernels::kAvx) return AllFiniteAvx(values, n);
+#endif
+  return AllFiniteGeneric(values, n);
 }
 
 }  // namespace gipsi

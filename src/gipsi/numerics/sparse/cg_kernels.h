@@ -1,9 +1,12 @@
 #pragma once
 /// @file
-/// The vector sweeps of the fused Jacobi-CG (pcg.cc, IterateFused), with an AVX version chosen
-/// at run time (numerics/simd.h). Both versions add the sums in four interleaved chains (entry
-/// i of a range in chain i mod 4, the chains combined as (c0 + c1) + (c2 + c3)), so they give
-/// the same bits; only the speed depends on the processor.
+/// The vector sweeps of the fused Jacobi-CG (pcg.cc, IterateFused) and the finiteness check of
+/// the matrices the solvers take, with an AVX version chosen at run time (numerics/simd.h). Both
+/// versions add the sums in four interleaved chains (entry i of a range in chain i mod 4, the
+/// chains combined as (c0 + c1) + (c2 + c3)), so they give the same bits; only the speed depends on
+/// the processor.
+
+#include <cstddef>
 
 #include "gipsi/base/export.h"
 
@@ -23,6 +26,9 @@ CgUpdateSums CgUpdateRows(double alpha, double beta, const double* d, const doub
 
 /// (a, b) over rows [begin, end).
 double DotRows(const double* a, const double* b, int begin, int end);
+
+/// True if all n values are finite (no NaN, no infinity).
+bool AllFiniteValues(const double* values, std::ptrdiff_t n);
 
 }  // namespace gipsi
 GIPSI_EXPORT_END

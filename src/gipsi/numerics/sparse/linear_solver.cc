@@ -13,6 +13,7 @@
 #include <fmt/format.h>
 
 #include "gipsi/base/error.h"
+#include "gipsi/numerics/sparse/cg_kernels.h"
 #include "gipsi/numerics/sparse/solvers.h"
 
 namespace gipsi {
@@ -88,9 +89,7 @@ Eigen::MatrixXd RigidBodyModes(const VecX& positions) {
   return modes;
 }
 
-bool AllValuesFinite(const SparseMatrix& A) {
-  return Eigen::Map<const VecX>(A.valuePtr(), A.nonZeros()).allFinite();
-}
+bool AllValuesFinite(const SparseMatrix& A) { return AllFiniteValues(A.valuePtr(), A.nonZeros()); }
 
 void CheckAnalysedShape(const SparseMatrix& A, Index rows, Index nonzeros, const char* who) {
   GIPSI_CHECK(A.rows() == A.cols() && A.isCompressed(), "{}: matrix must be square and compressed",
