@@ -559,6 +559,54 @@ bool GuccioneSolid::StressAndTangent(const Mat3& F, const MaterialPoint& mp, Mat
   return P.allFinite() && dPdF.allFinite();
 }
 
+bool GuccioneSolid::ElementStressAndStiffness(const Mat3& F, const MaterialPoint& mp,
+                                              const TetGradients& g, double volume, Mat3& P,
+                                              Mat12& K) const {
+  GuccionePoint pt;
+  if (!EvaluateGuccione(b_, F, mp.axes, pt)) return false;
+  const Mat3& A = mp.axes;
+  const double c = params_.C * std::exp(pt.q);
+  const double kappa = params_.bulk_modulus;
+  const Mat3 H = F.inverse().transpose();
+  Mat3 S = A * (c * pt.be) * A.transpose();
+  if (mp.active_tension != 0) S += ActivePk2(mp);
+  P.noalias() = F * S;
+  P.noalias() += (kappa * pt.log_j) * H;
+
+  Vec6 s, d;
+  for (int v = 0; v < 6; ++v) {
+    const int m = kVoigt[v][0], n = kVoigt[v][1];
+    s(v) = pt.be(m, n);
+    d(v) = (m == n ? 1.0 : 0.5) * b_(m, n);
+  }
+  const Eigen::Matrix<double, 3, 4> r = A.transpose() * g;  // gradients in the fibre frame
+  const Eigen::Matrix<double, 3, 4> h = H * g;
+  const Eigen::Matrix<double, 3, 4> sg = S * g;
+  std::array<Eigen::Matrix<double, 6, 3>, 4> B, dB;
+  std::array<Vec3, 4> tau;
+  for (int a = 0; a < 4; ++a) {
+    for (int v = 0; v < 6; ++v) {
+      const int m = kVoigt[v][0], n = kVoigt[v][1];
+      const double w = m == n ? 0.5 : 1.0;
+      B[a].row(v) = w * (pt.g.col(m) * r(n, a) + pt.g.col(n) * r(m, a)).transpose();
+    }
+    dB[a] = d.asDiagonal() * B[a];
+    tau[a] = B[a].transpose() * s;
+  }
+  for (int b = 0; b < 4; ++b) {
+    for (int a = 0; a <= b; ++a) {
+      Mat3 block = c * (B[a].transpose() * dB[b] + 2 * tau[a] * tau[b].transpose());
+      block.noalias() += kappa * (h.col(a) * h.col(b).transpose());
+      block.noalias() -= (kappa * pt.log_j) * (h.col(b) * h.col(a).transpose());
+      block.diagonal().array() += g.col(a).dot(sg.col(b));
+      block *= volume;
+      K.block<3, 3>(3 * a, 3 * b) = block;
+      if (a != b) K.block<3, 3>(3 * b, 3 * a) = block.transpose();
+    }
+  }
+  return P.allFinite() && K.allFinite();
+}
+
 // ---------------------------------------------------------------------------------------------
 // Registration
 

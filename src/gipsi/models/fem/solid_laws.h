@@ -234,6 +234,16 @@ class GuccioneSolid final : public SolidMaterial {
   [[nodiscard]] bool Stress(const Mat3& F, const MaterialPoint& mp, Mat3& P) const override;
   [[nodiscard]] bool StressAndTangent(const Mat3& F, const MaterialPoint& mp, Mat3& P,
                                       Mat9& dPdF) const override;
+  /// Closed form of the element stiffness (no 9×9 tangent): with r_a = Aᵀ g_a, G = F A, the
+  /// 6×3 strain–displacement matrix B_a (row (m, n) = w (G(:, m) r_a(n) + G(:, n) r_a(m))ᵀ,
+  /// w ½ on the normal rows), τ_a = B_aᵀ s and h_a = H g_a:
+  ///   K_ab = V [C e^Q (B_aᵀ diag(d) B_b + 2 τ_a τ_bᵀ) + (g_a·S g_b) I
+  ///             + κ (h_a h_bᵀ − ln J h_b h_aᵀ)],
+  /// the contraction of StressAndTangent's terms with the shape gradients (S includes the
+  /// active stress).
+  [[nodiscard]] bool ElementStressAndStiffness(const Mat3& F, const MaterialPoint& mp,
+                                               const TetGradients& g, double volume, Mat3& P,
+                                               Mat12& K) const override;
 
  private:
   GuccioneParams params_;
