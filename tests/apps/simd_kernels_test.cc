@@ -1,5 +1,5 @@
 // The vector kernels change the speed of a run, never its results: whole scenes write the same
-// bytes with the AVX kernels and with the generic ones (GIPSI_SIMD=generic), for the two laws
+// bytes with the AVX kernels and with the generic ones (GIPSI_SIMD=generic), for the three laws
 // with batch kernels and the fused Jacobi-CG. On a processor without AVX both runs use the
 // generic kernels and the comparison holds trivially; the --version check says which ran.
 
@@ -34,13 +34,15 @@ TEST(SimdKernels, GenericKernelsAreSelectedByTheEnvironment) {
   EXPECT_THAT(r.output, ::testing::HasSubstr("; generic kernels)"));
 }
 
-// The cantilever (corotational, Newton with the default, fused Jacobi-CG) and the hanging liver
-// (neo-Hookean, lagged CHOLMOD) for its first steps: frames, probes and series byte for byte.
+// The cantilever (corotational, Newton with the default, fused Jacobi-CG), the hanging liver
+// (neo-Hookean, lagged CHOLMOD) for its first step and the heart's first 0.1 s (Guccione with
+// the active tension rising): frames, probes, series and plots byte for byte.
 TEST(SimdKernels, ScenesWriteTheSameBytesWithAvxAndGenericKernels) {
   const fs::path dir = testing::TestTempDir();
   const std::string scenes = std::string(GIPSI_SOURCE_DIR) + "/scenes/";
   for (const auto& [scene, until] : {std::pair<std::string, std::string>{"cantilever.json", ""},
-                                     {"hanging_liver_fem.json", " --until 0.01"}}) {
+                                     {"hanging_liver_fem.json", " --until 0.01"},
+                                     {"heart.json", " --until 0.1"}}) {
     const fs::path active = dir / (scene + ".active"), generic = dir / (scene + ".generic");
     const testing::Result a =
         testing::Gipsi("run " + scenes + scene + until + " -q --out " + active.string());

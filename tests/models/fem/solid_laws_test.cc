@@ -495,6 +495,12 @@ TEST(CorotationalLaw, BatchedLanesMatchTheElementWiseStiffness) {
   ExpectBatchMatchesElementWise(law);
 }
 
+TEST(GuccioneLaw, BatchedLanesMatchTheElementWiseStiffness) {
+  const GuccioneSolid law(BenchmarkGuccione());
+  ASSERT_TRUE(law.has_batch_kernel());
+  ExpectBatchMatchesElementWise(law);  // its lanes take the actively tensed elements too
+}
+
 TEST(NeoHookeanLaw, BatchedLanesMatchTheElementWiseStiffness) {
   const NeoHookeanSolid law(kYoung, kPoisson);
   ASSERT_TRUE(law.has_batch_kernel());

@@ -161,8 +161,8 @@ GIPSI_SIMD_INLINE void Select(const V4i& mask, const V4d& yes, const V4d& no, V4
 // evaluated in full: F finite and comfortably away from inversion (the element-wise FastPolar's
 // test, det F > 1e-6 ‖F‖³), the polar iteration converged, P and K finite. The others are
 // computed on F = I, to be replaced by the caller.
-GIPSI_SIMD_INLINE void CorotationalLanes(double lambda_value, double mu_value, ElementBatch& batch,
-                                         V4i& fast) {
+GIPSI_SIMD_INLINE void CorotationalLanes(const double* params, ElementBatch& batch, V4i& fast) {
+  const double lambda_value = params[0], mu_value = params[1];
   M3 F, R;
   for (int k = 0; k < 9; ++k) Load(F.m[k], batch.F[k]);
   {
@@ -263,8 +263,8 @@ GIPSI_SIMD_INLINE void CorotationalLanes(double lambda_value, double mu_value, E
 
 // NeoHookeanSolid's closed form in the lanes. `fast` as for CorotationalLanes: J > kMinJacobian
 // (false for a non-finite F) and P, K finite; the other lanes compute on F = I.
-GIPSI_SIMD_INLINE void NeoHookeanLanes(double lambda_value, double mu_value, ElementBatch& batch,
-                                       V4i& fast) {
+GIPSI_SIMD_INLINE void NeoHookeanLanes(const double* params, ElementBatch& batch, V4i& fast) {
+  const double lambda_value = params[0], mu_value = params[1];
   M3 F, H;
   for (int k = 0; k < 9; ++k) Load(F.m[k], batch.F[k]);
   V4d J;
@@ -322,51 +322,175 @@ GIPSI_SIMD_INLINE void NeoHookeanLanes(double lambda_value, double mu_value, Ele
   fast &= (V4i)(finite_check == finite_check);
 }
 
-void NeoHookeanGeneric(double lambda, double mu, ElementBatch& batch, V4i& fast) {
-  NeoHookeanLanes(lambda, mu, batch, fast);
+// GuccioneSolid's closed form (solid_laws.h) in the lanes, with the active tension: params C,
+// b_f, b_t, b_fs, κ. `fast` as for the others: J > kMinJacobian and Q ≤ kMaxExponent (both false
+// for a non-finite F) and P, K finite; the other lanes compute on F = I.
+GIPSI_SIMD_INLINE void GuccioneLanes(const double* params, ElementBatch& batch, V4i& fast) {
+  const double C = params[0], bf = params[1], bt = params[2], bfs = params[3];
+  const double kappa_value = params[4];
+  const double b[9] = {bf, bfs, bfs, bfs, bt, bt, bfs, bt, bt};  // B, symmetric
+  M3 F, H, A;
+  for (int k = 0; k < 9; ++k) Load(F.m[k], batch.F[k]);
+  double axes[9][4], tension[4];
+  for (int l = 0; l < 4; ++l) {
+    for (int k = 0; k < 9; ++k) axes[k][l] = batch.mp[l].axes.data()[k];
+    tension[l] = batch.mp[l].active_tension;
+  }
+  for (int k = 0; k < 9; ++k) Load(A.m[k], axes[k]);
+  V4d J, zero, one;
+  Splat(zero, 0.0);
+  Splat(one, 1.0);
+  Cofactors(F, H, J);
+  V4d min_j;
+  Splat(min_j, kMinJacobian);
+  fast &= (V4i)(J > min_j);
+  for (int k = 0; k < 9; ++k) Select(fast, F.m[k], k % 4 == 0 ? one : zero, F.m[k]);
+  Cofactors(F, H, J);
+  const V4d inv_j = 1.0 / J;
+  for (V4d& v : H.m) v *= inv_j;
+  // G = F A; E' = ½ (GᵀG − I); B ∘ E'; Q = Σ E' ∘ (B ∘ E').
+  M3 G, be;
+  for (int j = 0; j < 3; ++j)
+    for (int i = 0; i < 3; ++i)
+      G.m[i + 3 * j] =
+          F.m[i] * A.m[3 * j] + F.m[i + 3] * A.m[3 * j + 1] + F.m[i + 6] * A.m[3 * j + 2];
+  V4d half, q;
+  Splat(half, 0.5);
+  Splat(q, 0.0);
+  for (int n = 0; n < 3; ++n)
+    for (int m = 0; m < 3; ++m) {
+      V4d e = half * (G.m[3 * m] * G.m[3 * n] + G.m[3 * m + 1] * G.m[3 * n + 1] +
+                      G.m[3 * m + 2] * G.m[3 * n + 2]);
+      if (m == n) e -= half;
+      be.m[m + 3 * n] = b[m + 3 * n] * e;
+      q += e * be.m[m + 3 * n];
+    }
+  V4d max_q;
+  Splat(max_q, GuccioneSolid::kMaxExponent);
+  fast &= (V4i)(q <= max_q);
+  double lanes_q[4], lanes_j[4];
+  Store(lanes_q, q);
+  Store(lanes_j, J);
+  for (int l = 0; l < 4; ++l) {
+    lanes_q[l] = fast[l] != 0 ? C * std::exp(lanes_q[l]) : 0.0;
+    lanes_j[l] = std::log(lanes_j[l]);
+  }
+  V4d c, log_j, kappa;
+  Load(c, lanes_q);
+  Load(log_j, lanes_j);
+  Splat(kappa, kappa_value);
+  // S = A (c B∘E') Aᵀ + Ta f fᵀ (f the first axis); P = F S + κ ln J H.
+  M3 AS, S;
+  for (int j = 0; j < 3; ++j)
+    for (int i = 0; i < 3; ++i)
+      AS.m[i + 3 * j] =
+          c * (A.m[i] * be.m[3 * j] + A.m[i + 3] * be.m[3 * j + 1] + A.m[i + 6] * be.m[3 * j + 2]);
+  V4d ta;
+  Load(ta, tension);
+  for (int j = 0; j < 3; ++j)
+    for (int i = 0; i < 3; ++i)
+      S.m[i + 3 * j] = AS.m[i] * A.m[j] + AS.m[i + 3] * A.m[j + 3] + AS.m[i + 6] * A.m[j + 6] +
+                       ta * (A.m[i] * A.m[j]);
+  V4d finite_check = zero;
+  const V4d kappa_log_j = kappa * log_j;
+  for (int j = 0; j < 3; ++j)
+    for (int i = 0; i < 3; ++i) {
+      const V4d p = F.m[i] * S.m[3 * j] + F.m[i + 3] * S.m[3 * j + 1] +
+                    F.m[i + 6] * S.m[3 * j + 2] + kappa_log_j * H.m[i + 3 * j];
+      finite_check += p * 0.0;
+      Store(batch.P[i + 3 * j], p);
+    }
+  // Per node: r_a = Aᵀ g_a, B_a (6×3, Voigt rows), d ∘ B_a, τ_a = B_aᵀ s, h_a = H g_a, S g_a.
+  constexpr int kPair[6][2] = {{0, 0}, {1, 1}, {2, 2}, {1, 2}, {0, 2}, {0, 1}};
+  V4d g[4][3], h[4][3], sg[4][3], tau[4][3], B[4][6][3], dB[4][6][3];
+  for (int a = 0; a < 4; ++a) {
+    for (int j = 0; j < 3; ++j) Load(g[a][j], batch.g[j + 3 * a]);
+    V4d r[3];
+    for (int n = 0; n < 3; ++n)
+      r[n] = A.m[3 * n] * g[a][0] + A.m[3 * n + 1] * g[a][1] + A.m[3 * n + 2] * g[a][2];
+    for (int i = 0; i < 3; ++i) {
+      h[a][i] = H.m[i] * g[a][0] + H.m[i + 3] * g[a][1] + H.m[i + 6] * g[a][2];
+      sg[a][i] = S.m[i] * g[a][0] + S.m[i + 3] * g[a][1] + S.m[i + 6] * g[a][2];
+      tau[a][i] = zero;
+    }
+    for (int v = 0; v < 6; ++v) {
+      const int m = kPair[v][0], n = kPair[v][1];
+      const double w = m == n ? 0.5 : 1.0;
+      const double d = (m == n ? 1.0 : 0.5) * b[m + 3 * n];
+      for (int i = 0; i < 3; ++i) {
+        B[a][v][i] = w * (G.m[i + 3 * m] * r[n] + G.m[i + 3 * n] * r[m]);
+        dB[a][v][i] = d * B[a][v][i];
+        tau[a][i] += B[a][v][i] * be.m[m + 3 * n];
+      }
+    }
+  }
+  V4d volume;
+  Load(volume, batch.volume);
+  const V4d two_c = 2.0 * c;
+  for (int bn = 0; bn < 4; ++bn)
+    for (int a = 0; a <= bn; ++a) {
+      const V4d gsg = g[a][0] * sg[bn][0] + g[a][1] * sg[bn][1] + g[a][2] * sg[bn][2];
+      for (int k = 0; k < 3; ++k)
+        for (int i = 0; i < 3; ++i) {
+          V4d material = B[a][0][i] * dB[bn][0][k];
+          for (int v = 1; v < 6; ++v) material += B[a][v][i] * dB[bn][v][k];
+          V4d value = c * material + two_c * (tau[a][i] * tau[bn][k]) +
+                      kappa * (h[a][i] * h[bn][k]) - kappa_log_j * (h[bn][i] * h[a][k]);
+          if (i == k) value += gsg;
+          value *= volume;
+          finite_check += value * 0.0;
+          Store(batch.K[(3 * a + i) + 12 * (3 * bn + k)], value);
+          if (a != bn) Store(batch.K[(3 * bn + k) + 12 * (3 * a + i)], value);
+        }
+    }
+  fast &= (V4i)(finite_check == finite_check);
 }
 
+// One generic and one AVX copy of each lanes kernel.
+#define GIPSI_LANES_COPIES(Name)                                             \
+  void Name##Generic(const double* params, ElementBatch& batch, V4i& fast) { \
+    Name##Lanes(params, batch, fast);                                        \
+  }                                                                          \
+  GIPSI_LANES_AVX(Name)
 #if defined(__x86_64__)
-__attribute__((target("avx"))) void NeoHookeanAvx(double lambda, double mu, ElementBatch& batch,
-                                                  V4i& fast) {
-  NeoHookeanLanes(lambda, mu, batch, fast);
-}
+#define GIPSI_LANES_AVX(Name)                                                              \
+  __attribute__((target("avx"))) void Name##Avx(const double* params, ElementBatch& batch, \
+                                                V4i& fast) {                               \
+    Name##Lanes(params, batch, fast);                                                      \
+  }
+#else
+#define GIPSI_LANES_AVX(Name)
 #endif
-
-void CorotationalGeneric(double lambda, double mu, ElementBatch& batch, V4i& fast) {
-  CorotationalLanes(lambda, mu, batch, fast);
-}
-
-#if defined(__x86_64__)
-__attribute__((target("avx"))) void CorotationalAvx(double lambda, double mu, ElementBatch& batch,
-                                                    V4i& fast) {
-  CorotationalLanes(lambda, mu, batch, fast);
-}
-#endif
+GIPSI_LANES_COPIES(Corotational)
+GIPSI_LANES_COPIES(NeoHookean)
+GIPSI_LANES_COPIES(Guccione)
+#undef GIPSI_LANES_COPIES
+#undef GIPSI_LANES_AVX
 
 }  // namespace
 
 namespace {
 
-using LanesKernel = void (*)(double lambda, double mu, ElementBatch& batch, V4i& fast);
+using LanesKernel = void (*)(const double* params, ElementBatch& batch, V4i& fast);
 
-// Runs a law's lanes kernel (AVX or generic) on a batch: every used lane without an active
-// tension is tried, unused lanes compute on lane 0's inputs; the lanes the kernel leaves out
-// are evaluated element-wise, from their inputs as given.
-void RunLanes(const SolidMaterial& law, double lambda, double mu, LanesKernel avx,
-              LanesKernel generic, ElementBatch& batch) {
+// Runs a law's lanes kernel (AVX or generic) on a batch: every used lane is tried (those with an
+// active tension only if the kernel takes it), unused lanes compute on lane 0's inputs; the
+// lanes the kernel leaves out are evaluated element-wise, from their inputs as given.
+void RunLanes(const SolidMaterial& law, const double* params, LanesKernel avx, LanesKernel generic,
+              bool takes_active, ElementBatch& batch) {
   constexpr int kLanes = ElementBatch::kLanes;
   V4i fast = {0, 0, 0, 0};
   for (int l = 0; l < kLanes; ++l) {
     if (l < batch.count) {
-      if (batch.mp[l].active_tension == 0) fast[l] = -1;
+      if (takes_active || batch.mp[l].active_tension == 0) fast[l] = -1;
     } else {
       for (int k = 0; k < 12; ++k) batch.g[k][l] = batch.g[k][0];
       batch.volume[l] = batch.volume[0];
       for (int k = 0; k < 9; ++k) batch.F[k][l] = batch.F[k][0];
+      batch.mp[l] = batch.mp[0];
     }
   }
-  (ActiveSimdKernels() == SimdKernels::kAvx && avx ? avx : generic)(lambda, mu, batch, fast);
+  (ActiveSimdKernels() == SimdKernels::kAvx && avx ? avx : generic)(params, batch, fast);
   for (int l = 0; l < batch.count; ++l) {
     if (fast[l] != 0)
       batch.ok[l] = true;
@@ -378,19 +502,28 @@ void RunLanes(const SolidMaterial& law, double lambda, double mu, LanesKernel av
 #if defined(__x86_64__)
 constexpr LanesKernel kCorotationalAvx = CorotationalAvx;
 constexpr LanesKernel kNeoHookeanAvx = NeoHookeanAvx;
+constexpr LanesKernel kGuccioneAvx = GuccioneAvx;
 #else
 constexpr LanesKernel kCorotationalAvx = nullptr;
 constexpr LanesKernel kNeoHookeanAvx = nullptr;
+constexpr LanesKernel kGuccioneAvx = nullptr;
 #endif
 
 }  // namespace
 
 void CorotationalSolid::ElementStressAndStiffnessBatch(ElementBatch& batch) const {
-  RunLanes(*this, lame_.lambda, lame_.mu, kCorotationalAvx, CorotationalGeneric, batch);
+  const double params[] = {lame_.lambda, lame_.mu};
+  RunLanes(*this, params, kCorotationalAvx, CorotationalGeneric, false, batch);
 }
 
 void NeoHookeanSolid::ElementStressAndStiffnessBatch(ElementBatch& batch) const {
-  RunLanes(*this, lame_.lambda, lame_.mu, kNeoHookeanAvx, NeoHookeanGeneric, batch);
+  const double params[] = {lame_.lambda, lame_.mu};
+  RunLanes(*this, params, kNeoHookeanAvx, NeoHookeanGeneric, false, batch);
+}
+
+void GuccioneSolid::ElementStressAndStiffnessBatch(ElementBatch& batch) const {
+  const double params[] = {params_.C, params_.bf, params_.bt, params_.bfs, params_.bulk_modulus};
+  RunLanes(*this, params, kGuccioneAvx, GuccioneGeneric, true, batch);
 }
 
 }  // namespace gipsi
