@@ -153,6 +153,15 @@ GIPSI_SIMD_INLINE void PolarLanes(const M3& F, M3& R, V4i& converged) {
   }
 }
 
+// Entry (i, k) of block (a, b) of K, a ≤ b, and its mirror in block (b, a); adds it to the lanes'
+// finiteness sum (x · 0 is 0 for a finite x and NaN otherwise).
+GIPSI_SIMD_INLINE void StoreStiffness(ElementBatch& batch, int a, int b, int i, int k, const V4d& v,
+                                      V4d& finite_check) {
+  finite_check += v * 0.0;
+  Store(batch.K[(3 * a + i) + 12 * (3 * b + k)], v);
+  if (a != b) Store(batch.K[(3 * b + k) + 12 * (3 * a + i)], v);
+}
+
 GIPSI_SIMD_INLINE void Select(const V4i& mask, const V4d& yes, const V4d& no, V4d& out) {
   out = (V4d)(((V4i)yes & mask) | ((V4i)no & ~mask));
 }
@@ -253,9 +262,7 @@ GIPSI_SIMD_INLINE void CorotationalLanes(const double* params, ElementBatch& bat
           V4d v = Y[a].m[i] * X[b].m[k] + Y[a].m[i + 3] * X[b].m[k + 3] +
                   Y[a].m[i + 6] * X[b].m[k + 6] + v_lambda * q[a][i] * q[b][k];
           if (i == k) v += gg;
-          finite_check += v * 0.0;
-          Store(batch.K[(3 * a + i) + 12 * (3 * b + k)], v);
-          if (a != b) Store(batch.K[(3 * b + k) + 12 * (3 * a + i)], v);
+          StoreStiffness(batch, a, b, i, k, v, finite_check);
         }
     }
   fast &= (V4i)(finite_check == finite_check);
@@ -314,9 +321,7 @@ GIPSI_SIMD_INLINE void NeoHookeanLanes(const double* params, ElementBatch& batch
         for (int i = 0; i < 3; ++i) {
           V4d v = c * (h[b][i] * h[a][k]) + v_lambda * (h[a][i] * h[b][k]);
           if (i == k) v += gg;
-          finite_check += v * 0.0;
-          Store(batch.K[(3 * a + i) + 12 * (3 * b + k)], v);
-          if (a != b) Store(batch.K[(3 * b + k) + 12 * (3 * a + i)], v);
+          StoreStiffness(batch, a, b, i, k, v, finite_check);
         }
     }
   fast &= (V4i)(finite_check == finite_check);
@@ -438,9 +443,7 @@ GIPSI_SIMD_INLINE void GuccioneLanes(const double* params, ElementBatch& batch, 
                       kappa * (h[a][i] * h[bn][k]) - kappa_log_j * (h[bn][i] * h[a][k]);
           if (i == k) value += gsg;
           value *= volume;
-          finite_check += value * 0.0;
-          Store(batch.K[(3 * a + i) + 12 * (3 * bn + k)], value);
-          if (a != bn) Store(batch.K[(3 * bn + k) + 12 * (3 * a + i)], value);
+          StoreStiffness(batch, a, bn, i, k, value, finite_check);
         }
     }
   fast &= (V4i)(finite_check == finite_check);
