@@ -1,6 +1,7 @@
-// FemSolid with the AMG-preconditioned CG (the fast interactive set-up of the benchmark): the
-// same steps as a direct solver, and CG iteration counts that stay bounded as the mesh is
-// refined (FemSolid hands the solver its rigid-body modes).
+// FemSolid with CG preconditioned by AMG or by symmetric block Gauss-Seidel ("sgs"), the
+// benchmark's interactive set-up: the same steps as a direct solver, AMG iteration counts that
+// stay bounded as the mesh is refined (FemSolid hands the solver its rigid-body modes), and
+// Gauss-Seidel's far fewer iterations than Jacobi.
 
 #include <memory>
 #include <string>
@@ -39,18 +40,38 @@ std::unique_ptr<FemSolid> SaggingCube(int cells, const LinearSolverOptions& solv
 // the displacement bounds the difference with a wide margin, while a wrong preconditioner
 // (CG not converging) or a wrong solution would miss it by orders of magnitude.
 TEST(FemAmg, StepsMatchTheDirectSolver) {
-  LinearSolverOptions amg{.type = "cg", .preconditioner = "amg", .tolerance = 1e-10};
   LinearSolverOptions direct{.type = "cholmod", .tolerance = 1e-10};
-  auto a = SaggingCube(6, amg);
-  auto b = SaggingCube(6, direct);
-  for (int step = 0; step < 5; ++step) {
-    ASSERT_TRUE(a->Step(0.01).ok());
-    ASSERT_TRUE(b->Step(0.01).ok());
+  for (const char* preconditioner : {"amg", "sgs"}) {
+    LinearSolverOptions cg{.type = "cg", .preconditioner = preconditioner, .tolerance = 1e-10};
+    auto a = SaggingCube(6, cg);
+    auto b = SaggingCube(6, direct);
+    for (int step = 0; step < 5; ++step) {
+      ASSERT_TRUE(a->Step(0.01).ok()) << preconditioner;
+      ASSERT_TRUE(b->Step(0.01).ok());
+    }
+    const VecX& ua = a->u();
+    const VecX& ub = b->u();
+    ASSERT_GT(ub.norm(), 0.0);
+    EXPECT_LE((ua - ub).norm(), 1e-6 * ub.norm()) << preconditioner;
   }
-  const VecX& ua = a->u();
-  const VecX& ub = b->u();
-  ASSERT_GT(ub.norm(), 0.0);
-  EXPECT_LE((ua - ub).norm(), 1e-6 * ub.norm());
+}
+
+// CG iterations per step at 1e-6 on the 9³-cell cube (3,645 tets, one Gauss-Seidel domain),
+// four steps, warm-started as in the benchmark. Measured: Jacobi 80.25, sgs 31.5 per step (81 and
+// 33 on the benchmark's 10³ cube). Half of Jacobi's leaves room for rounding; a preconditioner
+// that is only block-diagonal saves ~7 % (measured on the benchmark tangent).
+TEST(FemSgs, NeedsLessThanHalfTheIterationsOfJacobi) {
+  double per_step[2] = {0.0, 0.0};
+  const char* names[2] = {"jacobi", "sgs"};
+  for (int k = 0; k < 2; ++k) {
+    LinearSolverOptions cg{.type = "cg", .preconditioner = names[k], .tolerance = 1e-6};
+    auto fem = SaggingCube(9, cg);
+    for (int step = 0; step < 4; ++step) ASSERT_TRUE(fem->Step(0.01).ok()) << names[k];
+    per_step[k] = static_cast<double>(fem->profile().linear_iterations) /
+                  static_cast<double>(fem->profile().steps);
+  }
+  EXPECT_GT(per_step[1], 0.0);
+  EXPECT_LT(2.0 * per_step[1], per_step[0]);
 }
 
 // CG iterations per step at 1e-6 as the cube is refined from 6³ to 12³ cells (1,080 to 8,640

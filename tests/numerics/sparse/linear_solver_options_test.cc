@@ -59,7 +59,7 @@ TEST(LinearSolverOptions, UnknownPreconditionerNamesPathSuggestsAndListsChoices)
               ThrowsMessage<InputError>(
                   AllOf(HasSubstr("solver.preconditioner: unknown preconditioner 'jacoby'"),
                         HasSubstr("did you mean 'jacobi'"),
-                        HasSubstr("'none', 'jacobi', 'ic', 'cholesky', 'amg'"))));
+                        HasSubstr("'none', 'jacobi', 'sgs', 'ic', 'cholesky', 'amg'"))));
 }
 
 TEST(LinearSolverOptions, CholeskyPreconditionerOnlyWithCg) {
@@ -110,9 +110,10 @@ TEST(MakeLinearSolver, UnknownTypeOrPreconditionerThrowsListingChoices) {
                                               HasSubstr("'cg', 'ldlt', 'cholmod'"))));
   options.type = "cg";
   options.preconditioner = "ilu";
-  EXPECT_THAT([&] { (void)MakeLinearSolver(options); },
-              ThrowsMessage<InputError>(AllOf(HasSubstr("unknown preconditioner 'ilu'"),
-                                              HasSubstr("'none', 'jacobi', 'ic', 'cholesky'"))));
+  EXPECT_THAT(
+      [&] { (void)MakeLinearSolver(options); },
+      ThrowsMessage<InputError>(AllOf(HasSubstr("unknown preconditioner 'ilu'"),
+                                      HasSubstr("'none', 'jacobi', 'sgs', 'ic', 'cholesky'"))));
 }
 
 TEST(MakeLinearSolver, RejectsCholeskyWithDirectTypeAndBadNumbers) {

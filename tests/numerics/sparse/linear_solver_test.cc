@@ -130,9 +130,9 @@ TEST_P(SparseLinearSolver, ReanalysingMovesTheSolverToANewPattern) {
 
 INSTANTIATE_TEST_SUITE_P(AllSolvers, SparseLinearSolver,
                          ::testing::Values(SolverCase{"cg", "none"}, SolverCase{"cg", "jacobi"},
-                                           SolverCase{"cg", "ic"}, SolverCase{"cg", "cholesky"},
-                                           SolverCase{"cg", "amg"}, SolverCase{"ldlt", "ic"},
-                                           SolverCase{"cholmod", "ic"}),
+                                           SolverCase{"cg", "sgs"}, SolverCase{"cg", "ic"},
+                                           SolverCase{"cg", "cholesky"}, SolverCase{"cg", "amg"},
+                                           SolverCase{"ldlt", "ic"}, SolverCase{"cholmod", "ic"}),
                          CaseName);
 
 TEST(SparseLinearSolver, NamesSayWhichSolverAndPreconditioner) {

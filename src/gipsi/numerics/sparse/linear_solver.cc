@@ -20,8 +20,8 @@ namespace gipsi {
 namespace {
 
 constexpr std::array<std::string_view, 4> kTypes = {"cg", "ldlt", "cholmod", "umfpack"};
-constexpr std::array<std::string_view, 5> kPreconditioners = {"none", "jacobi", "ic", "cholesky",
-                                                              "amg"};
+constexpr std::array<std::string_view, 6> kPreconditioners = {"none", "jacobi",   "sgs",
+                                                              "ic",   "cholesky", "amg"};
 
 /// Empty if `value` is one of `choices`, else e.g. "unknown linear solver type 'gmres';
 /// choices: 'cg', 'ldlt', 'cholmod', 'umfpack'" (with a "did you mean" for a near miss).

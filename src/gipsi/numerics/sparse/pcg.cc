@@ -1,6 +1,6 @@
 // Preconditioned conjugate gradients with a warm start, a stopping rule on the true residual,
-// and five preconditioners (none, Jacobi, incomplete Cholesky, lagged CHOLMOD Cholesky,
-// smoothed-aggregation AMG with a lagged hierarchy).
+// and six preconditioners (none, Jacobi, symmetric block Gauss-Seidel, incomplete Cholesky,
+// lagged CHOLMOD Cholesky, smoothed-aggregation AMG with a lagged hierarchy).
 
 #include <algorithm>
 #include <atomic>
@@ -20,6 +20,7 @@
 #include "gipsi/numerics/sparse/amg.h"
 #include "gipsi/numerics/sparse/cg_kernels.h"
 #include "gipsi/numerics/sparse/node_block_copy.h"
+#include "gipsi/numerics/sparse/node_block_sgs.h"
 #include "gipsi/numerics/sparse/serial_openmp.h"
 #include "gipsi/numerics/sparse/solvers.h"
 #include "gipsi/numerics/sparse/team_barrier.h"
@@ -28,11 +29,12 @@
 namespace gipsi {
 namespace {
 
-enum class Preconditioner { kNone, kJacobi, kIncompleteCholesky, kLaggedCholesky, kAmg };
+enum class Preconditioner { kNone, kJacobi, kSgs, kIncompleteCholesky, kLaggedCholesky, kAmg };
 
 Preconditioner PreconditionerFromName(const std::string& name) {
   if (name == "none") return Preconditioner::kNone;
   if (name == "jacobi") return Preconditioner::kJacobi;
+  if (name == "sgs") return Preconditioner::kSgs;
   if (name == "ic") return Preconditioner::kIncompleteCholesky;
   if (name == "amg") return Preconditioner::kAmg;
   GIPSI_CHECK(name == "cholesky", "MakePcgSolver: unvalidated preconditioner '{}'", name);
@@ -66,7 +68,8 @@ class PcgSolver final : public LinearSolver {
     diagonal_index_.clear();  // found again by the next ComputeInverseDiagonal
     // The fused CG multiplies by a block-row copy of a node-block matrix (node_block_copy.h).
     block_copy_ready_ = false;
-    if (node_blocks_ && fused()) block_copy_.AssignPattern(A);
+    if (node_blocks_ && fused() && !sgs()) block_copy_.AssignPattern(A);
+    if (sgs()) sgs_.AssignPattern(A, SgsDomainCount(rows_));
     analysed_ = true;
     matrix_ = nullptr;
     has_factor_ = false;
@@ -77,6 +80,7 @@ class PcgSolver final : public LinearSolver {
         inverse_diagonal_.setOnes(rows_);  // IterateFused scales by it: M = I
         break;
       case Preconditioner::kJacobi:
+      case Preconditioner::kSgs:  // Jacobi for a matrix not made of node blocks
         inverse_diagonal_.setZero(rows_);
         break;
       case Preconditioner::kIncompleteCholesky:
@@ -112,6 +116,9 @@ class PcgSolver final : public LinearSolver {
       case Preconditioner::kJacobi:
         if (!ComputeInverseDiagonal(A)) return false;
         break;
+      case Preconditioner::kSgs:  // sgs_ copies the values below
+        if (!sgs() && !ComputeInverseDiagonal(A)) return false;
+        break;
       case Preconditioner::kIncompleteCholesky:
         incomplete_.factorize(A);
         refactorized_ = true;
@@ -141,10 +148,11 @@ class PcgSolver final : public LinearSolver {
         }
         break;
     }
-    if (node_blocks_ && fused()) {
+    if (node_blocks_ && fused() && !sgs()) {
       block_copy_.CopyValues(A, SetUpOnTeam());
       block_copy_ready_ = true;
     }
+    if (sgs() && !sgs_.Factorize(A, SetUpOnTeam())) return false;  // a diagonal block not SPD
     matrix_ = &A;
     return true;
   }
@@ -168,7 +176,8 @@ class PcgSolver final : public LinearSolver {
     // per iteration lately (team_choice_; its kernels give the same bits either way).
     const bool adaptive = fused();
     const bool team =
-        adaptive && team_choice_.Begin(rows_ >= kMinFusedParallelRows && omp_get_max_threads() > 1);
+        adaptive && team_choice_.Begin(rows_ >= kMinFusedParallelRows &&
+                                       omp_get_max_threads() > 1 && (!sgs() || sgs_.domains() > 1));
     std::optional<SerialOpenMp> alone;
     if (adaptive && !team) alone.emplace();
     double r_norm = std::numeric_limits<double>::quiet_NaN();
@@ -183,8 +192,11 @@ class PcgSolver final : public LinearSolver {
           break;
         }
         if (stats.iterations >= options_.max_iterations || stuck) break;
-        stuck = fused() ? !IterateFused(target, stats.iterations, x, team)
-                        : !Iterate(target, stats.iterations, x);
+        if (sgs())
+          stuck = !IterateSgs(target, stats.iterations, x, team);
+        else
+          stuck = fused() ? !IterateFused(target, stats.iterations, x, team)
+                          : !Iterate(target, stats.iterations, x);
         r_norm = TrueResidual(b, x);
       }
     }
@@ -293,7 +305,8 @@ class PcgSolver final : public LinearSolver {
           }
           return s;
         });
-      case Preconditioner::kJacobi: {
+      case Preconditioner::kJacobi:
+      case Preconditioner::kSgs: {  // (Iterate does not run with "sgs": IterateFused does)
         const double* __restrict pd = inverse_diagonal_.data();
         return DeterministicParallelSum(rows_, scratch_, [=](Index begin, Index end) {
           double s = 0.0;
@@ -325,9 +338,85 @@ class PcgSolver final : public LinearSolver {
   /// benchmark (3,993 rows, 2 threads, OMP_WAIT_POLICY=passive): 4.1 → 2.7 ms per solve.
   static constexpr int kMinFusedParallelRows = 2048;
 
-  /// Jacobi (or no) preconditioning runs the fused iteration below.
+  /// Jacobi (or no) preconditioning runs the fused iteration below, "sgs" IterateSgs on the
+  /// same block copy (or, for a matrix not made of node blocks, the fused Jacobi iteration).
   [[nodiscard]] bool fused() const {
-    return kind_ == Preconditioner::kJacobi || kind_ == Preconditioner::kNone;
+    return kind_ == Preconditioner::kJacobi || kind_ == Preconditioner::kNone ||
+           kind_ == Preconditioner::kSgs;
+  }
+  /// The block Gauss-Seidel sweeps run (node_block_sgs.h).
+  [[nodiscard]] bool sgs() const { return kind_ == Preconditioner::kSgs && node_blocks_; }
+
+  /// The same contract as Iterate, for "sgs": CG with symmetric block Gauss-Seidel in
+  /// Eisenstat's form (node_block_sgs.h), which needs no product with A: per iteration a
+  /// backward and a forward sweep of each domain and an update, the threads (each with a run of
+  /// whole domains) meeting at a TeamBarrier after each (three per iteration; t from other
+  /// domains must be final before the forward sweep). The sums are per domain, added in domain
+  /// order: the bits do not depend on the thread count. The residual r is the true one, updated
+  /// by the recurrence r −= α A t with A t from the sweeps.
+  bool IterateSgs(double target, int& iterations, VecX& x, bool on_team) {
+    const int domains = sgs_.domains();
+    const int threads =
+        on_team && rows_ >= kMinFusedParallelRows ? std::min(omp_get_max_threads(), domains) : 1;
+    partials_.assign(static_cast<std::size_t>(2 * domains), PartialSums{});
+    PartialSums* partials = partials_.data();
+    TeamBarrier barrier;
+    double* px = x.data();
+    double* pr = r_.data();
+    int done = iterations;
+    bool ok = false;
+    auto sweep = [&](const int team, const int t) {
+      const int first = domains * t / team, last = domains * (t + 1) / team;
+      // Per domain and round parity: (r, r), (Z, R) = γ, (P, w).
+      auto slot = [&](int round, int d) { return partials[(round & 1) * domains + d].sum; };
+      auto total = [&](int round, int which) {
+        double sum = 0.0;
+        for (int d = 0; d < domains; ++d) sum += slot(round, d)[which];
+        return sum;
+      };
+      for (int d = first; d < last; ++d) slot(0, d)[1] = sgs_.Start(pr, d);
+      barrier.Wait(team);
+      double gamma = total(0, 1), beta = 0.0;
+      int local = done;
+      bool converged = false;
+      for (int round = 1; local < options_.max_iterations; ++round) {
+        if (!(gamma > 0.0) || !std::isfinite(gamma)) break;  // not SPD, NaN
+        for (int d = first; d < last; ++d) sgs_.Backward(beta, d);
+        barrier.Wait(team);
+        for (int d = first; d < last; ++d) slot(round, d)[2] = sgs_.Forward(d);
+        barrier.Wait(team);
+        const double alpha = gamma / total(round, 2);
+        if (!(alpha > 0.0) || !std::isfinite(alpha)) break;
+        for (int d = first; d < last; ++d) {
+          const SgsUpdateSums sums = sgs_.Update(alpha, px, pr, d);
+          slot(round, d)[0] = sums.rr;
+          slot(round, d)[1] = sums.zr;
+        }
+        barrier.Wait(team);
+        ++local;
+        const double rr = total(round, 0);
+        if (!std::isfinite(rr)) break;
+        if (std::sqrt(rr) <= target) {
+          converged = true;
+          break;
+        }
+        const double gamma_next = total(round, 1);
+        beta = gamma_next / gamma;
+        gamma = gamma_next;
+      }
+      if (t == 0) {
+        done = local;
+        ok = converged;
+      }
+    };
+    if (threads > 1) {
+#pragma omp parallel num_threads(threads)
+      sweep(omp_get_num_threads(), omp_get_thread_num());
+    } else {
+      sweep(1, 0);
+    }
+    iterations = done;
+    return ok;
   }
 
   /// The same contract as Iterate, for the element-wise preconditioners: the Chronopoulos–Gear
@@ -516,6 +605,7 @@ class PcgSolver final : public LinearSolver {
   bool analysed_ = false;
   bool node_blocks_ = false;              ///< the analysed pattern has HasNodeBlockPattern
   NodeBlockCopy block_copy_;              ///< block-row copy of A for the fused CG
+  NodeBlockSgs sgs_;                      ///< "sgs": the sweeps on block_copy_
   bool block_copy_ready_ = false;         ///< block_copy_ holds the values of matrix_
   const SparseMatrix* matrix_ = nullptr;  ///< the last successfully factorised A
   bool refactorized_ = false;
