@@ -14,6 +14,7 @@ triad, CPU, vector kernels, core count and load average, so figures from differe
 Rows:
   STREAM triad [GB/s]                      the machine's memory bandwidth (sparse_bench)
   FEM step 5k / 20k / 78k tets [ms]        corotational, backward Euler, Jacobi-CG (fem_bench)
+  FEM step ..., sgs [ms]                   the same with block Gauss-Seidel CG ("sgs")
   SpMV 26^3 lattice [GB/s, % of triad]     symmetric sparse matrix-vector product (sparse_bench)
   TTP06 cell model [M node-steps/s]        ten Tusscher-Panfilov 2006, 10^5 cells (cell_models_bench)
   Collision query [ms]                     two 224x224 sheets, 50 % overlap (collision_bench)
@@ -117,11 +118,12 @@ def measure(threads, repetitions, quick):
     spmv = triad["BM_SymmetricSpMV/26/real_time"]["bytes_per_second"] / 1e9
     r["SpMV 26^3 lattice [GB/s]"] = spmv
     r["SpMV / triad [%]"] = 100 * spmv / r["STREAM triad [GB/s]"]
-    fem = run_benchmark("fem_bench", "BM_ImplicitStep/corotational/(10|16|25)/0/", threads,
+    fem = run_benchmark("fem_bench", "BM_ImplicitStep/corotational/(10|16|25)/(0|4)/", threads,
                         repetitions)
-    r["FEM step 5k tets [ms]"] = ms(fem["BM_ImplicitStep/corotational/10/0/real_time"])
-    r["FEM step 20k tets [ms]"] = ms(fem["BM_ImplicitStep/corotational/16/0/real_time"])
-    r["FEM step 78k tets [ms]"] = ms(fem["BM_ImplicitStep/corotational/25/0/real_time"])
+    for pre, name in ((0, ""), (4, ", sgs")):
+        for n, tets in ((10, "5k"), (16, "20k"), (25, "78k")):
+            r[f"FEM step {tets} tets{name} [ms]"] = ms(
+                fem[f"BM_ImplicitStep/corotational/{n}/{pre}/real_time"])
     cells = run_benchmark("cell_models_bench", "BM_CellModelStep/TenTusscherPanfilov2006/100000$",
                           threads, repetitions)
     r["TTP06 [M node-steps/s]"] = 1e5 / ms(

@@ -176,6 +176,20 @@ GIPSI_SIMD_INLINE SgsUpdateSums UpdateBody(const Sweep& s, double alpha, double*
   return {Lanes3(rr), Lanes3(zr)};
 }
 
+// y = A x for nodes [begin, end): D_I x_I, then the forward blocks, then the backward ones.
+GIPSI_SIMD_INLINE void MultiplyBody(const Sweep& s, const double* x, double* y, int begin,
+                                    int end) {
+  for (int node = begin; node < end; ++node) {
+    V4 sum = {0.0, 0.0, 0.0, 0.0};
+    AddBlock(sum, s.block + 9 * std::ptrdiff_t{node}, x + 3 * node);
+    for (int m = s.forward_start[node]; m < s.forward_start[node + 1]; ++m)
+      AddBlock(sum, s.forward_values + 9 * std::ptrdiff_t{m}, x + s.forward_column[m]);
+    for (int m = s.backward_start[node + 1]; m < s.backward_start[node]; ++m)
+      AddBlock(sum, s.backward_values + 9 * std::ptrdiff_t{m}, x + s.backward_column[m]);
+    Store3(y + 3 * node, sum);
+  }
+}
+
 // One generic and one AVX copy of each kernel (the same operations: the same bits).
 #if defined(__x86_64__)
 #define GIPSI_SGS_AVX(Ret, Name, Params, Args) \
@@ -191,6 +205,8 @@ GIPSI_SGS_COPIES(double, Start, (const Sweep& s, const double* r, int begin, int
 GIPSI_SGS_COPIES(void, Backward, (const Sweep& s, double beta, int begin, int end),
                  (s, beta, begin, end))
 GIPSI_SGS_COPIES(double, Forward, (const Sweep& s, int begin, int end), (s, begin, end))
+GIPSI_SGS_COPIES(void, Multiply, (const Sweep& s, const double* x, double* y, int begin, int end),
+                 (s, x, y, begin, end))
 GIPSI_SGS_COPIES(SgsUpdateSums, Update,
                  (const Sweep& s, double alpha, double* x, double* r, int begin, int end),
                  (s, alpha, x, r, begin, end))
@@ -390,6 +406,22 @@ SgsUpdateSums NodeBlockSgs::Update(double alpha, double* x, double* r, int d) {
   if (UseAvx()) return UpdateAvx(s, alpha, x, r, begin, end);
 #endif
   return UpdateGeneric(s, alpha, x, r, begin, end);
+}
+
+void NodeBlockSgs::Multiply(const VecX& x, VecX& y) {
+  const int n = nodes();
+  GIPSI_CHECK(x.size() == 3 * n && y.size() == 3 * n && x.data() != y.data(),
+              "NodeBlockSgs::Multiply: sizes do not match or x and y alias");
+  const Sweep s = MakeSweep();
+  const bool avx = UseAvx();
+  constexpr int kBatch = 64;
+  ForRange(0, (n + kBatch - 1) / kBatch, 3 * n >= kMinParallelLength, [&](int b) {
+    const int begin = b * kBatch, end = std::min((b + 1) * kBatch, n);
+#if defined(__x86_64__)
+    if (avx) return MultiplyAvx(s, x.data(), y.data(), begin, end);
+#endif
+    MultiplyGeneric(s, x.data(), y.data(), begin, end);
+  });
 }
 
 }  // namespace gipsi

@@ -86,6 +86,10 @@ class NodeBlockSgs {
   /// x += α t, r −= α (v + P), Z −= α w, R = D Z; returns (r, r) and (Z, R) over the domain.
   SgsUpdateSums Update(double alpha, double* x, double* r, int d);
 
+  /// y = A x from the copied blocks (x and y: 3 × nodes entries, not aliased), parallel over
+  /// nodes; each entry summed in a fixed order.
+  void Multiply(const VecX& x, VecX& y);
+
  private:
   sgs_detail::Sweep MakeSweep();
 
