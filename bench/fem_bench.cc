@@ -76,8 +76,8 @@ void BM_ImplicitStep(benchmark::State& state, const char* law) {
 }
 
 // Preconditioners: 0 Jacobi, 1 incomplete Cholesky, 2 lagged CHOLMOD factorisation, 3 lagged
-// smoothed-aggregation AMG. Eigen's incomplete Cholesky refactorises every step and costs more
-// than it saves on the larger meshes.
+// smoothed-aggregation AMG, 4 symmetric block Gauss-Seidel ("sgs", the default). Eigen's incomplete
+// Cholesky refactorises every step and costs more than it saves on the larger meshes.
 void Sizes(benchmark::internal::Benchmark* b) {
   for (int n : {10, 16, 25}) b->Args({n, 3});
   for (int n : {10, 16, 25}) b->Args({n, 2});

@@ -250,7 +250,7 @@ TEST(Newton, AnIndefiniteTangentFallsBackToLdltAndOtherwiseSaysWhatToTry) {
   ASSERT_TRUE(failed.linear_failure);
   EXPECT_EQ(failed.linear_failure_kind, LinearFailure::kNotPositiveDefinite);
   EXPECT_EQ(Describe(failed, options, cg.linear_solver().name()),
-            "Newton: the tangent matrix is not positive definite at iteration 1: the 'cg+jacobi' "
+            "Newton: the tangent matrix is not positive definite at iteration 1: the 'cg+sgs' "
             "linear solver needs a positive definite matrix and could not factorise it. A tangent "
             "turns indefinite when a load increment is too large for the volumetric penalty "
             "(bulk_modulus) or a follower pressure, or past a buckling or limit point: try more "

@@ -219,6 +219,7 @@ TEST(BlockGaussSeidelCg, NeedsFarFewerIterationsThanJacobi) {
 // convergence); new values with the same pattern work again; a matrix without node blocks (a
 // scalar Laplacian) is solved with Jacobi, as documented.
 TEST(BlockGaussSeidelCg, RejectsAnIndefiniteDiagonalBlockAndFollowsNewValues) {
+  EXPECT_EQ(LinearSolverOptions{}.preconditioner, "sgs");  // the documented default
   const SparseMatrix A = testing::TestLattice();
   const auto problem = Manufacture(A);
   auto solver = MakeLinearSolver(Cg("sgs"));

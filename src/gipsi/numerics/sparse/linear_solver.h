@@ -63,21 +63,22 @@ struct LinearSolverOptions {
   /// "cg" (preconditioned CG), "ldlt" (Eigen SimplicialLDLT), "cholmod" (SuiteSparse CHOLMOD
   /// supernodal LLᵀ) or "umfpack" (UMFPACK LU with pivoting: saddle points, any nonsingular).
   std::string type = "cg";
-  /// For "cg": "none", "jacobi", "sgs" (symmetric block Gauss-Seidel on 3×3 node blocks in
-  /// Eisenstat's form, node_block_sgs.h: about 2.5× fewer iterations than Jacobi on FEM
-  /// tangents for a similar cost per iteration, the fastest per core; sequential within a domain
-  /// of 12,288 rows, so smaller systems solve on one thread; a matrix not made of node blocks
-  /// gets Jacobi), "ic" (incomplete Cholesky), "cholesky" (a CHOLMOD
+  /// For "cg": "none", "jacobi" (runs the fused single-region CG, pcg.cc), "sgs" (the default:
+  /// symmetric block Gauss-Seidel on 3×3 node blocks in Eisenstat's form, node_block_sgs.h;
+  /// 2.4-2.7× fewer iterations than Jacobi on FEM tangents, 18-21 % less time per FEM step on
+  /// one core and up to 24 % on two (docs/performance.md); its sweeps are sequential within a
+  /// domain of 12,288 rows, so a smaller system solves on one thread, where many threads may
+  /// make Jacobi faster; a matrix not made of node blocks gets Jacobi, with Jacobi's bits),
+  /// "ic" (incomplete Cholesky), "cholesky" (a CHOLMOD
   /// factorisation of an earlier matrix, refreshed when CG needs more than
   /// `refactor_iterations` iterations with it, or when a solve needs at least the mean
   /// iterations per solve since the factorisation, the factorisation counted as its flops in
   /// CG iterations: the amortised rule, see pcg.cc) or "amg" (smoothed-aggregation algebraic
   /// multigrid on 3×3 node blocks, one damped-Jacobi V-cycle per CG iteration; its
   /// coarse levels are built from an earlier matrix and rebuilt under the same rule as
-  /// "cholesky", the finest level always uses the current matrix). The default, Jacobi, runs
-  /// the fused single-region CG (pcg.cc) and was the fastest on every FEM benchmark mesh
-  /// (5k-78k tets, docs/performance.md); "ic" refactorises every step and cost 5-7× more.
-  std::string preconditioner = "jacobi";
+  /// "cholesky", the finest level always uses the current matrix). "ic" refactorises every
+  /// step and cost 5-7× more than Jacobi on the FEM benchmark.
+  std::string preconditioner = "sgs";
   /// CG stops when ‖b − A x‖ ≤ tolerance · ‖b‖ (the true residual, checked with an SpMV; the
   /// initial residual counts, so a good warm start can take 0 iterations). Direct solvers
   /// report `converged` only if their residual also meets it.

@@ -47,9 +47,9 @@ struct Sweep;  // the kernels' view of the arrays (node_block_sgs.cc)
 /// kSgsDomainRows rows, at least one. A function of the matrix only, never of the threads, so
 /// that the bits do not depend on the thread count. Domains decouple the sweeps (threads can
 /// share the work) but weaken the preconditioner: on the FEM benchmark's 20k-tet tangent
-/// (14,739 rows) one domain took 51 iterations per step, four 67 (Jacobi 140); on the 78k-tet
-/// one (52,728 rows) two took 99 and four 103 (Jacobi 226). Systems below 2 × kSgsDomainRows
-/// rows keep one domain and solve on one thread.
+/// (14,739 rows) one domain took 51 iterations per step, two 67 (Jacobi 140); on the 78k-tet
+/// one (52,728 rows) two took 99, four 103 and eight 115 (Jacobi 226). Systems below 2 ×
+/// kSgsDomainRows rows keep one domain and solve on one thread.
 inline constexpr Index kSgsDomainRows = 12288;
 [[nodiscard]] inline int SgsDomainCount(Index rows) {
   return static_cast<int>(std::clamp<Index>(rows / kSgsDomainRows, 1, 1024));
