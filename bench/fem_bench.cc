@@ -100,19 +100,25 @@ BENCHMARK_CAPTURE(BM_ImplicitStep, neo_hookean, "NeoHookean")->Apply(Sizes);
 void BM_StreamTriad(benchmark::State& state) { RunStreamTriad(state); }
 BENCHMARK(BM_StreamTriad)->UseRealTime()->Unit(benchmark::kMillisecond);
 
-void BM_TangentSpMV(benchmark::State& state) {
-  const int cells = static_cast<int>(state.range(0));
+// The corotational stiffness of the benchmark cube of cells³ hexahedra at rest, into K; false
+// (and the benchmark skipped) if it has no node-block pattern.
+bool RestTangent(benchmark::State& state, int cells, SparseMatrix& K) {
   auto mesh = std::make_shared<const Mesh>(
       MakeTetBox(Vec3::Zero(), Vec3(0.1, 0.1, 0.1), {cells, cells, cells}, HexSplit::kFive));
   FemParams params;
   params.material = Law("Corotational");
   const FemSolid fem("cube", mesh, params);
-  SparseMatrix K;
   if (!fem.CalcStiffness(Eigen::Map<const VecX>(mesh->nodes.data(), mesh->nodes.size()), K) ||
       !HasNodeBlockPattern(K)) {
     state.SkipWithError("no node-block tangent");
-    return;
+    return false;
   }
+  return true;
+}
+
+void BM_TangentSpMV(benchmark::State& state) {
+  SparseMatrix K;
+  if (!RestTangent(state, static_cast<int>(state.range(0)), K)) return;
   const VecX x = VecX::Ones(K.cols());
   VecX y(K.rows());
   NodeBlockCopy copy;
@@ -142,18 +148,8 @@ BENCHMARK(BM_TangentSpMV)
 // sweep, 1 the forward sweep, 2 the update, 3 the node-block product (NodeBlockCopy, for
 // comparison). A CG iteration runs one of each of the first three.
 void BM_SgsSweep(benchmark::State& state) {
-  const int cells = static_cast<int>(state.range(0));
-  auto mesh = std::make_shared<const Mesh>(
-      MakeTetBox(Vec3::Zero(), Vec3(0.1, 0.1, 0.1), {cells, cells, cells}, HexSplit::kFive));
-  FemParams params;
-  params.material = Law("Corotational");
-  const FemSolid fem("cube", mesh, params);
   SparseMatrix K;
-  if (!fem.CalcStiffness(Eigen::Map<const VecX>(mesh->nodes.data(), mesh->nodes.size()), K) ||
-      !HasNodeBlockPattern(K)) {
-    state.SkipWithError("no node-block tangent");
-    return;
-  }
+  if (!RestTangent(state, static_cast<int>(state.range(0)), K)) return;
   // The rest tangent is singular (no constraints): add a mass-like diagonal to make it SPD.
   for (Index i = 0; i < K.rows(); ++i) K.coeffRef(i, i) += 1.0;
   NodeBlockCopy copy;

@@ -278,14 +278,7 @@ TEST(Pcg, JacobiFollowsFailedFactorizeAndNewPattern) {
   ASSERT_TRUE(solver->Solve(stiff_problem.b, x).converged);
   EXPECT_LE(IndependentRelativeResidual(stiffer, stiff_problem.b, x), 1e-6);
 
-  const SparseMatrix L = MakeLaplacian3D(12, 1e-2);  // no node blocks
-  ASSERT_FALSE(HasNodeBlockPattern(L));
-  const auto laplace = Manufacture(L);
-  solver->AnalyzePattern(L);
-  ASSERT_TRUE(solver->Factorize(L));
-  VecX y = VecX::Zero(L.rows());
-  ASSERT_TRUE(solver->Solve(laplace.b, y).converged);
-  EXPECT_LE(IndependentRelativeResidual(L, laplace.b, y), 1e-6);
+  EXPECT_LE(testing::SolveScalarLaplacian(*solver), 1e-6);  // no node blocks: Jacobi
 }
 
 TEST(LaggedCholeskyPcg, FirstFactorizeFactorizesAndConvergesInOneIteration) {

@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <cstring>
+#include <limits>
 #include <random>
 
 #include "gipsi/numerics/sparse/linear_solver.h"
@@ -57,5 +58,19 @@ inline SparseMatrix TestLattice(double stiffness_scale = 1.0) {
 
 /// The test's Laplacian: 16³ unknowns (4,096 rows) plus a small shift.
 inline SparseMatrix TestLaplacian() { return MakeLaplacian3D(16, 1e-2); }
+
+/// Moves `solver` to a 12³ Laplacian (no node blocks: the node-block preconditioners' scalar
+/// fallback) and solves a manufactured problem; returns ‖b − A x‖ / ‖b‖ by Eigen's product, or
+/// +∞ if Factorize or Solve failed.
+inline double SolveScalarLaplacian(LinearSolver& solver) {
+  const SparseMatrix L = MakeLaplacian3D(12, 1e-2);
+  if (HasNodeBlockPattern(L)) return std::numeric_limits<double>::infinity();
+  const ManufacturedProblem problem = Manufacture(L);
+  solver.AnalyzePattern(L);
+  VecX y = VecX::Zero(L.rows());
+  if (!solver.Factorize(L) || !solver.Solve(problem.b, y).converged)
+    return std::numeric_limits<double>::infinity();
+  return IndependentRelativeResidual(L, problem.b, y);
+}
 
 }  // namespace gipsi::testing

@@ -351,6 +351,41 @@ class PcgSolver final : public LinearSolver {
   /// The block Gauss-Seidel sweeps run (node_block_sgs.h).
   [[nodiscard]] bool sgs() const { return kind_ == Preconditioner::kSgs && node_blocks_; }
 
+  /// IterateFused's and IterateSgs's partial sums: three per block (or domain) and round parity,
+  /// each block's on its own cache line. Two rounds alternate, so a thread that runs ahead never
+  /// overwrites sums another is still reading; totals add the blocks in block order.
+  struct alignas(64) PartialSums {
+    double sum[3] = {0.0, 0.0, 0.0};
+  };
+  struct RoundSums {
+    PartialSums* partials;
+    int count;
+    [[nodiscard]] double* slot(int round, int block) const {
+      return partials[(round & 1) * count + block].sum;
+    }
+    [[nodiscard]] double total(int round, int which) const {
+      double sum = 0.0;
+      for (int k = 0; k < count; ++k) sum += slot(round, k)[which];
+      return sum;
+    }
+  };
+  RoundSums ResetRoundSums(int count) {
+    partials_.assign(static_cast<std::size_t>(2 * count), PartialSums{});
+    return {partials_.data(), count};
+  }
+
+  /// Runs sweep(team, t) for t < threads in one OpenMP region, or sweep(1, 0) on this thread
+  /// without a region when threads is 1 (even an inactive region costs a futex call).
+  template <class Sweep>
+  static void RunTeam(int threads, const Sweep& sweep) {
+    if (threads > 1) {
+#pragma omp parallel num_threads(threads)
+      sweep(omp_get_num_threads(), omp_get_thread_num());
+    } else {
+      sweep(1, 0);
+    }
+  }
+
   /// The same contract as Iterate, for "sgs": CG with symmetric block Gauss-Seidel in
   /// Eisenstat's form (node_block_sgs.h), which needs no product with A: per iteration a
   /// backward and a forward sweep of each domain and an update, the threads (each with a run of
@@ -362,22 +397,17 @@ class PcgSolver final : public LinearSolver {
     const int domains = sgs_.domains();
     const int threads =
         on_team && rows_ >= kMinFusedParallelRows ? std::min(omp_get_max_threads(), domains) : 1;
-    partials_.assign(static_cast<std::size_t>(2 * domains), PartialSums{});
-    PartialSums* partials = partials_.data();
+    // Per domain: (r, r), (Z, R) = γ, (P, w).
+    const RoundSums sums = ResetRoundSums(domains);
     TeamBarrier barrier;
     double* px = x.data();
     double* pr = r_.data();
     int done = iterations;
     bool ok = false;
-    auto sweep = [&](const int team, const int t) {
+    RunTeam(threads, [&](const int team, const int t) {
       const int first = domains * t / team, last = domains * (t + 1) / team;
-      // Per domain and round parity: (r, r), (Z, R) = γ, (P, w).
-      auto slot = [&](int round, int d) { return partials[(round & 1) * domains + d].sum; };
-      auto total = [&](int round, int which) {
-        double sum = 0.0;
-        for (int d = 0; d < domains; ++d) sum += slot(round, d)[which];
-        return sum;
-      };
+      auto slot = [&](int round, int d) { return sums.slot(round, d); };
+      auto total = [&](int round, int which) { return sums.total(round, which); };
       for (int d = first; d < last; ++d) slot(0, d)[1] = sgs_.Start(pr, d);
       barrier.Wait(team);
       double gamma = total(0, 1), beta = 0.0;
@@ -392,9 +422,9 @@ class PcgSolver final : public LinearSolver {
         const double alpha = gamma / total(round, 2);
         if (!(alpha > 0.0) || !std::isfinite(alpha)) break;
         for (int d = first; d < last; ++d) {
-          const SgsUpdateSums sums = sgs_.Update(alpha, px, pr, d);
-          slot(round, d)[0] = sums.rr;
-          slot(round, d)[1] = sums.zr;
+          const SgsUpdateSums update = sgs_.Update(alpha, px, pr, d);
+          slot(round, d)[0] = update.rr;
+          slot(round, d)[1] = update.zr;
         }
         barrier.Wait(team);
         ++local;
@@ -412,13 +442,7 @@ class PcgSolver final : public LinearSolver {
         done = local;
         ok = converged;
       }
-    };
-    if (threads > 1) {
-#pragma omp parallel num_threads(threads)
-      sweep(omp_get_num_threads(), omp_get_thread_num());
-    } else {
-      sweep(1, 0);
-    }
+    });
     iterations = done;
     return ok;
   }
@@ -470,9 +494,8 @@ class PcgSolver final : public LinearSolver {
     // without an OpenMP region (even an inactive one costs a futex call; EP on a small mesh
     // solves 10,000 times per simulated second).
     const int threads = on_team && n >= kMinFusedParallelRows ? omp_get_max_threads() : 1;
-    // Per block and round parity: (r, r), (r, z), (w, z), padded to a cache line. Two rounds
-    // alternate, so a thread that runs ahead never overwrites sums another is still reading.
-    partials_.assign(static_cast<std::size_t>(2 * count), PartialSums{});
+    // Per block: (r, r), (r, z), (w, z).
+    const RoundSums sums = ResetRoundSums(count);
     TeamBarrier barrier;
     const double* __restrict inverse = inverse_diagonal_.data();
     const int* start = block_start_.data();
@@ -482,17 +505,12 @@ class PcgSolver final : public LinearSolver {
     double* __restrict pp = p_.data();
     double* __restrict ps = q_.data();
     double* __restrict pw = w_.data();
-    PartialSums* partials = partials_.data();
     int done = iterations;
     bool ok = false;
-    auto sweep = [&](const int team, const int t) {
+    RunTeam(threads, [&](const int team, const int t) {
       const int first_block = count * t / team, end_block = count * (t + 1) / team;
-      auto slot = [&](int round, int block) { return partials[(round & 1) * count + block].sum; };
-      auto total = [&](int round, int which) {
-        double sum = 0.0;
-        for (int k = 0; k < count; ++k) sum += slot(round, k)[which];
-        return sum;
-      };
+      auto slot = [&](int round, int block) { return sums.slot(round, block); };
+      auto total = [&](int round, int which) { return sums.total(round, which); };
       auto spmv_and_wz = [&](int round) {  // sweep (2): w = A z, partial (w, z)
         for (int k = first_block; k < end_block; ++k) {
           const int begin = start[k], end = start[k + 1];
@@ -556,13 +574,7 @@ class PcgSolver final : public LinearSolver {
         done = local;
         ok = converged;
       }
-    };
-    if (threads > 1) {
-#pragma omp parallel num_threads(threads)
-      sweep(omp_get_num_threads(), omp_get_thread_num());
-    } else {
-      sweep(1, 0);
-    }
+    });
     iterations = done;
     return ok;
   }
@@ -621,11 +633,7 @@ class PcgSolver final : public LinearSolver {
   std::int64_t lagged_iterations_ = 0;  ///< their CG iterations
   VecX r_, z_, p_, q_;                  ///< residual, preconditioned residual, direction, A p
   VecX w_;                              ///< A z (IterateFused)
-  /// IterateFused's partial sums of one thread and round, alone on their cache line.
-  struct alignas(64) PartialSums {
-    double sum[3] = {0.0, 0.0, 0.0};
-  };
-  std::vector<PartialSums> partials_;
+  std::vector<PartialSums> partials_;   ///< RoundSums' storage
   std::vector<int> block_start_;  ///< IterateFused's row blocks (kSumBlocks + 1 starts, at most)
   AdaptiveParallel team_choice_;  ///< a fused solve on the team or on the calling thread
   VecX inverse_diagonal_;
