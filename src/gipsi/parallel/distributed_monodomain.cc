@@ -101,8 +101,10 @@ DistributedMonodomain::DistributedMonodomain(std::string name, const Mesh& whole
         "the distributed monodomain solves with 'cg' or a direct Cholesky ('cholmod' or 'ldlt': "
         "MUMPS across ranks), not '{}'",
         linear.type));
-  if (linear.type == "cg" && linear.preconditioner != "jacobi" && linear.preconditioner != "amg" &&
-      linear.preconditioner != "hypre" && linear.preconditioner != "none")
+  // "sgs" (block Gauss-Seidel) is Jacobi for this scalar matrix, serially and here.
+  if (linear.type == "cg" && linear.preconditioner != "jacobi" && linear.preconditioner != "sgs" &&
+      linear.preconditioner != "amg" && linear.preconditioner != "hypre" &&
+      linear.preconditioner != "none")
     throw InputError(
         fmt::format("unknown preconditioner '{}' for the distributed monodomain; choices: 'none', "
                     "'jacobi', 'amg' (PETSc's GAMG), 'hypre' (BoomerAMG)",

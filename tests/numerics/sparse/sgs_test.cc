@@ -243,6 +243,28 @@ TEST(BlockGaussSeidelCg, RejectsAnIndefiniteDiagonalBlockAndFollowsNewValues) {
   EXPECT_LE(testing::SolveScalarLaplacian(*solver), 1e-6);  // no node blocks: Jacobi
 }
 
+// A scalar matrix (EP's diffusion) has no node blocks: "sgs" is then Jacobi, the same code
+// path and the same bits, so the default's change leaves such runs as they were.
+TEST(BlockGaussSeidelCg, IsJacobiBitForBitOnAMatrixWithoutNodeBlocks) {
+  const SparseMatrix L = MakeLaplacian3D(14, 1e-2);
+  ASSERT_FALSE(HasNodeBlockPattern(L));
+  const auto problem = Manufacture(L);
+  VecX x[2];
+  int iterations[2] = {0, 0};
+  const char* names[2] = {"jacobi", "sgs"};
+  for (int k = 0; k < 2; ++k) {
+    auto solver = MakeLinearSolver(Cg(names[k]));
+    solver->AnalyzePattern(L);
+    ASSERT_TRUE(solver->Factorize(L));
+    x[k] = VecX::Zero(L.rows());
+    const LinearSolveStats stats = solver->Solve(problem.b, x[k]);
+    ASSERT_TRUE(stats.converged) << names[k];
+    iterations[k] = stats.iterations;
+  }
+  EXPECT_EQ(iterations[1], iterations[0]);
+  EXPECT_TRUE(SameBits(x[1], x[0]));
+}
+
 // The residual check multiplies by the sweeps' own copy of the blocks (forward, backward and
 // diagonal arrays): the product must be A's, for any domain split (which moves blocks between
 // the arrays), and the same bits with either kernel set.

@@ -18,10 +18,11 @@
 /// - a backward sweep: P ← R + βP, then t_I = D_I⁻¹ (P_I − Σ_{J>I} A_IJ t_J) in the domain;
 /// - a forward sweep: w_I = D_I⁻¹ (P_I + (C t)_I − Σ_{J<I} A_IJ u_J), u_I = w_I − t_I (w = t + u
 ///   is L_D⁻ᵀ Â p), and v = L t + C t (the same blocks, read once for both);
-/// - an update: α = (R, Z) / (P, w); x += α t, r −= α (v + P) (the true residual b − A x, as
-///   A t = v + P), Z −= α w, R = D Z (R = L_D ρ and Z = D⁻¹ R for CG's residual ρ).
+/// - an update: α = (R, Z) / (P, w); x += α t, r −= α (v + P) (the residual b − A x by
+///   recurrence, as A t = v + P), Z −= α w, R = D Z (R = L_D ρ and Z = D⁻¹ R for CG's residual
+///   ρ).
 /// Every block is read once per iteration (lower and cross blocks by the forward sweep, upper
-/// ones by the backward sweep), the memory traffic of one product with A, for about 2.5× fewer
+/// ones by the backward sweep), the memory traffic of one product with A, for 2.2-2.7× fewer
 /// iterations than Jacobi on the FEM benchmark meshes (docs/performance.md). The blocks are
 /// copied in the order the sweeps read them: the forward sweep's in node order, the backward
 /// sweep's in reverse node order (each node's farthest block first), so both sweeps stream

@@ -342,8 +342,8 @@ class PcgSolver final : public LinearSolver {
   /// benchmark (3,993 rows, 2 threads, OMP_WAIT_POLICY=passive): 4.1 → 2.7 ms per solve.
   static constexpr int kMinFusedParallelRows = 2048;
 
-  /// Jacobi (or no) preconditioning runs the fused iteration below, "sgs" IterateSgs on the
-  /// same block copy (or, for a matrix not made of node blocks, the fused Jacobi iteration).
+  /// Jacobi (or no) preconditioning runs the fused iteration below, "sgs" IterateSgs on its own
+  /// copy of the blocks (or, for a matrix not made of node blocks, the fused Jacobi iteration).
   [[nodiscard]] bool fused() const {
     return kind_ == Preconditioner::kJacobi || kind_ == Preconditioner::kNone ||
            kind_ == Preconditioner::kSgs;
