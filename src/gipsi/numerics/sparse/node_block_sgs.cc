@@ -13,7 +13,7 @@
 namespace gipsi {
 namespace sgs_detail {
 
-// What the kernels read and write (NodeBlockSgs's arrays and the copy's).
+// What the kernels read and write: NodeBlockSgs's arrays.
 struct Sweep {
   const int* forward_start;
   const int* forward_lower;
