@@ -30,7 +30,6 @@ struct Sweep {
   double* t;
   double* u;
   double* w;
-  double* v;
 };
 
 }  // namespace sgs_detail
@@ -126,15 +125,12 @@ GIPSI_SIMD_INLINE double ForwardBody(const Sweep& s, int begin, int end) {
   const V4 zero = {0.0, 0.0, 0.0, 0.0};
   V4 pw = zero;
   for (int node = begin; node < end; ++node) {
-    V4 c = zero, lt = zero, lu = zero;  // C t, L t and L u of the node's rows
+    V4 c = zero, lu = zero;  // C t and L u of the node's rows
     for (int m = s.forward_start[node]; m < s.forward_lower[node]; ++m)
       AddBlock(c, s.forward_values + 9 * std::ptrdiff_t{m}, s.t + s.forward_column[m]);
     // u of the node just solved (I − 1) enters last (J increasing).
-    for (int m = s.forward_lower[node]; m < s.forward_start[node + 1]; ++m) {
-      const double* b = s.forward_values + 9 * std::ptrdiff_t{m};
-      AddBlock(lt, b, s.t + s.forward_column[m]);
-      AddBlock(lu, b, s.u + s.forward_column[m]);
-    }
+    for (int m = s.forward_lower[node]; m < s.forward_start[node + 1]; ++m)
+      AddBlock(lu, s.forward_values + 9 * std::ptrdiff_t{m}, s.u + s.forward_column[m]);
     V4 pi, ti, wi;
     Load3(pi, s.p + 3 * node);
     Load3(ti, s.t + 3 * node);
@@ -142,38 +138,47 @@ GIPSI_SIMD_INLINE double ForwardBody(const Sweep& s, int begin, int end) {
     BlockTimes(wi, s.inverse + 9 * std::ptrdiff_t{node}, y);
     Store3(s.w + 3 * node, wi);
     Store3(s.u + 3 * node, wi - ti);
-    Store3(s.v + 3 * node, lt + c);
     pw += pi * wi;
   }
   return Lanes3(pw);
 }
 
-GIPSI_SIMD_INLINE SgsUpdateSums UpdateBody(const Sweep& s, double alpha, double* x, double* r,
-                                           int begin, int end) {
+// With kResidual, also r = (D + L) Z: the nodes before I in the domain already hold their new Z.
+template <bool kResidual>
+GIPSI_SIMD_INLINE SgsUpdateSums UpdateSweep(const Sweep& s, double alpha, double* x, int begin,
+                                            int end) {
   const V4 a = {alpha, alpha, alpha, alpha};
   V4 rr = {0.0, 0.0, 0.0, 0.0}, zr = rr;
   for (int node = begin; node < end; ++node) {
     const int i = 3 * node;
-    V4 xi, ti, ri, vi, pi, zi, wi, di;
+    V4 xi, ti, zi, wi, di;
     Load3(xi, x + i);
     Load3(ti, s.t + i);
-    Load3(ri, r + i);
-    Load3(vi, s.v + i);
-    Load3(pi, s.p + i);
     Load3(zi, s.z + i);
     Load3(wi, s.w + i);
     xi += a * ti;
-    ri -= a * (vi + pi);
     zi -= a * wi;
     BlockTimes(di, s.block + 9 * std::ptrdiff_t{node}, zi);
     Store3(x + i, xi);
-    Store3(r + i, ri);
     Store3(s.z + i, zi);
     Store3(s.rd + i, di);
-    rr += ri * ri;
     zr += zi * di;
+    if constexpr (kResidual) {
+      V4 ri = di;
+      for (int m = s.forward_lower[node]; m < s.forward_start[node + 1]; ++m)
+        AddBlock(ri, s.forward_values + 9 * std::ptrdiff_t{m}, s.z + s.forward_column[m]);
+      rr += ri * ri;
+    }
   }
   return {Lanes3(rr), Lanes3(zr)};
+}
+GIPSI_SIMD_INLINE SgsUpdateSums UpdateBody(const Sweep& s, double alpha, double* x, int begin,
+                                           int end) {
+  return UpdateSweep<false>(s, alpha, x, begin, end);
+}
+GIPSI_SIMD_INLINE SgsUpdateSums UpdateResidualBody(const Sweep& s, double alpha, double* x,
+                                                   int begin, int end) {
+  return UpdateSweep<true>(s, alpha, x, begin, end);
 }
 
 // y = A x for nodes [begin, end): D_I x_I, then the forward blocks, then the backward ones.
@@ -208,8 +213,11 @@ GIPSI_SGS_COPIES(double, Forward, (const Sweep& s, int begin, int end), (s, begi
 GIPSI_SGS_COPIES(void, Multiply, (const Sweep& s, const double* x, double* y, int begin, int end),
                  (s, x, y, begin, end))
 GIPSI_SGS_COPIES(SgsUpdateSums, Update,
-                 (const Sweep& s, double alpha, double* x, double* r, int begin, int end),
-                 (s, alpha, x, r, begin, end))
+                 (const Sweep& s, double alpha, double* x, int begin, int end),
+                 (s, alpha, x, begin, end))
+GIPSI_SGS_COPIES(SgsUpdateSums, UpdateResidual,
+                 (const Sweep& s, double alpha, double* x, int begin, int end),
+                 (s, alpha, x, begin, end))
 #undef GIPSI_SGS_COPIES
 #undef GIPSI_SGS_AVX
 
@@ -318,7 +326,7 @@ void NodeBlockSgs::AssignPattern(const SparseMatrix& A, int domains) {
   backward_values_.assign(9 * backward_column_.size() + kPadding, 0.0);
   inverse_.assign(9 * static_cast<std::size_t>(n) + kPadding, 0.0);
   block_.assign(9 * static_cast<std::size_t>(n) + kPadding, 0.0);
-  for (std::vector<double>* v : {&z_, &r_, &p_, &t_, &u_, &w_, &v_})
+  for (std::vector<double>* v : {&z_, &r_, &p_, &t_, &u_, &w_})
     v->assign(3 * static_cast<std::size_t>(n), 0.0);
   nonzeros_ = A.nonZeros();
 }
@@ -368,8 +376,7 @@ Sweep NodeBlockSgs::MakeSweep() {
           p_.data(),
           t_.data(),
           u_.data(),
-          w_.data(),
-          v_.data()};
+          w_.data()};
 }
 
 double NodeBlockSgs::Start(const double* r, int d) {
@@ -399,13 +406,16 @@ double NodeBlockSgs::Forward(int d) {
   return ForwardGeneric(s, begin, end);
 }
 
-SgsUpdateSums NodeBlockSgs::Update(double alpha, double* x, double* r, int d) {
+SgsUpdateSums NodeBlockSgs::Update(double alpha, double* x, bool residual, int d) {
   const Sweep s = MakeSweep();
   const int begin = domain_start(d), end = domain_start(d + 1);
 #if defined(__x86_64__)
-  if (UseAvx()) return UpdateAvx(s, alpha, x, r, begin, end);
+  if (UseAvx())
+    return residual ? UpdateResidualAvx(s, alpha, x, begin, end)
+                    : UpdateAvx(s, alpha, x, begin, end);
 #endif
-  return UpdateGeneric(s, alpha, x, r, begin, end);
+  return residual ? UpdateResidualGeneric(s, alpha, x, begin, end)
+                  : UpdateGeneric(s, alpha, x, begin, end);
 }
 
 void NodeBlockSgs::Multiply(const VecX& x, VecX& y) {

@@ -17,10 +17,12 @@
 /// A t = (D + L) t + (D + U) t − D t + C t. With P = L_D p and t = (D + U)⁻¹ P, one iteration is
 /// - a backward sweep: P ← R + βP, then t_I = D_I⁻¹ (P_I − Σ_{J>I} A_IJ t_J) in the domain;
 /// - a forward sweep: w_I = D_I⁻¹ (P_I + (C t)_I − Σ_{J<I} A_IJ u_J), u_I = w_I − t_I (w = t + u
-///   is L_D⁻ᵀ Â p), and v = L t + C t (the same blocks, read once for both);
-/// - an update: α = (R, Z) / (P, w); x += α t, r −= α (v + P) (the residual b − A x by
-///   recurrence, as A t = v + P), Z −= α w, R = D Z (R = L_D ρ and Z = D⁻¹ R for CG's residual
-///   ρ).
+///   is L_D⁻ᵀ Â p);
+/// - an update: α = (R, Z) / (P, w); x += α t, Z −= α w, R = D Z (R = L_D ρ and Z = D⁻¹ R for
+///   CG's residual ρ).
+/// The residual b − A x equals W ρ = (D + L) Z (by induction: (D + L) w = A t), so the update
+/// can also return ‖(D + L) Z‖, at the price of a second pass over the L blocks; the solver asks
+/// for it only where the stopping test may decide (pcg.cc).
 /// Every block is read once per iteration (lower and cross blocks by the forward sweep, upper
 /// ones by the backward sweep), the memory traffic of one product with A, for 2.2-2.7× fewer
 /// iterations than Jacobi on the FEM benchmark meshes (docs/performance.md). The blocks are
@@ -58,7 +60,7 @@ inline constexpr Index kSgsDomainRows = 12288;
 
 /// Partial sums of one update sweep.
 struct SgsUpdateSums {
-  double rr = 0.0;  ///< (r, r): the squared true residual
+  double rr = 0.0;  ///< (r, r) for r = (D + L) Z, the residual (0 unless asked for)
   double zr = 0.0;  ///< (Z, R) = (ρ, ρ): CG's γ
 };
 
@@ -82,10 +84,11 @@ class NodeBlockSgs {
   double Start(const double* r, int d);
   /// P ← R + βP, then t = (D + U)⁻¹ P, nodes in reverse order.
   void Backward(double beta, int d);
-  /// w, u and v from P and t (t final in every domain); returns (P, w) over the domain.
+  /// w and u from P and t (t final in every domain); returns (P, w) over the domain.
   double Forward(int d);
-  /// x += α t, r −= α (v + P), Z −= α w, R = D Z; returns (r, r) and (Z, R) over the domain.
-  SgsUpdateSums Update(double alpha, double* x, double* r, int d);
+  /// x += α t, Z −= α w, R = D Z; returns (Z, R) over the domain and, with `residual`, the
+  /// squared norm of the residual r = (D + L) Z over the domain (else 0).
+  SgsUpdateSums Update(double alpha, double* x, bool residual, int d);
 
   /// y = A x from the copied blocks (x and y: 3 × nodes entries, not aliased), parallel over
   /// nodes; each entry summed in a fixed order.
@@ -112,8 +115,8 @@ class NodeBlockSgs {
   /// Blocks column-major (A(3I + a, 3J + i) at 9m + 3i + a), each array followed by padding:
   /// the forward and backward blocks, D_I and D_I⁻¹ (9 per node).
   std::vector<double> forward_values_, backward_values_, block_, inverse_;
-  std::vector<double> z_, r_, p_, t_, u_, w_, v_;  ///< Z, R, P, t, u, w, v (3 × nodes)
-  Index nonzeros_ = 0;                             ///< of the analysed pattern
+  std::vector<double> z_, r_, p_, t_, u_, w_;  ///< Z, R, P, t, u, w (3 × nodes)
+  Index nonzeros_ = 0;                         ///< of the analysed pattern
 };
 
 }  // namespace gipsi
