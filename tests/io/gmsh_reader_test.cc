@@ -155,6 +155,41 @@ std::filesystem::path Edited22(std::string_view name, std::string_view from, std
   return WriteBytes(Scratch(name), text);
 }
 
+// Second order: the corners make the linear mesh, the edges' middle nodes its second-order
+// geometry (the one off its midpoint, on edge 10-20, kept where it is), and a physical curve's
+// 3-node line keeps only its end nodes.
+TEST(GmshReader, ReadsSecondOrderElementsWithTheirEdgeNodesApart) {
+  Mesh mesh = ReadGmsh(MeshData("two_tets_order2_v22.msh"));
+  EXPECT_EQ(mesh.num_nodes(), 5);
+  EXPECT_EQ(mesh.num_tets(), 2);
+  EXPECT_EQ(mesh.num_triangles(), 1);
+  EXPECT_EQ(mesh.tets.col(1), Eigen::Vector4i(1, 2, 3, 4));
+  EXPECT_EQ(mesh.triangles.col(0), Eigen::Vector3i(0, 2, 1));
+  EXPECT_THAT(mesh.FindGroup("edge")->items, ElementsAre(0, 1));
+  ASSERT_EQ(mesh.edge_node_ends.cols(), 9);
+  for (Index k = 0; k < 9; ++k) {
+    const int a = mesh.edge_node_ends(0, k), b = mesh.edge_node_ends(1, k);
+    EXPECT_LT(a, b);
+    const Vec3 midpoint = 0.5 * (mesh.nodes.col(a) + mesh.nodes.col(b));
+    const Vec3 expected = a == 0 && b == 1 ? Vec3(0.5, -0.1, 0) : midpoint;
+    EXPECT_EQ(mesh.edge_nodes.col(k), expected) << "edge " << a << "-" << b;
+  }
+  // Scaling and moving the mesh moves the edge nodes with it.
+  mesh.Transform(2, Vec3(1, 0, 0));
+  EXPECT_EQ(mesh.edge_nodes.col(0), Vec3(2, -0.2, 0));
+}
+
+TEST(GmshReader, RejectsSecondOrderElementsThatDisagreeOnAnEdgeNode) {
+  std::string text = test::ReadBytes(MeshData("two_tets_order2_v22.msh"));
+  text.replace(text.find("14\n"), 3, "15\n");
+  text.replace(text.find("$EndNodes"), 0, "110 0.5 0.6 0\n");
+  text.replace(text.find("20 30 40 50 102"), 15, "20 30 40 50 110");
+  auto path = WriteBytes(Scratch("nonconforming.msh"), text);
+  EXPECT_THAT(InputErrorMessage([&] { ReadGmsh(path); }),
+              HasSubstr("element 4 puts node 110 in the middle of the edge between nodes 20 and "
+                        "30, where another element has a node elsewhere"));
+}
+
 TEST(GmshReader, ReportsFileAndLineOfShortTetrahedron) {
   auto path = Edited22("cube.msh", "6 4 2 1 1 20 30 40 50", "6 4 2 1 1 20 30 40");
   EXPECT_EQ(InputErrorMessage([&] { ReadGmsh(path); }),

@@ -57,6 +57,20 @@ void Mesh::Validate(std::string_view source) const {
   }
   CheckConnectivity(tets, num_nodes(), "tetrahedron", source);
   CheckConnectivity(triangles, num_nodes(), "triangle", source);
+  if (edge_nodes.cols() != edge_node_ends.cols())
+    ThrowInputError(source, "",
+                    fmt::format("{} second-order edge nodes for {} edges", edge_nodes.cols(),
+                                edge_node_ends.cols()));
+  for (Index k = 0; k < edge_node_ends.cols(); ++k) {
+    const int a = edge_node_ends(0, k), b = edge_node_ends(1, k);
+    if (a < 0 || b >= num_nodes() || a >= b)
+      ThrowInputError(source, fmt::format("second-order edge {}", k),
+                      fmt::format("ends {} and {} are not two nodes in [0, {}), smaller first", a,
+                                  b, num_nodes()));
+    if (!edge_nodes.col(k).allFinite())
+      ThrowInputError(source, fmt::format("second-order edge {}", k),
+                      "the middle node's coordinates are not finite");
+  }
   if (!tet_ids.empty() && static_cast<Index>(tet_ids.size()) != num_tets())
     ThrowInputError(source, "", fmt::format("{} tet ids for {} tets", tet_ids.size(), num_tets()));
   std::set<std::string> names;
@@ -75,21 +89,24 @@ void Mesh::Validate(std::string_view source) const {
 }
 
 std::vector<int> Mesh::RemoveUnusedNodes() {
-  std::vector<int> old_of_new;
-  if (num_tets() == 0 && num_triangles() == 0) {
-    old_of_new.resize(static_cast<std::size_t>(num_nodes()));
-    for (Index i = 0; i < num_nodes(); ++i) old_of_new[static_cast<std::size_t>(i)] = int(i);
-    return old_of_new;
-  }
-  std::vector<int> new_of_old(static_cast<std::size_t>(num_nodes()), -1);
+  std::vector<std::uint8_t> used(static_cast<std::size_t>(num_nodes()), 0);
+  if (num_tets() == 0 && num_triangles() == 0) std::fill(used.begin(), used.end(), 1);
   auto mark = [&](auto& conn) {
     for (Index e = 0; e < conn.cols(); ++e)
-      for (Index a = 0; a < conn.rows(); ++a) new_of_old[static_cast<std::size_t>(conn(a, e))] = 0;
+      for (Index a = 0; a < conn.rows(); ++a) used[static_cast<std::size_t>(conn(a, e))] = 1;
   };
   mark(tets);
   mark(triangles);
-  for (std::size_t i = 0; i < new_of_old.size(); ++i) {
-    if (new_of_old[i] == 0) {
+  return KeepNodes(used);
+}
+
+std::vector<int> Mesh::KeepNodes(const std::vector<std::uint8_t>& keep) {
+  GIPSI_CHECK(static_cast<Index>(keep.size()) == num_nodes(), "KeepNodes: {} flags for {} nodes",
+              keep.size(), num_nodes());
+  std::vector<int> old_of_new;
+  std::vector<int> new_of_old(keep.size(), -1);
+  for (std::size_t i = 0; i < keep.size(); ++i) {
+    if (keep[i]) {
       new_of_old[i] = static_cast<int>(old_of_new.size());
       old_of_new.push_back(static_cast<int>(i));
     }
@@ -100,8 +117,11 @@ std::vector<int> Mesh::RemoveUnusedNodes() {
   nodes = std::move(kept);
   auto renumber = [&](auto& conn) {
     for (Index e = 0; e < conn.cols(); ++e)
-      for (Index a = 0; a < conn.rows(); ++a)
-        conn(a, e) = new_of_old[static_cast<std::size_t>(conn(a, e))];
+      for (Index a = 0; a < conn.rows(); ++a) {
+        const int n = new_of_old[static_cast<std::size_t>(conn(a, e))];
+        GIPSI_CHECK(n >= 0, "KeepNodes: an element refers to dropped node {}", conn(a, e));
+        conn(a, e) = n;
+      }
   };
   renumber(tets);
   renumber(triangles);
@@ -113,7 +133,24 @@ std::vector<int> Mesh::RemoveUnusedNodes() {
         items.push_back(new_of_old[static_cast<std::size_t>(i)]);
     g.items = std::move(items);
   }
+  Index kept_edges = 0;
+  for (Index k = 0; k < edge_node_ends.cols(); ++k) {
+    const int a = new_of_old[static_cast<std::size_t>(edge_node_ends(0, k))];
+    const int b = new_of_old[static_cast<std::size_t>(edge_node_ends(1, k))];
+    if (a < 0 || b < 0) continue;
+    edge_node_ends(0, kept_edges) = std::min(a, b);
+    edge_node_ends(1, kept_edges) = std::max(a, b);
+    edge_nodes.col(kept_edges) = edge_nodes.col(k);
+    ++kept_edges;
+  }
+  edge_node_ends.conservativeResize(2, kept_edges);
+  edge_nodes.conservativeResize(3, kept_edges);
   return old_of_new;
+}
+
+void Mesh::Transform(double scale, const Vec3& translate) {
+  nodes = (scale * nodes).colwise() + translate;
+  edge_nodes = (scale * edge_nodes).colwise() + translate;
 }
 
 }  // namespace gipsi

@@ -35,6 +35,14 @@ struct Mesh {
   /// are named by their 0-based index. Messages name tets through TetName.
   std::vector<std::int64_t> tet_ids;
   std::string tet_id_kind;
+  /// Second-order (curved) geometry, from files with 10-node tets or 6-node triangles (Gmsh
+  /// types 11 and 9): column k of `edge_nodes` is the position of the node in the middle of
+  /// the edge between nodes `edge_node_ends(0, k)` < `edge_node_ends(1, k)`. Those middle nodes
+  /// are not in `nodes`, so every object on linear elements sees the mesh of the corners;
+  /// quadratic elements (MixedSolid) take their edge nodes from here, where the edges curve.
+  /// Empty for linear meshes.
+  Eigen::Matrix2Xi edge_node_ends = Eigen::Matrix2Xi(2, 0);
+  Points edge_nodes = Points(3, 0);
 
   [[nodiscard]] Index num_nodes() const { return nodes.cols(); }
   [[nodiscard]] Index num_tets() const { return tets.cols(); }
@@ -63,8 +71,14 @@ struct Mesh {
   void Validate(std::string_view source) const;
 
   /// Drops nodes no element refers to (keeps all when there are no elements) and renumbers
-  /// connectivity and node groups. Returns the old index of each kept node.
+  /// connectivity, node groups and `edge_node_ends`. Returns the old index of each kept node.
   std::vector<int> RemoveUnusedNodes();
+  /// Keeps the nodes with `keep[i]` true (`keep` has one entry per node; elements must not
+  /// refer to the others), renumbering as RemoveUnusedNodes; node groups and second-order edges
+  /// lose the dropped nodes. Returns the old index of each kept node.
+  std::vector<int> KeepNodes(const std::vector<std::uint8_t>& keep);
+  /// Scales, then translates, every position (nodes and second-order edge nodes).
+  void Transform(double scale, const Vec3& translate);
 };
 
 }  // namespace gipsi

@@ -145,7 +145,10 @@ class GmshParser {
     }
     if (!have_nodes_) r_.Fail("expected a $Nodes (or $NOD) section, got end of file");
     BuildGroups();
-    return b_.Build(r_.source());
+    Mesh mesh = b_.Build(r_.source());
+    SeparateEdgeNodes(mesh);
+    mesh.Validate(r_.source());
+    return mesh;
   }
 
  private:
@@ -517,12 +520,12 @@ class GmshParser {
     bool tet = type == 4 || type == 11;
     bool tri = type == 2 || type == 9;
     if (tet || tri) {
-      int corners = tet ? 4 : 3;
-      for (int a = 0; a < corners; ++a)
-        for (int c = 0; c < a; ++c)
-          if (idx_[std::size_t(a)] == idx_[std::size_t(c)])
-            Fail(fmt::format("element {} repeats node {}", tag, tags_[std::size_t(a)]));
+      const std::size_t count = idx_.size();
+      for (std::size_t a = 0; a < count; ++a)
+        for (std::size_t c = 0; c < a; ++c)
+          if (idx_[a] == idx_[c]) Fail(fmt::format("element {} repeats node {}", tag, tags_[a]));
     }
+    if (type == 11 || type == 9) AddEdgeNodes(type == 11, tag);
     int item = -1;
     if (tet) {
       item = b_.AddTet(idx_[0], idx_[1], idx_[2], idx_[3]);
@@ -537,6 +540,57 @@ class GmshParser {
         items.push_back(item);
       }
     }
+  }
+
+  /// Records the middle nodes of a 10-node tet's or 6-node triangle's edges (node indices in
+  /// `idx_`, Gmsh's local order: after the corners, the edges (0,1), (1,2), (2,0), then for
+  /// tets (3,0), (3,2), (3,1)). Fails if another element put a different node in the middle
+  /// of the same edge (a non-conforming mesh).
+  void AddEdgeNodes(bool tet, std::int64_t tag) {
+    static constexpr int kEdges[6][2] = {{0, 1}, {1, 2}, {0, 2}, {0, 3}, {2, 3}, {1, 3}};
+    const int corners = tet ? 4 : 3;
+    for (int k = 0; k < (tet ? 6 : 3); ++k) {
+      const int a = idx_[std::size_t(kEdges[k][0])], b = idx_[std::size_t(kEdges[k][1])];
+      const int middle = idx_[std::size_t(corners + k)];
+      const auto key = (std::uint64_t(std::min(a, b)) << 32) | std::uint64_t(std::max(a, b));
+      const auto [it, inserted] = edge_middle_.emplace(key, middle);
+      if (inserted || it->second == middle) continue;
+      const std::size_t p = 3 * std::size_t(middle), q = 3 * std::size_t(it->second);
+      if (std::equal(b_.coords.begin() + std::ptrdiff_t(p),
+                     b_.coords.begin() + std::ptrdiff_t(p + 3),
+                     b_.coords.begin() + std::ptrdiff_t(q)))
+        continue;
+      Fail(
+          fmt::format("element {} puts node {} in the middle of the edge between nodes {} and "
+                      "{}, where another element has a node elsewhere: the second-order mesh "
+                      "is not conforming",
+                      tag, tags_[std::size_t(corners + k)], tags_[std::size_t(kEdges[k][0])],
+                      tags_[std::size_t(kEdges[k][1])]));
+    }
+  }
+
+  /// Moves the middle nodes of second-order edges out of the mesh's nodes into its
+  /// second-order geometry (Mesh::edge_nodes), keeping a middle node that is also an element's
+  /// corner.
+  void SeparateEdgeNodes(Mesh& mesh) const {
+    if (edge_middle_.empty()) return;
+    const Index n = mesh.num_nodes();
+    std::vector<std::uint8_t> keep(std::size_t(n), 1);
+    std::vector<std::pair<std::uint64_t, int>> edges(edge_middle_.begin(), edge_middle_.end());
+    std::sort(edges.begin(), edges.end());
+    for (const auto& [key, middle] : edges) keep[std::size_t(middle)] = 0;
+    for (Index e = 0; e < mesh.num_tets(); ++e)
+      for (int a = 0; a < 4; ++a) keep[std::size_t(mesh.tets(a, e))] = 1;
+    for (Index t = 0; t < mesh.num_triangles(); ++t)
+      for (int a = 0; a < 3; ++a) keep[std::size_t(mesh.triangles(a, t))] = 1;
+    mesh.edge_node_ends.resize(2, Index(edges.size()));
+    mesh.edge_nodes.resize(3, Index(edges.size()));
+    for (std::size_t k = 0; k < edges.size(); ++k) {
+      mesh.edge_node_ends(0, Index(k)) = int(edges[k].first >> 32);
+      mesh.edge_node_ends(1, Index(k)) = int(edges[k].first & 0xffffffffU);
+      mesh.edge_nodes.col(Index(k)) = mesh.nodes.col(edges[k].second);
+    }
+    mesh.KeepNodes(keep);
   }
 
   void BuildGroups() {
@@ -578,6 +632,7 @@ class GmshParser {
   std::vector<int> idx_;                              // scratch: node indices of one element
   std::vector<std::int64_t> tet_tags_;                // element tag of every tet, in order
   std::vector<Key> keys_;                             // scratch: physical groups of one element
+  std::map<std::uint64_t, int> edge_middle_;  // second-order edge (min·2³² + max) -> middle node
 };
 
 }  // namespace

@@ -16,11 +16,14 @@ namespace gipsi {
 /// Reads a Gmsh mesh file.
 ///
 /// Kept elements: 4-node tetrahedra (type 4) and 3-node triangles (type 2); second-order
-/// tetrahedra (type 11) and triangles (type 9) contribute their corner nodes. Other element types
-/// (points, lines, quads, hexahedra, ...) are not kept, but their physical groups are.
+/// tetrahedra (type 11) and triangles (type 9) become linear elements on their corners, and
+/// their edges' middle nodes go to the mesh's second-order geometry (`Mesh::edge_nodes`, which
+/// quadratic elements use for curved edges), not to its nodes. Other element types (points,
+/// lines, quads, hexahedra, ...) are not kept, but their physical groups are.
 ///
 /// Node tags may be any distinct positive integers: nodes are renumbered 0..N-1 in file order and
-/// all nodes are kept (also those no kept element uses).
+/// all nodes are kept (also those no kept element uses), except the middle nodes of
+/// second-order edges.
 ///
 /// Physical groups become `MeshGroup`s: a group of volumes holds tet indices (dim 3), a group of
 /// surfaces triangle indices (dim 2), a group of curves or points node indices (dim 0). Names come
@@ -31,8 +34,8 @@ namespace gipsi {
 ///
 /// Throws InputError naming the file and the line (or byte offset for binary data) for a missing
 /// file, an unsupported version, truncated sections, malformed numbers, non-finite coordinates,
-/// elements with the wrong number of nodes, references to undefined nodes, and duplicate node
-/// tags. The result has passed `Mesh::Validate`.
+/// elements with the wrong number of nodes, references to undefined nodes, duplicate node
+/// tags, and second-order elements that disagree on an edge's middle node. The result has passed `Mesh::Validate`.
 Mesh ReadGmsh(const std::filesystem::path& path);
 
 /// The same, also giving the file's element tag of every tet, in the order of the mesh's tets

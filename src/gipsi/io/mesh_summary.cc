@@ -15,6 +15,18 @@ std::string DescribeMesh(const Mesh& mesh) {
   out += fmt::format("nodes:           {}\n", mesh.num_nodes());
   out += fmt::format("tetrahedra:      {}\n", mesh.num_tets());
   out += fmt::format("triangles:       {}\n", mesh.num_triangles());
+  if (mesh.edge_nodes.cols() > 0) {
+    Index curved = 0;
+    for (Index k = 0; k < mesh.edge_nodes.cols(); ++k) {
+      const Vec3 a = mesh.nodes.col(mesh.edge_node_ends(0, k));
+      const Vec3 b = mesh.nodes.col(mesh.edge_node_ends(1, k));
+      curved += (mesh.edge_nodes.col(k) - 0.5 * (a + b)).norm() > 1e-12 * (b - a).norm();
+    }
+    out += fmt::format(
+        "second order:    {} edge nodes, {} off their edge's midpoint (curved; "
+        "used by MixedSolid)\n",
+        mesh.edge_nodes.cols(), curved);
+  }
   if (mesh.num_nodes() > 0) {
     Vec3 lo = mesh.nodes.rowwise().minCoeff(), hi = mesh.nodes.rowwise().maxCoeff();
     out += fmt::format("bounding box:    [{:.6g}, {:.6g}, {:.6g}] to [{:.6g}, {:.6g}, {:.6g}]\n",

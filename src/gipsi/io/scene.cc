@@ -370,8 +370,11 @@ Mesh BuildMesh(const JsonNode& node, const std::filesystem::path& base_dir) {
       node.Fail(what);
     }
   }
-  if (auto scale = node.Find("scale")) mesh.nodes *= scale->AsPositive();
-  if (auto translate = node.Find("translate")) mesh.nodes.colwise() += translate->AsVec3();
+  const auto scale = node.Find("scale");
+  const auto translate = node.Find("translate");
+  if (scale || translate)
+    mesh.Transform(scale ? scale->AsPositive() : 1.0,
+                   translate ? translate->AsVec3() : Vec3::Zero());
   return mesh;
 }
 

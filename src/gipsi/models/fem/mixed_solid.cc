@@ -53,10 +53,10 @@ MixedSolid::MixedSolid(std::string name, std::shared_ptr<const Mesh> domain,
   state_.active_new = VecX::Zero(mesh_.num_elements());
   SetGeometry(domain, MakeBoundary(*domain));
 
-  // Element geometry: volumes and P2 gradients at the quadrature points.
+  // Element geometry: P2 gradients and volume weights at the quadrature points.
   const Index ne = mesh_.num_elements();
   const TetQuadrature& rule = TetRuleDegree2();
-  volume_.resize(ne);
+  weight_.resize(ne * kQuad);
   grad_.resize(static_cast<std::size_t>(ne) * kQuad * 30);
   for (Index e = 0; e < ne; ++e) {
     Mat3 dm;
@@ -68,7 +68,10 @@ MixedSolid::MixedSolid(std::string name, std::shared_ptr<const Mesh> domain,
           fmt::format("object '{}': {} is degenerate or inverted (rest "
                       "volume {:.3g} m³)",
                       this->path(), domain->TetName(e), det / 6));
-    volume_[e] = det / 6;
+    if (mesh_.IsCurved(e)) {
+      CurvedElementGeometry(e, *domain);
+      continue;
+    }
     const Mat3 inv = dm.inverse();
     Eigen::Matrix<double, 3, 4> gl;
     gl.rightCols<3>() = inv.transpose();
@@ -78,6 +81,7 @@ MixedSolid::MixedSolid(std::string name, std::shared_ptr<const Mesh> domain,
           gl * QuadraticTetShapeDerivatives(rule.points[static_cast<std::size_t>(q)]).transpose();
       Eigen::Map<Eigen::Matrix<double, 3, 10>>(grad_.data() +
                                                (static_cast<std::size_t>(e) * kQuad + q) * 30) = g;
+      weight_[e * kQuad + q] = det / 6 * rule.weights[static_cast<std::size_t>(q)];
     }
   }
   // Slivers: the mixed element's pressure is continuous and linear, so a flat tet can change
@@ -226,13 +230,49 @@ Mat3 MixedSolid::DeformationGradient(Index e, int q, const VecX& z) const {
   return F;
 }
 
-double MixedSolid::CurrentVolume() const {
+void MixedSolid::CurvedElementGeometry(Index e, const Mesh& domain) {
+  // Isoparametric map x(ξ) = Σ_a X_a N_a(ξ), ξ = (L_1, L_2, L_3): its Jacobian D = ∂x/∂ξ
+  // varies over the element; ∇N_a = D⁻ᵀ ∂N_a/∂ξ and dV = det D / 6 × the rule's weight.
+  Eigen::Matrix<double, 3, 10> x;
+  for (int a = 0; a < 10; ++a) x.col(a) = mesh_.rest.col(mesh_.elements(a, e));
+  auto reference_derivatives = [](const Eigen::Vector4d& L) {
+    const Eigen::Matrix<double, 10, 4> d = QuadraticTetShapeDerivatives(L);
+    Eigen::Matrix<double, 10, 3> dxi;
+    for (int k = 0; k < 3; ++k) dxi.col(k) = d.col(k + 1) - d.col(0);
+    return dxi;
+  };
+  auto fail = [&](double det, const std::string& where) {
+    throw InputError(fmt::format(
+        "object '{}': {} is curved too much: the Jacobian of its map from the reference tet is "
+        "{:.3g} at {} (it must be positive throughout the element); move its edges' middle "
+        "nodes closer to the midpoints, or refine the mesh where the surface curves",
+        this->path(), domain.TetName(e), det, where));
+  };
+  // Where the Jacobian is most often lowest: the corners (the quadrature points follow).
+  for (int a = 0; a < 4; ++a) {
+    const double det = (x * reference_derivatives(Eigen::Vector4d::Unit(a))).determinant();
+    if (!(det > 0)) fail(det, fmt::format("its corner {}", a));
+  }
   const TetQuadrature& rule = TetRuleDegree2();
+  for (int q = 0; q < kQuad; ++q) {
+    const Eigen::Matrix<double, 10, 3> dxi =
+        reference_derivatives(rule.points[static_cast<std::size_t>(q)]);
+    const Mat3 jacobian = x * dxi;
+    const double det = jacobian.determinant();
+    if (!(det > 0)) fail(det, fmt::format("its quadrature point {}", q));
+    Eigen::Map<Eigen::Matrix<double, 3, 10>>(grad_.data() +
+                                             (static_cast<std::size_t>(e) * kQuad + q) * 30) =
+        jacobian.inverse().transpose() * dxi.transpose();
+    weight_[e * kQuad + q] = det / 6 * rule.weights[static_cast<std::size_t>(q)];
+  }
+}
+
+double MixedSolid::CurrentVolume() const {
   double v = 0;
   for (Index e = 0; e < mesh_.num_elements(); ++e)
     for (int q = 0; q < kQuad; ++q) {
       const Mat3 F = DeformationGradient(e, q, state_.z);
-      v += volume_[e] * rule.weights[static_cast<std::size_t>(q)] * F.determinant();
+      v += weight_[e * kQuad + q] * F.determinant();
     }
   return v;
 }
@@ -256,7 +296,6 @@ MaterialPoint MixedSolid::PointOf(Index e, int q, double load) const {
 }
 
 double MixedSolid::ElementEnergy(Index e, const VecX& z) const {
-  const TetQuadrature& rule = TetRuleDegree2();
   double w = 0;
   for (int q = 0; q < kQuad; ++q) {
     const MaterialPoint mp = PointOf(e, q, 1.0);
@@ -266,7 +305,7 @@ double MixedSolid::ElementEnergy(Index e, const VecX& z) const {
       const double log_j = std::log(F.determinant());
       energy -= 0.5 * kappa_ * log_j * log_j;
     }
-    w += volume_[e] * rule.weights[static_cast<std::size_t>(q)] * energy;
+    w += weight_[e * kQuad + q] * energy;
   }
   return w;
 }
@@ -294,7 +333,7 @@ bool MixedSolid::Assemble(const VecX& z, double load, VecX& r, double* jv) const
       const auto g = Eigen::Map<const Eigen::Matrix<double, 3, 10>>(
           grad_.data() + (static_cast<std::size_t>(e) * kQuad + q) * 30);
       const Eigen::Vector4d& lq = rule.points[static_cast<std::size_t>(q)];
-      const double w = volume_[e] * rule.weights[static_cast<std::size_t>(q)];
+      const double w = weight_[e * kQuad + q];
       const MaterialPoint mp = PointOf(e, q, load);
       const Mat3 F = Mat3::Identity() + u * g.transpose();
       const double J = F.determinant();

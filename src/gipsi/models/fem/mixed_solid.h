@@ -161,6 +161,9 @@ class MixedSolid final : public SimObject {
   void SetTargets(VecX& z, double s) const;
   StepStatus Advance(double s0, double s1, int depth);
   void UpdatePositions();
+  /// grad_ and weight_ of curved element e (isoparametric); throws InputError naming the tet
+  /// of `domain` if its map from the reference tet is not positive.
+  void CurvedElementGeometry(Index e, const Mesh& domain);
   /// F = I + Σ_a u_a ⊗ ∇N_a at quadrature point q of element e for the unknowns z.
   [[nodiscard]] Mat3 DeformationGradient(Index e, int q, const VecX& z) const;
   [[nodiscard]] double ElementEnergy(Index e, const VecX& z) const;
@@ -172,7 +175,7 @@ class MixedSolid final : public SimObject {
   double kappa_ = 0;
   QuadraticTets mesh_;
   std::vector<double> grad_;  // per element and quadrature point: 3 × 10 ∇N (column-major)
-  VecX volume_;               // rest volume per element
+  VecX weight_;               // per element and quadrature point: its share of the rest volume
   double pressure_scale_ = 1;
   // Boundary faces as 6-node triangles (P2 node ids).
   Eigen::Matrix<int, 6, Eigen::Dynamic> faces_;

@@ -51,7 +51,32 @@ QuadraticTets ElevateToQuadratic(const Mesh& mesh) {
     q.rest.col(q.num_vertices + col) =
         0.5 * (mesh.nodes.col(edges[k][0]) + mesh.nodes.col(edges[k][1]));
   }
+  // Curved edges of a second-order mesh: a middle node off the straight midpoint by more than
+  // round-off (1e-12 of the edge's length) moves the edge node there.
+  std::vector<std::uint8_t> curved_edge(edges.size(), 0);
+  for (Index k = 0; k < mesh.edge_node_ends.cols(); ++k) {
+    const int node = q.EdgeNode(mesh.edge_node_ends(0, k), mesh.edge_node_ends(1, k));
+    if (node < 0) continue;  // an edge of triangles only
+    const Vec3 a = mesh.nodes.col(mesh.edge_node_ends(0, k));
+    const Vec3 b = mesh.nodes.col(mesh.edge_node_ends(1, k));
+    const Vec3 middle = mesh.edge_nodes.col(k);
+    if ((middle - q.rest.col(node)).norm() <= 1e-12 * (b - a).norm()) continue;
+    q.rest.col(node) = middle;
+    curved_edge[static_cast<std::size_t>(node - q.num_vertices)] = 1;
+    ++q.num_curved_edges;
+  }
+  if (q.num_curved_edges > 0) {
+    q.curved.assign(static_cast<std::size_t>(ne), 0);
+    for (Index e = 0; e < ne; ++e)
+      for (int k = 0; k < 6; ++k)
+        if (curved_edge[static_cast<std::size_t>(q.elements(4 + k, e) - q.num_vertices)])
+          q.curved[static_cast<std::size_t>(e)] = 1;
+  }
   return q;
+}
+
+bool QuadraticTets::IsCurved(Index e) const {
+  return !curved.empty() && curved[static_cast<std::size_t>(e)] != 0;
 }
 
 Eigen::Matrix<double, 10, 1> QuadraticTetShape(const Eigen::Vector4d& L) {

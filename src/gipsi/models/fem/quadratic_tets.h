@@ -1,9 +1,10 @@
 #pragma once
 /// @file
 /// Quadratic (P2, 10-node) tetrahedra and 6-node triangles: a linear tet mesh elevated to P2
-/// by adding one node at the midpoint of every edge (straight-sided elements, so the map from
-/// the reference element is affine and shape-function gradients are those of P1 combined),
-/// the shape functions, and the quadrature rules the mixed elements use.
+/// by adding one node on every edge — at its midpoint (straight-sided elements: the map from
+/// the reference element is affine and shape-function gradients are those of P1 combined), or
+/// where a second-order mesh file puts it (curved, isoparametric elements) — the shape
+/// functions, and the quadrature rules the mixed elements use.
 ///
 /// Shape functions in barycentric coordinates L_0..L_3 (Σ L = 1, ∇L_k the constant P1
 /// gradients): vertex a: N_a = L_a (2 L_a − 1); midpoint of edge (i, j): N = 4 L_i L_j.
@@ -58,9 +59,19 @@ struct QuadraticTets {
   [[nodiscard]] int EdgeNode(int a, int b) const;
 
   std::unordered_map<std::uint64_t, int> edge_index;  ///< key min·2³² + max → edge node
+
+  /// Edge nodes placed off their edge's midpoint by a second-order mesh, and per element
+  /// whether any of its edges is curved (empty when none is).
+  Index num_curved_edges = 0;
+  std::vector<std::uint8_t> curved;
+  /// Whether element e has a curved edge: its map from the reference tet is not affine.
+  [[nodiscard]] bool IsCurved(Index e) const;
 };
 
-/// Elevates the tets of `mesh` (its triangles are ignored) to P2 with straight edges.
+/// Elevates the tets of `mesh` (its triangles are ignored) to P2: an edge node sits at the
+/// position a second-order mesh gives it (`Mesh::edge_nodes`, curved edges) or else at the
+/// edge's midpoint (straight edges; a middle node within 1e-12 of the edge's length of the
+/// midpoint counts as straight and is put exactly there).
 /// Throws InputError if the mesh has no tets. O(tets) with a hash map of the edges.
 [[nodiscard]] QuadraticTets ElevateToQuadratic(const Mesh& mesh);
 
