@@ -1,7 +1,9 @@
 #include <clocale>
 #include <cmath>
 #include <numbers>
+#include <set>
 #include <string>
+#include <utility>
 #include <vector>
 
 #ifdef _OPENMP
@@ -123,6 +125,57 @@ TEST(EllipsoidShell, NumbersNodesAndTetsAlongTheDomain) {
   // 0.8 and 1.6, with a few long jumps between the curve's blocks.
   EXPECT_LT(MeanStep(centroids), 2 * spec.mesh_size);
   EXPECT_LT(MeanStep(mesh.nodes), 2 * spec.mesh_size);
+}
+
+/// Distance of x from the ellipsoid (x²+y²)/a² + z²/c² = 1, to first order.
+double EllipsoidGap(const Vec3& x, double a, double c) {
+  const double f = (x.x() * x.x() + x.y() * x.y()) / (a * a) + x.z() * x.z() / (c * c);
+  return std::abs(std::sqrt(f) - 1) * a;
+}
+
+// Order 2: the same corner mesh as order 1 (objects on linear tets see no difference), one
+// middle node per tet edge, and on the endocardium the middle nodes lie on the ellipsoid where
+// the straight midpoints cut inside it.
+TEST(EllipsoidShell, SecondOrderPutsEdgeNodesOnTheSurfaces) {
+  EllipsoidShellSpec spec;
+  spec.mesh_size = 2.5;
+  const Mesh linear = MakeEllipsoidShell(spec);
+  spec.order = 2;
+  const Mesh mesh = MakeEllipsoidShell(spec);
+  EXPECT_EQ(mesh.nodes, linear.nodes);
+  EXPECT_EQ(mesh.tets, linear.tets);
+  EXPECT_EQ(mesh.triangles, linear.triangles);
+  std::set<std::pair<int, int>> edges;
+  for (Index e = 0; e < mesh.num_tets(); ++e)
+    for (int a = 0; a < 4; ++a)
+      for (int b = a + 1; b < 4; ++b) edges.insert(std::minmax(mesh.tets(a, e), mesh.tets(b, e)));
+  ASSERT_EQ(mesh.edge_nodes.cols(), Index(edges.size()));
+  int on_endo = 0;
+  double worst_node = 0, mean_midpoint = 0;
+  for (Index k = 0; k < mesh.edge_nodes.cols(); ++k) {
+    const Vec3 a = mesh.nodes.col(mesh.edge_node_ends(0, k));
+    const Vec3 b = mesh.nodes.col(mesh.edge_node_ends(1, k));
+    EXPECT_TRUE(edges.count({mesh.edge_node_ends(0, k), mesh.edge_node_ends(1, k)}));
+    const double tol = 1e-6 * spec.mesh_size;
+    if (EllipsoidGap(a, spec.endo_short, spec.endo_long) > tol ||
+        EllipsoidGap(b, spec.endo_short, spec.endo_long) > tol ||
+        (std::abs(a.z() - spec.base_z) < tol && std::abs(b.z() - spec.base_z) < tol))
+      continue;
+    ++on_endo;
+    worst_node =
+        std::max(worst_node, EllipsoidGap(mesh.edge_nodes.col(k), spec.endo_short, spec.endo_long));
+    mean_midpoint += EllipsoidGap(0.5 * (a + b), spec.endo_short, spec.endo_long);
+  }
+  mean_midpoint /= on_endo;
+  std::cout << "[ info     ] " << on_endo << " endocardial edges: middle nodes within "
+            << worst_node << " of the surface, straight midpoints " << mean_midpoint
+            << " inside on average\n";
+  EXPECT_GT(on_endo, 50);
+  EXPECT_LT(worst_node, 1e-6 * spec.mesh_size);
+  EXPECT_GT(mean_midpoint, 1e-3 * spec.mesh_size);
+  spec.order = 3;
+  EXPECT_THAT([&] { (void)MakeEllipsoidShell(spec); },
+              ThrowsMessage<InputError>(HasSubstr("order must be 1 or 2, got 3")));
 }
 
 TEST(EllipsoidShell, RejectsInconsistentDimensions) {

@@ -272,5 +272,20 @@ TEST(SceneErrors, AMeshGivenByItsNodesNamesTheBadValueByItsPath) {
               HasSubstr("meshes.m: expected exactly one of 'file', 'generate', 'nodes'"));
 }
 
+TEST(SceneErrors, OnlyTheGmshShellGeneratorsTakeAnOrder) {
+  auto scene = [](const std::string& mesh) {
+    return R"({"meshes": {"m": )" + mesh + R"(},
+      "objects": {"o": {"type": "MassSpring", "domain": "m", "dt": 0.001}},
+      "schedule": {"end": 1}})";
+  };
+  EXPECT_THAT(LoadError(scene(R"({"generate": "box", "min": [0,0,0], "max": [1,1,1],
+                                  "cells": [1,1,1], "order": 2})")),
+              HasSubstr("meshes.m.order: only the generators \"ellipsoid_shell\" and "
+                        "\"cylinder_shell\" take 'order'"));
+  EXPECT_THAT(LoadError(scene(R"({"generate": "cylinder_shell", "inner_radius": 1,
+                                  "outer_radius": 2, "height": 1, "size": 0.5, "order": 3})")),
+              HasSubstr("meshes.m.order: expected 1 (linear tets) or 2 (second order), got 3"));
+}
+
 }  // namespace
 }  // namespace gipsi

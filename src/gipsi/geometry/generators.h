@@ -45,8 +45,13 @@ struct EllipsoidShellSpec {
   double epi_short = 10, epi_long = 20;
   double base_z = 5;
   double mesh_size = 2;
+  /// 2: second-order tets from Gmsh, their edges' middle nodes on the ellipsoids
+  /// (Mesh::edge_nodes; curved MixedSolid elements). Objects on linear tets see the same
+  /// corners either way.
+  int order = 1;
 };
-/// Tet mesh of the shell by Gmsh (OpenCASCADE kernel; `mesh_size` is the largest element size).
+/// Tet mesh of the shell by Gmsh (OpenCASCADE kernel; `mesh_size` is the largest element size;
+/// `order` 1 or 2).
 /// Tets are positively oriented; the boundary triangles are the closed boundary of the tets,
 /// oriented out of the wall (on "endo" they point into the cavity). Groups: "endo", "epi",
 /// "base" (dim 2) and "wall" (dim 3). Throws InputError for inconsistent dimensions (endo must
@@ -54,10 +59,12 @@ struct EllipsoidShellSpec {
 /// Thread-safe: Gmsh's global state is guarded by a process-wide mutex.
 Mesh MakeEllipsoidShell(const EllipsoidShellSpec& spec);
 
-/// A hollow cylinder around the z axis from z=0 to z=height, meshed like `MakeEllipsoidShell`.
+/// A hollow cylinder around the z axis from z=0 to z=height, meshed like `MakeEllipsoidShell`
+/// (`order` 2: second order, the middle nodes on the cylinders).
 /// Groups: "inner", "outer", "bottom", "top" (dim 2), "wall" (dim 3). Throws InputError for
 /// inner >= outer, a non-positive size, too many tets, or if Gmsh fails.
-Mesh MakeCylinderShell(double inner_radius, double outer_radius, double height, double mesh_size);
+Mesh MakeCylinderShell(double inner_radius, double outer_radius, double height, double mesh_size,
+                       int order = 1);
 
 /// Tetrahedralises the volume enclosed by a closed triangle surface (`vertices` 3 by V,
 /// `triangles` 3 by T) with Gmsh: the surface is reparametrised (Gmsh's classifySurfaces and

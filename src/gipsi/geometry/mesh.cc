@@ -148,6 +148,27 @@ std::vector<int> Mesh::KeepNodes(const std::vector<std::uint8_t>& keep) {
   return old_of_new;
 }
 
+void Mesh::SeparateEdgeNodes(const std::map<std::uint64_t, int>& middle_of_edge) {
+  if (middle_of_edge.empty()) return;
+  std::vector<std::uint8_t> keep(static_cast<std::size_t>(num_nodes()), 1);
+  for (const auto& [key, middle] : middle_of_edge) keep[static_cast<std::size_t>(middle)] = 0;
+  for (Index e = 0; e < num_tets(); ++e)
+    for (int a = 0; a < 4; ++a) keep[static_cast<std::size_t>(tets(a, e))] = 1;
+  for (Index t = 0; t < num_triangles(); ++t)
+    for (int a = 0; a < 3; ++a) keep[static_cast<std::size_t>(triangles(a, t))] = 1;
+  const auto count = static_cast<Index>(middle_of_edge.size());
+  edge_node_ends.resize(2, count);
+  edge_nodes.resize(3, count);
+  Index k = 0;
+  for (const auto& [key, middle] : middle_of_edge) {
+    edge_node_ends(0, k) = static_cast<int>(key >> 32);
+    edge_node_ends(1, k) = static_cast<int>(key & 0xffffffffU);
+    edge_nodes.col(k) = nodes.col(middle);
+    ++k;
+  }
+  KeepNodes(keep);
+}
+
 void Mesh::Transform(double scale, const Vec3& translate) {
   nodes = (scale * nodes).colwise() + translate;
   edge_nodes = (scale * edge_nodes).colwise() + translate;

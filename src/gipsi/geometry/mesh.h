@@ -5,6 +5,7 @@
 /// groups, VTK/TetGen region markers). Shared between objects as `std::shared_ptr<const Mesh>`.
 
 #include <cstdint>
+#include <map>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -22,6 +23,10 @@ struct MeshGroup {
   int dim = 0;
   std::vector<int> items;
 };
+
+/// Gmsh's local order of the edges whose middle nodes follow the corners of a second-order
+/// element: nodes 4..9 of a 10-node tet, and (the first three) nodes 3..5 of a 6-node triangle.
+inline constexpr int kGmshSecondOrderEdges[6][2] = {{0, 1}, {1, 2}, {0, 2}, {0, 3}, {2, 3}, {1, 3}};
 
 /// Nodes plus tetrahedra and/or triangles. Both connectivity blocks may be present (a tet mesh
 /// with tagged boundary triangles, as Gmsh writes them). Plain data: copyable and movable.
@@ -77,6 +82,11 @@ struct Mesh {
   /// refer to the others), renumbering as RemoveUnusedNodes; node groups and second-order edges
   /// lose the dropped nodes. Returns the old index of each kept node.
   std::vector<int> KeepNodes(const std::vector<std::uint8_t>& keep);
+  /// For second-order input read as linear elements on the corners: `middle_of_edge` maps each
+  /// edge (key min·2³² + max of its end nodes) to the node in its middle. Sets `edge_nodes` and
+  /// `edge_node_ends` from them and drops those nodes (but not one that is also an element's
+  /// corner), renumbering as KeepNodes.
+  void SeparateEdgeNodes(const std::map<std::uint64_t, int>& middle_of_edge);
   /// Scales, then translates, every position (nodes and second-order edge nodes).
   void Transform(double scale, const Vec3& translate);
 };

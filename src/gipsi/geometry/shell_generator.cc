@@ -45,6 +45,7 @@ namespace {
 
 /// Gmsh element type of the 4-node tetrahedron.
 constexpr int kGmshTet4 = 4;
+constexpr int kGmshTet10 = 11;
 /// Refuse to mesh when the estimated number of tets exceeds this (a too small mesh size).
 constexpr double kMaxEstimatedTets = 2e7;
 
@@ -136,6 +137,12 @@ void SortAlongZOrderCurve(Mesh& mesh) {
   for (Index e = 0; e < ne; ++e)
     for (int a = 0; a < 4; ++a)
       mesh.tets(a, e) = new_index[static_cast<std::size_t>(mesh.tets(a, e))];
+  for (Index k = 0; k < mesh.edge_node_ends.cols(); ++k) {
+    const int a = new_index[static_cast<std::size_t>(mesh.edge_node_ends(0, k))];
+    const int b = new_index[static_cast<std::size_t>(mesh.edge_node_ends(1, k))];
+    mesh.edge_node_ends(0, k) = std::min(a, b);
+    mesh.edge_node_ends(1, k) = std::max(a, b);
+  }
 
   order.resize(static_cast<std::size_t>(ne));
   for (Index e = 0; e < ne; ++e) {
@@ -150,9 +157,10 @@ void SortAlongZOrderCurve(Mesh& mesh) {
   mesh.tets = std::move(tets);
 }
 
-/// Reads all nodes and linear tets of the current Gmsh model into a mesh, with every tet
-/// positively oriented, unused nodes dropped and both numbered along a Z-order curve.
-Mesh ReadGmshTets() {
+/// Reads all nodes and tets of the current Gmsh model into a mesh, with every tet positively
+/// oriented, unused nodes dropped and both numbered along a Z-order curve. `order` 2 reads
+/// 10-node tets: their corners make the tets, their edges' middle nodes Mesh::edge_nodes.
+Mesh ReadGmshTets(int order) {
   std::vector<std::size_t> node_tags;
   std::vector<double> coords, params;
   gmsh::model::mesh::getNodes(node_tags, coords, params, -1, -1, /*includeBoundary=*/false,
@@ -166,20 +174,31 @@ Mesh ReadGmshTets() {
     index_of_tag[node_tags[i]] = int(i);
     mesh.nodes.col(Index(i)) = Vec3(coords[3 * i], coords[3 * i + 1], coords[3 * i + 2]);
   }
+  auto index = [&](std::size_t tag) {
+    GIPSI_CHECK(tag <= max_tag && index_of_tag[tag] >= 0, "Gmsh tet refers to unknown node");
+    return index_of_tag[tag];
+  };
+  const std::size_t per = order == 2 ? 10 : 4;
   std::vector<std::size_t> element_tags, element_nodes;
-  gmsh::model::mesh::getElementsByType(kGmshTet4, element_tags, element_nodes);
+  gmsh::model::mesh::getElementsByType(order == 2 ? kGmshTet10 : kGmshTet4, element_tags,
+                                       element_nodes);
   mesh.tets.resize(4, Index(element_tags.size()));
+  std::map<std::uint64_t, int> middle_of_edge;
   for (std::size_t e = 0; e < element_tags.size(); ++e) {
-    for (std::size_t a = 0; a < 4; ++a) {
-      const std::size_t tag = element_nodes[4 * e + a];
-      GIPSI_CHECK(tag <= max_tag && index_of_tag[tag] >= 0, "Gmsh tet refers to unknown node");
-      mesh.tets(Index(a), Index(e)) = index_of_tag[tag];
+    const std::size_t* nodes = element_nodes.data() + per * e;
+    for (std::size_t a = 0; a < 4; ++a) mesh.tets(Index(a), Index(e)) = index(nodes[a]);
+    for (std::size_t k = 0; k + 4 < per; ++k) {
+      const int a = index(nodes[kGmshSecondOrderEdges[k][0]]);
+      const int b = index(nodes[kGmshSecondOrderEdges[k][1]]);
+      middle_of_edge.emplace((std::uint64_t(std::min(a, b)) << 32) | std::uint64_t(std::max(a, b)),
+                             index(nodes[4 + k]));
     }
     const auto t = mesh.tets.col(Index(e));
     if (TetSignedVolume(mesh.nodes.col(t[0]), mesh.nodes.col(t[1]), mesh.nodes.col(t[2]),
                         mesh.nodes.col(t[3])) < 0)
       std::swap(mesh.tets(2, Index(e)), mesh.tets(3, Index(e)));
   }
+  mesh.SeparateEdgeNodes(middle_of_edge);
   mesh.RemoveUnusedNodes();
   SortAlongZOrderCurve(mesh);
   return mesh;
@@ -227,10 +246,11 @@ void AddBoundaryGroups(Mesh& mesh, const std::vector<std::string>& names,
 
 /// Runs `build` (which creates an OpenCASCADE model, synchronised here unless `occ_kernel` is
 /// false and `build` synchronises its own built-in-kernel model) in a Gmsh session,
-/// meshes it in 3-D with maximal element size `mesh_size` and reads the tets back. Gmsh
-/// failures become InputError naming `what`.
+/// meshes it in 3-D with maximal element size `mesh_size` (and elevates it to second order, the
+/// edges' middle nodes on the model's curved surfaces, for `order` 2) and reads the tets back.
+/// Gmsh failures become InputError naming `what`.
 Mesh MeshWithGmsh(const std::string& what, double mesh_size, const std::function<void()>& build,
-                  bool occ_kernel = true) {
+                  bool occ_kernel = true, int order = 1) {
   GmshSession session;
   try {
     gmsh::model::add("gipsi_shell");
@@ -239,7 +259,8 @@ Mesh MeshWithGmsh(const std::string& what, double mesh_size, const std::function
     gmsh::option::setNumber("Mesh.MeshSizeMax", mesh_size);
     gmsh::option::setNumber("Mesh.MeshSizeMin", 0.0);
     gmsh::model::mesh::generate(3);
-    Mesh mesh = ReadGmshTets();
+    if (order == 2) gmsh::model::mesh::setOrder(2);
+    Mesh mesh = ReadGmshTets(order);
     if (mesh.num_tets() == 0) ThrowInputError("", what, "Gmsh produced no tetrahedra");
     return mesh;
   } catch (const InputError&) {
@@ -249,6 +270,11 @@ Mesh MeshWithGmsh(const std::string& what, double mesh_size, const std::function
   } catch (...) {
     ThrowInputError("", what, fmt::format("Gmsh failed: {}", LastGmshError()));
   }
+}
+
+void CheckOrder(const std::string& what, int order) {
+  if (order != 1 && order != 2)
+    ThrowInputError("", what, fmt::format("order must be 1 or 2, got {}", order));
 }
 
 void CheckPositive(const std::string& what, const char* name, double value) {
@@ -296,19 +322,23 @@ Mesh MakeEllipsoidShell(const EllipsoidShellSpec& spec) {
                      TruncatedEllipsoidVolume(spec.endo_short, spec.endo_long, spec.base_z),
                  spec.mesh_size);
 
-  Mesh mesh = MeshWithGmsh(what, spec.mesh_size, [&] {
-    namespace occ = gmsh::model::occ;
-    const int epi = occ::addSphere(0, 0, 0, 1);
-    occ::dilate({{3, epi}}, 0, 0, 0, spec.epi_short, spec.epi_short, spec.epi_long);
-    const int endo = occ::addSphere(0, 0, 0, 1);
-    occ::dilate({{3, endo}}, 0, 0, 0, spec.endo_short, spec.endo_short, spec.endo_long);
-    gmsh::vectorpair shell, cut;
-    std::vector<gmsh::vectorpair> map;
-    occ::cut({{3, epi}}, {{3, endo}}, shell, map);
-    const double l = 2 * (spec.epi_short + spec.epi_long);
-    const int top = occ::addBox(-l, -l, spec.base_z, 2 * l, 2 * l, l);
-    occ::cut(shell, {{3, top}}, cut, map);
-  });
+  CheckOrder(what, spec.order);
+  Mesh mesh = MeshWithGmsh(
+      what, spec.mesh_size,
+      [&] {
+        namespace occ = gmsh::model::occ;
+        const int epi = occ::addSphere(0, 0, 0, 1);
+        occ::dilate({{3, epi}}, 0, 0, 0, spec.epi_short, spec.epi_short, spec.epi_long);
+        const int endo = occ::addSphere(0, 0, 0, 1);
+        occ::dilate({{3, endo}}, 0, 0, 0, spec.endo_short, spec.endo_short, spec.endo_long);
+        gmsh::vectorpair shell, cut;
+        std::vector<gmsh::vectorpair> map;
+        occ::cut({{3, epi}}, {{3, endo}}, shell, map);
+        const double l = 2 * (spec.epi_short + spec.epi_long);
+        const int top = occ::addBox(-l, -l, spec.base_z, 2 * l, 2 * l, l);
+        occ::cut(shell, {{3, top}}, cut, map);
+      },
+      /*occ_kernel=*/true, spec.order);
 
   // Group boundary triangles: base (all corners on z = base_z), else the closer ellipsoid.
   const double plane_tol = 1e-6 * spec.epi_long;
@@ -333,8 +363,10 @@ Mesh MakeEllipsoidShell(const EllipsoidShellSpec& spec) {
   return mesh;
 }
 
-Mesh MakeCylinderShell(double inner_radius, double outer_radius, double height, double mesh_size) {
+Mesh MakeCylinderShell(double inner_radius, double outer_radius, double height, double mesh_size,
+                       int order) {
   const std::string what = "cylinder shell";
+  CheckOrder(what, order);
   CheckPositive(what, "inner_radius", inner_radius);
   CheckPositive(what, "outer_radius", outer_radius);
   CheckPositive(what, "height", height);
@@ -347,15 +379,18 @@ Mesh MakeCylinderShell(double inner_radius, double outer_radius, double height, 
       what, std::numbers::pi * (outer_radius * outer_radius - inner_radius * inner_radius) * height,
       mesh_size);
 
-  Mesh mesh = MeshWithGmsh(what, mesh_size, [&] {
-    namespace occ = gmsh::model::occ;
-    const int outer = occ::addCylinder(0, 0, 0, 0, 0, height, outer_radius);
-    // The hole sticks out at both ends so that the cut has no coincident faces.
-    const int inner = occ::addCylinder(0, 0, -height, 0, 0, 3 * height, inner_radius);
-    gmsh::vectorpair out;
-    std::vector<gmsh::vectorpair> map;
-    occ::cut({{3, outer}}, {{3, inner}}, out, map);
-  });
+  Mesh mesh = MeshWithGmsh(
+      what, mesh_size,
+      [&] {
+        namespace occ = gmsh::model::occ;
+        const int outer = occ::addCylinder(0, 0, 0, 0, 0, height, outer_radius);
+        // The hole sticks out at both ends so that the cut has no coincident faces.
+        const int inner = occ::addCylinder(0, 0, -height, 0, 0, 3 * height, inner_radius);
+        gmsh::vectorpair out;
+        std::vector<gmsh::vectorpair> map;
+        occ::cut({{3, outer}}, {{3, inner}}, out, map);
+      },
+      /*occ_kernel=*/true, order);
 
   const double plane_tol = 1e-6 * std::max(height, outer_radius);
   AddBoundaryGroups(

@@ -13,7 +13,7 @@ Mesh MakeEllipsoidShell(const EllipsoidShellSpec& /*spec*/) {
 }
 
 Mesh MakeCylinderShell(double /*inner_radius*/, double /*outer_radius*/, double /*height*/,
-                       double /*mesh_size*/) {
+                       double /*mesh_size*/, int /*order*/) {
   throw InputError(MissingFeature("generating a cylinder shell", "Gmsh", "GIPSI_WITH_GMSH"));
 }
 

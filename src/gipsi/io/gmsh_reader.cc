@@ -146,7 +146,7 @@ class GmshParser {
     if (!have_nodes_) r_.Fail("expected a $Nodes (or $NOD) section, got end of file");
     BuildGroups();
     Mesh mesh = b_.Build(r_.source());
-    SeparateEdgeNodes(mesh);
+    mesh.SeparateEdgeNodes(edge_middle_);
     mesh.Validate(r_.source());
     return mesh;
   }
@@ -547,7 +547,7 @@ class GmshParser {
   /// tets (3,0), (3,2), (3,1)). Fails if another element put a different node in the middle
   /// of the same edge (a non-conforming mesh).
   void AddEdgeNodes(bool tet, std::int64_t tag) {
-    static constexpr int kEdges[6][2] = {{0, 1}, {1, 2}, {0, 2}, {0, 3}, {2, 3}, {1, 3}};
+    const auto& kEdges = kGmshSecondOrderEdges;
     const int corners = tet ? 4 : 3;
     for (int k = 0; k < (tet ? 6 : 3); ++k) {
       const int a = idx_[std::size_t(kEdges[k][0])], b = idx_[std::size_t(kEdges[k][1])];
@@ -567,30 +567,6 @@ class GmshParser {
                       tag, tags_[std::size_t(corners + k)], tags_[std::size_t(kEdges[k][0])],
                       tags_[std::size_t(kEdges[k][1])]));
     }
-  }
-
-  /// Moves the middle nodes of second-order edges out of the mesh's nodes into its
-  /// second-order geometry (Mesh::edge_nodes), keeping a middle node that is also an element's
-  /// corner.
-  void SeparateEdgeNodes(Mesh& mesh) const {
-    if (edge_middle_.empty()) return;
-    const Index n = mesh.num_nodes();
-    std::vector<std::uint8_t> keep(std::size_t(n), 1);
-    std::vector<std::pair<std::uint64_t, int>> edges(edge_middle_.begin(), edge_middle_.end());
-    std::sort(edges.begin(), edges.end());
-    for (const auto& [key, middle] : edges) keep[std::size_t(middle)] = 0;
-    for (Index e = 0; e < mesh.num_tets(); ++e)
-      for (int a = 0; a < 4; ++a) keep[std::size_t(mesh.tets(a, e))] = 1;
-    for (Index t = 0; t < mesh.num_triangles(); ++t)
-      for (int a = 0; a < 3; ++a) keep[std::size_t(mesh.triangles(a, t))] = 1;
-    mesh.edge_node_ends.resize(2, Index(edges.size()));
-    mesh.edge_nodes.resize(3, Index(edges.size()));
-    for (std::size_t k = 0; k < edges.size(); ++k) {
-      mesh.edge_node_ends(0, Index(k)) = int(edges[k].first >> 32);
-      mesh.edge_node_ends(1, Index(k)) = int(edges[k].first & 0xffffffffU);
-      mesh.edge_nodes.col(Index(k)) = mesh.nodes.col(edges[k].second);
-    }
-    mesh.KeepNodes(keep);
   }
 
   void BuildGroups() {

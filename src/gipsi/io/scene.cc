@@ -290,6 +290,15 @@ Mesh InlineMesh(const JsonNode& node) {
   return mesh;
 }
 
+/// A Gmsh shell generator's "order": 1 (linear tets, the default) or 2 (second order).
+int GeneratedOrder(const JsonNode& node) {
+  const auto order = node.Find("order");
+  if (!order) return 1;
+  const std::int64_t value = order->AsInt();
+  if (value != 1 && value != 2) order->Expected("1 (linear tets) or 2 (second order)");
+  return static_cast<int>(value);
+}
+
 }  // namespace
 
 Mesh BuildMesh(const JsonNode& node, const std::filesystem::path& base_dir) {
@@ -297,10 +306,18 @@ Mesh BuildMesh(const JsonNode& node, const std::filesystem::path& base_dir) {
                   "max",          "cells",    "origin",        "u",         "v",
                   "endo",         "epi",      "base_z",        "size",      "inner_radius",
                   "outer_radius", "height",   "tets_per_cell", "surface",   "description",
-                  "nodes",        "tets",     "triangles"});
+                  "nodes",        "tets",     "triangles",     "order"});
   Mesh mesh;
   if (int(node.Has("file")) + int(node.Has("generate")) + int(node.Has("nodes")) != 1)
     node.Fail("expected exactly one of 'file', 'generate', 'nodes'");
+  if (auto order = node.Find("order")) {
+    const auto gen = node.Find("generate");
+    const std::string kind = gen && gen->is_string() ? gen->AsString() : "";
+    if (kind != "ellipsoid_shell" && kind != "cylinder_shell")
+      order->Fail(
+          "only the generators \"ellipsoid_shell\" and \"cylinder_shell\" take 'order' (a "
+          "Gmsh file's elements have their own)");
+  }
   if (!node.Has("nodes"))
     for (const char* key : {"tets", "triangles"})
       if (node.Has(key)) node.At(key).Fail("only a mesh given by its 'nodes' takes this key");
@@ -346,6 +363,7 @@ Mesh BuildMesh(const JsonNode& node, const std::filesystem::path& base_dir) {
         spec.epi_long = epi[1];
         spec.base_z = node.Number("base_z", spec.base_z);
         spec.mesh_size = node.Positive("size", spec.mesh_size);
+        spec.order = GeneratedOrder(node);
         mesh = MakeEllipsoidShell(spec);
       } else if (kind == "tetrahedralize") {
         const JsonNode surface_node = node.At("surface");
@@ -361,8 +379,9 @@ Mesh BuildMesh(const JsonNode& node, const std::filesystem::path& base_dir) {
           surface_node.Fail(fmt::format("'{}' has no triangles to fill", path.string()));
         mesh = MakeTetsInSurface(surface.nodes, surface.triangles, node.Positive("size"));
       } else {
-        mesh = MakeCylinderShell(node.Positive("inner_radius"), node.Positive("outer_radius"),
-                                 node.Positive("height"), node.Positive("size"));
+        mesh =
+            MakeCylinderShell(node.Positive("inner_radius"), node.Positive("outer_radius"),
+                              node.Positive("height"), node.Positive("size"), GeneratedOrder(node));
       }
     } catch (const InputError& e) {
       std::string what = e.what();
