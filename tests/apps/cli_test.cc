@@ -4,7 +4,9 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <set>
 #include <sstream>
+#include <utility>
 
 #include <fmt/format.h>
 #include <gmock/gmock.h>
@@ -81,6 +83,32 @@ TEST(GipsiRun, LiverSceneWritesEmbeddedDisplaySurface) {
   auto files = PvdFiles(out / "liver_display.pvd");
   ASSERT_FALSE(files.empty());
   EXPECT_EQ(ReadVtu(out / files.back()).num_triangles(), 4384);
+}
+
+// A MixedSolid's series holds quadratic tets (VTK type 24): the vertices, then one node per
+// edge where the P2 solution puts it, so ParaView draws the bent beam curved.
+TEST(GipsiRun, MixedSolidWritesQuadraticTets) {
+  fs::path out = TempDir("land_beam_p2");
+  Result r = Gipsi("run -q " + Scene("land_beam_p2.json") + " --out " + out.string());
+  ASSERT_EQ(r.code, 0) << r.output;
+  auto files = PvdFiles(out / "beam.pvd");
+  ASSERT_EQ(files.size(), 2u);
+  const Mesh beam = ReadVtu(out / files.back());
+  ASSERT_EQ(beam.num_tets(), 480);  // 10 x 1 x 1 cubes of 6 tets, 2 per mm
+  std::set<std::pair<int, int>> edges;
+  for (Index e = 0; e < beam.num_tets(); ++e)
+    for (int a = 0; a < 4; ++a)
+      for (int b = a + 1; b < 4; ++b) edges.insert(std::minmax(beam.tets(a, e), beam.tets(b, e)));
+  ASSERT_EQ(beam.edge_nodes.cols(), Index(edges.size()));
+  Index bent = 0;
+  for (Index k = 0; k < beam.edge_nodes.cols(); ++k) {
+    const Vec3 a = beam.nodes.col(beam.edge_node_ends(0, k));
+    const Vec3 b = beam.nodes.col(beam.edge_node_ends(1, k));
+    const double off = (beam.edge_nodes.col(k) - 0.5 * (a + b)).norm();
+    EXPECT_LT(off, 0.1 * (b - a).norm()) << "edge " << k;  // a sane quadratic edge
+    bent += off > 1e-9;
+  }
+  EXPECT_GT(bent, beam.edge_nodes.cols() / 2);
 }
 
 TEST(GipsiRun, ProfileShowsWhereTheTimeWent) {

@@ -75,6 +75,40 @@ TEST(VtuWriter, WritesPointAndCellDataBitExactly) {
   EXPECT_EQ(ReadVtu(path).num_tets(), mesh.num_tets());  // still a readable grid
 }
 
+// Quadratic tets (VTK type 24) read back as linear tets on their corners with the middle
+// points as the mesh's second-order geometry, bit for bit; the file's size is predicted.
+TEST(VtuWriter, RoundTripsQuadraticTetsThroughTheSecondOrderGeometry) {
+  const Mesh order2 = ReadGmsh(test::MeshData("two_tets_order2_v22.msh"));
+  // Nodes: the corners, then one per edge (VTK's edge order, the middle nodes of the file).
+  const int edges[6][2] = {{0, 1}, {1, 2}, {0, 2}, {0, 3}, {1, 3}, {2, 3}};
+  Points nodes(3, order2.num_nodes() + order2.edge_nodes.cols());
+  nodes << order2.nodes, order2.edge_nodes;
+  QuadraticTetCells cells(10, order2.num_tets());
+  for (Index e = 0; e < order2.num_tets(); ++e) {
+    cells.col(e).head<4>() = order2.tets.col(e);
+    for (int k = 0; k < 6; ++k) {
+      const int a = std::min(order2.tets(edges[k][0], e), order2.tets(edges[k][1], e));
+      const int b = std::max(order2.tets(edges[k][0], e), order2.tets(edges[k][1], e));
+      for (Index j = 0; j < order2.edge_node_ends.cols(); ++j)
+        if (order2.edge_node_ends(0, j) == a && order2.edge_node_ends(1, j) == b)
+          cells(4 + k, e) = static_cast<int>(order2.num_nodes() + j);
+    }
+  }
+  VtuFields fields;
+  fields.point_data.push_back({"displacement", 3, Eigen::MatrixXd::Random(3, nodes.cols())});
+  fields.cell_data.push_back({"volume_ratio", 1, Eigen::MatrixXd::Random(1, cells.cols())});
+  auto path = Scratch("quadratic.vtu");
+  WriteQuadraticVtu(path, nodes, cells, fields);
+  EXPECT_EQ(QuadraticVtuFileBytes(nodes.cols(), cells.cols(), {{"displacement", 3}},
+                                  {{"volume_ratio", 1}}),
+            std::filesystem::file_size(path));
+  const Mesh back = ReadVtu(path);
+  EXPECT_EQ(back.nodes, order2.nodes);
+  EXPECT_EQ(back.tets, order2.tets);
+  EXPECT_EQ(back.edge_node_ends, order2.edge_node_ends);
+  EXPECT_EQ(back.edge_nodes, order2.edge_nodes);
+}
+
 TEST(VtuWriter, RejectsUnwritablePathNamingTheReason) {
   try {
     WriteVtu("/nonexistent/dir/x.vtu", Mesh{});

@@ -150,6 +150,26 @@ class SimObject {
   /// one piece of as many as there are ranks: each rank writes its piece and the first rank
   /// the `.pvtu` that joins them (io/outputs.h).
   [[nodiscard]] virtual OutputPiece output_piece() const { return {this, 0, 1}; }
+  /// Output on quadratic (10-node) tets, for objects whose domain is elevated to them
+  /// (MixedSolid): the current positions of the edge nodes, numbered after the domain's nodes;
+  /// the two domain nodes at the ends of each; and the 10-node tets (the domain's tets in order:
+  /// vertices, then the middle nodes of the edges (0,1), (1,2), (0,2), (0,3), (1,3), (2,3)).
+  /// Plain struct.
+  struct QuadraticOutput {
+    Points edge_positions = Points(3, 0);
+    Eigen::Matrix2Xi edge_ends = Eigen::Matrix2Xi(2, 0);
+    Eigen::Matrix<int, 10, Eigen::Dynamic> tets = Eigen::Matrix<int, 10, Eigen::Dynamic>(10, 0);
+  };
+  /// Fills `out` and returns true if the object has quadratic output; VTU series then write
+  /// quadratic cells. Default: false.
+  [[nodiscard]] virtual bool GetQuadraticOutput(QuadraticOutput& /*out*/) const { return false; }
+  /// Node field `id` at the edge nodes (components by edges): true if the object computes it
+  /// there (a quadratic field such as displacement); false leaves the writer the mean of the
+  /// edge's ends (exact for fields linear on each tet). Default: false.
+  [[nodiscard]] virtual bool ReadEdgeNodeField(FieldId /*id*/,
+                                               Eigen::Ref<Eigen::MatrixXd> /*out*/) const {
+    return false;
+  }
   /// Leaf objects for output (an aggregate returns its parts; a plain object returns itself).
   virtual void CollectLeaves(std::vector<const SimObject*>& out) const { out.push_back(this); }
   /// A part of an aggregate by (possibly dotted) name; plain objects have none (nullptr).

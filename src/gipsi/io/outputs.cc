@@ -36,6 +36,30 @@ VtuSeriesWriter::VtuSeriesWriter(std::vector<const SimObject*> objects,
   }
 }
 
+namespace {
+
+/// A frame of an object on 10-node tets: its nodes, then its edge nodes, with each node field
+/// extended to the edge nodes (the object's own values, or the mean of the edge's ends).
+void WriteQuadraticFrame(const SimObject& object, const SimObject::QuadraticOutput& quadratic,
+                         const std::vector<FieldId>& point_ids, VtuFields& fields,
+                         const std::filesystem::path& path) {
+  const Index n = object.domain_positions().cols();
+  const Index k = quadratic.edge_positions.cols();
+  Points nodes(3, n + k);
+  nodes << object.domain_positions(), quadratic.edge_positions;
+  for (std::size_t f = 0; f < point_ids.size(); ++f) {
+    Eigen::MatrixXd& values = fields.point_data[f].values;
+    values.conservativeResize(Eigen::NoChange, n + k);
+    if (object.ReadEdgeNodeField(point_ids[f], values.rightCols(k))) continue;
+    for (Index e = 0; e < k; ++e)
+      values.col(n + e) =
+          0.5 * (values.col(quadratic.edge_ends(0, e)) + values.col(quadratic.edge_ends(1, e)));
+  }
+  WriteQuadraticVtu(path, nodes, quadratic.tets, fields);
+}
+
+}  // namespace
+
 void VtuSeriesWriter::WriteFrame(Series& series, double t) {
   // A distributed object: this rank's part, one piece of the frame (output_piece).
   const SimObject::OutputPiece piece = series.object->output_piece();
@@ -43,6 +67,7 @@ void VtuSeriesWriter::WriteFrame(Series& series, double t) {
   const SimObject& object = *piece.object;
   const Mesh& mesh = object.domain();
   VtuFields fields;
+  std::vector<FieldId> point_ids;
   for (std::size_t f = 0; f < object.fields().size(); ++f) {
     const FieldInfo& info = object.fields()[f];
     if (!info.readable()) continue;
@@ -51,6 +76,7 @@ void VtuSeriesWriter::WriteFrame(Series& series, double t) {
     NamedArray array{info.name, info.components,
                      Eigen::MatrixXd(info.components, object.FieldCount(id))};
     object.ReadField(id, array.values);
+    if (info.location == FieldLocation::kNode) point_ids.push_back(id);
     (info.location == FieldLocation::kNode ? fields.point_data : fields.cell_data)
         .push_back(std::move(array));
   }
@@ -72,7 +98,10 @@ void VtuSeriesWriter::WriteFrame(Series& series, double t) {
   }
   const std::string name = object.name();
   const std::string file = fmt::format("{}/{}_{:06d}.vtu", name, name, frame_);
-  if (mesh.num_tets() > 0) {
+  SimObject::QuadraticOutput quadratic;
+  if (mesh.num_tets() > 0 && object.GetQuadraticOutput(quadratic)) {
+    WriteQuadraticFrame(object, quadratic, point_ids, fields, directory_ / file);
+  } else if (mesh.num_tets() > 0) {
     WriteVtu(directory_ / file, object.domain_positions(), mesh.tets, Triangles(3, 0), fields);
   } else if (mesh.num_triangles() > 0) {
     WriteVtu(directory_ / file, object.domain_positions(), Tets(4, 0), mesh.triangles, fields);
@@ -242,7 +271,12 @@ std::uintmax_t FrameBytes(const SimObject& object, bool display) {
       cell_data.push_back({info.name, info.components});
   }
   std::uintmax_t bytes = 0;
-  if (mesh.num_tets() > 0 || mesh.num_triangles() > 0) {
+  SimObject::QuadraticOutput quadratic;
+  if (mesh.num_tets() > 0 && object.GetQuadraticOutput(quadratic)) {
+    bytes =
+        QuadraticVtuFileBytes(object.domain_positions().cols() + quadratic.edge_positions.cols(),
+                              quadratic.tets.cols(), point_data, cell_data);
+  } else if (mesh.num_tets() > 0 || mesh.num_triangles() > 0) {
     bytes = VtuFileBytes(object.domain_positions().cols(), mesh.num_tets(),
                          mesh.num_tets() > 0 ? 0 : mesh.num_triangles(), point_data, cell_data);
   } else if (object.boundary().num_triangles() > 0) {

@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <cstring>
 #include <limits>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -90,7 +91,9 @@ class VtuParser {
       ++pieces;
     }
     if (pieces == 0) Fail(grid, "expected at least one <Piece>");
-    return b_.Build(source_);
+    Mesh mesh = b_.Build(source_);
+    mesh.SeparateEdgeNodes(middle_of_edge_);
+    return mesh;
   }
 
  private:
@@ -321,12 +324,18 @@ class VtuParser {
     for (std::size_t c = 0; c < offsets.size(); ++c) {
       std::int64_t begin = c == 0 ? 0 : offsets[c - 1];
       std::int64_t k = offsets[c] - begin;
-      if (types[c] != 10 && types[c] != 5) continue;
-      std::int64_t want = types[c] == 10 ? 4 : 3;
+      const std::int64_t type = types[c];
+      const bool tet = type == 10 || type == 24;
+      if (!tet && type != 5 && type != 22) continue;
+      const std::int64_t want = type == 10 ? 4 : type == 5 ? 3 : type == 24 ? 10 : 6;
+      const char* name = type == 10   ? "tetrahedron"
+                         : type == 5  ? "triangle"
+                         : type == 24 ? "quadratic tetrahedron"
+                                      : "quadratic triangle";
       if (k != want)
-        Fail(conn_node, fmt::format("expected {} point indices for a {} (cell {}), got {}", want,
-                                    types[c] == 10 ? "tetrahedron" : "triangle", c, k));
-      int idx[4];
+        Fail(conn_node,
+             fmt::format("expected {} point indices for a {} (cell {}), got {}", want, name, c, k));
+      int idx[10];
       for (std::int64_t a = 0; a < k; ++a) {
         std::int64_t p = conn[std::size_t(begin + a)];
         if (p < 0 || static_cast<std::uint64_t>(p) >= num_points)
@@ -336,10 +345,24 @@ class VtuParser {
         for (std::int64_t c2 = 0; c2 < a; ++c2)
           if (idx[c2] == idx[a]) Fail(conn_node, fmt::format("cell {} repeats point {}", c, p));
       }
-      if (k == 4)
+      if (tet)
         b_.AddTet(idx[0], idx[1], idx[2], idx[3]);
       else
         b_.AddTriangle(idx[0], idx[1], idx[2]);
+      // VTK's quadratic cells: after the corners, the middle nodes of the edges (0,1), (1,2),
+      // (0,2), then for tets (0,3), (1,3), (2,3).
+      static constexpr int kEdges[6][2] = {{0, 1}, {1, 2}, {0, 2}, {0, 3}, {1, 3}, {2, 3}};
+      const int corners = tet ? 4 : 3;
+      for (int e = 0; e + corners < k; ++e) {
+        const int a = idx[kEdges[e][0]], b = idx[kEdges[e][1]];
+        const auto key = (std::uint64_t(std::min(a, b)) << 32) | std::uint64_t(std::max(a, b));
+        const auto [it, inserted] = middle_of_edge_.emplace(key, idx[corners + e]);
+        if (!inserted && it->second != idx[corners + e])
+          Fail(conn_node, fmt::format("cell {} puts point {} in the middle of an edge where "
+                                      "another cell has point {}: the quadratic cells do not "
+                                      "conform",
+                                      c, idx[corners + e] - base, it->second - base));
+      }
     }
   }
 
@@ -353,6 +376,7 @@ class VtuParser {
   bool compressed_ = false;
   int header_bytes_ = 4;
   internal::MeshBuilder b_;
+  std::map<std::uint64_t, int> middle_of_edge_;  // quadratic cells' edges -> middle point
 };
 
 }  // namespace

@@ -14,7 +14,9 @@ namespace gipsi {
 /// `format="binary"` (inline base64) and `format="appended"` (raw or base64 `AppendedData`),
 /// uncompressed or with `compressor="vtkZLibDataCompressor"`, `header_type` UInt32 or UInt64,
 /// either byte order, element types Int8..UInt64, Float32 and Float64. All pieces are read and
-/// concatenated. Cells of type 10 (tetrahedron) and 5 (triangle) are kept; others are ignored.
+/// concatenated. Cells of type 10 (tetrahedron) and 5 (triangle) are kept, and quadratic ones (24
+/// and 22) as linear cells on their corners, their edges' middle points going to the mesh's
+/// second-order geometry (`Mesh::edge_nodes`) as with Gmsh's; others are ignored.
 /// Point and cell data are not read.
 ///
 /// Declared sizes are checked against the data actually present before allocating. Throws

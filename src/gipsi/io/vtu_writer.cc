@@ -7,6 +7,7 @@
 #include <cerrno>
 #include <cstdint>
 #include <cstring>
+#include <initializer_list>
 #include <utility>
 
 #include <fmt/format.h>
@@ -104,32 +105,40 @@ void AppendFields(std::string& xml, const char* tag, const std::vector<NamedArra
   xml += fmt::format("      </{}>\n", tag);
 }
 
-}  // namespace
+/// Cells of one kind: `rows` node indices per cell, column-major, and their VTK type.
+struct CellBlock {
+  const int* data = nullptr;
+  Index rows = 0;
+  Index cols = 0;
+  std::uint8_t type = 0;
+};
 
-void WriteVtu(const std::filesystem::path& path, const Points& nodes, const Tets& tets,
-              const Triangles& triangles, const VtuFields& fields) {
+void WriteCells(const std::filesystem::path& path, const Points& nodes,
+                std::initializer_list<CellBlock> blocks, const VtuFields& fields) {
   const Index num_nodes = nodes.cols();
-  const Index num_cells = tets.cols() + triangles.cols();
-  GIPSI_CHECK(tets.size() == 0 || (tets.minCoeff() >= 0 && tets.maxCoeff() < num_nodes),
-              "tet node index out of range [0, {})", num_nodes);
-  GIPSI_CHECK(
-      triangles.size() == 0 || (triangles.minCoeff() >= 0 && triangles.maxCoeff() < num_nodes),
-      "triangle node index out of range [0, {})", num_nodes);
+  Index num_cells = 0;
+  std::size_t num_indices = 0;
+  for (const CellBlock& b : blocks) {
+    num_cells += b.cols;
+    num_indices += static_cast<std::size_t>(b.rows * b.cols);
+  }
   std::vector<std::int64_t> conn;
   std::vector<std::int64_t> offsets;
   std::vector<std::uint8_t> types;
-  conn.reserve(static_cast<std::size_t>(tets.size() + triangles.size()));
+  conn.reserve(num_indices);
   offsets.reserve(static_cast<std::size_t>(num_cells));
   types.reserve(static_cast<std::size_t>(num_cells));
-  for (Index e = 0; e < tets.cols(); ++e) {
-    for (Index a = 0; a < 4; ++a) conn.push_back(tets(a, e));
-    offsets.push_back(static_cast<std::int64_t>(conn.size()));
-    types.push_back(10);
-  }
-  for (Index t = 0; t < triangles.cols(); ++t) {
-    for (Index a = 0; a < 3; ++a) conn.push_back(triangles(a, t));
-    offsets.push_back(static_cast<std::int64_t>(conn.size()));
-    types.push_back(5);
+  for (const CellBlock& b : blocks) {
+    for (Index e = 0; e < b.cols; ++e) {
+      for (Index a = 0; a < b.rows; ++a) {
+        const int n = b.data[e * b.rows + a];
+        GIPSI_CHECK(n >= 0 && n < num_nodes, "cell node index {} out of range [0, {})", n,
+                    num_nodes);
+        conn.push_back(n);
+      }
+      offsets.push_back(static_cast<std::int64_t>(conn.size()));
+      types.push_back(b.type);
+    }
   }
   std::string xml = PieceOpening(num_nodes, num_cells);
   AppendFields(xml, "PointData", fields.point_data, num_nodes);
@@ -145,13 +154,13 @@ void WriteVtu(const std::filesystem::path& path, const Points& nodes, const Tets
   internal::WriteFileBytes(path, xml);
 }
 
-std::uintmax_t VtuFileBytes(Index num_nodes, Index num_tets, Index num_triangles,
-                            const std::vector<VtuArrayShape>& point_data,
-                            const std::vector<VtuArrayShape>& cell_data) {
+/// VtuFileBytes for `cells` cells of `indices` node indices in all.
+std::uintmax_t FileBytes(Index num_nodes, Index num_cells, std::uintmax_t indices,
+                         const std::vector<VtuArrayShape>& point_data,
+                         const std::vector<VtuArrayShape>& cell_data) {
   const auto nodes = static_cast<std::uintmax_t>(num_nodes);
-  const auto cells = static_cast<std::uintmax_t>(num_tets + num_triangles);
-  const auto corners = static_cast<std::uintmax_t>(4 * num_tets + 3 * num_triangles);
-  std::uintmax_t total = PieceOpening(num_nodes, num_tets + num_triangles).size();
+  const auto cells = static_cast<std::uintmax_t>(num_cells);
+  std::uintmax_t total = PieceOpening(num_nodes, num_cells).size();
   auto fields = [&](std::string_view tag, const std::vector<VtuArrayShape>& arrays,
                     std::uintmax_t count) {
     total += fmt::format("      <{}>\n", tag).size() + fmt::format("      </{}>\n", tag).size();
@@ -162,9 +171,38 @@ std::uintmax_t VtuFileBytes(Index num_nodes, Index num_tets, Index num_triangles
   fields("PointData", point_data, nodes);
   fields("CellData", cell_data, cells);
   total += kPointsOpening.size() + ArrayBytes("Float64", "Points", 3, 24 * nodes);
-  total += kCellsOpening.size() + ArrayBytes("Int64", "connectivity", 1, 8 * corners) +
+  total += kCellsOpening.size() + ArrayBytes("Int64", "connectivity", 1, 8 * indices) +
            ArrayBytes("Int64", "offsets", 1, 8 * cells) + ArrayBytes("UInt8", "types", 1, cells);
   return total + kPieceClosing.size();
+}
+
+}  // namespace
+
+void WriteVtu(const std::filesystem::path& path, const Points& nodes, const Tets& tets,
+              const Triangles& triangles, const VtuFields& fields) {
+  WriteCells(path, nodes,
+             {{tets.data(), 4, tets.cols(), 10}, {triangles.data(), 3, triangles.cols(), 5}},
+             fields);
+}
+
+void WriteQuadraticVtu(const std::filesystem::path& path, const Points& nodes,
+                       const QuadraticTetCells& tets, const VtuFields& fields) {
+  WriteCells(path, nodes, {{tets.data(), 10, tets.cols(), 24}}, fields);
+}
+
+std::uintmax_t QuadraticVtuFileBytes(Index num_nodes, Index num_tets,
+                                     const std::vector<VtuArrayShape>& point_data,
+                                     const std::vector<VtuArrayShape>& cell_data) {
+  return FileBytes(num_nodes, num_tets, 10 * static_cast<std::uintmax_t>(num_tets), point_data,
+                   cell_data);
+}
+
+std::uintmax_t VtuFileBytes(Index num_nodes, Index num_tets, Index num_triangles,
+                            const std::vector<VtuArrayShape>& point_data,
+                            const std::vector<VtuArrayShape>& cell_data) {
+  return FileBytes(num_nodes, num_tets + num_triangles,
+                   static_cast<std::uintmax_t>(4 * num_tets + 3 * num_triangles), point_data,
+                   cell_data);
 }
 
 void WritePvtu(const std::filesystem::path& path, const std::vector<std::string>& pieces,

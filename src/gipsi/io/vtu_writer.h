@@ -44,6 +44,15 @@ struct VtuFields {
 void WriteVtu(const std::filesystem::path& path, const Points& nodes, const Tets& tets,
               const Triangles& triangles, const VtuFields& fields = {});
 
+/// Node indices of 10-node tets, one column per cell: the four vertices, then the middle nodes
+/// of the edges (0,1), (1,2), (0,2), (0,3), (1,3), (2,3) (VTK_QUADRATIC_TETRA's order).
+using QuadraticTetCells = Eigen::Matrix<int, 10, Eigen::Dynamic>;
+
+/// Writes 10-node tets as VTK_QUADRATIC_TETRA cells (type 24; ParaView draws them curved and
+/// subdivides them for its filters), like WriteVtu otherwise.
+void WriteQuadraticVtu(const std::filesystem::path& path, const Points& nodes,
+                       const QuadraticTetCells& tets, const VtuFields& fields = {});
+
 /// Name and number of components of a data array, for sizing a `.vtu` before writing it.
 struct VtuArrayShape {
   std::string name;
@@ -57,6 +66,11 @@ struct VtuArrayShape {
 std::uintmax_t VtuFileBytes(Index num_nodes, Index num_tets, Index num_triangles,
                             const std::vector<VtuArrayShape>& point_data,
                             const std::vector<VtuArrayShape>& cell_data);
+
+/// The same for WriteQuadraticVtu's file of `num_tets` 10-node tets.
+std::uintmax_t QuadraticVtuFileBytes(Index num_nodes, Index num_tets,
+                                     const std::vector<VtuArrayShape>& point_data,
+                                     const std::vector<VtuArrayShape>& cell_data);
 
 /// Writes a parallel unstructured grid (`.pvtu`): the index of `pieces` (`.vtu` paths relative
 /// to the `.pvtu`'s folder, as ParaView resolves them), each written by WriteVtu with these

@@ -631,6 +631,32 @@ void MixedSolid::UpdatePositions() {
   vertex_positions_ = domain().nodes + Eigen::Map<const Points>(state_.z.data(), 3, nv);
 }
 
+bool MixedSolid::GetQuadraticOutput(QuadraticOutput& out) const {
+  const Index nv = mesh_.num_vertices;
+  const Index ne = mesh_.edges.cols();
+  out.edge_positions =
+      mesh_.rest.rightCols(ne) + Eigen::Map<const Points>(state_.z.data() + 3 * nv, 3, ne);
+  out.edge_ends = mesh_.edges;
+  out.tets = mesh_.elements;  // the vertices keep the domain's numbers, edge node k is nv + k
+  return true;
+}
+
+bool MixedSolid::ReadEdgeNodeField(FieldId id, Eigen::Ref<Eigen::MatrixXd> out) const {
+  const Index nv = mesh_.num_vertices;
+  const Index ne = mesh_.edges.cols();
+  const auto u = Eigen::Map<const Points>(state_.z.data() + 3 * nv, 3, ne);
+  if (id == mech_.displacement) {
+    out = u;
+  } else if (id == mech_.position) {
+    out = mesh_.rest.rightCols(ne) + u;
+  } else if (id == mech_.external_force || id == mech_.reaction_force) {
+    out.setZero();  // nodal forces live on the vertices (the reaction's edge shares included)
+  } else {
+    return false;
+  }
+  return true;
+}
+
 void MixedSolid::DoReadField(FieldId id, Eigen::Ref<Eigen::MatrixXd> out) const {
   const Index nv = mesh_.num_vertices;
   const Index nu = 3 * mesh_.num_nodes();

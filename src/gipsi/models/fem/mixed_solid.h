@@ -48,8 +48,8 @@
 /// start and kept factorisation (a resumed run continues bitwise); a snapshot restore drops the
 /// latter (the retry factorises afresh), as for FemSolid.
 ///
-/// Not yet: dynamics (mass, damping), cavities coupled to blood, quadratic (curved) output,
-/// collision and haptic local models. Units: SI.
+/// Not yet: dynamics (mass, damping), cavities coupled to blood, collision and haptic local
+/// models. Units: SI.
 
 #include <memory>
 #include <string>
@@ -95,6 +95,11 @@ class MixedSolid final : public SimObject {
   [[nodiscard]] std::string_view type_name() const override { return "MixedSolid"; }
   [[nodiscard]] const Points& domain_positions() const override { return vertex_positions_; }
   [[nodiscard]] std::string failure_detail() const override { return failure_detail_; }
+  /// The P2 mesh, curved where the domain's second-order geometry curves it: VTU series write
+  /// VTK_QUADRATIC_TETRA cells with the displacement and position of the edge nodes (pressure
+  /// and the other node fields linear along each edge).
+  [[nodiscard]] bool GetQuadraticOutput(QuadraticOutput& out) const override;
+  [[nodiscard]] bool ReadEdgeNodeField(FieldId id, Eigen::Ref<Eigen::MatrixXd> out) const override;
 
   [[nodiscard]] const MixedSolidParams& params() const { return params_; }
   [[nodiscard]] const QuadraticTets& quadratic_mesh() const { return mesh_; }
