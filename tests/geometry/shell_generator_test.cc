@@ -217,6 +217,26 @@ TEST(CylinderShell, HasPositiveTetsNamedSurfacesAndTheAnalyticVolume) {
   EXPECT_NEAR(MeanAlignment(mesh, "bottom", [](const Vec3&) { return Vec3(0, 0, -1); }), 1, 1e-12);
 }
 
+// Order 2: the same corners; the middle node of every edge with both ends on the outer
+// cylinder lies on it (the straight midpoint cuts inside unless the edge runs along z).
+TEST(CylinderShell, SecondOrderPutsEdgeNodesOnTheCylinders) {
+  const double r = 1, R = 2, h = 3;
+  const Mesh linear = MakeCylinderShell(r, R, h, 0.5);
+  const Mesh mesh = MakeCylinderShell(r, R, h, 0.5, 2);
+  EXPECT_EQ(mesh.nodes, linear.nodes);
+  EXPECT_EQ(mesh.tets, linear.tets);
+  int on_outer = 0;
+  for (Index k = 0; k < mesh.edge_nodes.cols(); ++k) {
+    const Vec3 a = mesh.nodes.col(mesh.edge_node_ends(0, k));
+    const Vec3 b = mesh.nodes.col(mesh.edge_node_ends(1, k));
+    if (std::abs(a.head<2>().norm() - R) > 1e-9 || std::abs(b.head<2>().norm() - R) > 1e-9)
+      continue;
+    ++on_outer;
+    EXPECT_NEAR(mesh.edge_nodes.col(k).head<2>().norm(), R, 1e-9) << "edge " << k;
+  }
+  EXPECT_GT(on_outer, 100);
+}
+
 TEST(CylinderShell, IsDeterministic) {
   const Mesh a = MakeCylinderShell(1, 2, 1, 0.6);
   const Mesh b = MakeCylinderShell(1, 2, 1, 0.6);

@@ -109,6 +109,21 @@ TEST(VtuWriter, RoundTripsQuadraticTetsThroughTheSecondOrderGeometry) {
   EXPECT_EQ(back.edge_nodes, order2.edge_nodes);
 }
 
+// Two quadratic tets on one edge with different middle points: the reader names both.
+TEST(VtuWriter, QuadraticTetsThatDisagreeOnAnEdgeAreRefusedWhenRead) {
+  Points nodes(3, 17);
+  nodes.leftCols<5>() << 0, 1, 0, 0, 1, 0, 0, 1, 0, 1, 0, 0, 0, 1, 1;
+  nodes.rightCols<12>().setRandom();
+  QuadraticTetCells cells(10, 2);
+  cells.col(0) << 0, 1, 2, 3, 5, 6, 7, 8, 9, 10;
+  cells.col(1) << 1, 2, 3, 4, 16, 11, 12, 13, 14, 15;  // edge (1, 2): point 16, not 6
+  auto path = Scratch("nonconforming.vtu");
+  WriteQuadraticVtu(path, nodes, cells);
+  EXPECT_THAT(test::InputErrorMessage([&] { ReadVtu(path); }),
+              HasSubstr("cell 1 puts point 16 in the middle of an edge where another cell has "
+                        "point 6: the quadratic cells do not conform"));
+}
+
 TEST(VtuWriter, RejectsUnwritablePathNamingTheReason) {
   try {
     WriteVtu("/nonexistent/dir/x.vtu", Mesh{});
