@@ -35,7 +35,8 @@ namespace gipsi {
 /// Throws InputError naming the file and the line (or byte offset for binary data) for a missing
 /// file, an unsupported version, truncated sections, malformed numbers, non-finite coordinates,
 /// elements with the wrong number of nodes, references to undefined nodes, duplicate node
-/// tags, and second-order elements that disagree on an edge's middle node. The result has passed `Mesh::Validate`.
+/// tags, and second-order elements that disagree on an edge's middle node. The result has
+/// passed `Mesh::Validate`.
 Mesh ReadGmsh(const std::filesystem::path& path);
 
 /// The same, also giving the file's element tag of every tet, in the order of the mesh's tets
