@@ -590,5 +590,6 @@ class ObjectBase:
       "read_mesh", [](const std::filesystem::path& file) { return MeshDict(ReadMesh(file)); },
       py::arg("file"),
       "Reads a mesh file (.msh, .vtu, .vtk, .obj, ...) as a dict of arrays: nodes (N, 3), tets "
-      "(E, 4), triangles (T, 3), groups {name: item indices}.");
+      "(E, 4), triangles (T, 3), groups {name: item indices}; a second-order file also gives "
+      "edge_nodes (K, 3), the edges' middle nodes, and edge_node_ends (K, 2), their edges.");
 }

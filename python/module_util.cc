@@ -51,6 +51,12 @@ py::dict MeshDict(const Mesh& mesh) {
   d["nodes"] = py::array_t<double>({mesh.num_nodes(), Index{3}}, mesh.nodes.data());
   d["tets"] = py::array_t<int>({mesh.num_tets(), Index{4}}, mesh.tets.data());
   d["triangles"] = py::array_t<int>({mesh.num_triangles(), Index{3}}, mesh.triangles.data());
+  if (mesh.edge_nodes.cols() > 0) {  // a second-order file's middle nodes
+    d["edge_nodes"] =
+        py::array_t<double>({mesh.edge_nodes.cols(), Index{3}}, mesh.edge_nodes.data());
+    d["edge_node_ends"] =
+        py::array_t<int>({mesh.edge_node_ends.cols(), Index{2}}, mesh.edge_node_ends.data());
+  }
   py::dict groups;
   for (const MeshGroup& g : mesh.groups)
     groups[py::str(g.name)] =

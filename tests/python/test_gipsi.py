@@ -407,6 +407,16 @@ class Meshes(unittest.TestCase):
         np.testing.assert_array_equal(liver.rest_positions, mesh["nodes"])
         np.testing.assert_array_equal(liver.tets, mesh["tets"])
 
+    def test_read_mesh_gives_a_second_order_files_edge_nodes_apart(self):
+        path = os.path.join(SOURCE_DIR, "tests", "data", "meshes", "two_tets_order2_v22.msh")
+        mesh = gipsi.read_mesh(path)
+        self.assertEqual(mesh["nodes"].shape, (5, 3))
+        self.assertEqual(mesh["edge_nodes"].shape, (9, 3))
+        np.testing.assert_array_equal(mesh["edge_node_ends"][0], [0, 1])
+        np.testing.assert_array_equal(mesh["edge_nodes"][0], [0.5, -0.1, 0])
+        linear = gipsi.read_mesh(os.path.join(SOURCE_DIR, "scenes", "meshes", "liver.msh"))
+        self.assertNotIn("edge_nodes", linear)
+
     def test_write_mesh_then_read_mesh_gives_the_arrays_back(self):
         nodes = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1.5]], dtype=float)
         tets = np.array([[0, 1, 2, 3]])
