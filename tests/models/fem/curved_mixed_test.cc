@@ -31,7 +31,7 @@ constexpr double kInner = 0.01;  // rest radii [m]
 constexpr double kOuter = 0.02;
 
 /// Internal pressure over μ that inflates an incompressible neo-Hookean sphere (radii A < B)
-/// to inner stretch λ_a = a/A (Ogden, Non-linear elastic deformations, 1984, §5.2.2; for
+/// to inner stretch λ_a = a/A (Ogden, Non-linear elastic deformations, 1984; for
 /// W = μ/2 (I₁ − 3)): P/μ = 2 [1/λ_b + 1/(4 λ_b⁴) − 1/λ_a − 1/(4 λ_a⁴)] with the outer
 /// stretch λ_b = b/B from the constant volume, b³ − a³ = B³ − A³.
 double SpherePressureOverMu(double lambda_a) {
