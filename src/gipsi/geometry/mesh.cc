@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 
 #include "gipsi/base/error.h"
+#include "gipsi/geometry/edge_key.h"
 
 namespace gipsi {
 namespace {
@@ -161,8 +162,8 @@ void Mesh::SeparateEdgeNodes(const std::map<std::uint64_t, int>& middle_of_edge)
   edge_nodes.resize(3, count);
   Index k = 0;
   for (const auto& [key, middle] : middle_of_edge) {
-    edge_node_ends(0, k) = static_cast<int>(key >> 32);
-    edge_node_ends(1, k) = static_cast<int>(key & 0xffffffffU);
+    edge_node_ends(0, k) = EdgeKeyLow(key);
+    edge_node_ends(1, k) = EdgeKeyHigh(key);
     edge_nodes.col(k) = nodes.col(middle);
     ++k;
   }

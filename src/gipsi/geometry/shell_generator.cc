@@ -36,6 +36,7 @@
 
 #include "gipsi/base/error.h"
 #include "gipsi/geometry/boundary.h"
+#include "gipsi/geometry/edge_key.h"
 #include "gipsi/geometry/enclosed_volume.h"
 #include "gipsi/geometry/generators.h"
 #include "gipsi/geometry/quality.h"
@@ -190,8 +191,7 @@ Mesh ReadGmshTets(int order) {
     for (std::size_t k = 0; k + 4 < per; ++k) {
       const int a = index(nodes[kGmshSecondOrderEdges[k][0]]);
       const int b = index(nodes[kGmshSecondOrderEdges[k][1]]);
-      middle_of_edge.emplace((std::uint64_t(std::min(a, b)) << 32) | std::uint64_t(std::max(a, b)),
-                             index(nodes[4 + k]));
+      middle_of_edge.emplace(EdgeKey(a, b), index(nodes[4 + k]));
     }
     const auto t = mesh.tets.col(Index(e));
     if (TetSignedVolume(mesh.nodes.col(t[0]), mesh.nodes.col(t[1]), mesh.nodes.col(t[2]),

@@ -12,6 +12,7 @@
 #include <fmt/format.h>
 
 #include "gipsi/base/error.h"
+#include "gipsi/geometry/edge_key.h"
 #include "gipsi/io/mesh_builder.h"
 #include "gipsi/io/text_reader.h"
 
@@ -552,8 +553,7 @@ class GmshParser {
     for (int k = 0; k < (tet ? 6 : 3); ++k) {
       const int a = idx_[std::size_t(kEdges[k][0])], b = idx_[std::size_t(kEdges[k][1])];
       const int middle = idx_[std::size_t(corners + k)];
-      const auto key = (std::uint64_t(std::min(a, b)) << 32) | std::uint64_t(std::max(a, b));
-      const auto [it, inserted] = edge_middle_.emplace(key, middle);
+      const auto [it, inserted] = edge_middle_.emplace(EdgeKey(a, b), middle);
       if (inserted || it->second == middle) continue;
       const std::size_t p = 3 * std::size_t(middle), q = 3 * std::size_t(it->second);
       if (std::equal(b_.coords.begin() + std::ptrdiff_t(p),

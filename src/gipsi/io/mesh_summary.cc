@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 
 #include "gipsi/geometry/boundary.h"
+#include "gipsi/geometry/edge_key.h"
 #include "gipsi/geometry/quality.h"
 
 namespace gipsi {
@@ -17,11 +18,9 @@ std::string DescribeMesh(const Mesh& mesh) {
   out += fmt::format("triangles:       {}\n", mesh.num_triangles());
   if (mesh.edge_nodes.cols() > 0) {
     Index curved = 0;
-    for (Index k = 0; k < mesh.edge_nodes.cols(); ++k) {
-      const Vec3 a = mesh.nodes.col(mesh.edge_node_ends(0, k));
-      const Vec3 b = mesh.nodes.col(mesh.edge_node_ends(1, k));
-      curved += (mesh.edge_nodes.col(k) - 0.5 * (a + b)).norm() > 1e-12 * (b - a).norm();
-    }
+    for (Index k = 0; k < mesh.edge_nodes.cols(); ++k)
+      curved += IsOffMidpoint(mesh.nodes.col(mesh.edge_node_ends(0, k)),
+                              mesh.nodes.col(mesh.edge_node_ends(1, k)), mesh.edge_nodes.col(k));
     out += fmt::format(
         "second order:    {} edge nodes, {} off their edge's midpoint (curved; "
         "used by MixedSolid)\n",

@@ -14,6 +14,7 @@
 #include <pugixml.hpp>
 
 #include "gipsi/base/error.h"
+#include "gipsi/geometry/edge_key.h"
 #include "gipsi/io/base64.h"
 #include "gipsi/io/mesh_builder.h"
 #include "gipsi/io/text_reader.h"
@@ -355,8 +356,7 @@ class VtuParser {
       const int corners = tet ? 4 : 3;
       for (int e = 0; e + corners < k; ++e) {
         const int a = idx[kEdges[e][0]], b = idx[kEdges[e][1]];
-        const auto key = (std::uint64_t(std::min(a, b)) << 32) | std::uint64_t(std::max(a, b));
-        const auto [it, inserted] = middle_of_edge_.emplace(key, idx[corners + e]);
+        const auto [it, inserted] = middle_of_edge_.emplace(EdgeKey(a, b), idx[corners + e]);
         if (!inserted && it->second != idx[corners + e])
           Fail(conn_node, fmt::format("cell {} puts point {} in the middle of an edge where "
                                       "another cell has point {}: the quadratic cells do not "

@@ -4,17 +4,9 @@
 #include <utility>
 
 #include "gipsi/base/error.h"
+#include "gipsi/geometry/edge_key.h"
 
 namespace gipsi {
-namespace {
-
-std::uint64_t EdgeKey(int a, int b) {
-  const auto lo = static_cast<std::uint64_t>(std::min(a, b));
-  const auto hi = static_cast<std::uint64_t>(std::max(a, b));
-  return (lo << 32) | hi;
-}
-
-}  // namespace
 
 int QuadraticTets::EdgeNode(int a, int b) const {
   const auto it = edge_index.find(EdgeKey(a, b));
@@ -57,10 +49,10 @@ QuadraticTets ElevateToQuadratic(const Mesh& mesh) {
   for (Index k = 0; k < mesh.edge_node_ends.cols(); ++k) {
     const int node = q.EdgeNode(mesh.edge_node_ends(0, k), mesh.edge_node_ends(1, k));
     if (node < 0) continue;  // an edge of triangles only
-    const Vec3 a = mesh.nodes.col(mesh.edge_node_ends(0, k));
-    const Vec3 b = mesh.nodes.col(mesh.edge_node_ends(1, k));
     const Vec3 middle = mesh.edge_nodes.col(k);
-    if ((middle - q.rest.col(node)).norm() <= 1e-12 * (b - a).norm()) continue;
+    if (!IsOffMidpoint(mesh.nodes.col(mesh.edge_node_ends(0, k)),
+                       mesh.nodes.col(mesh.edge_node_ends(1, k)), middle))
+      continue;
     q.rest.col(node) = middle;
     curved_edge[static_cast<std::size_t>(node - q.num_vertices)] = 1;
     ++q.num_curved_edges;
