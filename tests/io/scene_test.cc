@@ -100,6 +100,17 @@ TEST(SceneErrors, WrongParameterTypeNamesThePath) {
             "scene.json: objects.cube.stiffness: expected a positive number, got \"abc\"");
 }
 
+TEST(SceneErrors, AndersonDepthIsAnIntegerUpToEight) {
+  std::string text = SceneText();
+  text.replace(text.find("\"MassSpring\""), 12, "\"FemSolid\"");
+  text.replace(text.find("\"stiffness\": 100"), 16,
+               R"("material": {"law": "NeoHookean", "youngs_modulus": 1000, "poisson_ratio": 0.3},
+                  "newton": {"reuse_factorization": true, "anderson": 9})");
+  EXPECT_EQ(LoadError(text),
+            "scene.json: objects.cube.newton.anderson: expected an integer in [0, 8] (0: off), "
+            "got 9");
+}
+
 TEST(SceneErrors, NonFiniteParameterIsRejected) {
   // JSON has no NaN literal; an overflowing literal is the way a non-finite value sneaks in,
   // and the parser refuses it before any parameter sees it.

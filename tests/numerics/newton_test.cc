@@ -1,6 +1,6 @@
 // NewtonSolver on small algebraic systems: the globalisation (residual and natural
-// monotonicity tests), the tolerance semantics, the budget extension of a converging solve and
-// the stop request.
+// monotonicity tests), the tolerance semantics, the budget extension of a converging solve, the
+// stop request, and the Anderson acceleration of a kept factorisation.
 
 #include <gtest/gtest.h>
 
@@ -9,6 +9,7 @@
 #include <functional>
 #include <vector>
 
+#include "gipsi/base/state.h"
 #include "gipsi/numerics/newton.h"
 #include "gipsi/numerics/sparse/linear_solver.h"
 
@@ -354,6 +355,142 @@ TEST(Newton, ABorderedPressureKeepsQuadraticConvergenceUnderAStiffVolumeConstrai
   ASSERT_TRUE(modified.converged);
   EXPECT_LT((z - x).head<3>().lpNorm<Eigen::Infinity>(), 1e-9);
   EXPECT_NEAR(z[3], x[3], 1e-6 * x[3]);
+}
+
+// A chain of n nonlinear springs between two walls, each node pulled by the same load:
+// r_i = k (2 x_i − x_{i−1} − x_{i+1}) + c x_i³ − load. Raising the load step by step makes it
+// the modified Newton of a time-stepping object: the factorisation of an earlier tangent is
+// kept across steps while it still halves the residual, and the cubic term makes that tangent
+// stiffer than the kept one as the chain stretches.
+class SpringChain final : public NonlinearSystem {
+ public:
+  static constexpr double kSpring = 1, kCubic = 0.05;
+  double load = 0;
+  bool CalcResidual(const VecX& x, VecX& r) override {
+    const Index n = x.size();
+    for (Index i = 0; i < n; ++i) {
+      const double left = i > 0 ? x[i - 1] : 0, right = i + 1 < n ? x[i + 1] : 0;
+      r[i] = kSpring * (2 * x[i] - left - right) + kCubic * x[i] * x[i] * x[i] - load;
+    }
+    return r.allFinite();
+  }
+  bool CalcResidualAndJacobian(const VecX& x, VecX& r, SparseMatrix& J) override {
+    if (!CalcResidual(x, r)) return false;
+    for (Index i = 0; i < x.size(); ++i) {
+      J.coeffRef(i, i) = 2 * kSpring + 3 * kCubic * x[i] * x[i];
+      if (i > 0) J.coeffRef(i, i - 1) = J.coeffRef(i - 1, i) = -kSpring;
+    }
+    return true;
+  }
+  [[nodiscard]] double force_scale() const override { return std::abs(load); }
+};
+
+SparseMatrix ChainPattern(Index n) {
+  SparseMatrix J(n, n);
+  for (Index i = 0; i < n; ++i)
+    for (Index j = std::max<Index>(i - 1, 0); j <= std::min<Index>(i + 1, n - 1); ++j)
+      J.insert(i, j) = i == j ? 1 : 0;
+  J.makeCompressed();
+  return J;
+}
+
+constexpr int kChainNodes = 20, kLoadSteps = 24;
+double ChainLoad(int step) { return 0.004 * step; }
+
+NewtonOptions KeptFactorOptions(int anderson) {
+  NewtonOptions options;
+  options.tolerance = 1e-10;
+  options.reuse_factorization = true;
+  options.anderson = anderson;
+  return options;
+}
+
+struct ChainRun {
+  std::vector<VecX> states;  // after each load step
+  int iterations = 0, factorizations = 0, accepts = 0, rejects = 0;
+};
+
+// Load steps [first, last] on `newton` (prepared), from x.
+void RunChain(NewtonSolver& newton, SparseMatrix& J, VecX& x, int first, int last, ChainRun& run) {
+  SpringChain chain;
+  for (int step = first; step <= last; ++step) {
+    chain.load = ChainLoad(step);
+    const NewtonStats stats = newton.Solve(chain, x, J);
+    ASSERT_TRUE(stats.converged) << "step " << step << ": " << Describe(stats, newton.options());
+    run.iterations += stats.iterations;
+    run.factorizations += stats.refactorizations;
+    run.accepts += stats.anderson_accepts;
+    run.rejects += stats.anderson_rejects;
+    run.states.push_back(x);
+  }
+}
+
+ChainRun SolveChain(int anderson) {
+  NewtonSolver newton(KeptFactorOptions(anderson),
+                      MakeLinearSolver(LinearSolverOptions{.type = "ldlt"}));
+  SparseMatrix J = ChainPattern(kChainNodes);
+  newton.Prepare(J);
+  VecX x = VecX::Zero(kChainNodes);
+  ChainRun run;
+  RunChain(newton, J, x, 1, kLoadSteps, run);
+  return run;
+}
+
+TEST(Newton, AndersonAccelerationOfAKeptFactorisationSavesIterationsAndFindsTheSameStates) {
+  const ChainRun plain = SolveChain(0);
+  const ChainRun accelerated = SolveChain(5);
+  ASSERT_EQ(plain.states.size(), accelerated.states.size());
+  // Both end each step at ‖r‖ ≤ 1e-10 max(‖r₀‖, load), and the chain's tangent has
+  // ‖J⁻¹‖ ≤ (n + 1)²/π² ≈ 45: each state is within 5e-9 max(‖r₀‖, load) of the solution, far
+  // below 2e-8 of the state (about 50 load for the linear chain).
+  for (std::size_t s = 0; s < plain.states.size(); ++s) {
+    const double scale = plain.states[s].lpNorm<Eigen::Infinity>();
+    EXPECT_LT((accelerated.states[s] - plain.states[s]).lpNorm<Eigen::Infinity>(), 2e-8 * scale)
+        << "load step " << s + 1;
+  }
+  // Measured: plain modified Newton 353 iterations and 5 factorisations; accelerated 207 and 3,
+  // with 203 accelerated steps accepted and 1 refused.
+  EXPECT_EQ(plain.accepts + plain.rejects, 0);
+  EXPECT_GT(accelerated.accepts, 0);
+  EXPECT_LE(accelerated.iterations, 0.75 * plain.iterations)
+      << plain.iterations << " plain iterations";
+  EXPECT_LE(accelerated.factorizations, plain.factorizations);
+}
+
+TEST(Newton, AResumedSolverContinuesItsAndersonHistoryBitwise) {
+  // Twelve load steps, a checkpoint, twelve more: in the same solver, and in a new one
+  // restored from the checkpoint. The kept factorisation and the Anderson history it carries
+  // both come back, so the iterates are the same bits.
+  auto make = [] {
+    return NewtonSolver(KeptFactorOptions(5),
+                        MakeLinearSolver(LinearSolverOptions{.type = "ldlt"}));
+  };
+  NewtonSolver first = make();
+  SparseMatrix J = ChainPattern(kChainNodes);
+  first.Prepare(J);
+  VecX x = VecX::Zero(kChainNodes);
+  ChainRun before;
+  RunChain(first, J, x, 1, kLoadSteps / 2, before);
+  StateWriter out;
+  first.SaveState(out, J);
+  const VecX saved = x;
+  ChainRun uninterrupted;
+  RunChain(first, J, x, kLoadSteps / 2 + 1, kLoadSteps, uninterrupted);
+  ASSERT_GT(uninterrupted.accepts, 0);
+
+  NewtonSolver second = make();
+  SparseMatrix J2 = ChainPattern(kChainNodes);
+  second.Prepare(J2);
+  StateReader in(out.TakeBytes(), "the test's checkpoint");
+  second.RestoreState(in, J2);
+  VecX y = saved;
+  ChainRun resumed;
+  RunChain(second, J2, y, kLoadSteps / 2 + 1, kLoadSteps, resumed);
+  EXPECT_EQ(resumed.iterations, uninterrupted.iterations);
+  EXPECT_EQ(resumed.accepts, uninterrupted.accepts);
+  ASSERT_EQ(resumed.states.size(), uninterrupted.states.size());
+  for (std::size_t s = 0; s < resumed.states.size(); ++s)
+    EXPECT_EQ(resumed.states[s], uninterrupted.states[s]) << "load step " << s;
 }
 
 }  // namespace

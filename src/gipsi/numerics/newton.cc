@@ -31,6 +31,15 @@ void NewtonSolver::Prepare(const SparseMatrix& pattern, int bordered) {
   d_trial_.setZero(n);
   rhs_.setZero(n);
   simplified_.setZero(n);
+  GIPSI_CHECK(options_.anderson >= 0 && options_.anderson <= kMaxAnderson);
+  if (options_.anderson > 0) {
+    aa_dx_.setZero(n, options_.anderson);
+    aa_df_.setZero(n, options_.anderson);
+    aa_x_.setZero(n);
+    aa_f_.setZero(n);
+    aa_step_.setZero(n);
+  }
+  ClearAnderson();
   linear_->AnalyzePattern(pattern);
 }
 
@@ -72,6 +81,13 @@ NewtonStats NewtonSolver::Solve(NonlinearSystem& system, VecX& d, SparseMatrix& 
               "Newton: an iterate of {} unknowns for a solver prepared for {}", d.size(),
               r_.size());
   const bool reuse = options_.reuse_factorization && !options_.fixed_iterations;
+  const bool accelerate = reuse && options_.anderson > 0;
+  // Each Solve has a new residual, but mostly by an additive shift (the loads, the inertia of
+  // the step's start), which cancels in the differences: the columns stay while the factor
+  // does, and only the last iterate (a point of the old residual) is dropped. Measured on
+  // scenes/heart_fine.json over 0.8 s with depth 5: 725 iterations, against 776 when each Solve
+  // starts without history and 944 without acceleration.
+  aa_prev_ = false;
   // With reuse, the previous Solve's factorisation is tried first (only the residual is new).
   bool need_factor = !(reuse && factor_valid_);
   const bool first_ok =
@@ -123,6 +139,7 @@ NewtonStats NewtonSolver::Solve(NonlinearSystem& system, VecX& d, SparseMatrix& 
     if (need_factor) {
       factor_valid_ = false;
       low_rank_kept_ = false;
+      ClearAnderson();  // the fixed-point map changes with the factor
       if (!FactorizeTangent(J, stats)) {
         stats.linear_failure = true;
         return stats;
@@ -167,8 +184,25 @@ NewtonStats NewtonSolver::Solve(NonlinearSystem& system, VecX& d, SparseMatrix& 
     bool by_monotonicity = false;
     double trial_norm = 0;
     double trial_merit = 0;
+    const double full_armijo = 1 - 1e-4;
+    // With a kept factorisation and history, the Anderson step first (NewtonOptions::anderson):
+    // kept only if it lowers the residual, with or without the line search.
+    if (accelerate && AndersonStep(d)) {
+      d_trial_ = d + aa_step_;
+      if (system.CalcResidual(d_trial_, r_trial_)) {
+        trial_norm = Norms(system, r_trial_, trial_merit);
+        accepted = std::isfinite(trial_norm) &&
+                   (trial_merit <= full_armijo * merit || trial_norm <= full_armijo * norm);
+      }
+      if (accepted) {
+        ++stats.anderson_accepts;
+      } else {
+        ++stats.anderson_rejects;
+        aa_count_ = aa_head_ = 0;  // restart from this iterate and its plain correction
+      }
+    }
     const int tries = options_.line_search ? options_.max_line_search_steps : 1;
-    for (int ls_step = 0; ls_step < tries; ++ls_step, alpha *= 0.5) {
+    for (int ls_step = 0; !accepted && ls_step < tries; ++ls_step, alpha *= 0.5) {
       if (ls_step > 0) {
         ++stats.backtracks;
         if (stop.stop_requested()) {
@@ -255,6 +289,62 @@ NewtonStats NewtonSolver::Solve(NonlinearSystem& system, VecX& d, SparseMatrix& 
     factor_valid_ = false;
   }
   return stats;
+}
+
+bool NewtonSolver::AndersonStep(const VecX& d) {
+  const int depth = options_.anderson;
+  if (aa_prev_) {
+    aa_dx_.col(aa_head_) = d - aa_x_;
+    aa_df_.col(aa_head_) = delta_ - aa_f_;
+    aa_head_ = (aa_head_ + 1) % depth;
+    aa_count_ = std::min(aa_count_ + 1, depth);
+  }
+  aa_x_ = d;
+  aa_f_ = delta_;
+  aa_prev_ = true;
+  if (aa_count_ == 0) return false;
+  // γ = argmin ‖f − ΔF γ‖ over the sparse unknowns (the bordered ones follow them and have
+  // other units), by the normal equations of the unit-scaled columns, newest first. Columns
+  // are dropped, oldest first, until the Gram matrix is well conditioned (cond ≤ 1e10, i.e.
+  // the columns' ≤ 1e5): nearly dependent differences would give huge, meaningless γ.
+  const Index n = sparse_size_;
+  using Small =
+      Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxAnderson, kMaxAnderson>;
+  using SmallVec = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxAnderson, 1>;
+  std::array<int, kMaxAnderson> col{};
+  std::array<double, kMaxAnderson> scale{};
+  int usable = 0;
+  for (int a = 0; a < aa_count_; ++a) {
+    const int c = (aa_head_ - 1 - a + 2 * depth) % depth;
+    const double norm = aa_df_.col(c).head(n).norm();
+    if (!(norm > 0) || !std::isfinite(norm)) break;
+    col[static_cast<std::size_t>(usable)] = c;
+    scale[static_cast<std::size_t>(usable++)] = norm;
+  }
+  Small gram(usable, usable);
+  SmallVec rhs(usable);
+  for (int i = 0; i < usable; ++i) {
+    const auto ui = static_cast<std::size_t>(i);
+    const auto fi = aa_df_.col(col[ui]).head(n);
+    rhs[i] = fi.dot(delta_.head(n)) / scale[ui];
+    for (int j = 0; j <= i; ++j) {
+      const auto uj = static_cast<std::size_t>(j);
+      gram(i, j) = gram(j, i) = fi.dot(aa_df_.col(col[uj]).head(n)) / (scale[ui] * scale[uj]);
+    }
+  }
+  for (int k = usable; k > 0; --k) {
+    const Eigen::LDLT<Small> ldlt(gram.topLeftCorner(k, k));
+    if (ldlt.info() != Eigen::Success || !(ldlt.rcond() >= 1e-10)) continue;
+    const SmallVec gamma = ldlt.solve(rhs.head(k));
+    aa_step_ = delta_;
+    for (int i = 0; i < k; ++i) {
+      const auto ui = static_cast<std::size_t>(i);
+      const double g = gamma[i] / scale[ui];
+      aa_step_ -= g * (aa_dx_.col(col[ui]) + aa_df_.col(col[ui]));
+    }
+    return aa_step_.allFinite();
+  }
+  return false;
 }
 
 double NewtonSolver::Norms(const NonlinearSystem& system, const VecX& r, double& merit) const {

@@ -125,6 +125,18 @@ struct NewtonOptions {
   /// slowly varying problems (a beating heart). Needs the Jacobian matrix left untouched
   /// between Solves (the system only writes it in CalcResidualAndJacobian).
   bool reuse_factorization = false;
+  /// With reuse_factorization: Anderson acceleration of the iterations that reuse a kept
+  /// factorisation, with the differences of the last `anderson` iterates (0 = off, at most 8).
+  /// The iteration with a kept factor is the fixed point x ← x + Δ(x), Δ = −Ĵ⁻¹ r(x) (Ĵ: the
+  /// kept, older tangent), which converges linearly. Anderson's type-II mixing (Walker & Ni,
+  /// SIAM J. Numer. Anal. 49, 2011) steps from the combination of the last corrections whose
+  /// linearised correction is smallest in the least-squares sense: on a linear problem, with the
+  /// whole history, essentially GMRES preconditioned by Ĵ. The accelerated step is tried first and
+  /// kept if it lowers ‖r‖ (Armijo); otherwise the plain step is taken and the history restarts.
+  /// The history belongs to the factorisation: cleared when it is replaced, kept across Solves (and
+  /// in checkpoints) while it is kept. On the fine heart it saves a fifth of the iterations and a
+  /// sixth of the factorisations (docs/newton.md).
+  int anderson = 5;
 };
 
 /// Why a linear solve failed. Plain enum.
@@ -152,6 +164,10 @@ struct NewtonStats {
   /// residual grew (the case a residual-only line search would have cut).
   int monotonicity_accepts = 0;
   int backtracks = 0;  ///< step halvings in the line search, over all iterations
+  /// Iterations whose Anderson-accelerated step was accepted, and tried but refused
+  /// (NewtonOptions::anderson).
+  int anderson_accepts = 0;
+  int anderson_rejects = 0;
   double initial_residual = 0;
   double final_residual = 0;
   static constexpr int kHistory = 8;
@@ -172,6 +188,8 @@ struct NewtonStats {
     v("refactorizations", s.refactorizations);
     v("monotonicity_accepts", s.monotonicity_accepts);
     v("backtracks", s.backtracks);
+    v("anderson_accepts", s.anderson_accepts);
+    v("anderson_rejects", s.anderson_rejects);
     v("initial_residual", s.initial_residual);
     v("final_residual", s.final_residual);
     v("residual_history", s.residual_history, Shape::kFixed);
@@ -213,6 +231,7 @@ class NewtonSolver {
     warm_valid_ = false;
     factor_valid_ = false;
     low_rank_kept_ = false;
+    ClearAnderson();
   }
 
  private:
@@ -226,12 +245,21 @@ class NewtonSolver {
   bool factor_valid_ = false;  // the linear solver holds a factorisation of the current J
   bool indefinite_ = false;    // the linear solver was switched to its indefinite mode
   static constexpr int kMaxLowRankTerms = 8;
+  static constexpr int kMaxAnderson = 8;
   std::vector<VecX> low_rank_z_;  // J⁻¹ b_k of the low-rank terms (sized on first use)
   // With bordered unknowns the b_k are kept with the factorisation, like J: a kept
   // factorisation then costs one solve per iteration instead of 1 + num_low_rank_terms (the
   // residual stays exact, so Newton converges to the same solution).
   std::vector<VecX> low_rank_b_;
   bool low_rank_kept_ = false;  // low_rank_b_ and low_rank_z_ belong to the factorisation
+  // Anderson acceleration (NewtonOptions::anderson): the differences of the last iterates and
+  // of their corrections with the current factorisation (columns of a ring), the last iterate
+  // and correction, and the accelerated step.
+  Eigen::MatrixXd aa_dx_, aa_df_;
+  VecX aa_x_, aa_f_, aa_step_;
+  int aa_count_ = 0;  // valid columns
+  int aa_head_ = 0;   // next column to write
+  bool aa_prev_ = false;
 
   /// The correction delta_ = −J⁻¹ r_ with the low-rank terms and bordered unknowns, started
   /// from warm_ if `warm`; false if the linear solve fails (`ls` tells how).
@@ -249,6 +277,13 @@ class NewtonSolver {
   static double LowRankWeight(const NonlinearSystem& system, int k);
   /// The natural monotonicity test of trial step α: true if ‖J⁻¹ r_trial_‖ ≤ (1 − α/4) ‖Δ‖.
   bool Monotone(NonlinearSystem& system, NewtonStats& stats, double alpha);
+  /// Records the iterate d and its correction delta_ in the Anderson history; with history,
+  /// sets aa_step_ to the accelerated step and returns true.
+  bool AndersonStep(const VecX& d);
+  void ClearAnderson() {
+    aa_count_ = aa_head_ = 0;
+    aa_prev_ = false;
+  }
   /// Factorises J; on failure of an SPD-only direct solver, switches it to its indefinite
   /// (LDLᵀ) mode once and retries. Sets the failure kind.
   bool FactorizeTangent(const SparseMatrix& J, NewtonStats& stats);

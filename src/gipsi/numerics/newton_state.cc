@@ -2,7 +2,8 @@
 /// NewtonSolver checkpoints: the warm start of the next Solve's first linear solve (it changes
 /// the iterates of iterative linear solvers), and with reuse_factorization the factorisation
 /// kept for the next Solve, saved as the values of the matrix that was factorised and
-/// factorised again on restore. Bitwise continuation needs both.
+/// factorised again on restore, with the Anderson history that belongs to it. Bitwise
+/// continuation needs all of them.
 ///
 /// The factorised values are those of J: while a factorisation is kept (factor_valid_), Solve
 /// writes J only in CalcResidualAndJacobian, and it marks the factors stale whenever it does so
@@ -22,7 +23,7 @@
 namespace gipsi {
 
 void NewtonSolver::SaveState(StateWriter& out, const SparseMatrix& J) const {
-  out.BeginSection("NewtonSolver", 3);
+  out.BeginSection("NewtonSolver", 4);
   out.WriteBool(warm_valid_);
   out.WriteMatrix(warm_);
   const bool keep = options_.reuse_factorization && factor_valid_;
@@ -35,16 +36,25 @@ void NewtonSolver::SaveState(StateWriter& out, const SparseMatrix& J) const {
       out.WriteInt(static_cast<std::int64_t>(low_rank_b_.size()));
       for (const VecX& b : low_rank_b_) out.WriteMatrix(b);
     }
+    // The Anderson history kept with it (NewtonOptions::anderson): the next Solve starts from
+    // it.
+    out.WriteInt(aa_count_);
+    if (aa_count_ > 0) {
+      out.WriteInt(aa_head_);
+      out.WriteMatrix(aa_dx_);
+      out.WriteMatrix(aa_df_);
+    }
   }
   out.EndSection();
 }
 
 void NewtonSolver::RestoreState(StateReader& in, SparseMatrix& J) {
-  in.BeginSection("NewtonSolver", 3);
+  in.BeginSection("NewtonSolver", 4);
   warm_valid_ = in.ReadBool();
   in.ReadMatrixExact(warm_, "the warm start of the Newton solver");
   factor_valid_ = false;
   low_rank_kept_ = false;
+  ClearAnderson();
   if (in.ReadBool()) {
     if (!options_.reuse_factorization)
       in.Fail("the checkpoint keeps a Newton factorisation but this scene does not reuse them");
@@ -70,6 +80,17 @@ void NewtonSolver::RestoreState(StateReader& in, SparseMatrix& J) {
       }
       low_rank_kept_ = true;
     }
+    const std::int64_t count = in.ReadInt();
+    if (count < 0 || count > options_.anderson)
+      in.Fail("the checkpoint keeps a longer Anderson history than this scene's \"anderson\"");
+    if (count > 0) {
+      const std::int64_t head = in.ReadInt();
+      if (head < 0 || head >= options_.anderson) in.Fail("a corrupted Anderson history");
+      in.ReadMatrixExact(aa_dx_, "the Newton solver's Anderson history");
+      in.ReadMatrixExact(aa_df_, "the Newton solver's Anderson history");
+      aa_head_ = static_cast<int>(head);
+    }
+    aa_count_ = static_cast<int>(count);
   }
   in.EndSection();
 }

@@ -45,7 +45,7 @@ std::unique_ptr<OdeIntegrator> ParseIntegrator(const JsonNode& node, const TypeR
 NewtonOptions ParseNewtonOptions(const JsonNode& node, NewtonOptions options) {
   node.CheckKeys({"max_iterations", "tolerance", "absolute_tolerance", "increment_tolerance",
                   "relative_increment_tolerance", "line_search", "monotonicity_test",
-                  "fixed_iterations", "reuse_factorization"});
+                  "fixed_iterations", "reuse_factorization", "anderson"});
   if (auto it = node.Find("max_iterations")) {
     const std::int64_t n = it->AsInt();
     if (n < 1 || n > 10000) it->Expected("an integer in [1, 10000]");
@@ -61,6 +61,11 @@ NewtonOptions ParseNewtonOptions(const JsonNode& node, NewtonOptions options) {
   options.monotonicity_test = node.Bool("monotonicity_test", options.monotonicity_test);
   options.fixed_iterations = node.Bool("fixed_iterations", options.fixed_iterations);
   options.reuse_factorization = node.Bool("reuse_factorization", options.reuse_factorization);
+  if (auto it = node.Find("anderson")) {
+    const std::int64_t m = it->AsInt();
+    if (m < 0 || m > 8) it->Expected("an integer in [0, 8] (0: off)");
+    options.anderson = static_cast<int>(m);
+  }
   return options;
 }
 
