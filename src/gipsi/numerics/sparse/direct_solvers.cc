@@ -15,6 +15,7 @@
 #include "gipsi/numerics/sparse/blas_threads.h"
 #include "gipsi/numerics/sparse/serial_openmp.h"
 #include "gipsi/numerics/sparse/solvers.h"
+#include "gipsi/numerics/sparse/supernodal_solve.h"
 #include "gipsi/numerics/sparse/vector_ops.h"
 
 namespace gipsi {
@@ -138,7 +139,30 @@ class LdltSolver final : public DirectSolver {
   bool indefinite_ = false;
 };
 
-/// CHOLMOD supernodal LLᵀ (ordered by AMD or METIS, whichever fills less).
+/// Eigen's CHOLMOD supernodal LLᵀ with its factor in reach (for SupernodalSolve).
+class CholmodLlt final : public Eigen::CholmodSupernodalLLT<SparseMatrix, Eigen::Lower> {
+ public:
+  /// The factor as SupernodalSolve reads it; false if it is not a real double supernodal LLᵀ
+  /// with int indices (then CHOLMOD's own solve is used).
+  bool View(SupernodalFactorView& view) const {
+    const cholmod_factor* L = m_cholmodFactor;
+    if (L == nullptr || !L->is_super || !L->is_ll || L->itype != CHOLMOD_INT ||
+        L->xtype != CHOLMOD_REAL || L->dtype != CHOLMOD_DOUBLE || L->x == nullptr)
+      return false;
+    view.n = static_cast<int>(L->n);
+    view.nsuper = static_cast<int>(L->nsuper);
+    view.super = static_cast<const int*>(L->super);
+    view.pi = static_cast<const int*>(L->pi);
+    view.px = static_cast<const int*>(L->px);
+    view.s_rows = static_cast<const int*>(L->s);
+    view.values = static_cast<const double*>(L->x);
+    view.perm = static_cast<const int*>(L->Perm);
+    return true;
+  }
+};
+
+/// CHOLMOD supernodal LLᵀ (ordered by AMD or METIS, whichever fills less), solved by
+/// SupernodalSolve (the two halves of a nested dissection on two threads).
 /// Both read the lower triangle only. After AcceptIndefinite, a matrix that LLᵀ finds not
 /// positive definite is factorised by LDLᵀ instead (the simplicial LdltSolver's pivot rule):
 /// the tangents of pressure-loaded solids are positive definite most of the time, and the
@@ -187,6 +211,7 @@ class CholmodSolver final : public DirectSolver {
     c.method[1].ordering = CHOLMOD_METIS;
     llt_.analyzePattern(A);
     ldlt_analysed_ = false;
+    solve_analysed_ = false;
   }
   bool FactorizeNumeric(const SparseMatrix& A) override {
     use_ldlt_ = false;
@@ -211,6 +236,14 @@ class CholmodSolver final : public DirectSolver {
       x = ldlt_.solve(b);
       return ldlt_.info() == Eigen::Success;
     }
+    SupernodalFactorView view;
+    if (llt_.View(view)) {
+      // The structure is the symbolic analysis's; only the values change per factorisation.
+      if (!solve_analysed_) supernodal_.Analyze(view);
+      solve_analysed_ = true;
+      supernodal_.Solve(view, b, x);
+      return true;  // Solve's residual check judges x
+    }
     const SerialOpenMp serial;
     x = llt_.solve(b);
     return llt_.info() == Eigen::Success;
@@ -218,7 +251,9 @@ class CholmodSolver final : public DirectSolver {
 
  private:
   static constexpr Index kSmallRows = 5000;  ///< relaxed supernodes up to this size
-  Eigen::CholmodSupernodalLLT<SparseMatrix, Eigen::Lower> llt_;
+  CholmodLlt llt_;
+  SupernodalSolve supernodal_;
+  bool solve_analysed_ = false;  // supernodal_ has read the current analysis's structure
   Eigen::SimplicialLDLT<SparseMatrix, Eigen::Lower, Eigen::AMDOrdering<int>> ldlt_;
   bool indefinite_ = false;
   bool ldlt_analysed_ = false;
