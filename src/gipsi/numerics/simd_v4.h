@@ -23,4 +23,22 @@ typedef long long V4i __attribute__((vector_size(32)));
 GIPSI_SIMD_INLINE void Load(V4d& v, const double* p) { std::memcpy(&v, p, sizeof v); }
 GIPSI_SIMD_INLINE void Store(double* p, const V4d& v) { std::memcpy(p, &v, sizeof v); }
 
+/// Σ_{i ∈ [begin, end)} a[i] b[i] in four lanes (the tail added to lanes 0–2), then
+/// (lane 0 + lane 1) + (lane 2 + lane 3): the same bits in either copy.
+GIPSI_SIMD_INLINE double Dot(const double* __restrict a, const double* __restrict b, int begin,
+                             int end) {
+  V4d sum = {0.0, 0.0, 0.0, 0.0};
+  int i = begin;
+  for (; i + 4 <= end; i += 4) {
+    V4d ai, bi;
+    Load(ai, a + i);
+    Load(bi, b + i);
+    sum += ai * bi;
+  }
+  double chain[4];
+  Store(chain, sum);
+  for (int c = 0; i < end; ++i, ++c) chain[c] += a[i] * b[i];
+  return (chain[0] + chain[1]) + (chain[2] + chain[3]);
+}
+
 }  // namespace gipsi::simd

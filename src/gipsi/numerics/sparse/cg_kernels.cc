@@ -56,22 +56,6 @@ GIPSI_SIMD_INLINE CgUpdateSums UpdateBody(double alpha, double beta, const doubl
           (chain_rz[0] + chain_rz[1]) + (chain_rz[2] + chain_rz[3])};
 }
 
-GIPSI_SIMD_INLINE double DotBody(const double* __restrict a, const double* __restrict b, int begin,
-                                 int end) {
-  V4 sum = {0.0, 0.0, 0.0, 0.0};
-  int i = begin;
-  for (; i + 4 <= end; i += 4) {
-    V4 ai, bi;
-    Load(ai, a + i);
-    Load(bi, b + i);
-    sum += ai * bi;
-  }
-  double chain[4];
-  Store(chain, sum);
-  for (int c = 0; i < end; ++i, ++c) chain[c] += a[i] * b[i];
-  return (chain[0] + chain[1]) + (chain[2] + chain[3]);
-}
-
 // x · 0 is 0 for a finite x and NaN otherwise, so one sum of them is NaN iff a value is not
 // finite (then its comparison with itself fails).
 GIPSI_SIMD_INLINE bool AllFiniteBody(const double* __restrict values, std::ptrdiff_t n) {
@@ -97,7 +81,7 @@ CgUpdateSums UpdateGeneric(double alpha, double beta, const double* d, const dou
 }
 
 double DotGeneric(const double* a, const double* b, int begin, int end) {
-  return DotBody(a, b, begin, end);
+  return simd::Dot(a, b, begin, end);
 }
 
 #if defined(__x86_64__)
@@ -113,7 +97,7 @@ __attribute__((target("avx"))) bool AllFiniteAvx(const double* values, std::ptrd
 }
 
 __attribute__((target("avx"))) double DotAvx(const double* a, const double* b, int begin, int end) {
-  return DotBody(a, b, begin, end);
+  return simd::Dot(a, b, begin, end);
 }
 #endif
 

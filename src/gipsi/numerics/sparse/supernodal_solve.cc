@@ -78,23 +78,6 @@ GIPSI_SIMD_INLINE void ForwardBody(const double* __restrict block, double* __res
   }
 }
 
-/// Σ_{i ∈ [begin, end)} a[i] b[i] in four lanes, summed pairwise.
-GIPSI_SIMD_INLINE double Dot(const double* __restrict a, const double* __restrict b, int begin,
-                             int end) {
-  V4 sum = {0.0, 0.0, 0.0, 0.0};
-  int i = begin;
-  for (; i + 4 <= end; i += 4) {
-    V4 ai, bi;
-    Load(ai, a + i);
-    Load(bi, b + i);
-    sum += ai * bi;
-  }
-  double chain[4];
-  Store(chain, sum);
-  for (int c = 0; i < end; ++i, ++c) chain[c] += a[i] * b[i];
-  return (chain[0] + chain[1]) + (chain[2] + chain[3]);
-}
-
 /// Backward: w[0, nscol) ← L₁₁⁻ᵀ (w[0, nscol) − L₂₁ᵀ w[nscol, nsrow)), from the last column,
 /// four columns at a time (their dot products with the solved rows below them share the loads
 /// of w).
@@ -150,7 +133,7 @@ GIPSI_SIMD_INLINE void BackwardBody(const double* __restrict block, double* __re
   }
   for (--j; j >= 0; --j) {
     const double* column = block + j * ld;
-    w[j] = (w[j] - Dot(column, w, j + 1, nsrow)) / column[j];
+    w[j] = (w[j] - simd::Dot(column, w, j + 1, nsrow)) / column[j];
   }
 }
 
