@@ -204,6 +204,11 @@ TEST(Resume, FemIsBitwiseIdentical) {
   ExpectBitwiseResume("cantilever.json", "fem", 0.05, 0.07, 0.12);
 }
 
+TEST(Resume, DynamicMixedSolidIsBitwiseIdentical) {
+  // BDF2's history, the incompressible pressure and Newton's kept factorisation all resume.
+  ExpectBitwiseResume("cantilever_p2.json", "mixed", 0.05, 0.07, 0.12);
+}
+
 TEST(Resume, FemThroughTheOdeContractIsBitwiseIdentical) {
   ExpectBitwiseResume("cantilever_explicit.json", "fem_ode", 0.05, 0.07, 0.12);
 }

@@ -92,6 +92,24 @@ TEST(QuadraticTets, QuadratureRulesAreExactToTheirDegree) {
     for (int a : alpha) exact *= fact(a);
     EXPECT_NEAR(q, exact, 1e-15) << alpha[0] << alpha[1] << alpha[2] << alpha[3];
   }
+  // The mass rule: every monomial L^α of degree up to 7.
+  const TetQuadrature& mass = TetRuleDegree7();
+  for (int a0 = 0; a0 <= 7; ++a0)
+    for (int a1 = 0; a0 + a1 <= 7; ++a1)
+      for (int a2 = 0; a0 + a1 + a2 <= 7; ++a2)
+        for (int a3 = 0; a0 + a1 + a2 + a3 <= 7; ++a3) {
+          const std::array<int, 4> alpha = {a0, a1, a2, a3};
+          double q = 0;
+          for (std::size_t i = 0; i < mass.points.size(); ++i) {
+            double v = mass.weights[i];
+            for (int k = 0; k < 4; ++k)
+              v *= std::pow(mass.points[i][k], alpha[static_cast<std::size_t>(k)]);
+            q += v;
+          }
+          double exact = fact(3) / fact(a0 + a1 + a2 + a3 + 3);
+          for (int a : alpha) exact *= fact(a);
+          EXPECT_NEAR(q, exact, 1e-14 * exact) << a0 << a1 << a2 << a3;
+        }
   const TriangleQuadrature& tri = TriangleRuleDegree4();
   for (const auto& alpha : std::vector<std::array<int, 3>>{
            {0, 0, 0}, {2, 0, 0}, {4, 0, 0}, {2, 2, 0}, {2, 1, 1}, {3, 1, 0}, {1, 1, 1}}) {
@@ -420,8 +438,14 @@ TEST(MixedSolid, SceneErrorsNameThePathAndWhatWasExpected) {
                       "linear_solver": {"type": "ldlt"})",
                    "objects.s.linear_solver.type");
   ExpectSceneError(R"(, "material": {"law": "NeoHookean", "youngs_modulus": 1e4,
-                      "poisson_ratio": 0.3}, "integrator": "BackwardEuler")",
+                      "poisson_ratio": 0.3}, "integrator": "Newmark")",
                    "objects.s.integrator");
+  ExpectSceneError(R"(, "material": {"law": "NeoHookean", "youngs_modulus": 1e4,
+                      "poisson_ratio": 0.3}, "integrator": "BDF2", "load_steps": 4)",
+                   "objects.s.load_steps: has no effect with a dynamic integrator");
+  ExpectSceneError(R"(, "material": {"law": "NeoHookean", "youngs_modulus": 1e4,
+                      "poisson_ratio": 0.3}, "integrator": "BDF2", "density": 0)",
+                   "objects.s.density");
   ExpectSceneError(R"(, "material": {"law": "NeoHookean", "youngs_modulus": 1e4,
                       "poisson_ratio": 0.3}, "formulation": "P1-P1")",
                    "objects.s.formulation");

@@ -46,6 +46,19 @@ MixedSolid::MixedSolid(std::string name, std::shared_ptr<const Mesh> domain,
         this->path(), law_->law()));
   if (params_.fibre.norm() == 0)
     throw InputError(fmt::format("object '{}': the fibre direction is zero", this->path()));
+  if (!(params_.density > 0) || !std::isfinite(params_.density))
+    throw InputError(fmt::format("object '{}': the density must be positive, not {}", this->path(),
+                                 params_.density));
+  if (params_.scheme == ImplicitSchemeKind::kNewmark)
+    throw InputError(fmt::format(
+        "object '{}': MixedSolid has no Newmark scheme yet (it needs the initial acceleration); "
+        "use \"BackwardEuler\" or \"BDF2\"",
+        this->path()));
+  if (dynamic() && params_.load_steps != 1)
+    throw InputError(fmt::format(
+        "object '{}': load_steps {} with a dynamic scheme: a dynamic step is one solve at the "
+        "step's loads (make the time step smaller instead)",
+        this->path(), params_.load_steps));
   mesh_ = ElevateToQuadratic(*domain);
   state_.axes.Write().assign(static_cast<std::size_t>(kQuad * mesh_.num_elements()),
                              MaterialAxes(params_.fibre, params_.sheet));
@@ -83,6 +96,30 @@ MixedSolid::MixedSolid(std::string name, std::shared_ptr<const Mesh> domain,
                                                (static_cast<std::size_t>(e) * kQuad + q) * 30) = g;
       weight_[e * kQuad + q] = det / 6 * rule.weights[static_cast<std::size_t>(q)];
     }
+  }
+  // Dynamics and gravity: the consistent mass of every element, exact also for curved ones
+  // (N_a N_b det J is of degree 4 + 3).
+  const bool needs_mass = dynamic() || params_.gravity.squaredNorm() > 0;
+  if (needs_mass) {
+    const TetQuadrature& mass_rule = TetRuleDegree7();
+    mass_.assign(static_cast<std::size_t>(ne) * 100, 0.0);
+    for (Index e = 0; e < ne; ++e) {
+      Eigen::Matrix<double, 3, 10> x;
+      for (int a = 0; a < 10; ++a) x.col(a) = mesh_.rest.col(mesh_.elements(a, e));
+      Eigen::Map<Eigen::Matrix<double, 10, 10>> m(mass_.data() + static_cast<std::size_t>(e) * 100);
+      for (std::size_t q = 0; q < mass_rule.points.size(); ++q) {
+        const Eigen::Vector4d& l = mass_rule.points[q];
+        // dX/dξ for the reference coordinates ξ_k = L_{k+1} (L_0 = 1 − Σ ξ).
+        const Eigen::Matrix<double, 10, 4> dl = QuadraticTetShapeDerivatives(l);
+        const Eigen::Matrix<double, 10, 3> dxi = dl.rightCols<3>().colwise() - dl.col(0);
+        const double det = (x * dxi).determinant();  // 6 × the volume for a straight tet
+        const Eigen::Matrix<double, 10, 1> n = QuadraticTetShape(l);
+        m.noalias() += (params_.density * mass_rule.weights[q] * det / 6) * (n * n.transpose());
+      }
+    }
+    Points ones(3, mesh_.num_nodes());
+    ones.colwise() = params_.gravity;
+    gravity_force_ = Eigen::Map<const VecX>(ApplyMass(ones).data(), 3 * mesh_.num_nodes());
   }
   // Slivers: the mixed element's pressure is continuous and linear, so a flat tet can change
   // volume while its neighbours make up for it, at little cost in energy; on Gmsh's 2 mm Land
@@ -212,6 +249,13 @@ MixedSolid::MixedSolid(std::string name, std::shared_ptr<const Mesh> domain,
                             "incompressible)"});
   f_newton_ = DeclareField({"newton_iterations", L::kGlobal, 1, "1", A::kRead,
                             "Newton iterations of the last load increment"});
+  f_kinetic_ = DeclareField({"kinetic_energy", L::kGlobal, 1, "J", A::kRead,
+                             "1/2 v' M v over the P2 nodes (0 when quasi-static)"});
+  state_.scheme = ImplicitScheme(params_.scheme);
+  if (dynamic()) {
+    const VecX zero = VecX::Zero(nu);
+    state_.scheme.Reset(zero, zero, zero);
+  }
   BindState(state_);
 }
 
@@ -220,6 +264,53 @@ Points MixedSolid::NodeDisplacements() const {
 }
 
 VecX MixedSolid::Pressures() const { return pressure_scale_ * state_.z.tail(mesh_.num_vertices); }
+
+Points MixedSolid::ApplyMass(const Points& x) const {
+  GIPSI_CHECK(x.cols() == mesh_.num_nodes() && !mass_.empty(),
+              "MixedSolid::ApplyMass: a field of {} nodes, or no mass (quasi-static, no gravity)",
+              x.cols());
+  Points y = Points::Zero(3, mesh_.num_nodes());
+  for (Index e = 0; e < mesh_.num_elements(); ++e) {
+    const Eigen::Map<const Eigen::Matrix<double, 10, 10>> m(mass_.data() +
+                                                            static_cast<std::size_t>(e) * 100);
+    for (int b = 0; b < 10; ++b) {
+      const Vec3 xb = x.col(mesh_.elements(b, e));
+      for (int a = 0; a < 10; ++a) y.col(mesh_.elements(a, e)) += m(a, b) * xb;
+    }
+  }
+  return y;
+}
+
+Points MixedSolid::NodeVelocities() const {
+  if (!dynamic()) return Points::Zero(3, mesh_.num_nodes());
+  return Eigen::Map<const Points>(state_.scheme.v().data(), 3, mesh_.num_nodes());
+}
+
+void MixedSolid::AssembleInertia(const VecX& z, VecX& r, double* jv) const {
+  const ImplicitScheme& scheme = state_.scheme;
+  const double alpha = params_.rayleigh_mass;
+  const double c_a = scheme.c_a(), c_v = scheme.c_v();
+  const VecX& x_n = scheme.x();
+  const VecX& a_hat = scheme.a_hat();
+  const VecX& v_hat = scheme.v_hat();
+  for (Index e = 0; e < mesh_.num_elements(); ++e) {
+    const Eigen::Map<const Eigen::Matrix<double, 10, 10>> m(mass_.data() +
+                                                            static_cast<std::size_t>(e) * 100);
+    for (int b = 0; b < 10; ++b) {
+      const Index db = 3 * mesh_.elements(b, e);
+      // a + α v of node b: both affine in its increment d = u − x_n.
+      const Vec3 d = z.segment<3>(db) - x_n.segment<3>(db);
+      const Vec3 w = (c_a * d + a_hat.segment<3>(db)) + alpha * (c_v * d + v_hat.segment<3>(db));
+      for (int a = 0; a < 10; ++a) r.segment<3>(3 * mesh_.elements(a, e)) += m(a, b) * w;
+    }
+    if (jv == nullptr) continue;
+    const int* idx = element_value_index_.data() + static_cast<std::size_t>(e) * kLocal * kLocal;
+    const double c = c_a + alpha * c_v;
+    for (int b = 0; b < 10; ++b)
+      for (int a = 0; a < 10; ++a)
+        for (int i = 0; i < 3; ++i) jv[idx[(3 * b + i) * kLocal + 3 * a + i]] += c * m(a, b);
+  }
+}
 
 Mat3 MixedSolid::DeformationGradient(Index e, int q, const VecX& z) const {
   const auto g = Eigen::Map<const Eigen::Matrix<double, 3, 10>>(
@@ -392,6 +483,9 @@ bool MixedSolid::Assemble(const VecX& z, double load, VecX& r, double* jv) const
 
 void MixedSolid::AssembleLoads(const VecX& z, double s, VecX& r, double* jv) const {
   const Index nv = mesh_.num_vertices;
+  // Gravity: in full from the first dynamic step; ramped in from the first quasi-static one.
+  if (gravity_force_.size() > 0)
+    r.head(gravity_force_.size()) -= (dynamic() || state_.have_prev ? 1.0 : s) * gravity_force_;
   for (Index v = 0; v < nv; ++v)
     r.segment<3>(3 * v) -=
         (1 - s) * state_.force_prev.segment<3>(3 * v) + s * force_new_.segment<3>(3 * v);
@@ -482,6 +576,7 @@ class MixedSolid::Increment final : public NonlinearSystem {
 
 bool MixedSolid::IncrementResidual(double s, const VecX& z, VecX& r, double* jv) const {
   if (!Assemble(z, s, r, jv)) return false;
+  if (dynamic()) AssembleInertia(z, r, jv);
   AssembleLoads(z, s, r, jv);
   ApplyConstraints(r, jv);
   return r.allFinite();
@@ -566,12 +661,13 @@ StepStatus MixedSolid::Advance(double s0, double s1, int depth) {
     if (state_.last_newton.converged) continue;
     state_.z = z_start;
     if (state_.last_newton.interrupted) return StepStatus::Stopped();
-    if (depth >= params_.max_bisections) {
+    if (depth >= params_.max_bisections || dynamic()) {
       failure_detail_ =
           fmt::format("load increment {:.6g} → {:.6g} of the step: {}{}", sa, sb,
                       Describe(state_.last_newton, params_.newton, newton_->linear_solver().name()),
                       MostCompressedElement());
-      return StepStatus::Failed("Newton did not converge (bisections exhausted)");
+      return StepStatus::Failed(dynamic() ? "Newton did not converge (try a smaller dt)"
+                                          : "Newton did not converge (bisections exhausted)");
     }
     const StepStatus status = Advance(sa, sb, depth + 1);
     if (!status.ok()) return status;
@@ -599,23 +695,28 @@ std::string MixedSolid::MostCompressedElement() const {
       smallest, domain().TetName(worst), centre.x(), centre.y(), centre.z());
 }
 
-StepStatus MixedSolid::DoStep(double /*t*/, double /*dt*/) {
+StepStatus MixedSolid::DoStep(double /*t*/, double dt) {
   failure_detail_.clear();
   if (const Index v = GatherLoads(); v >= 0) {
     failure_detail_ = fmt::format(
-        "boundary vertex {} has a prescribed velocity; MixedSolid is quasi-static: prescribe a "
-        "displacement instead",
+        "boundary vertex {} has a prescribed velocity; MixedSolid takes prescribed displacements "
+        "only",
         v);
-    return StepStatus::Failed("a prescribed velocity on a quasi-static object", v);
+    return StepStatus::Failed("a prescribed velocity on a MixedSolid", v);
   }
   // Prescribed displacements ramp from where the constrained dofs are now.
   for (int dof : constrained_dofs_) target_prev_[dof] = state_.z[dof];
   z_begin_ = state_.z;
+  if (dynamic()) state_.scheme.Begin(dt);
   const StepStatus status = Advance(0, 1, 0);
   if (!status.ok()) {
     state_.z = z_begin_;
     UpdatePositions();
     return status;
+  }
+  if (dynamic()) {
+    const Index nu = 3 * mesh_.num_nodes();
+    state_.scheme.Commit(state_.z.head(nu) - state_.scheme.x());
   }
   state_.force_prev = force_new_;
   state_.active_prev = state_.active_new;
@@ -661,11 +762,17 @@ void MixedSolid::DoReadField(FieldId id, Eigen::Ref<Eigen::MatrixXd> out) const 
   const Index nv = mesh_.num_vertices;
   const Index nu = 3 * mesh_.num_nodes();
   static const VecX kNoVelocity;
-  if (id == mech_.boundary_velocity || id == mech_.velocity) {
+  if (!dynamic() && (id == mech_.boundary_velocity || id == mech_.velocity)) {
     out.setZero();  // quasi-static
     return;
   }
-  if (ReadBoundaryKinematics(mech_, id, vertex_positions_, kNoVelocity.data(), out)) return;
+  // The scheme's velocities are node-major over the P2 nodes, vertices first.
+  const double* velocity = dynamic() ? state_.scheme.v().data() : kNoVelocity.data();
+  if (ReadBoundaryKinematics(mech_, id, vertex_positions_, velocity, out)) return;
+  if (id == mech_.velocity) {
+    out = Eigen::Map<const Points>(velocity, 3, nv);
+    return;
+  }
   if (id == mech_.position) {
     out = vertex_positions_;
   } else if (id == mech_.displacement) {
@@ -673,10 +780,19 @@ void MixedSolid::DoReadField(FieldId id, Eigen::Ref<Eigen::MatrixXd> out) const 
   } else if (id == mech_.external_force) {
     out = state_.external_force.get();
   } else if (id == mech_.reaction_force) {
-    // f_int − f_ext on the held axes of the vertices, at the current state and loads.
+    // f_int − f_ext (+ M (a + α v) when dynamic) on the held axes of the vertices, at the
+    // current state and loads.
     out.setZero();
     VecX r;
     if (!EvaluateUnconstrained(state_.z, 1.0, r, nullptr)) return;
+    if (dynamic()) {
+      // M (a + α v) of the last step: the held nodes also carry their neighbours' inertia
+      // through the consistent mass.
+      const Index nn = mesh_.num_nodes();
+      const Points w = Eigen::Map<const Points>(state_.scheme.a().data(), 3, nn) +
+                       params_.rayleigh_mass * NodeVelocities();
+      r.head(nu) += Eigen::Map<const VecX>(ApplyMass(w).data(), nu);
+    }
     // An edge node is held where both its vertices are; its reaction goes half to each, so
     // the vertices carry the whole: for a uniform traction on a 6-node face the vertex nodes'
     // own share is zero (∫ N_vertex dA = 0) and the edge nodes' is all of it.
@@ -717,6 +833,12 @@ void MixedSolid::DoReadField(FieldId id, Eigen::Ref<Eigen::MatrixXd> out) const 
     out(0, 0) = w;
   } else if (id == f_newton_) {
     out(0, 0) = state_.last_newton.iterations;
+  } else if (id == f_kinetic_) {
+    out(0, 0) = 0;
+    if (dynamic()) {
+      const Points v = NodeVelocities();
+      out(0, 0) = 0.5 * (v.array() * ApplyMass(v).array()).sum();
+    }
   }
 }
 
@@ -739,9 +861,10 @@ void MixedSolid::DoWriteField(FieldId id, const Eigen::Ref<const Eigen::MatrixXd
     for (Index k = 0; k < mesh_.edges.cols(); ++k)
       state_.z.segment<3>(3 * (nv + k)) =
           0.5 * (u.col(mesh_.edges(0, k)) + u.col(mesh_.edges(1, k)));
+    if (dynamic()) state_.scheme.SetPositions(state_.z.head(3 * mesh_.num_nodes()));
     UpdatePositions();
   }
-  // Velocity writes are ignored: the object is quasi-static.
+  // Velocity writes are ignored (the state's velocities follow from its displacements).
 }
 
 }  // namespace gipsi

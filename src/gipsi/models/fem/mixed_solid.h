@@ -1,6 +1,7 @@
 #pragma once
 /// @file
-/// `MixedSolid`: quasi-static, nearly or fully incompressible hyperelasticity without locking —
+/// `MixedSolid`: nearly or fully incompressible hyperelasticity without locking, quasi-static or
+/// dynamic —
 /// Taylor–Hood P2–P1 elements (quadratic displacements on 10-node tets, continuous linear
 /// pressure on the vertices), the classic inf–sup stable pair, verified on the cardiac-mechanics
 /// benchmarks (Land et al., "Verification of cardiac mechanics software: benchmark problems and
@@ -48,8 +49,17 @@
 /// start and kept factorisation (a resumed run continues bitwise); a snapshot restore drops the
 /// latter (the retry factorises afresh), as for FemSolid.
 ///
-/// Not yet: dynamics (mass, damping), cavities coupled to blood, collision and haptic local
-/// models. Units: SI.
+/// Dynamics (`scheme` BackwardEuler or BDF2; implicit_scheme.h): the displacement unknowns
+/// carry inertia and mass-proportional damping, r_u += M (a + α v) with the consistent P2 mass
+/// M_ab = ∫ ρ N_a N_b dV (integrated exactly, curved elements included: TetRuleDegree7), and
+/// the pressure rows are unchanged (the constraint holds at every instant). A dynamic step is
+/// one nonlinear solve at the step's loads (no load increments, no bisection: a step that does
+/// not converge fails, and the kernel's caller may retry with a smaller step). Gravity ρ g acts
+/// as the consistent body force M g, ramped with the loads in quasi-static steps. Fields
+/// "velocity" (node; the vertices') and "kinetic_energy" (global, ½ vᵀ M v over all P2 nodes).
+///
+/// Not yet: Newmark (it needs the initial acceleration M⁻¹ r(u₀)), cavities coupled to blood,
+/// collision and haptic local models. Units: SI.
 
 #include <memory>
 #include <string>
@@ -61,6 +71,7 @@
 #include "gipsi/models/fem/mixed_state.h"
 #include "gipsi/models/fem/quadratic_tets.h"
 #include "gipsi/models/fem/solid_material.h"
+#include "gipsi/numerics/implicit_scheme.h"
 #include "gipsi/numerics/newton.h"
 
 GIPSI_EXPORT_BEGIN
@@ -74,8 +85,13 @@ struct MixedSolidParams {
   bool incompressible = false;
   Vec3 fibre = Vec3::UnitX();  ///< uniform fibre direction (reference configuration)
   Vec3 sheet = Vec3::UnitY();  ///< uniform sheet direction (orthogonalised against the fibre)
-  int load_steps = 1;          ///< increments per step
+  int load_steps = 1;          ///< increments per (quasi-static) step
   int max_bisections = 6;      ///< halvings of a failed increment before the step fails
+  /// kStatic (quasi-static), kBackwardEuler or kBdf2 (dynamic; kNewmark is refused).
+  ImplicitSchemeKind scheme = ImplicitSchemeKind::kStatic;
+  double density = 1000;        ///< ρ [kg/m³], for the mass and gravity
+  double rayleigh_mass = 0;     ///< α [1/s]: damping force α M v
+  Vec3 gravity = Vec3::Zero();  ///< g [m/s²]
   NewtonOptions newton;
   LinearSolverOptions linear_solver = [] {
     LinearSolverOptions o;
@@ -89,7 +105,8 @@ struct MixedSolidParams {
 class MixedSolid final : public SimObject {
  public:
   /// Throws InputError for a mesh without tets, inverted or degenerate tets, a missing law or
-  /// one without a split volumetric term, or a zero fibre direction.
+  /// one without a split volumetric term, a zero fibre direction, a non-positive density, the
+  /// Newmark scheme, or several load steps with a dynamic scheme.
   MixedSolid(std::string name, std::shared_ptr<const Mesh> domain, MixedSolidParams params);
 
   [[nodiscard]] std::string_view type_name() const override { return "MixedSolid"; }
@@ -109,6 +126,12 @@ class MixedSolid final : public SimObject {
   [[nodiscard]] VecX Pressures() const;
   /// ∫ J dV over the body [m³] at the current state.
   [[nodiscard]] double CurrentVolume() const;
+  /// M x for a field x on the P2 nodes (3 by num_nodes), M the consistent mass [kg].
+  [[nodiscard]] Points ApplyMass(const Points& x) const;
+  /// Whether the scheme is dynamic (not kStatic).
+  [[nodiscard]] bool dynamic() const { return params_.scheme != ImplicitSchemeKind::kStatic; }
+  /// Velocities of every P2 node (3 by num_nodes; zero when quasi-static).
+  [[nodiscard]] Points NodeVelocities() const;
   /// Statistics of the last Newton solve.
   [[nodiscard]] const NewtonStats& last_newton() const { return state_.last_newton; }
   /// Total Newton iterations and factorisations over all steps (for benchmarks).
@@ -156,12 +179,14 @@ class MixedSolid final : public SimObject {
   bool Assemble(const VecX& z, double load, VecX& r, double* jv) const;
   /// Material axes at quadrature point q of element e, active tension at load fraction `load`.
   [[nodiscard]] MaterialPoint PointOf(Index e, int q, double load) const;
+  /// Adds M (a + α v) of the dynamic step's increment z − x_n (and (c_a + α c_v) M to J).
+  void AssembleInertia(const VecX& z, VecX& r, double* jv) const;
   /// Adds −f_ext at load fraction s and its tangent (face loads) at z.
   void AssembleLoads(const VecX& z, double s, VecX& r, double* jv) const;
   /// Zeroes the constrained rows (and columns in J, unit diagonal times diag_scale_).
   void ApplyConstraints(VecX& r, double* jv) const;
   /// This step's loads and constraints; returns a boundary vertex with a prescribed velocity
-  /// (which a quasi-static object cannot honour), or -1.
+  /// (which MixedSolid does not take), or -1.
   Index GatherLoads();
   void SetTargets(VecX& z, double s) const;
   StepStatus Advance(double s0, double s1, int depth);
@@ -181,6 +206,8 @@ class MixedSolid final : public SimObject {
   QuadraticTets mesh_;
   std::vector<double> grad_;  // per element and quadrature point: 3 × 10 ∇N (column-major)
   VecX weight_;               // per element and quadrature point: its share of the rest volume
+  std::vector<double> mass_;  // per element: the 10 × 10 consistent mass (column-major) [kg]
+  VecX gravity_force_;        // M g on the displacement unknowns (3 per node) [N]
   double pressure_scale_ = 1;
   // Boundary faces as 6-node triangles (P2 node ids).
   Eigen::Matrix<int, 6, Eigen::Dynamic> faces_;
@@ -206,7 +233,8 @@ class MixedSolid final : public SimObject {
   std::unique_ptr<NewtonSolver> newton_;
   std::string failure_detail_;
   MechanicalFieldIds mech_;
-  FieldId f_fibre_, f_active_, f_pressure_, f_jacobian_, f_volume_, f_energy_, f_newton_;
+  FieldId f_fibre_, f_active_, f_pressure_, f_jacobian_, f_volume_, f_energy_, f_newton_,
+      f_kinetic_;
 };
 
 /// Registers "MixedSolid".

@@ -16,14 +16,30 @@ void RegisterMixedSolid(TypeRegistry& registry) {
       [](const ObjectBuildContext& ctx) -> std::unique_ptr<SimObject> {
         const JsonNode& p = ctx.params;
         ctx.CheckKeys({"material", "formulation", "incompressible", "fibres", "load_steps",
-                       "max_bisections", "newton", "linear_solver", "active_tension"});
+                       "max_bisections", "newton", "linear_solver", "active_tension", "integrator",
+                       "density", "damping", "gravity"});
         MixedSolidParams params;
         params.material = ctx.registry.CreateMaterialAs<SolidMaterial>(p.At("material"), "solid");
         if (auto formulation = p.Find("formulation"))
           static_cast<void>(formulation->AsChoice({"P2-P1"}));
 
-        if (auto integrator = p.Find("integrator"))
-          static_cast<void>(integrator->AsChoice({"Static"}));
+        if (auto integrator = p.Find("integrator")) {
+          const std::string kind = integrator->AsChoice({"Static", "BackwardEuler", "BDF2"});
+          params.scheme = kind == "BackwardEuler" ? ImplicitSchemeKind::kBackwardEuler
+                          : kind == "BDF2"        ? ImplicitSchemeKind::kBdf2
+                                                  : ImplicitSchemeKind::kStatic;
+          if (params.scheme != ImplicitSchemeKind::kStatic && p.Has("load_steps"))
+            p.At("load_steps")
+                .Fail(
+                    "has no effect with a dynamic integrator: a dynamic step is one solve at "
+                    "the step's loads (make dt smaller instead)");
+        }
+        params.density = p.Positive("density", params.density);
+        if (auto damping = p.Find("damping")) {
+          damping->CheckKeys({"mass"});
+          params.rayleigh_mass = damping->NonNegative("mass", 0);
+        }
+        params.gravity = p.Vector3("gravity", params.gravity);
         if (auto newton = p.Find("newton"))
           params.newton = ParseNewtonOptions(*newton, params.newton);
         params.incompressible = p.Bool("incompressible", params.incompressible);
@@ -87,8 +103,8 @@ void RegisterMixedSolid(TypeRegistry& registry) {
           p.Fail(e.what());
         }
       },
-      "quasi-static nearly or fully incompressible solid on Taylor–Hood P2–P1 tetrahedra "
-      "(locking-free)");
+      "nearly or fully incompressible solid on Taylor–Hood P2–P1 tetrahedra (locking-free), "
+      "quasi-static or dynamic");
 }
 
 }  // namespace gipsi

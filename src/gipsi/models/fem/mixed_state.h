@@ -12,6 +12,7 @@
 #include "gipsi/base/export.h"
 #include "gipsi/base/math.h"
 #include "gipsi/base/state_value.h"
+#include "gipsi/numerics/implicit_scheme.h"
 #include "gipsi/numerics/newton.h"
 
 GIPSI_EXPORT_BEGIN
@@ -20,7 +21,7 @@ namespace gipsi {
 /// Copyable. Shapes: N P2 nodes, V vertices, E elements, F boundary faces.
 struct MixedState {
   static constexpr const char* kTag = "MixedState";
-  static constexpr std::uint32_t kVersion = 1;
+  static constexpr std::uint32_t kVersion = 2;
 
   VecX z;  ///< the unknowns: displacements (3N, node-major), then scaled pressures (V)
   /// The previous step's loads (s = 0 of the load ramp within a step).
@@ -34,6 +35,8 @@ struct MixedState {
   VecX active_new;                 ///< per element active tension [Pa]
   /// Material axes (fibre, sheet, normal) at each quadrature point, 4 per element.
   Stamped<std::vector<Mat3>> axes;
+  /// The time scheme's history over the displacement unknowns (3N; static: kind only).
+  ImplicitScheme scheme;
   NewtonStats last_newton;  ///< of the last increment (the field "newton_iterations")
   std::int64_t total_iterations = 0;
 
@@ -48,6 +51,7 @@ struct MixedState {
     v("external_force", s.external_force, Shape::kFixed);
     v("active_new", s.active_new, Shape::kFixed);
     v("axes", s.axes, Shape::kFixed);
+    v("scheme", s.scheme);
     v("last_newton", s.last_newton);
     v("total_iterations", s.total_iterations);
   }

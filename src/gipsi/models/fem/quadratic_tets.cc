@@ -127,6 +127,33 @@ const TetQuadrature& TetRuleDegree2() {
   return rule;
 }
 
+const TetQuadrature& TetRuleDegree7() {
+  static const TetQuadrature rule = [] {
+    // Conical product (Stroud 1971, §2.4): the unit tet as the image of the unit cube under
+    // x = a, y = (1 − a) b, z = (1 − a)(1 − b) c, Jacobian (1 − a)² (1 − b), with 5-point
+    // Gauss–Legendre rules in a, b and c. A polynomial of degree p on the tet becomes one of
+    // degree p + 2, p + 1 and p in a, b and c; the 5-point rule is exact to degree 9, so the
+    // product is exact for p ≤ 7.
+    const double x[5] = {-0.9061798459386640, -0.5384693101056831, 0.0, 0.5384693101056831,
+                         0.9061798459386640};
+    const double w[5] = {0.2369268850561891, 0.4786286704993665, 0.5688888888888889,
+                         0.4786286704993665, 0.2369268850561891};
+    TetQuadrature r;
+    for (int i = 0; i < 5; ++i)
+      for (int j = 0; j < 5; ++j)
+        for (int k = 0; k < 5; ++k) {
+          const double a = 0.5 * (x[i] + 1), b = 0.5 * (x[j] + 1), c = 0.5 * (x[k] + 1);
+          const double px = a, py = (1 - a) * b, pz = (1 - a) * (1 - b) * c;
+          r.points.emplace_back(1 - px - py - pz, px, py, pz);
+          // The cube's weights (each halved for [0, 1]) times the Jacobian, times 6 (the unit
+          // tet's volume is 1/6) so that they sum to 1.
+          r.weights.push_back(6 * 0.125 * w[i] * w[j] * w[k] * (1 - a) * (1 - a) * (1 - b));
+        }
+    return r;
+  }();
+  return rule;
+}
+
 const TriangleQuadrature& TriangleRuleDegree4() {
   static const TriangleQuadrature rule = [] {
     TriangleQuadrature r;

@@ -17,6 +17,8 @@
 ///    the rule of the standard 10-node hybrid tetrahedron: the stiffness of a straight P2 tet
 ///    (gradients linear, products quadratic) and the P1-pressure coupling are integrated
 ///    exactly; energy and convergence rates of P2 (O(h²) in the energy norm) need degree 2;
+///  - tetrahedra, 125 points, exact for degree 7 (a conical product rule): the consistent mass
+///    matrix, also of curved elements;
 ///  - triangles, 6 points, exact for degree 4 (Dunavant, "High degree efficient symmetrical
 ///    Gaussian quadrature rules for the triangle", IJNME 21, 1985): follower pressure on a
 ///    curved deformed face (shape function × area normal, degree 2 + 2).
@@ -96,6 +98,9 @@ struct TriangleQuadrature {
 };
 /// The 4-point degree-2 tet rule (above).
 [[nodiscard]] const TetQuadrature& TetRuleDegree2();
+/// A 125-point rule exact for polynomials of degree 7 (a conical product of Gauss rules,
+/// positive weights): the consistent mass of a curved P2 tet (N_a N_b det J, degree 4 + 3).
+[[nodiscard]] const TetQuadrature& TetRuleDegree7();
 /// The 6-point degree-4 triangle rule (above).
 [[nodiscard]] const TriangleQuadrature& TriangleRuleDegree4();
 
