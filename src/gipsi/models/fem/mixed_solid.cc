@@ -610,12 +610,20 @@ Index MixedSolid::GatherLoads() {
     const Index node = bnd.vertex_to_node[static_cast<std::size_t>(j)];
     for (int a = 0; a < 3; ++a) {
       if (bcs.kind(j, a) == ConstraintKind::kFree) continue;
+      const Index dof = 3 * node + a;
       if (bcs.kind(j, a) == ConstraintKind::kVelocity) {
-        velocity_vertex = j;
+        if (!dynamic()) {
+          velocity_vertex = j;
+          continue;
+        }
+        // The increment that gives this velocity at the end of the step (Begin has run).
+        constrained_[static_cast<std::size_t>(dof)] = 1;
+        target_new_[dof] =
+            state_.scheme.x()[dof] + state_.scheme.IncrementForVelocity(dof, bcs.value(j)[a]);
         continue;
       }
-      constrained_[static_cast<std::size_t>(3 * node + a)] = 1;
-      target_new_[3 * node + a] = bcs.value(j)[a];
+      constrained_[static_cast<std::size_t>(dof)] = 1;
+      target_new_[dof] = bcs.value(j)[a];
     }
   }
   for (Index k = 0; k < mesh_.edges.cols(); ++k) {
@@ -697,17 +705,17 @@ std::string MixedSolid::MostCompressedElement() const {
 
 StepStatus MixedSolid::DoStep(double /*t*/, double dt) {
   failure_detail_.clear();
+  if (dynamic()) state_.scheme.Begin(dt);  // before GatherLoads: prescribed velocities need it
   if (const Index v = GatherLoads(); v >= 0) {
     failure_detail_ = fmt::format(
-        "boundary vertex {} has a prescribed velocity; MixedSolid takes prescribed displacements "
-        "only",
+        "boundary vertex {} has a prescribed velocity; a quasi-static MixedSolid takes prescribed "
+        "displacements only (a dynamic \"integrator\" takes velocities too)",
         v);
-    return StepStatus::Failed("a prescribed velocity on a MixedSolid", v);
+    return StepStatus::Failed("a prescribed velocity on a quasi-static MixedSolid", v);
   }
   // Prescribed displacements ramp from where the constrained dofs are now.
   for (int dof : constrained_dofs_) target_prev_[dof] = state_.z[dof];
   z_begin_ = state_.z;
-  if (dynamic()) state_.scheme.Begin(dt);
   const StepStatus status = Advance(0, 1, 0);
   if (!status.ok()) {
     state_.z = z_begin_;
@@ -863,8 +871,17 @@ void MixedSolid::DoWriteField(FieldId id, const Eigen::Ref<const Eigen::MatrixXd
           0.5 * (u.col(mesh_.edges(0, k)) + u.col(mesh_.edges(1, k)));
     if (dynamic()) state_.scheme.SetPositions(state_.z.head(3 * mesh_.num_nodes()));
     UpdatePositions();
+  } else if (id == mech_.velocity && dynamic()) {
+    // Vertices as written, edge nodes at the mean of their ends (exact for a rigid motion on
+    // straight edges); the multistep history restarts.
+    const Index nv = mesh_.num_vertices;
+    VecX v(3 * mesh_.num_nodes());
+    for (Index a = 0; a < nv; ++a) v.segment<3>(3 * a) = in.col(a);
+    for (Index k = 0; k < mesh_.edges.cols(); ++k)
+      v.segment<3>(3 * (nv + k)) = 0.5 * (in.col(mesh_.edges(0, k)) + in.col(mesh_.edges(1, k)));
+    state_.scheme.SetVelocity(v);
   }
-  // Velocity writes are ignored (the state's velocities follow from its displacements).
+  // Velocity writes to a quasi-static object are ignored.
 }
 
 }  // namespace gipsi

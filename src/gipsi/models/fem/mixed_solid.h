@@ -55,8 +55,10 @@
 /// the pressure rows are unchanged (the constraint holds at every instant). A dynamic step is
 /// one nonlinear solve at the step's loads (no load increments, no bisection: a step that does
 /// not converge fails, and the kernel's caller may retry with a smaller step). Gravity ρ g acts
-/// as the consistent body force M g, ramped with the loads in quasi-static steps. Fields
-/// "velocity" (node; the vertices') and "kinetic_energy" (global, ½ vᵀ M v over all P2 nodes).
+/// as the consistent body force M g, ramped with the loads in quasi-static steps. Prescribed
+/// velocities are honoured (the increment that gives them; refused quasi-statically). Fields
+/// "velocity" (node, read/write: the vertices'; a write gives the edge nodes the mean of their
+/// ends) and "kinetic_energy" (global, ½ vᵀ M v over all P2 nodes).
 ///
 /// Not yet: Newmark (it needs the initial acceleration M⁻¹ r(u₀)), cavities coupled to blood,
 /// collision and haptic local models. Units: SI.
