@@ -173,10 +173,8 @@ SparseMatrix SaddlePoint(int n, int stride) {
 // same whatever runs them).
 void ExpectAccurateAndTheSameBitsOnAnyTeamAndKernelSet(const SparseMatrix& A) {
   const auto problem = Manufacture(A);
-  const int saved_threads = omp_get_max_threads();
   auto solve = [&](int threads, SimdKernels kernels) {
-    omp_set_num_threads(threads);
-    const SimdKernels saved_kernels = LimitSimdKernels(kernels);
+    const testing::ScopedTeamAndKernels team(threads, kernels);
     LinearSolverOptions options;
     options.type = "cholmod";
     auto solver = MakeLinearSolver(options);
@@ -184,8 +182,6 @@ void ExpectAccurateAndTheSameBitsOnAnyTeamAndKernelSet(const SparseMatrix& A) {
     EXPECT_TRUE(solver->Factorize(A));
     VecX x = VecX::Zero(A.rows());
     const LinearSolveStats stats = solver->Solve(problem.b, x);
-    LimitSimdKernels(saved_kernels);
-    omp_set_num_threads(saved_threads);
     EXPECT_TRUE(stats.converged);
     return x;
   };
@@ -198,7 +194,7 @@ void ExpectAccurateAndTheSameBitsOnAnyTeamAndKernelSet(const SparseMatrix& A) {
   for (int threads : {1, 2}) {
     for (SimdKernels kernels : {SimdKernels::kAvx, SimdKernels::kGeneric}) {
       const VecX x = solve(threads, kernels);
-      EXPECT_TRUE((x.array() == reference.array()).all())
+      EXPECT_TRUE(testing::SameBits(x, reference))
           << threads << " threads, " << SimdKernelsName(kernels) << " kernels";
     }
   }

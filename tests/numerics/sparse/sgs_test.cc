@@ -9,7 +9,6 @@
 #include <vector>
 
 #include <gtest/gtest.h>
-#include <omp.h>
 
 #include "gipsi/numerics/simd.h"
 #include "gipsi/numerics/sparse/linear_solver.h"
@@ -164,17 +163,13 @@ TEST(BlockGaussSeidelCg, SameBitsForAnyThreadCountAndEitherKernelSet) {
   const SparseMatrix A = Lattice(24);
   ASSERT_GT(SgsDomainCount(A.rows()), 2);
   const auto problem = Manufacture(A);
-  const int saved_threads = omp_get_max_threads();
   auto solve = [&](int threads, SimdKernels kernels, int& iterations) {
-    omp_set_num_threads(threads);
-    const SimdKernels saved_kernels = LimitSimdKernels(kernels);
+    const testing::ScopedTeamAndKernels team(threads, kernels);
     auto solver = MakeLinearSolver(Cg("sgs"));
     solver->AnalyzePattern(A);
     EXPECT_TRUE(solver->Factorize(A));
     VecX x = VecX::Zero(A.rows());
     const LinearSolveStats stats = solver->Solve(problem.b, x);
-    LimitSimdKernels(saved_kernels);
-    omp_set_num_threads(saved_threads);
     EXPECT_TRUE(stats.converged);
     iterations = stats.iterations;
     return x;

@@ -8,6 +8,9 @@
 #include <limits>
 #include <random>
 
+#include <omp.h>
+
+#include "gipsi/numerics/simd.h"
 #include "gipsi/numerics/sparse/linear_solver.h"
 #include "gipsi/numerics/sparse/model_problems.h"
 
@@ -27,6 +30,26 @@ inline bool SameBits(const VecX& a, const VecX& b) {
   return a.size() == b.size() &&
          std::memcmp(a.data(), b.data(), sizeof(double) * static_cast<std::size_t>(a.size())) == 0;
 }
+
+/// Runs the scope with `threads` OpenMP threads and at most `kernels` (numerics/simd.h), and
+/// restores both when it ends (also on a failed ASSERT).
+class ScopedTeamAndKernels {
+ public:
+  ScopedTeamAndKernels(int threads, SimdKernels kernels)
+      : threads_(omp_get_max_threads()), kernels_(LimitSimdKernels(kernels)) {
+    omp_set_num_threads(threads);
+  }
+  ScopedTeamAndKernels(const ScopedTeamAndKernels&) = delete;
+  ScopedTeamAndKernels& operator=(const ScopedTeamAndKernels&) = delete;
+  ~ScopedTeamAndKernels() {
+    LimitSimdKernels(kernels_);
+    omp_set_num_threads(threads_);
+  }
+
+ private:
+  int threads_;
+  SimdKernels kernels_;
+};
 
 /// A x_true = b with a random x_true; b is computed with SymmetricSpMV, so x_true has a
 /// residual of exactly 0 under the solvers' own product.

@@ -167,7 +167,6 @@ void SupernodalSolve::Analyze(const SupernodalFactorView& f) {
   std::vector<int> parent(ns, -1), first(ns);
   std::vector<std::vector<int>> children(ns);
   std::vector<double> subtree(ns, 0);
-  double total = 0;
   int widest = 1;
   bool ordered = true;  // children numbered before their parents
   for (int s = 0; s < nsuper_; ++s)
@@ -177,7 +176,6 @@ void SupernodalSolve::Analyze(const SupernodalFactorView& f) {
     const int nsrow = f.pi[s + 1] - f.pi[s];
     widest = std::max(widest, nsrow);
     subtree[at(s)] = static_cast<double>(nsrow) * nscol;
-    total += subtree[at(s)];
     first[at(s)] = s;
     if (nsrow > nscol) parent[at(s)] = col_super[at(f.s_rows[f.pi[s] + nscol])];
     if (parent[at(s)] >= 0 && parent[at(s)] <= s) ordered = false;
@@ -256,17 +254,11 @@ void SupernodalSolve::Analyze(const SupernodalFactorView& f) {
   }
   top_.clear();
   top_row_.assign(at(n_), 0);
-  double group_work[2] = {0, 0};
-  for (int g = 0; g < 2; ++g)
-    for (const auto& [a, b] : ranges_[g]) group_work[g] += subtree[at(b - 1)];
   for (int s = 0; s < nsuper_; ++s) {
     if (in_group[at(s)]) continue;
     top_.push_back(s);
     for (int k = f.super[s]; k < f.super[s + 1]; ++k) top_row_[at(k)] = 1;
   }
-  share_[0] = total > 0 ? group_work[0] / total : 0;
-  share_[1] = total > 0 ? group_work[1] / total : 0;
-  share_[2] = 1 - share_[0] - share_[1];
   parallel_ = !ranges_[0].empty() && !ranges_[1].empty() && n_ >= kParallelRows;
   y_.setZero(n_);
   buffer_.setZero(n_);

@@ -53,10 +53,6 @@ class SupernodalSolve {
   /// large enough to pay for waking the second.
   void Solve(const SupernodalFactorView& factor, const VecX& b, VecX& x);
 
-  /// The shares of the factor's entries solved by the first thread's subtrees, the second's,
-  /// and the separators above them (one thread). Sums to 1.
-  [[nodiscard]] double share(int part) const { return share_[static_cast<std::size_t>(part)]; }
-
  private:
   int n_ = 0, nsuper_ = 0;
   std::vector<std::pair<int, int>> ranges_[2];  // each thread's subtrees: [first, last) supernodes
@@ -64,10 +60,9 @@ class SupernodalSolve {
   std::vector<char> top_row_;                   // rows (columns of L) of the separators
   bool parallel_ = false;
   bool avx_ = false;  // the AVX kernels (the same bits; numerics/simd.h)
-  double share_[3] = {0, 0, 1};
-  VecX y_;           // the permuted right-hand side, solved in place
-  VecX buffer_;      // the second thread's updates of separator rows
-  VecX scratch_[2];  // per-thread work vectors (the tallest supernode)
+  VecX y_;            // the permuted right-hand side, solved in place
+  VecX buffer_;       // the second thread's updates of separator rows
+  VecX scratch_[2];   // per-thread work vectors (the tallest supernode)
 
   void ForwardOne(const SupernodalFactorView& f, int s, int group);
   void BackwardOne(const SupernodalFactorView& f, int s, int group);
