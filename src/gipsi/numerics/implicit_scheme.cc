@@ -120,4 +120,24 @@ void ImplicitScheme::Commit(const VecX& d) {
   dt_prev_ = dt_;
 }
 
+void PredictIncrement(const ImplicitScheme& scheme, StepPredictor predictor, double h, VecX& d) {
+  if (predictor == StepPredictor::kNone) {
+    d.setZero();  // keeps d's size (a static scheme has no velocities)
+    return;
+  }
+  const VecX& v = scheme.v();
+  const VecX& a = scheme.a();
+  d.resize(v.size());
+  switch (predictor) {
+    case StepPredictor::kNone:
+      return;
+    case StepPredictor::kConstantVelocity:
+      d = h * v;
+      return;
+    case StepPredictor::kConstantAcceleration:
+      for (Index i = 0; i < d.size(); ++i) d[i] = scheme.IncrementForVelocity(i, v[i] + h * a[i]);
+      return;
+  }
+}
+
 }  // namespace gipsi

@@ -17,6 +17,7 @@
 ///                   acceleration) is second order and conserves the energy of linear systems.
 ///                   (N. M. Newmark, J. Eng. Mech. Div. ASCE 85(3):67–94, 1959.)
 
+#include <cstdint>
 #include <string_view>
 
 #include "gipsi/base/export.h"
@@ -95,6 +96,18 @@ class ImplicitScheme {
   double c_a_ = 0, c_v_ = 0;
   VecX a_hat_, v_hat_;
 };
+
+/// Where a dynamic step's nonlinear solve starts (the solids' scene key "predictor"):
+/// - kNone: at x_n (increment 0);
+/// - kConstantVelocity: at x_n + h v_n; for smooth motion the first iterate is then O(h² a)
+///   from the solution instead of O(h v);
+/// - kConstantAcceleration: at the increment the scheme turns into the velocity v_n + h a_n
+///   (x_n + h v_n + h² a_n for backward Euler), O(h³ ȧ) from the solution.
+enum class StepPredictor : std::uint8_t { kNone, kConstantVelocity, kConstantAcceleration };
+
+/// The predicted increment d of a step of length h, after scheme.Begin(h) (kNone: zero, d's size
+/// kept; otherwise sized as scheme.v()).
+void PredictIncrement(const ImplicitScheme& scheme, StepPredictor predictor, double h, VecX& d);
 
 }  // namespace gipsi
 GIPSI_EXPORT_END

@@ -111,6 +111,8 @@ FemSolid::FemSolid(std::string name, std::shared_ptr<const Mesh> domain, FemPara
       {"newton_iterations", L::kGlobal, 1, "1", A::kRead, "Newton iterations of the last step"});
   f_inverted_ = DeclareField(
       {"inverted_elements", L::kGlobal, 1, "1", A::kRead, "number of elements with det F <= 0"});
+  f_volume_ = DeclareField({"volume", L::kGlobal, 1, "m^3", A::kRead,
+                            "current volume (the sum of the tets' signed volumes)"});
   for (WallCavity& wall : MakeWallCavities(
            this->name(), params_.cavities, *domain, bnd,
            [this](FieldInfo info) { return DeclareField(std::move(info)); },
@@ -590,17 +592,8 @@ StepStatus FemSolid::Advance(double s0, double s1, double dt, int depth) {
   const bool predict = params_.predictor != FemParams::Predictor::kNone &&
                        params_.scheme != ImplicitSchemeKind::kStatic;
   auto solve = [&](bool predicted) {
-    if (!predicted) {
-      d_.setZero();
-    } else if (params_.predictor == FemParams::Predictor::kConstantVelocity) {
-      d_ = ((s1 - s0) * dt) * state_.scheme.v();
-    } else {
-      const double h = (s1 - s0) * dt;
-      const VecX& v = state_.scheme.v();
-      const VecX& a = state_.scheme.a();
-      for (Index i = 0; i < d_.size(); ++i)
-        d_[i] = state_.scheme.IncrementForVelocity(i, v[i] + h * a[i]);
-    }
+    PredictIncrement(state_.scheme, predicted ? params_.predictor : StepPredictor::kNone,
+                     (s1 - s0) * dt, d_);
     const VecX& xn = state_.scheme.x();
     for (int dof : constrained_dofs_) {
       if (constraint_[static_cast<std::size_t>(dof)] == 1)
@@ -837,6 +830,16 @@ void FemSolid::DoReadField(FieldId id, Eigen::Ref<Eigen::MatrixXd> out) const {
     out(0, 0) = state_.last_newton.iterations;
   } else if (id == f_inverted_) {
     out(0, 0) = static_cast<double>(CountInvertedElements());
+  } else if (id == f_volume_) {
+    double v = 0;
+    const auto& tets = assembly_.tets();
+    for (Index e = 0; e < tets.cols(); ++e) {
+      const Vec3 x0 = positions_.col(tets(0, e));
+      v += (positions_.col(tets(1, e)) - x0)
+               .dot((positions_.col(tets(2, e)) - x0).cross(positions_.col(tets(3, e)) - x0)) /
+           6;
+    }
+    out(0, 0) = v;
   } else {
     for (std::size_t i = 0; i < cavities_.size(); ++i) {
       if (id == cavities_[i].f_volume) out(0, 0) = CavityVolume(i);

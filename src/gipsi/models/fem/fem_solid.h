@@ -70,7 +70,7 @@ struct FemParams {
   ///   v_n + Δt a_n (x_n + Δt v_n + Δt² a_n for backward Euler), O(Δt³ ȧ) from the solution.
   ///   The heart's muscle then needs 15 % fewer Newton iterations than with constant velocity
   ///   (docs/performance.md).
-  enum class Predictor : std::uint8_t { kNone, kConstantVelocity, kConstantAcceleration };
+  using Predictor = StepPredictor;
   Predictor predictor = Predictor::kNone;
   Vec3 fibre = Vec3::UnitX();  ///< uniform fibre direction (reference configuration)
   Vec3 sheet = Vec3::UnitY();  ///< uniform sheet direction (orthogonalised against the fibre)
@@ -296,7 +296,7 @@ class FemSolid final : public SimObject, public CavityWall {
 
   MechanicalFieldIds mech_;
   FieldId f_fibre_, f_active_, f_nodal_active_, f_von_mises_, f_jacobian_, f_kinetic_,
-      f_strain_energy_, f_newton_, f_inverted_;
+      f_strain_energy_, f_newton_, f_inverted_, f_volume_;
 };
 
 /// Registers "FemSolid".

@@ -69,6 +69,16 @@ NewtonOptions ParseNewtonOptions(const JsonNode& node, NewtonOptions options) {
   return options;
 }
 
+StepPredictor ParsePredictor(const JsonNode& object, StepPredictor fallback) {
+  auto predictor = object.Find("predictor");
+  if (!predictor) return fallback;
+  const std::string choice =
+      predictor->AsChoice({"none", "constant_velocity", "constant_acceleration"});
+  return choice == "constant_velocity"       ? StepPredictor::kConstantVelocity
+         : choice == "constant_acceleration" ? StepPredictor::kConstantAcceleration
+                                             : StepPredictor::kNone;
+}
+
 void ParseLoadStepping(const JsonNode& object, int& load_steps, int& max_bisections) {
   if (auto steps = object.Find("load_steps")) {
     const std::int64_t n = steps->AsInt();
@@ -137,14 +147,7 @@ void RegisterFemSolid(TypeRegistry& registry) {
         if (auto solver = p.Find("linear_solver"))
           params.linear_solver = ParseLinearSolverOptions(*solver);
         ParseLoadStepping(p, params.load_steps, params.max_bisections);
-        if (auto predictor = p.Find("predictor")) {
-          const std::string choice =
-              predictor->AsChoice({"none", "constant_velocity", "constant_acceleration"});
-          params.predictor = choice == "constant_velocity" ? FemParams::Predictor::kConstantVelocity
-                             : choice == "constant_acceleration"
-                                 ? FemParams::Predictor::kConstantAcceleration
-                                 : FemParams::Predictor::kNone;
-        }
+        params.predictor = ParsePredictor(p, params.predictor);
         std::optional<TransmuralFibreRule> fibre_rule;
         if (auto fibres = p.Find("fibres"); fibres && fibres->Has("rule")) {
           fibre_rule = ParseTransmuralFibreRule(*fibres);

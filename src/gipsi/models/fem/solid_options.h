@@ -4,6 +4,7 @@
 
 #include "gipsi/base/export.h"
 #include "gipsi/base/json_node.h"
+#include "gipsi/numerics/implicit_scheme.h"
 #include "gipsi/numerics/newton.h"
 
 GIPSI_EXPORT_BEGIN
@@ -16,6 +17,10 @@ namespace gipsi {
 /// The object's "load_steps" (an integer in [1, 100000]) and "max_bisections" (in [0, 30]),
 /// each left as given when absent; throws InputError naming the JSON path of a bad value.
 void ParseLoadStepping(const JsonNode& object, int& load_steps, int& max_bisections);
+
+/// The object's "predictor" ("none", "constant_velocity" or "constant_acceleration"); `fallback`
+/// when absent. Throws InputError naming the JSON path of a bad value.
+[[nodiscard]] StepPredictor ParsePredictor(const JsonNode& object, StepPredictor fallback);
 
 }  // namespace gipsi
 GIPSI_EXPORT_END
