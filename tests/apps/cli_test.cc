@@ -193,7 +193,7 @@ TEST(GipsiValidate, AcceptsTheDemoScenes) {
         "cantilever.json", "indentation.json", "hanging_liver_fem.json", "slab_ep_0.5mm.json",
         "slab_ep_0.2mm.json", "slab_ep_grid_0.5mm.json", "slab_ep_grid_0.2mm.json",
         "spiral_wave.json", "lv_activation.json", "heart.json", "heart_mass_spring.json",
-        "heart_fine.json"}) {
+        "heart_fine.json", "heart_mixed.json"}) {
     Result r = Gipsi("validate " + Scene(scene));
     EXPECT_EQ(r.code, 0) << scene << "\n" << r.output;
     EXPECT_THAT(r.output, HasSubstr("valid scene"));

@@ -235,6 +235,13 @@ TEST(Resume, MassSpringHeartIsBitwiseIdentical) {
   ExpectBitwiseResume("heart_mass_spring.json", "heart_ms", 0.1, 0.12, 0.25);
 }
 
+TEST(Resume, MixedHeartIsBitwiseIdentical) {
+  // The heart with its incompressible P2-P1 muscle: the cavity pressure solved with the wall (a
+  // bordered unknown of Newton), the kept UMFPACK factorisation and the predictor's history;
+  // checkpoint at 20 ms, resumed to 50 ms.
+  ExpectBitwiseResume("heart_mixed.json", "heart_mixed", 0.02, 0.03, 0.05);
+}
+
 TEST(Resume, HapticPalpationIsBitwiseIdentical) {
   // The multi-rate haptic demo: an FEM liver, a synchronous probe on a scripted path ticking at
   // 1 kHz and the coupling that publishes local models. The contact starts at about 1.18 s;

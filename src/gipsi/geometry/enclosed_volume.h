@@ -8,6 +8,7 @@
 /// the centroid moves with the loop, so its contribution to the gradient is shared equally among
 /// the loop's vertices.
 
+#include <utility>
 #include <vector>
 
 #include "gipsi/base/export.h"
@@ -39,6 +40,10 @@ class EnclosedVolume {
 
   /// Number of boundary loops capped (0 for a closed surface).
   [[nodiscard]] Index num_loops() const { return static_cast<Index>(loops_.size()); }
+  /// Each boundary loop as its half-edges (a → b, vertex indices, as oriented in the surface).
+  [[nodiscard]] const std::vector<std::vector<std::pair<int, int>>>& loops() const {
+    return loops_;
+  }
   /// Enclosed volume for vertex positions `x` (3 by num_vertices) [m³ if x in m]. If
   /// `gradient` is not null it is resized to 3 by num_vertices and receives ∂V/∂x.
   double Compute(const Points& x, Points* gradient = nullptr) const;

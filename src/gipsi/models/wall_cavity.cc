@@ -3,6 +3,9 @@
 
 #include "gipsi/models/wall_cavity.h"
 
+#include <algorithm>
+#include <cmath>
+
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
@@ -58,6 +61,13 @@ std::vector<WallCavity> MakeWallCavities(std::string_view object, std::span<cons
                                   .f_pressure = f_pressure});
   }
   return cavities;
+}
+
+double CavityLawStiffness(CavityLaw& law, double t, double dt, double p, double vb) {
+  const double dp = std::max(1e-3, 1e-6 * std::abs(p));
+  double v1 = 0;
+  if (law.EndVolume(t, dt, p + dp, v1) && std::isfinite(v1) && vb > v1) return dp / (vb - v1);
+  return 0;
 }
 
 std::vector<std::string> CavityNames(std::span<const CavitySpec> specs) {

@@ -58,6 +58,12 @@ std::vector<WallCavity> MakeWallCavities(std::string_view object, std::span<cons
                                          const std::function<FieldId(FieldInfo)>& declare,
                                          std::string_view pressure_description);
 
+/// −dp/dV_b of `law` at pressure p [Pa/m³] over the step [t, t + dt], given V_b(p) = vb: a
+/// one-sided difference of 1e-6 of the pressure (at least 1 mPa); 0 if the law fails there or
+/// is not decreasing (then p is not determined by the volume). The weight of a cavity's
+/// rank-one tangent term and 1 / ∂r_p/∂p of its bordered pressure.
+double CavityLawStiffness(CavityLaw& law, double t, double dt, double p, double vb);
+
 /// The names of `specs`, in order (CavityWall::cavity_names).
 std::vector<std::string> CavityNames(std::span<const CavitySpec> specs);
 

@@ -77,9 +77,11 @@ TEST(HeartMassSpring, BadMuscleModelsAndStepsGetClearErrors) {
   EXPECT_EQ(SceneLoadError(With(R"(, "muscle_model": "fem", "dt": "5 ms")")), "(no error)");
   EXPECT_EQ(SceneLoadError(With(R"(, "muscle_model": "springs", "dt": "0.1 ms")")),
             R"(scene.json: objects.heart.muscle_model: expected one of 'fem', 'mass_spring', )"
-            R"(got "springs")");
-  EXPECT_EQ(SceneLoadError(With(R"(, "muscle_model": 2, "dt": "0.1 ms")")),
-            "scene.json: objects.heart.muscle_model: expected one of 'fem', 'mass_spring', got 2");
+            R"('mixed', got "springs")");
+  EXPECT_EQ(
+      SceneLoadError(With(R"(, "muscle_model": 2, "dt": "0.1 ms")")),
+      "scene.json: objects.heart.muscle_model: expected one of 'fem', 'mass_spring', 'mixed', "
+      "got 2");
   // The FEM heart's 5 ms macro step would make the explicit wall sub-step inside the blood's
   // step; the heart says so when it loads instead of failing in the first step.
   EXPECT_EQ(SceneLoadError(With(R"(, "muscle_model": "mass_spring", "dt": "5 ms")")),

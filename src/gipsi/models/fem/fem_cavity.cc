@@ -15,7 +15,6 @@
 // search cuts the steps, and Newton needed 6–13 iterations with several factorisations at each
 // isovolumetric phase of the heart. As a bordered unknown p absorbs that error linearly.
 
-#include <algorithm>
 #include <cmath>
 
 #include <fmt/format.h>
@@ -25,19 +24,6 @@
 #include "gipsi/models/fem/fem_solid.h"
 
 namespace gipsi {
-namespace {
-
-/// −dp/dV_b of the law at p [Pa/m³] by a one-sided difference of 1e-6 of the pressure (at least
-/// 1 mPa), given V_b(p) = vb; 0 if the law fails there or is not decreasing.
-double LawStiffness(CavityLaw& law, double t, double dt, double p, double vb) {
-  const double dp = std::max(1e-3, 1e-6 * std::abs(p));
-  double v1 = 0;
-  if (law.EndVolume(t, dt, p + dp, v1) && std::isfinite(v1) && vb > v1) return dp / (vb - v1);
-  return 0;
-}
-
-}  // namespace
-
 std::vector<std::string> FemSolid::cavity_names() const { return CavityNames(params_.cavities); }
 
 void FemSolid::AttachCavityLaw(std::string_view cavity, CavityLaw* law) {
@@ -94,7 +80,7 @@ bool FemSolid::AddCoupledCavityLoads(const double* u) {
     // Evaluated with every residual (two law evaluations): the Woodbury solve and the
     // elimination of Δp then use the stiffness at the current pressure even while a
     // factorisation of an older tangent is kept, e.g. when a valve has just closed.
-    cs.stiffness = LawStiffness(*cavity.law, step_time_, step_dt_, p, vb);
+    cs.stiffness = CavityLawStiffness(*cavity.law, step_time_, step_dt_, p, vb);
     if (!(cs.stiffness > 0)) {  // p would not be determined by the volume
       failed_cavity_ = static_cast<int>(c);
       return false;

@@ -18,8 +18,7 @@
 namespace gipsi {
 namespace {
 
-constexpr int kLocal = 34;  // 30 displacement and 4 pressure unknowns per element
-constexpr int kQuad = 4;    // quadrature points per element
+constexpr int kQuad = 4;  // quadrature points per element
 constexpr double kEps = std::numeric_limits<double>::epsilon();
 /// Aspect ratio (CheckTetQuality: 1 regular) above which the constructor warns of a sliver.
 constexpr double kSliverAspect = 6;
@@ -251,6 +250,7 @@ MixedSolid::MixedSolid(std::string name, std::shared_ptr<const Mesh> domain,
                             "Newton iterations of the last load increment"});
   f_kinetic_ = DeclareField({"kinetic_energy", L::kGlobal, 1, "J", A::kRead,
                              "1/2 v' M v over the P2 nodes (0 when quasi-static)"});
+  MakeCavities(*domain);
   state_.scheme = ImplicitScheme(params_.scheme);
   if (dynamic()) {
     const VecX zero = VecX::Zero(nu);
@@ -557,7 +557,7 @@ void MixedSolid::ApplyConstraints(VecX& r, double* jv) const {
 /// applied loads at s).
 class MixedSolid::Increment final : public NonlinearSystem {
  public:
-  Increment(const MixedSolid& solid, double s, double force_scale)
+  Increment(MixedSolid& solid, double s, double force_scale)
       : solid_(solid), s_(s), force_scale_(force_scale) {}
   bool CalcResidual(const VecX& z, VecX& r) override {
     return solid_.IncrementResidual(s_, z, r, nullptr);
@@ -567,18 +567,37 @@ class MixedSolid::Increment final : public NonlinearSystem {
   }
   [[nodiscard]] double force_scale() const override { return force_scale_; }
   [[nodiscard]] double residual_floor() const override { return solid_.residual_floor_; }
+  [[nodiscard]] int num_low_rank_terms() const override { return solid_.num_low_rank_terms(); }
+  void LowRankTerm(int k, const VecX*& b, double& w) const override { solid_.LowRankTerm(k, b, w); }
+  [[nodiscard]] int num_bordered() const override { return solid_.bordered_; }
 
  private:
-  const MixedSolid& solid_;
+  MixedSolid& solid_;
   const double s_;
   const double force_scale_;
 };
 
-bool MixedSolid::IncrementResidual(double s, const VecX& z, VecX& r, double* jv) const {
-  if (!Assemble(z, s, r, jv)) return false;
-  if (dynamic()) AssembleInertia(z, r, jv);
-  AssembleLoads(z, s, r, jv);
-  ApplyConstraints(r, jv);
+bool MixedSolid::IncrementResidual(double s, const VecX& x, VecX& r, double* jv) {
+  if (bordered_ == 0) {
+    if (!Assemble(x, s, r, jv)) return false;
+    if (dynamic()) AssembleInertia(x, r, jv);
+    AssembleLoads(x, s, r, jv);
+    ApplyConstraints(r, jv);
+    return r.allFinite();
+  }
+  // (z, p): the pressures go to the state, where the cavity loads read them.
+  TakeIterate(x);
+  const VecX& z = state_.z;
+  if (!Assemble(z, s, iterate_r_, jv)) return false;
+  if (dynamic()) AssembleInertia(z, iterate_r_, jv);
+  AssembleLoads(z, s, iterate_r_, jv);
+  if (!AddCavityLoads(z, iterate_r_, jv, true)) return false;
+  ApplyConstraints(iterate_r_, jv);
+  const Index n = z.size();
+  r.head(n) = iterate_r_;
+  Index k = n;
+  for (const Cavity& cavity : cavities_)
+    if (cavity.wall.law != nullptr) r[k++] = cavity.volume_residual;
   return r.allFinite();
 }
 
@@ -587,7 +606,10 @@ bool MixedSolid::EvaluateUnconstrained(const VecX& z, double s, VecX& r,
   if (jacobian != nullptr) *jacobian = jac_;
   double* jv = jacobian != nullptr ? jacobian->valuePtr() : nullptr;
   const bool ok = Assemble(z, s, r, jv);
-  if (ok) AssembleLoads(z, s, r, jv);
+  if (ok) {
+    AssembleLoads(z, s, r, jv);
+    AddCavityLoads(z, r, jv, false);  // at the state's pressures
+  }
   return ok;
 }
 
@@ -603,6 +625,10 @@ Index MixedSolid::GatherLoads() {
     pressure_new_[f] = bcs.pressure(f);
     traction_new_.col(f) = bcs.traction(f);
   }
+  for (std::size_t c = 0; c < cavities_.size(); ++c)
+    if (cavities_[c].wall.law == nullptr)
+      for (int f : cavities_[c].wall.faces)
+        pressure_new_[f] += state_.cavity_pressure[static_cast<Index>(c)];
   // Constraints on the vertices; an edge node is held on the axes held at both of its ends,
   // at their mean displacement.
   std::fill(constrained_.begin(), constrained_.end(), 0);
@@ -659,21 +685,54 @@ StepStatus MixedSolid::Advance(double s0, double s1, int depth) {
     const double sb = k == n ? s1 : s0 + (s1 - s0) * k / n;
     if (stop_token().stop_requested()) return StepStatus::Stopped();
     const VecX z_start = state_.z;
-    SetTargets(state_.z, sb);
+    const VecX p_start = state_.cavity_pressure;
     VecX loads = VecX::Zero(state_.z.size());
     AssembleLoads(state_.z, sb, loads, nullptr);
+    AddCavityLoads(state_.z, loads, nullptr, false);  // the pressures of the increment's start
     ApplyConstraints(loads, nullptr);
-    Increment increment(*this, sb, loads.norm());
-    state_.last_newton = newton_->Solve(increment, state_.z, jac_, stop_token());
-    state_.total_iterations += state_.last_newton.iterations;
+    const double force_scale = loads.norm();
+    auto solve = [&](bool predicted) {
+      if (predicted) {  // a dynamic step: one increment, the scheme begun
+        PredictIncrement(state_.scheme, params_.predictor, step_dt_, predicted_);
+        state_.z.head(predicted_.size()) = state_.scheme.x() + predicted_;
+      }
+      SetTargets(state_.z, sb);
+      Increment increment(*this, sb, force_scale);
+      if (bordered_ == 0) {
+        state_.last_newton = newton_->Solve(increment, state_.z, jac_, stop_token());
+      } else {
+        GiveIterate(newton_x_);
+        state_.last_newton = newton_->Solve(increment, newton_x_, jac_, stop_token());
+        TakeIterate(newton_x_);  // the last residual may have been a rejected trial's
+      }
+      state_.total_iterations += state_.last_newton.iterations;
+    };
+    const bool predict = dynamic() && params_.predictor != StepPredictor::kNone;
+    solve(predict);
+    if (predict && state_.last_newton.inadmissible && state_.last_newton.iterations == 0) {
+      state_.z = z_start;  // the predicted state was not admissible: start from the last one
+      state_.cavity_pressure = p_start;
+      solve(false);
+    }
     if (state_.last_newton.converged) continue;
     state_.z = z_start;
+    state_.cavity_pressure = p_start;
     if (state_.last_newton.interrupted) return StepStatus::Stopped();
     if (depth >= params_.max_bisections || dynamic()) {
       failure_detail_ =
           fmt::format("load increment {:.6g} → {:.6g} of the step: {}{}", sa, sb,
                       Describe(state_.last_newton, params_.newton, newton_->linear_solver().name()),
                       MostCompressedElement());
+      if (failed_cavity_ >= 0) {
+        failure_detail_ += fmt::format(
+            "; the blood coupled to cavity '{}' could not give its volume at the wall's "
+            "pressure, or its volume does not fall as the pressure rises (is the blood object "
+            "stepped right after this one?)",
+            params_.cavities[static_cast<std::size_t>(failed_cavity_)].name);
+        if (state_.last_newton.inadmissible)
+          return StepStatus::Failed("the blood coupled to a cavity could not answer; cavity",
+                                    failed_cavity_);
+      }
       return StepStatus::Failed(dynamic() ? "Newton did not converge (try a smaller dt)"
                                           : "Newton did not converge (bisections exhausted)");
     }
@@ -703,8 +762,11 @@ std::string MixedSolid::MostCompressedElement() const {
       smallest, domain().TetName(worst), centre.x(), centre.y(), centre.z());
 }
 
-StepStatus MixedSolid::DoStep(double /*t*/, double dt) {
+StepStatus MixedSolid::DoStep(double t, double dt) {
   failure_detail_.clear();
+  step_time_ = t;
+  step_dt_ = dt;
+  failed_cavity_ = -1;
   if (dynamic()) state_.scheme.Begin(dt);  // before GatherLoads: prescribed velocities need it
   if (const Index v = GatherLoads(); v >= 0) {
     failure_detail_ = fmt::format(
@@ -716,9 +778,11 @@ StepStatus MixedSolid::DoStep(double /*t*/, double dt) {
   // Prescribed displacements ramp from where the constrained dofs are now.
   for (int dof : constrained_dofs_) target_prev_[dof] = state_.z[dof];
   z_begin_ = state_.z;
+  cavity_pressure_begin_ = state_.cavity_pressure;
   const StepStatus status = Advance(0, 1, 0);
   if (!status.ok()) {
     state_.z = z_begin_;
+    state_.cavity_pressure = cavity_pressure_begin_;
     UpdatePositions();
     return status;
   }
@@ -847,6 +911,11 @@ void MixedSolid::DoReadField(FieldId id, Eigen::Ref<Eigen::MatrixXd> out) const 
       const Points v = NodeVelocities();
       out(0, 0) = 0.5 * (v.array() * ApplyMass(v).array()).sum();
     }
+  } else {
+    for (std::size_t c = 0; c < cavities_.size(); ++c) {
+      if (id == cavities_[c].wall.f_volume) out(0, 0) = CavityVolume(c);
+      if (id == cavities_[c].wall.f_pressure) out(0, 0) = CavityPressure(c);
+    }
   }
 }
 
@@ -881,7 +950,11 @@ void MixedSolid::DoWriteField(FieldId id, const Eigen::Ref<const Eigen::MatrixXd
       v.segment<3>(3 * (nv + k)) = 0.5 * (in.col(mesh_.edges(0, k)) + in.col(mesh_.edges(1, k)));
     state_.scheme.SetVelocity(v);
   }
-  // Velocity writes to a quasi-static object are ignored.
+  for (std::size_t c = 0; c < cavities_.size(); ++c)
+    if (id == cavities_[c].wall.f_pressure && cavities_[c].wall.law == nullptr)
+      state_.cavity_pressure[static_cast<Index>(c)] = in(0, 0);
+  // Velocity writes to a quasi-static object are ignored, and so are pressure writes to a
+  // cavity coupled to blood (its pressure is solved with the wall).
 }
 
 }  // namespace gipsi

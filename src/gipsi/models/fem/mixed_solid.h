@@ -60,19 +60,32 @@
 /// "velocity" (node, read/write: the vertices'; a write gives the edge nodes the mean of their
 /// ends) and "kinetic_energy" (global, ½ vᵀ M v over all P2 nodes).
 ///
-/// Not yet: Newmark (it needs the initial acceleration M⁻¹ r(u₀)), cavities coupled to blood,
-/// collision and haptic local models. Units: SI.
+/// Cavities (`cavities`, as for FemSolid; wall_cavity.h): the volume a cavity's curved faces
+/// enclose (quadratic_volume.h) and its pressure are the fields "<name>_volume" and
+/// "<name>_pressure". An uncoupled cavity's pressure is written from outside and acts on its
+/// faces like a boundary pressure. A CavityCoupling makes the pressure an unknown of the step
+/// (CavityWall): Newton solves the wall with V(u) = V_b(p), the blood law's end volume, the
+/// pressure bordered onto the saddle-point system and its rank-one term ∂V/∂x ⊗ ∂V/∂x / C
+/// solved by Woodbury (fem_cavity.cc explains the formulation for FemSolid); the follower load
+/// p ∂V/∂x has its exact tangent p ∂²V/∂x² on the faces (the rim caps' share is left out: exact
+/// when the rim is held).
+///
+/// Not yet: Newmark (it needs the initial acceleration M⁻¹ r(u₀)), collision and haptic local
+/// models. Units: SI.
 
 #include <memory>
 #include <string>
 #include <vector>
 
 #include "gipsi/base/export.h"
+#include "gipsi/core/cavity_law.h"
 #include "gipsi/core/registry.h"
 #include "gipsi/core/sim_object.h"
 #include "gipsi/models/fem/mixed_state.h"
 #include "gipsi/models/fem/quadratic_tets.h"
+#include "gipsi/models/fem/quadratic_volume.h"
 #include "gipsi/models/fem/solid_material.h"
+#include "gipsi/models/wall_cavity.h"
 #include "gipsi/numerics/implicit_scheme.h"
 #include "gipsi/numerics/newton.h"
 
@@ -94,6 +107,12 @@ struct MixedSolidParams {
   double density = 1000;        ///< ρ [kg/m³], for the mass and gravity
   double rayleigh_mass = 0;     ///< α [1/s]: damping force α M v
   Vec3 gravity = Vec3::Zero();  ///< g [m/s²]
+  /// Where a dynamic step's Newton solve starts (implicit_scheme.h); a predicted state with an
+  /// inverted element falls back to the last step's.
+  StepPredictor predictor = StepPredictor::kNone;
+  /// Cavities bounded by parts of the boundary (wall_cavity.h), coupled to blood by a
+  /// CavityCoupling or loaded by their written pressure.
+  std::vector<CavitySpec> cavities;
   NewtonOptions newton;
   LinearSolverOptions linear_solver = [] {
     LinearSolverOptions o;
@@ -104,11 +123,12 @@ struct MixedSolidParams {
 };
 
 /// Not copyable or movable (a SimObject).
-class MixedSolid final : public SimObject {
+class MixedSolid final : public SimObject, public CavityWall {
  public:
   /// Throws InputError for a mesh without tets, inverted or degenerate tets, a missing law or
   /// one without a split volumetric term, a zero fibre direction, a non-positive density, the
-  /// Newmark scheme, or several load steps with a dynamic scheme.
+  /// Newmark scheme, several load steps with a dynamic scheme, or a cavity whose region selects
+  /// no face or whose rim is not a set of simple loops.
   MixedSolid(std::string name, std::shared_ptr<const Mesh> domain, MixedSolidParams params);
 
   [[nodiscard]] std::string_view type_name() const override { return "MixedSolid"; }
@@ -156,6 +176,21 @@ class MixedSolid final : public SimObject {
   /// The current unknowns z.
   [[nodiscard]] const VecX& unknowns() const { return state_.z; }
 
+  // CavityWall.
+  [[nodiscard]] std::vector<std::string> cavity_names() const override {
+    return CavityNames(params_.cavities);
+  }
+  /// Throws InputError for an unknown cavity or one already coupled.
+  void AttachCavityLaw(std::string_view cavity, CavityLaw* law) override;
+  /// Volume enclosed by cavity i's curved faces at the current state [m³].
+  [[nodiscard]] double CavityVolume(std::size_t i) const;
+  /// Its pressure [Pa] (solved with the wall when coupled to blood).
+  [[nodiscard]] double CavityPressure(std::size_t i) const;
+  /// Cavity i's volume as a function of the P2 node positions (its curved faces and rim caps).
+  [[nodiscard]] const QuadraticEnclosedVolume& cavity_volume(std::size_t i) const {
+    return cavities_.at(i).volume;
+  }
+
   /// The state that evolves (mixed_state.h), bound with BindState.
   [[nodiscard]] const MixedState& state() const { return state_; }
 
@@ -171,9 +206,32 @@ class MixedSolid final : public SimObject {
  private:
   /// One load increment as the nonlinear system Newton solves (mixed_solid.cc).
   class Increment;
-  /// The increment's residual r(z) at load fraction s (and J's values if `jv` is not null);
-  /// false if z is not admissible.
-  bool IncrementResidual(double s, const VecX& z, VecX& r, double* jv) const;
+  static constexpr int kLocal = 34;  // 30 displacement and 4 pressure unknowns per element
+  /// One cavity: the wall's (faces, fields, law) and its curved volume. The work members are
+  /// set with every residual.
+  struct Cavity {
+    WallCavity wall;
+    QuadraticEnclosedVolume volume;
+    std::vector<int> boundary_faces;  // the boundary face of each of volume.faces()
+    mutable VecX gradient;            // ∂V/∂z (the unknowns; zero on held dofs and pressures)
+    mutable Points node_gradient;     // ∂V/∂x of the P2 nodes, 3 by nodes
+    mutable double volume_residual = 0;  // V(u) − V_b(p)
+    mutable double stiffness = 0;        // −dp/dV_b
+  };
+  /// The increment's residual r(x) at load fraction s (and J's values if `jv` is not null),
+  /// x = (z, coupled cavity pressures); false if x is not admissible or a blood law fails.
+  bool IncrementResidual(double s, const VecX& x, VecX& r, double* jv);
+  /// For each coupled cavity: V and ∂V/∂z at z, the load −p ∂V/∂z into r (and −p ∂²V/∂x² into
+  /// J's values if `jv` is not null) at the state's pressure; with `laws`, its blood law's
+  /// volume residual and stiffness too (false if the law cannot answer).
+  bool AddCavityLoads(const VecX& z, VecX& r, double* jv, bool laws) const;
+  [[nodiscard]] int num_low_rank_terms() const { return bordered_; }
+  void LowRankTerm(int k, const VecX*& b, double& w) const;
+  /// Builds cavities_ from params_.cavities and declares their fields (mixed_cavity.cc).
+  void MakeCavities(const Mesh& domain);
+  /// Newton's iterate (z, coupled pressures) to and from the state.
+  void GiveIterate(VecX& x) const;
+  void TakeIterate(const VecX& x);
 
   /// Element terms of r (and J's values if `jv` is not null) at z and load fraction `load`
   /// (the active tension is ramped with the loads); false if an element is
@@ -187,7 +245,8 @@ class MixedSolid final : public SimObject {
   void AssembleLoads(const VecX& z, double s, VecX& r, double* jv) const;
   /// Zeroes the constrained rows (and columns in J, unit diagonal times diag_scale_).
   void ApplyConstraints(VecX& r, double* jv) const;
-  /// This step's loads and constraints; returns a boundary vertex with a prescribed velocity
+  /// This step's loads and constraints (an uncoupled cavity's pressure loads its faces);
+  /// returns a boundary vertex with a prescribed velocity
   /// (which MixedSolid does not take), or -1.
   Index GatherLoads();
   void SetTargets(VecX& z, double s) const;
@@ -231,6 +290,13 @@ class MixedSolid final : public SimObject {
   bool exact_load_tangent_ = false;  // the linear solver takes nonsymmetric matrices
   MixedState state_;                 // everything that evolves (mixed_state.h)
   VecX z_begin_;
+  VecX cavity_pressure_begin_;
+  std::vector<Cavity> cavities_;
+  mutable Points node_positions_;  // work: rest + displacement of every P2 node
+  int bordered_ = 0;               // coupled cavities: Newton's bordered unknowns
+  VecX newton_x_, iterate_z_, iterate_r_, predicted_;
+  double step_time_ = 0, step_dt_ = 0;
+  mutable int failed_cavity_ = -1;
   Points vertex_positions_;
   std::unique_ptr<NewtonSolver> newton_;
   std::string failure_detail_;

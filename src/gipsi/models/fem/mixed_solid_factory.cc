@@ -17,7 +17,7 @@ void RegisterMixedSolid(TypeRegistry& registry) {
         const JsonNode& p = ctx.params;
         ctx.CheckKeys({"material", "formulation", "incompressible", "fibres", "load_steps",
                        "max_bisections", "newton", "linear_solver", "active_tension", "integrator",
-                       "density", "damping", "gravity"});
+                       "density", "damping", "gravity", "cavities", "predictor"});
         MixedSolidParams params;
         params.material = ctx.registry.CreateMaterialAs<SolidMaterial>(p.At("material"), "solid");
         if (auto formulation = p.Find("formulation"))
@@ -34,12 +34,19 @@ void RegisterMixedSolid(TypeRegistry& registry) {
                     "has no effect with a dynamic integrator: a dynamic step is one solve at "
                     "the step's loads (make dt smaller instead)");
         }
+        params.predictor = ParsePredictor(p, params.predictor);
+        if (params.scheme == ImplicitSchemeKind::kStatic && p.Has("predictor"))
+          p.At("predictor")
+              .Fail(
+                  "has no effect on a quasi-static MixedSolid (it predicts a dynamic step from "
+                  "the velocities; set \"integrator\")");
         params.density = p.Positive("density", params.density);
         if (auto damping = p.Find("damping")) {
           damping->CheckKeys({"mass"});
           params.rayleigh_mass = damping->NonNegative("mass", 0);
         }
         params.gravity = p.Vector3("gravity", params.gravity);
+        if (auto cavities = p.Find("cavities")) params.cavities = ParseCavitySpecs(*cavities);
         if (auto newton = p.Find("newton"))
           params.newton = ParseNewtonOptions(*newton, params.newton);
         params.incompressible = p.Bool("incompressible", params.incompressible);

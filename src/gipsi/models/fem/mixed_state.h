@@ -21,7 +21,7 @@ namespace gipsi {
 /// Copyable. Shapes: N P2 nodes, V vertices, E elements, F boundary faces.
 struct MixedState {
   static constexpr const char* kTag = "MixedState";
-  static constexpr std::uint32_t kVersion = 2;
+  static constexpr std::uint32_t kVersion = 3;
 
   VecX z;  ///< the unknowns: displacements (3N, node-major), then scaled pressures (V)
   /// The previous step's loads (s = 0 of the load ramp within a step).
@@ -37,6 +37,7 @@ struct MixedState {
   Stamped<std::vector<Mat3>> axes;
   /// The time scheme's history over the displacement unknowns (3N; static: kind only).
   ImplicitScheme scheme;
+  VecX cavity_pressure;     ///< per cavity [Pa]
   NewtonStats last_newton;  ///< of the last increment (the field "newton_iterations")
   std::int64_t total_iterations = 0;
 
@@ -52,6 +53,7 @@ struct MixedState {
     v("active_new", s.active_new, Shape::kFixed);
     v("axes", s.axes, Shape::kFixed);
     v("scheme", s.scheme);
+    v("cavity_pressure", s.cavity_pressure, Shape::kFixed);
     v("last_newton", s.last_newton);
     v("total_iterations", s.total_iterations);
   }

@@ -83,6 +83,28 @@ constexpr const char* kMassSpringPatch = R"({
   "parts": {"blood": {"dt": "0.1 ms"}}
 })";
 
+/// `"muscle_model": "mixed"`: the muscle part becomes a MixedSolid (Taylor–Hood P2–P1, fully
+/// incompressible: docs/incompressible.md) on the same mesh, with the same law, fibres, cavity,
+/// held base, scheme and Newton settings; UMFPACK factorises its saddle-point tangent. The
+/// excitation-contraction connector then writes the element field "active_tension" (MixedSolid
+/// has no nodal one). The law's bulk modulus is not used (J = 1).
+constexpr const char* kMixedMuscle = R"({
+  "type": "MixedSolid", "domain": "lv", "dt": "5 ms",
+  "material": {"law": "Guccione", "C": 1000, "bf": 8, "bt": 2, "bfs": 4, "bulk_modulus": 50000},
+  "incompressible": true,
+  "fibres": {"rule": "transmural", "endo": {"group": "endo"}, "epi": {"group": "epi"},
+             "axis": [0, 0, 1], "endo_angle": 60, "epi_angle": -60},
+  "integrator": "BackwardEuler", "predictor": "constant_acceleration", "density": 1060,
+  "linear_solver": {"type": "umfpack"},
+  "newton": {"tolerance": 1e-6, "max_iterations": 40, "reuse_factorization": true},
+  "cavities": {"lumen": {"group": "endo"}},
+  "boundary_conditions": [{"name": "base", "region": {"group": "base"}, "fix": true}]
+})";
+
+constexpr const char* kMixedPatch = R"({
+  "connectors": {"excitation_contraction": {"to": "muscle.active_tension"}}
+})";
+
 }  // namespace
 
 Heart::Heart(std::string name, Coordinator parts, HeartMonitorSpec monitor)
@@ -245,11 +267,14 @@ void RegisterHeart(TypeRegistry& registry) {
           if (key != "dt") patch.erase(key);
         std::string muscle_model = "fem";
         if (auto model = ctx.params.Find("muscle_model"))
-          muscle_model = model->AsChoice({"fem", "mass_spring"});
+          muscle_model = model->AsChoice({"fem", "mass_spring", "mixed"});
         patch.erase("muscle_model");
         if (muscle_model == "mass_spring") {
           merged["parts"]["muscle"] = nlohmann::ordered_json::parse(kMassSpringMuscle);
           merged.merge_patch(nlohmann::ordered_json::parse(kMassSpringPatch));
+        } else if (muscle_model == "mixed") {
+          merged["parts"]["muscle"] = nlohmann::ordered_json::parse(kMixedMuscle);
+          merged.merge_patch(nlohmann::ordered_json::parse(kMixedPatch));
         }
         merged.merge_patch(patch);
         const JsonNode root(
