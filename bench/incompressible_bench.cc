@@ -74,7 +74,8 @@ double TipMm(const SimObject& object) {
   return -1;
 }
 
-void BM_LandBeamMixedP2P1(benchmark::State& state) {
+/// The mixed beam with linear solver `solver` ("umfpack" or "schur_gmres").
+void LandBeamMixed(benchmark::State& state, const char* solver) {
   const int n = static_cast<int>(state.range(0));
   const auto mesh = Beam(n);
   double tip = 0, iterations = 0, unknowns = 0, seconds = 0;
@@ -87,6 +88,7 @@ void BM_LandBeamMixedP2P1(benchmark::State& state) {
     params.load_steps = 8;
     params.newton.tolerance = 1e-10;
     params.newton.max_iterations = 40;
+    params.linear_solver.type = solver;
     MixedSolid solid("beam", mesh, params);
     Load(solid);
     const StepStatus status = solid.Step(1);
@@ -102,7 +104,18 @@ void BM_LandBeamMixedP2P1(benchmark::State& state) {
   state.counters["ms_per_it"] =
       1e3 * seconds / (iterations * static_cast<double>(state.iterations()));
 }
+
+void BM_LandBeamMixedP2P1(benchmark::State& state) { LandBeamMixed(state, "umfpack"); }
 BENCHMARK(BM_LandBeamMixedP2P1)
+    ->Arg(1)
+    ->Arg(2)
+    ->Arg(4)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+
+/// The same with GMRES and the block preconditioner (saddle_point_solver.h).
+void BM_LandBeamMixedP2P1Schur(benchmark::State& state) { LandBeamMixed(state, "schur_gmres"); }
+BENCHMARK(BM_LandBeamMixedP2P1Schur)
     ->Arg(1)
     ->Arg(2)
     ->Arg(4)

@@ -14,6 +14,7 @@
 #include "gipsi/geometry/quality.h"
 #include "gipsi/models/fem/fem_geometry.h"
 #include "gipsi/models/fem/solid_laws.h"
+#include "gipsi/numerics/sparse/saddle_point_solver.h"
 
 namespace gipsi {
 namespace {
@@ -224,9 +225,50 @@ MixedSolid::MixedSolid(std::string name, std::shared_ptr<const Mesh> domain,
   z_begin_ = state_.z;
   vertex_positions_ = domain->nodes;
 
-  auto linear = MakeLinearSolver(params_.linear_solver);
+  std::unique_ptr<LinearSolver> linear;
+  if (params_.linear_solver.type == "schur_gmres") {
+    // Ŝ ≈ C + B K⁻¹ Bᵀ: each element's pressure mass ∫ L_a L_b dV over its shear modulus (plus
+    // 1/κ, the C block's), in the scaled pressure's units (s² ×); the moduli follow the tangent
+    // (UpdateSchur), so a stiffening law keeps GMRES's iteration count down.
+    const double e0 = law_->small_strain_youngs_modulus();
+    rest_shear_ = e0 / (2 * (1 + law_->small_strain_poisson_ratio()));
+    element_shear_ = VecX::Constant(ne, rest_shear_);
+    element_pressure_mass_.assign(static_cast<std::size_t>(ne) * 16, 0.0);
+    std::vector<Eigen::Triplet<double, int>> entries;
+    for (Index e2 = 0; e2 < ne; ++e2)
+      for (int q = 0; q < kQuad; ++q) {
+        const Eigen::Vector4d& l = rule.points[static_cast<std::size_t>(q)];
+        for (int a = 0; a < 4; ++a)
+          for (int b = 0; b < 4; ++b) {
+            element_pressure_mass_[static_cast<std::size_t>(e2 * 16 + 4 * b + a)] +=
+                weight_[e2 * kQuad + q] * l[a] * l[b];
+            entries.emplace_back(mesh_.elements(a, e2), mesh_.elements(b, e2), 0.0);
+          }
+      }
+    schur_.resize(nv, nv);
+    schur_.setFromTriplets(entries.begin(), entries.end());
+    schur_.makeCompressed();
+    schur_index_.resize(static_cast<std::size_t>(ne) * 16);
+    for (Index e2 = 0; e2 < ne; ++e2)
+      for (int a = 0; a < 4; ++a)
+        for (int b = 0; b < 4; ++b) {
+          const int col = mesh_.elements(b, e2), row = mesh_.elements(a, e2);
+          const int* begin = schur_.innerIndexPtr() + schur_.outerIndexPtr()[col];
+          const int* end = schur_.innerIndexPtr() + schur_.outerIndexPtr()[col + 1];
+          schur_index_[static_cast<std::size_t>(e2 * 16 + 4 * b + a)] =
+              static_cast<int>(std::lower_bound(begin, end, row) - schur_.innerIndexPtr());
+        }
+    FillSchur();
+    augmentation_.assign(static_cast<std::size_t>(jac_.nonZeros()), 0.0);
+    auto saddle = std::make_unique<SaddlePointSolver>(nu, schur_, params_.linear_solver);
+    saddle_ = saddle.get();
+    linear = std::move(saddle);
+  } else {
+    linear = MakeLinearSolver(params_.linear_solver);
+  }
   linear->AcceptIndefinite();
-  exact_load_tangent_ = linear->name() == "umfpack";
+  // UMFPACK's LU and GMRES take the exact, nonsymmetric load tangent.
+  exact_load_tangent_ = linear->name() == "umfpack" || linear->name() == "schur_gmres";
   newton_ = std::make_unique<NewtonSolver>(params_.newton, std::move(linear));
   newton_->Prepare(jac_);
 
@@ -408,6 +450,8 @@ bool MixedSolid::Assemble(const VecX& z, double load, VecX& r, double* jv) const
   const double inv_kappa = params_.incompressible ? 0.0 : 1.0 / kappa_;
   r.setZero(z.size());
   if (jv != nullptr) std::fill(jv, jv + jac_.nonZeros(), 0.0);
+  if (jv != nullptr && saddle_ != nullptr)
+    std::fill(augmentation_.begin(), augmentation_.end(), 0.0);
   double floor_sq = 0;
   Mat3 P;
   Mat9 C;
@@ -420,6 +464,9 @@ bool MixedSolid::Assemble(const VecX& z, double load, VecX& r, double* jv) const
     Eigen::Matrix<double, kLocal, kLocal> ke;
     if (jv != nullptr) ke.setZero();
     double floor_e = 0;  // magnitude of the terms that cancel in this element's residual
+    double shear = 0;
+    Eigen::Matrix<double, 30, 30> augment;
+    if (jv != nullptr && saddle_ != nullptr) augment.setZero();
     for (int q = 0; q < kQuad; ++q) {
       const auto g = Eigen::Map<const Eigen::Matrix<double, 3, 10>>(
           grad_.data() + (static_cast<std::size_t>(e) * kQuad + q) * 30);
@@ -450,6 +497,17 @@ bool MixedSolid::Assemble(const VecX& z, double load, VecX& r, double* jv) const
           for (int j = 0; j < 3; ++j)
             for (int i = 0; i < 3; ++i)
               C(i + 3 * j, k + 3 * l) += -kappa_ * H(i, j) * H(k, l) + c2 * H(i, l) * H(k, j);
+      // The element's effective shear modulus for the Schur approximation: Σ ∂P_ij/∂F_ij / 12
+      // (μ for an isotropic deviatoric law at rest), from the tangent without its κ term.
+      if (saddle_ != nullptr) {
+        const double mu_q = std::max(C.diagonal().sum() / 12, 0.01 * rest_shear_);
+        shear += mu_q / kQuad;
+        // The preconditioner's augmentation γ ∫ (H : ∇N_a)(H : ∇N_b), γ = μ_q: positive on the
+        // volume-changing motions that the pressure's own terms may leave indefinite.
+        const Eigen::Matrix<double, 3, 10> hg = H * g;
+        const Eigen::Map<const Eigen::Matrix<double, 30, 1>> d(hg.data());
+        augment.noalias() += (w * mu_q) * (d * d.transpose());
+      }
       for (int b = 0; b < 10; ++b) {
         Eigen::Matrix<double, 9, 3> t;
         for (int k = 0; k < 3; ++k)
@@ -469,6 +527,12 @@ bool MixedSolid::Assemble(const VecX& z, double load, VecX& r, double* jv) const
       ke.bottomRightCorner<4, 4>() -= (w * s * s * inv_kappa) * (lq * lq.transpose());
     }
     floor_sq += floor_e * floor_e;
+    if (jv != nullptr && saddle_ != nullptr) {
+      element_shear_[e] = shear;
+      const int* idx = element_value_index_.data() + static_cast<std::size_t>(e) * kLocal * kLocal;
+      for (int c = 0; c < 30; ++c)
+        for (int rr = 0; rr < 30; ++rr) augmentation_[idx[c * kLocal + rr]] += augment(rr, c);
+    }
     for (int a = 0; a < 10; ++a) r.segment<3>(3 * mesh_.elements(a, e)) += re.segment<3>(3 * a);
     for (int b = 0; b < 4; ++b) r[nu + mesh_.elements(b, e)] += re[30 + b];
     if (jv == nullptr) continue;
@@ -577,7 +641,43 @@ class MixedSolid::Increment final : public NonlinearSystem {
   const double force_scale_;
 };
 
+void MixedSolid::FillSchur() {
+  const double inv_kappa = params_.incompressible ? 0.0 : 1.0 / kappa_;
+  const double s2 = pressure_scale_ * pressure_scale_;
+  double* values = schur_.valuePtr();
+  std::fill(values, values + schur_.nonZeros(), 0.0);
+  for (Index e = 0; e < mesh_.num_elements(); ++e) {
+    // A modulus that the pressure's geometric term drives down (or below zero) is kept at a
+    // hundredth of the law's small-strain one: Ŝ stays positive definite.
+    const double mu = std::max(element_shear_[e], 0.01 * rest_shear_);
+    const double c = s2 * (2 / mu + inv_kappa);  // 1/μ + 1/γ with γ = μ
+    for (int k = 0; k < 16; ++k)
+      values[schur_index_[static_cast<std::size_t>(e * 16 + k)]] +=
+          c * element_pressure_mass_[static_cast<std::size_t>(e * 16 + k)];
+  }
+}
+
 bool MixedSolid::IncrementResidual(double s, const VecX& x, VecX& r, double* jv) {
+  const bool ok = IncrementResidualOnly(s, x, r, jv);
+  if (ok && jv != nullptr && saddle_ != nullptr) {
+    // Held dofs keep the unit rows and columns ApplyConstraints gave them.
+    const Index nu = 3 * mesh_.num_nodes();
+    for (Index c = 0; c < jac_.outerSize(); ++c) {
+      const bool col_held = c < nu && constrained_[static_cast<std::size_t>(c)] != 0;
+      for (int k = jac_.outerIndexPtr()[c]; k < jac_.outerIndexPtr()[c + 1]; ++k) {
+        const int row = jac_.innerIndexPtr()[k];
+        if (col_held || (row < nu && constrained_[static_cast<std::size_t>(row)] != 0))
+          augmentation_[static_cast<std::size_t>(k)] = 0;
+      }
+    }
+    FillSchur();
+    saddle_->UpdateSchur(schur_);
+    saddle_->SetPrimaryAugmentation(augmentation_.data());
+  }
+  return ok;
+}
+
+bool MixedSolid::IncrementResidualOnly(double s, const VecX& x, VecX& r, double* jv) {
   if (bordered_ == 0) {
     if (!Assemble(x, s, r, jv)) return false;
     if (dynamic()) AssembleInertia(x, r, jv);
@@ -706,6 +806,7 @@ StepStatus MixedSolid::Advance(double s0, double s1, int depth) {
         TakeIterate(newton_x_);  // the last residual may have been a rejected trial's
       }
       state_.total_iterations += state_.last_newton.iterations;
+      total_linear_iterations_ += state_.last_newton.linear_iterations;
     };
     const bool predict = dynamic() && params_.predictor != StepPredictor::kNone;
     solve(predict);

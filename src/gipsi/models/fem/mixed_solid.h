@@ -19,7 +19,10 @@
 /// with P̃ = ∂W̃/∂F, N_a the P2 and L_b the P1 shape functions, integrated with the 4-point
 /// degree-2 rule (quadratic_tets.h). The tangent is exact: the element terms (symmetric,
 /// indefinite: [[K, Bᵀ], [B, −M/κ]]) plus the follower-load tangent (not symmetric), solved by
-/// a direct LU with pivoting ("umfpack", the default); with "ldlt" (finite κ only) the load
+/// a direct LU with pivoting ("umfpack", the default) or, for large meshes, by GMRES with a
+/// block preconditioner ("schur_gmres", saddle_point_solver.h: CHOLMOD on the displacement block
+/// augmented by γ ∫ (H:∇N_a)(H:∇N_b), each element's pressure mass over its shear modulus for
+/// the Schur complement, both from the last tangent); with "ldlt" (finite κ only) the load
 /// tangent is symmetrised and Newton converges linearly under large follower loads. The pressure
 /// unknown is scaled to the displacements' units (p = s p̃, s = E/h with E the law's small-strain
 /// modulus and h the mean edge length) so that Newton's residual and increment tests weigh both
@@ -88,6 +91,7 @@
 #include "gipsi/models/wall_cavity.h"
 #include "gipsi/numerics/implicit_scheme.h"
 #include "gipsi/numerics/newton.h"
+#include "gipsi/numerics/sparse/saddle_point_solver.h"
 
 GIPSI_EXPORT_BEGIN
 namespace gipsi {
@@ -158,6 +162,8 @@ class MixedSolid final : public SimObject, public CavityWall {
   [[nodiscard]] const NewtonStats& last_newton() const { return state_.last_newton; }
   /// Total Newton iterations and factorisations over all steps (for benchmarks).
   [[nodiscard]] std::int64_t total_newton_iterations() const { return state_.total_iterations; }
+  /// Total iterations of an iterative linear solver ("schur_gmres") in this run (not saved).
+  [[nodiscard]] std::int64_t total_linear_iterations() const { return total_linear_iterations_; }
 
   /// The residual r(z) and, if `jacobian` is not null, the Jacobian at the unknowns z =
   /// (u node-major, p̃) for the loads at load fraction s of the current step, with no
@@ -221,6 +227,9 @@ class MixedSolid final : public SimObject, public CavityWall {
   /// The increment's residual r(x) at load fraction s (and J's values if `jv` is not null),
   /// x = (z, coupled cavity pressures); false if x is not admissible or a blood law fails.
   bool IncrementResidual(double s, const VecX& x, VecX& r, double* jv);
+  bool IncrementResidualOnly(double s, const VecX& x, VecX& r, double* jv);
+  /// schur_'s values from element_shear_ ("schur_gmres").
+  void FillSchur();
   /// For each coupled cavity: V and ∂V/∂z at z, the load −p ∂V/∂z into r (and −p ∂²V/∂x² into
   /// J's values if `jv` is not null) at the state's pressure; with `laws`, its blood law's
   /// volume residual and stiffness too (false if the law cannot answer).
@@ -297,8 +306,17 @@ class MixedSolid final : public SimObject, public CavityWall {
   VecX newton_x_, iterate_z_, iterate_r_, predicted_;
   double step_time_ = 0, step_dt_ = 0;
   mutable int failed_cavity_ = -1;
+  std::int64_t total_linear_iterations_ = 0;
   Points vertex_positions_;
   std::unique_ptr<NewtonSolver> newton_;
+  // "schur_gmres": the solver (owned by newton_), its Schur approximation and what it is made of.
+  SaddlePointSolver* saddle_ = nullptr;
+  SparseMatrix schur_;
+  std::vector<int> schur_index_;               // 16 per element: positions in schur_
+  std::vector<double> element_pressure_mass_;  // 16 per element: ∫ L_a L_b dV
+  mutable VecX element_shear_;                 // per element, from the last tangent
+  mutable std::vector<double> augmentation_;   // the K̂ augmentation, at jac_'s positions
+  double rest_shear_ = 0;
   std::string failure_detail_;
   MechanicalFieldIds mech_;
   FieldId f_fibre_, f_active_, f_pressure_, f_jacobian_, f_volume_, f_energy_, f_newton_,

@@ -51,7 +51,9 @@ void RegisterMixedSolid(TypeRegistry& registry) {
           params.newton = ParseNewtonOptions(*newton, params.newton);
         params.incompressible = p.Bool("incompressible", params.incompressible);
         if (auto solver = p.Find("linear_solver")) {
+          const double tolerance = params.linear_solver.tolerance;  // MixedSolid's default
           params.linear_solver = ParseLinearSolverOptions(*solver);
+          if (!solver->Has("tolerance")) params.linear_solver.tolerance = tolerance;
           if (params.linear_solver.type == "cg" || params.linear_solver.type == "cholmod")
             solver->At("type").Expected(
                 "\"umfpack\" or \"ldlt\": the mixed system is a saddle point, not positive "

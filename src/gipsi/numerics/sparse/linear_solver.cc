@@ -19,7 +19,8 @@
 namespace gipsi {
 namespace {
 
-constexpr std::array<std::string_view, 4> kTypes = {"cg", "ldlt", "cholmod", "umfpack"};
+constexpr std::array<std::string_view, 5> kTypes = {"cg", "ldlt", "cholmod", "umfpack",
+                                                    "schur_gmres"};
 constexpr std::array<std::string_view, 6> kPreconditioners = {"none", "jacobi",   "sgs",
                                                               "ic",   "cholesky", "amg"};
 
@@ -118,6 +119,10 @@ std::unique_ptr<LinearSolver> MakeLinearSolver(const LinearSolverOptions& option
   if (options.type == "ldlt") return MakeLdltSolver(options);
   if (options.type == "cholmod") return MakeCholmodSolver(options);
   if (options.type == "umfpack") return MakeUmfpackSolver(options);
+  if (options.type == "schur_gmres")
+    throw InputError(
+        "linear solver type 'schur_gmres' solves the saddle points of mixed elements (a "
+        "MixedSolid's); this object's systems are not saddle points");
   return MakePcgSolver(options);
 }
 

@@ -61,7 +61,9 @@ void SymmetricSpMVRows(const SparseMatrix& A, const double* x, double* y, int be
 /// Which solver and how hard it works. Plain struct.
 struct LinearSolverOptions {
   /// "cg" (preconditioned CG), "ldlt" (Eigen SimplicialLDLT), "cholmod" (SuiteSparse CHOLMOD
-  /// supernodal LLᵀ) or "umfpack" (UMFPACK LU with pivoting: saddle points, any nonsingular).
+  /// supernodal LLᵀ), "umfpack" (UMFPACK LU with pivoting: saddle points, any nonsingular) or
+  /// "schur_gmres" (GMRES with a block preconditioner, for a MixedSolid's saddle points only:
+  /// saddle_point_solver.h; MakeLinearSolver refuses it).
   std::string type = "cg";
   /// For "cg": "none", "jacobi" (runs the fused single-region CG, pcg.cc), "sgs" (the default:
   /// symmetric block Gauss-Seidel on 3×3 node blocks in Eisenstat's form, node_block_sgs.h;
