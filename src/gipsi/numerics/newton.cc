@@ -505,6 +505,13 @@ std::string Describe(const NewtonStats& stats, const NewtonOptions& options,
             "limit point: try more \"load_steps\"; |r|: {}",
             stats.iterations, name, history);
       default:
+        if (solver == "schur_gmres")  // a MixedSolid's iterative solver: its direct one
+          return fmt::format(
+              "Newton: the linear solve failed at iteration {}: {} did not reach its tolerance "
+              "(an ill-conditioned tangent: a collapsing element?): try \"linear_solver\": "
+              "{{\"type\": \"umfpack\"}}, a larger \"max_iterations\" or more "
+              "\"load_steps\"; |r|: {}",
+              stats.iterations, name, history);
         return fmt::format(
             "Newton: the linear solve failed at iteration {}: {} did not reach its tolerance "
             "(an ill-conditioned or indefinite tangent): try \"linear_solver\": {{\"type\": "

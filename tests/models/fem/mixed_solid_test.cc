@@ -405,6 +405,29 @@ TEST(MixedSolid, SchurGmresFindsTheDirectSolversBeamWithMeshIndependentIteration
   EXPECT_LT(per_newton[1], 1.4 * per_newton[0]);
 }
 
+// A GMRES budget too small to converge fails the step with a diagnostic that names the solver
+// and what to try instead (the direct solver), not CHOLMOD, which MixedSolid refuses.
+TEST(MixedSolid, SchurGmresThatRunsOutOfIterationsSaysWhatToTry) {
+  MixedSolidParams params;
+  params.material = Law(kGuccione);
+  params.incompressible = true;
+  params.max_bisections = 0;
+  params.linear_solver.type = "schur_gmres";
+  params.linear_solver.max_iterations = 2;
+  MixedSolid solid("beam", Box(Vec3(0.01, 0.001, 0.001), {10, 1, 1}), params);
+  BoundaryConditions& bcs = solid.boundary_conditions();
+  for (Index v : VerticesWhere(solid, [](const Vec3& x) { return x.x() < 1e-12; })) bcs.Fix(v);
+  for (Index f : FacesWhere(solid, [](const Vec3& x) { return x.z() < 1e-12; }))
+    bcs.SetPressure(f, 4.0);
+  const StepStatus status = solid.Step(1);
+  EXPECT_FALSE(status.ok());
+  EXPECT_THAT(solid.failure_detail(),
+              ::testing::HasSubstr(
+                  "the 'schur_gmres' linear solver did not reach its tolerance (an "
+                  "ill-conditioned tangent: a collapsing element?): try \"linear_solver\": "
+                  "{\"type\": \"umfpack\"}"));
+}
+
 TEST(MixedSolid, LandBeamConvergesToTheBenchmarkWithoutLocking) {
   std::array<double, 3> tips{};
   for (std::size_t i = 0; i < tips.size(); ++i) {
