@@ -213,6 +213,7 @@ class MixedSolid final : public SimObject, public CavityWall {
   /// One load increment as the nonlinear system Newton solves (mixed_solid.cc).
   class Increment;
   static constexpr int kLocal = 34;  // 30 displacement and 4 pressure unknowns per element
+  static constexpr int kQuad = 4;    // quadrature points per element
   /// One cavity: the wall's (faces, fields, law) and its curved volume. The work members are
   /// set with every residual.
   struct Cavity {
@@ -228,8 +229,11 @@ class MixedSolid final : public SimObject, public CavityWall {
   /// x = (z, coupled cavity pressures); false if x is not admissible or a blood law fails.
   bool IncrementResidual(double s, const VecX& x, VecX& r, double* jv);
   bool IncrementResidualOnly(double s, const VecX& x, VecX& r, double* jv);
-  /// schur_'s values from element_shear_ ("schur_gmres").
+  /// "schur_gmres" (mixed_schur.cc): the solver, schur_'s values from element_shear_, and
+  /// both preconditioner parts handed to the solver after a tangent is assembled.
+  std::unique_ptr<LinearSolver> MakeSchurSolver();
   void FillSchur();
+  void UpdatePreconditioner();
   /// For each coupled cavity: V and ∂V/∂z at z, the load −p ∂V/∂z into r (and −p ∂²V/∂x² into
   /// J's values if `jv` is not null) at the state's pressure; with `laws`, its blood law's
   /// volume residual and stiffness too (false if the law cannot answer).
