@@ -148,6 +148,7 @@ const struct {
                   {"circulation_closed_loop.json", 0.4, 0.9},
                   {"heart.json", 0.1, 0.13},
                   {"heart_mass_spring.json", 0.1, 0.13},
+                  {"heart_mixed.json", 0.02, 0.035},
                   {"liver_palpation.json", 1.25, 1.3}};
 
 TEST(Restep, FromOneSnapshotEveryBuiltInTypeIsBitwise) {
@@ -253,6 +254,11 @@ TEST(Restep, HeartIsBitwise) {
 
 TEST(Restep, MassSpringHeartIsBitwise) {
   ExpectRestepIsBitwise("heart_mass_spring.json", 0.1, 0.13);
+}
+
+TEST(Restep, MixedHeartIsBitwise) {
+  // The incompressible P2-P1 wall with its cavity pressure solved as a bordered unknown.
+  ExpectRestepIsBitwise("heart_mixed.json", 0.02, 0.035);
 }
 
 TEST(Restep, HapticPalpationIsBitwise) {
