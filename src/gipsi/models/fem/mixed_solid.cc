@@ -1,6 +1,7 @@
 #include "gipsi/models/fem/mixed_solid.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <limits>
 #include <utility>
@@ -607,9 +608,20 @@ class MixedSolid::Increment final : public NonlinearSystem {
 };
 
 bool MixedSolid::IncrementResidual(double s, const VecX& x, VecX& r, double* jv) {
+  const auto start = std::chrono::steady_clock::now();
   const bool ok = IncrementResidualOnly(s, x, r, jv);
   if (ok && jv != nullptr && saddle_ != nullptr) UpdatePreconditioner();
+  assembly_seconds_ +=
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return ok;
+}
+
+std::vector<SimObject::ProfileEntry> MixedSolid::ProfileBreakdown() const {
+  return {{"assembly (residual, tangent)", assembly_seconds_, "s"},
+          {"linear solves (factorisations included)", newton_seconds_ - assembly_seconds_, "s"},
+          {"Newton iterations", static_cast<double>(state_.total_iterations), ""},
+          {"linear iterations", static_cast<double>(total_linear_iterations_), ""},
+          {"factorisations", static_cast<double>(factorizations_), ""}};
 }
 
 bool MixedSolid::IncrementResidualOnly(double s, const VecX& x, VecX& r, double* jv) {
@@ -733,6 +745,7 @@ StepStatus MixedSolid::Advance(double s0, double s1, int depth) {
       }
       SetTargets(state_.z, sb);
       Increment increment(*this, sb, force_scale);
+      const auto start = std::chrono::steady_clock::now();
       if (bordered_ == 0) {
         state_.last_newton = newton_->Solve(increment, state_.z, jac_, stop_token());
       } else {
@@ -742,6 +755,9 @@ StepStatus MixedSolid::Advance(double s0, double s1, int depth) {
       }
       state_.total_iterations += state_.last_newton.iterations;
       total_linear_iterations_ += state_.last_newton.linear_iterations;
+      factorizations_ += state_.last_newton.refactorizations;
+      newton_seconds_ +=
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     };
     const bool predict = dynamic() && params_.predictor != StepPredictor::kNone;
     solve(predict);

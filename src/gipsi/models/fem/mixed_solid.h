@@ -138,6 +138,9 @@ class MixedSolid final : public SimObject, public CavityWall {
   [[nodiscard]] std::string_view type_name() const override { return "MixedSolid"; }
   [[nodiscard]] const Points& domain_positions() const override { return vertex_positions_; }
   [[nodiscard]] std::string failure_detail() const override { return failure_detail_; }
+  /// Assembly and linear-solve time, Newton and linear iterations and factorisations of this
+  /// run (`gipsi run --profile`; not saved in checkpoints).
+  [[nodiscard]] std::vector<ProfileEntry> ProfileBreakdown() const override;
   /// The P2 mesh, curved where the domain's second-order geometry curves it: VTU series write
   /// VTK_QUADRATIC_TETRA cells with the displacement and position of the edge nodes (pressure
   /// and the other node fields linear along each edge).
@@ -311,6 +314,9 @@ class MixedSolid final : public SimObject, public CavityWall {
   double step_time_ = 0, step_dt_ = 0;
   mutable int failed_cavity_ = -1;
   std::int64_t total_linear_iterations_ = 0;
+  mutable double assembly_seconds_ = 0;  // residuals and tangents (IncrementResidual)
+  double newton_seconds_ = 0;            // Newton's solves, assembly included
+  std::int64_t factorizations_ = 0;
   Points vertex_positions_;
   std::unique_ptr<NewtonSolver> newton_;
   // "schur_gmres": the solver (owned by newton_), its Schur approximation and what it is made of.
