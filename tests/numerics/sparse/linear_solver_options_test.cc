@@ -54,6 +54,18 @@ TEST(LinearSolverOptions, UnknownTypeNamesPathAndListsChoices) {
               ThrowsMessage<InputError>(HasSubstr("scene.json: solver.type: expected a string")));
 }
 
+// "schur_gmres" needs a saddle point's blocks: only MixedSolid asks for it; any other object
+// gets the key's path and why.
+TEST(LinearSolverOptions, SchurGmresIsForSaddlePointsOnly) {
+  EXPECT_THAT([] { Parse(R"({"type": "schur_gmres"})"); },
+              ThrowsMessage<InputError>(HasSubstr(
+                  "scene.json: solver.type: 'schur_gmres' solves the saddle points of mixed "
+                  "elements (a MixedSolid's); this object's systems are not saddle points")));
+  const JsonDocument doc =
+      JsonDocument::Parse(R"({"solver": {"type": "schur_gmres"}})", "scene.json");
+  EXPECT_EQ(ParseLinearSolverOptions(doc.root().At("solver"), true).type, "schur_gmres");
+}
+
 TEST(LinearSolverOptions, UnknownPreconditionerNamesPathSuggestsAndListsChoices) {
   EXPECT_THAT([] { Parse(R"({"preconditioner": "jacoby"})"); },
               ThrowsMessage<InputError>(

@@ -52,7 +52,7 @@ void RegisterMixedSolid(TypeRegistry& registry) {
         params.incompressible = p.Bool("incompressible", params.incompressible);
         if (auto solver = p.Find("linear_solver")) {
           const double tolerance = params.linear_solver.tolerance;  // MixedSolid's default
-          params.linear_solver = ParseLinearSolverOptions(*solver);
+          params.linear_solver = ParseLinearSolverOptions(*solver, /*saddle_point=*/true);
           if (!solver->Has("tolerance")) params.linear_solver.tolerance = tolerance;
           if (params.linear_solver.type == "cg" || params.linear_solver.type == "cholmod")
             solver->At("type").Expected(

@@ -126,10 +126,16 @@ std::unique_ptr<LinearSolver> MakeLinearSolver(const LinearSolverOptions& option
   return MakePcgSolver(options);
 }
 
-LinearSolverOptions ParseLinearSolverOptions(const JsonNode& node) {
+LinearSolverOptions ParseLinearSolverOptions(const JsonNode& node, bool saddle_point) {
   node.CheckKeys({"type", "preconditioner", "tolerance", "max_iterations", "refactor_iterations"});
   LinearSolverOptions options;
-  if (auto type = node.Find("type")) options.type = ReadChoice(*type, "linear solver type", kTypes);
+  if (auto type = node.Find("type")) {
+    options.type = ReadChoice(*type, "linear solver type", kTypes);
+    if (options.type == "schur_gmres" && !saddle_point)
+      type->Fail(
+          "'schur_gmres' solves the saddle points of mixed elements (a MixedSolid's); this "
+          "object's systems are not saddle points");
+  }
   if (auto preconditioner = node.Find("preconditioner")) {
     options.preconditioner = ReadChoice(*preconditioner, "preconditioner", kPreconditioners);
     if (auto complaint = CholeskyNeedsCg(options)) preconditioner->Fail(*complaint);

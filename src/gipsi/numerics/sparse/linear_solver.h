@@ -162,8 +162,9 @@ std::unique_ptr<LinearSolver> MakeLinearSolver(const LinearSolverOptions& option
 /// Reads {"type", "preconditioner", "tolerance", "max_iterations", "refactor_iterations"} (all
 /// optional, defaults as in LinearSolverOptions); throws InputError naming the JSON path for an
 /// unknown key, an unknown type/preconditioner (listing the choices), "cholesky" or "amg" with
-/// a type other than "cg", a non-positive tolerance or an out-of-range iteration count.
-LinearSolverOptions ParseLinearSolverOptions(const JsonNode& node);
+/// a type other than "cg", a non-positive tolerance or an out-of-range iteration count, and for
+/// "schur_gmres" unless `saddle_point` (the caller's systems are a MixedSolid's).
+LinearSolverOptions ParseLinearSolverOptions(const JsonNode& node, bool saddle_point = false);
 
 }  // namespace gipsi
 GIPSI_EXPORT_END
