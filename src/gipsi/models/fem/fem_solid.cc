@@ -10,6 +10,7 @@
 
 #include "gipsi/base/error.h"
 #include "gipsi/base/log.h"
+#include "gipsi/geometry/quality.h"
 #include "gipsi/models/fem/fem_geometry.h"
 #include "gipsi/models/fem/surface_loads.h"
 #include "gipsi/numerics/adaptive_parallel.h"
@@ -833,12 +834,9 @@ void FemSolid::DoReadField(FieldId id, Eigen::Ref<Eigen::MatrixXd> out) const {
   } else if (id == f_volume_) {
     double v = 0;
     const auto& tets = assembly_.tets();
-    for (Index e = 0; e < tets.cols(); ++e) {
-      const Vec3 x0 = positions_.col(tets(0, e));
-      v += (positions_.col(tets(1, e)) - x0)
-               .dot((positions_.col(tets(2, e)) - x0).cross(positions_.col(tets(3, e)) - x0)) /
-           6;
-    }
+    for (Index e = 0; e < tets.cols(); ++e)
+      v += TetSignedVolume(positions_.col(tets(0, e)), positions_.col(tets(1, e)),
+                           positions_.col(tets(2, e)), positions_.col(tets(3, e)));
     out(0, 0) = v;
   } else {
     for (std::size_t i = 0; i < cavities_.size(); ++i) {

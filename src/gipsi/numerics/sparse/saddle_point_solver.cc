@@ -57,7 +57,7 @@ struct SaddlePointSolver::Impl {
   bool refactorized = false;
   // GMRES work, sized by AnalyzePattern.
   Eigen::MatrixXd v, h;
-  VecX cs, sn, g, w, z, r, xu, zu, tp;
+  VecX cs, sn, g, y, w, z, r, xu, zu, tp, sp;
 
   /// z = P⁻¹ x; false if the K̂ solve produced non-finite values.
   bool Precondition(const Eigen::Ref<const VecX>& x, VecX& out) {
@@ -67,7 +67,8 @@ struct SaddlePointSolver::Impl {
     tp.noalias() = b * zu;
     tp -= x.tail(np);
     out.head(nu) = zu;
-    out.tail(np) = schur.solve(tp);
+    sp = schur.solve(tp);
+    out.tail(np) = sp;
     return out.allFinite();
   }
 };
@@ -120,7 +121,9 @@ void SaddlePointSolver::AnalyzePattern(const SparseMatrix& A) {
   m.cs.resize(kRestart);
   m.sn.resize(kRestart);
   m.g.resize(kRestart + 1);
+  m.y.resize(kRestart);
   m.w.resize(n);
+  m.sp.resize(m.np);
   m.z.resize(n);
   m.r.resize(n);
   m.tp.resize(m.np);
@@ -207,7 +210,8 @@ LinearSolveStats SaddlePointSolver::Solve(const VecX& rhs, VecX& x) {
       }
     }
     // u = V y with H y = g (upper triangular), x += P⁻¹ u.
-    VecX y = m.g.head(j);
+    m.y.head(j) = m.g.head(j);  // y is sized once (AnalyzePattern)
+    auto y = m.y.head(j);
     m.h.topLeftCorner(j, j).triangularView<Eigen::Upper>().solveInPlace(y);
     m.w.noalias() = m.v.leftCols(j) * y;
     if (!m.Precondition(m.w, m.z)) return stats;
