@@ -210,7 +210,8 @@ struct Ranks {
   std::function<void()> barrier;
   /// DistributedRun::AgreeOnFailure.
   std::function<std::optional<std::string>(const std::string&)> agree_on_failure;
-  std::vector<std::string> type_names;  ///< of the distributed types
+  /// The objects split over the ranks, as "name (Type)" (once the scene is loaded).
+  std::function<std::vector<std::string>()> split_objects;
   [[nodiscard]] bool distributed() const { return size > 1; }
 };
 
@@ -492,9 +493,12 @@ int Run(const std::string& file, const std::string& out_dir, double until, bool 
   summary += fmt::format("simulated time:   {:.6g} s (from {:.6g} s)\n",
                          result.end_time - result.start_time, result.start_time);
   summary += fmt::format("wall time:        {:.3f} s\n", result.wall_seconds);
-  if (ranks.distributed())
-    summary += fmt::format("MPI ranks:        {} (distributed: {})\n", ranks.size,
-                           fmt::join(ranks.type_names, ", "));
+  if (ranks.distributed()) {
+    const std::vector<std::string> split = ranks.split_objects();
+    summary += fmt::format("MPI ranks:        {} (split over them: {})\n", ranks.size,
+                           split.empty() ? std::string("none, every object runs whole on each")
+                                         : fmt::format("{}", fmt::join(split, ", ")));
+  }
   summary += fmt::format("real-time factor: {:.3g}\n", result.real_time_factor());
   summary +=
       fmt::format("macro steps:      {} of {:.6g} s\n", result.macro_steps, kernel.macro_dt());
@@ -885,7 +889,7 @@ int main(int argc, char** argv) {
     ranks.rank = mpi->rank();
     ranks.size = mpi->size();
     ranks.register_types = [&mpi](gipsi::TypeRegistry& r) { mpi->RegisterTypes(r); };
-    ranks.type_names = mpi->type_names();
+    ranks.split_objects = [&mpi] { return mpi->split_objects(); };
     ranks.abort = [&mpi](int code) { mpi->Abort(code); };
     ranks.barrier = [&mpi] { mpi->Barrier(); };
     // How long a rank that met an error waits for the others to report one too before it

@@ -127,6 +127,11 @@ class FactoryTable {
     if (!description.empty()) it->second.description = std::move(description);
   }
   [[nodiscard]] bool Contains(std::string_view name) const { return table_.count(name) > 0; }
+  /// The factory for `name`, or null.
+  [[nodiscard]] const Factory* Find(std::string_view name) const {
+    auto it = table_.find(name);
+    return it == table_.end() ? nullptr : &it->second.factory;
+  }
   /// The factory for `name`; throws InputError at `where` listing the known names.
   [[nodiscard]] const Factory& Get(std::string_view name, const JsonNode& where) const {
     auto it = table_.find(name);

@@ -70,9 +70,9 @@ bool NewtonSolver::Monotone(NonlinearSystem& system, NewtonStats& stats, double 
   simplified_ = (1 - alpha) * delta_;
   const LinearSolveStats ls = linear_->Solve(rhs_, simplified_);
   stats.linear_iterations += ls.iterations;
-  if (!ls.converged || !simplified_.allFinite()) return false;
+  if (!ls.converged || !All(simplified_.allFinite())) return false;
   if (!ApplyLowRank(system, stats, simplified_)) return false;
-  return simplified_.norm() <= (1 - 0.25 * alpha) * delta_.norm();
+  return Norm(simplified_) <= (1 - 0.25 * alpha) * Norm(delta_);
 }
 
 NewtonStats NewtonSolver::Solve(NonlinearSystem& system, VecX& d, SparseMatrix& J, StopToken stop) {
@@ -243,7 +243,7 @@ NewtonStats NewtonSolver::Solve(NonlinearSystem& system, VecX& d, SparseMatrix& 
       // out of a poor start); otherwise report the failure.
       alpha = 1;
       d_trial_ = d + delta_;
-      if (!system.CalcResidual(d_trial_, r_trial_) || !r_trial_.allFinite()) {
+      if (!system.CalcResidual(d_trial_, r_trial_) || !All(r_trial_.allFinite())) {
         stats.inadmissible = true;
         return stats;
       }
@@ -254,16 +254,15 @@ NewtonStats NewtonSolver::Solve(NonlinearSystem& system, VecX& d, SparseMatrix& 
     if (by_monotonicity) ++stats.monotonicity_accepts;
     contraction[0] = contraction[1];
     contraction[1] = alpha < 1 || !accepted ? 1.0
-                     : by_monotonicity      ? simplified_.norm() / delta_.norm()
+                     : by_monotonicity      ? Norm(simplified_) / Norm(delta_)
                                             : ratio;
     norm = trial_norm;
     merit = trial_merit;
     stats.final_residual = norm;
     if (it < NewtonStats::kHistory) stats.residual_history[static_cast<std::size_t>(it)] = norm;
-    const double step = delta_.lpNorm<Eigen::Infinity>();  // the full Newton correction
+    const double step = NormInf(delta_);  // the full Newton correction
     const double step_tolerance =
-        std::max(options_.increment_tolerance,
-                 options_.relative_increment_tolerance * d.lpNorm<Eigen::Infinity>());
+        std::max(options_.increment_tolerance, options_.relative_increment_tolerance * NormInf(d));
     if (done(norm) ||
         (!options_.fixed_iterations && step_tolerance > 0 && step <= step_tolerance)) {
       r_.swap(r_trial_);
@@ -316,7 +315,8 @@ bool NewtonSolver::AndersonStep(const VecX& d) {
   int usable = 0;
   for (int a = 0; a < aa_count_; ++a) {
     const int c = (aa_head_ - 1 - a + 2 * depth) % depth;
-    const double norm = aa_df_.col(c).head(n).norm();
+    const double norm =
+        reduction_ ? std::sqrt(Dot(aa_df_.col(c), aa_df_.col(c), n)) : aa_df_.col(c).head(n).norm();
     if (!(norm > 0) || !std::isfinite(norm)) break;
     col[static_cast<std::size_t>(usable)] = c;
     scale[static_cast<std::size_t>(usable++)] = norm;
@@ -325,11 +325,11 @@ bool NewtonSolver::AndersonStep(const VecX& d) {
   SmallVec rhs(usable);
   for (int i = 0; i < usable; ++i) {
     const auto ui = static_cast<std::size_t>(i);
-    const auto fi = aa_df_.col(col[ui]).head(n);
-    rhs[i] = fi.dot(delta_.head(n)) / scale[ui];
+    rhs[i] = Dot(aa_df_.col(col[ui]), delta_, n) / scale[ui];
     for (int j = 0; j <= i; ++j) {
       const auto uj = static_cast<std::size_t>(j);
-      gram(i, j) = gram(j, i) = fi.dot(aa_df_.col(col[uj]).head(n)) / (scale[ui] * scale[uj]);
+      gram(i, j) = gram(j, i) =
+          Dot(aa_df_.col(col[ui]), aa_df_.col(col[uj]), n) / (scale[ui] * scale[uj]);
     }
   }
   for (int k = usable; k > 0; --k) {
@@ -342,21 +342,21 @@ bool NewtonSolver::AndersonStep(const VecX& d) {
       const double g = gamma[i] / scale[ui];
       aa_step_ -= g * (aa_dx_.col(col[ui]) + aa_df_.col(col[ui]));
     }
-    return aa_step_.allFinite();
+    return All(aa_step_.allFinite());
   }
   return false;
 }
 
 double NewtonSolver::Norms(const NonlinearSystem& system, const VecX& r, double& merit) const {
   const int m = system.num_bordered();
-  if (m == 0) return merit = r.norm();
-  merit = r.head(sparse_size_).norm();
+  if (m == 0) return merit = Norm(r);
+  merit = reduction_ ? std::sqrt(Dot(r, r, sparse_size_)) : r.head(sparse_size_).norm();
   double sum = merit * merit;
   for (int k = 0; k < m; ++k) {
     const VecX* b = nullptr;
     double w = 0;
     system.LowRankTerm(k, b, w);
-    const double equivalent = w * b->norm() * r[sparse_size_ + k];
+    const double equivalent = w * Norm(*b) * r[sparse_size_ + k];
     sum += equivalent * equivalent;
   }
   return std::sqrt(sum);
@@ -373,7 +373,7 @@ bool NewtonSolver::SolveCorrection(NonlinearSystem& system, NewtonStats& stats, 
       delta_.setZero();
     ls = linear_->Solve(rhs_, delta_);
     stats.linear_iterations += ls.iterations;
-    return ls.converged && delta_.allFinite() && ApplyLowRank(system, stats, delta_);
+    return ls.converged && All(delta_.allFinite()) && ApplyLowRank(system, stats, delta_);
   }
   // Eliminate the bordered unknowns (NonlinearSystem::num_bordered) with the b_k kept with the
   // factorisation (KeepLowRank).
@@ -391,14 +391,15 @@ bool NewtonSolver::SolveCorrection(NonlinearSystem& system, NewtonStats& stats, 
     bordered_x_.setZero();
   ls = linear_->Solve(bordered_rhs_, bordered_x_);
   stats.linear_iterations += ls.iterations;
-  if (!ls.converged || !bordered_x_.allFinite() || !ApplyLowRank(system, stats, bordered_x_, true))
+  if (!ls.converged || !All(bordered_x_.allFinite()) ||
+      !ApplyLowRank(system, stats, bordered_x_, true))
     return false;
   delta_.head(n) = bordered_x_;
   for (int k = 0; k < m; ++k) {
     delta_[n + k] = -LowRankWeight(system, k) *
-                    (r_[n + k] + low_rank_b_[static_cast<std::size_t>(k)].dot(bordered_x_));
+                    (r_[n + k] + Dot(low_rank_b_[static_cast<std::size_t>(k)], bordered_x_, n));
   }
-  return delta_.allFinite();
+  return All(delta_.allFinite());
 }
 
 double NewtonSolver::LowRankWeight(const NonlinearSystem& system, int k) {
@@ -429,7 +430,7 @@ bool NewtonSolver::SolveLowRankZ(const VecX& b, VecX& z, NewtonStats& stats) {
   if (z.size() != b.size()) z.setZero(b.size());
   const LinearSolveStats ls = linear_->Solve(b, z);  // warm-started from the last z
   stats.linear_iterations += ls.iterations;
-  return ls.converged && z.allFinite();
+  return ls.converged && All(z.allFinite());
 }
 
 bool NewtonSolver::ApplyLowRank(NonlinearSystem& system, NewtonStats& stats, VecX& x, bool kept) {
@@ -463,16 +464,48 @@ bool NewtonSolver::ApplyLowRank(NonlinearSystem& system, NewtonStats& stats, Vec
   SmallVec c(m);
   for (int i = 0; i < m; ++i) {
     const auto ai = static_cast<std::size_t>(active[static_cast<std::size_t>(i)]);
-    c[i] = b[ai]->dot(x);
+    c[i] = Dot(*b[ai], x, x.size());
     for (int j = 0; j < m; ++j)
       s(i, j) =
-          b[ai]->dot(low_rank_z_[static_cast<std::size_t>(active[static_cast<std::size_t>(j)])]);
+          Dot(*b[ai], low_rank_z_[static_cast<std::size_t>(active[static_cast<std::size_t>(j)])],
+              x.size());
     s(i, i) += 1 / w[ai];
   }
   const SmallVec coef = s.ldlt().solve(c);
   for (int j = 0; j < m; ++j)
     x -= coef[j] * low_rank_z_[static_cast<std::size_t>(active[static_cast<std::size_t>(j)])];
-  return x.allFinite();
+  return All(x.allFinite());
+}
+
+double NewtonSolver::Dot(Eigen::Ref<const VecX> a, Eigen::Ref<const VecX> b, Index n) const {
+  if (!reduction_) return n == a.size() && n == b.size() ? a.dot(b) : a.head(n).dot(b.head(n));
+  const Index owned = std::min(n, reduction_->owned());
+  double sum = a.head(owned).dot(b.head(owned));
+  reduction_->Reduce({&sum, 1}, false);
+  return sum;
+}
+
+double NewtonSolver::Norm(const VecX& a) const {
+  if (!reduction_) return a.norm();
+  const Index n = std::min(a.size(), sparse_size_);
+  return std::sqrt(Dot(a, a, n) + a.tail(a.size() - n).squaredNorm());
+}
+
+double NewtonSolver::NormInf(const VecX& a) const {
+  if (!reduction_) return a.lpNorm<Eigen::Infinity>();
+  const Index owned = std::min(a.size(), reduction_->owned());
+  const Index n = std::min(a.size(), sparse_size_);
+  double local = owned > 0 ? a.head(owned).lpNorm<Eigen::Infinity>() : 0.0;
+  if (a.size() > n) local = std::max(local, a.tail(a.size() - n).lpNorm<Eigen::Infinity>());
+  reduction_->Reduce({&local, 1}, true);
+  return local;
+}
+
+bool NewtonSolver::All(bool ok) const {
+  if (!reduction_) return ok;
+  double bad = ok ? 0.0 : 1.0;
+  reduction_->Reduce({&bad, 1}, true);
+  return bad == 0;
 }
 
 std::string Describe(const NewtonStats& stats, const NewtonOptions& options,

@@ -30,6 +30,7 @@
 #include <array>
 #include <cstdint>
 #include <memory>
+#include <span>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -84,6 +85,22 @@ class NonlinearSystem {
   /// Must not change between Prepare and Solve; a term with w_k ≤ 0 (q_k not determined) fails
   /// the iteration's linear solve.
   [[nodiscard]] virtual int num_bordered() const { return 0; }
+};
+
+/// How Newton measures vectors of a system split over processes (a FemSolid on one MPI rank's
+/// part of a mesh, parallel/distributed_solid.h). Each process holds its share of the sparse
+/// unknowns, the first `owned()` entries, followed by copies of entries other processes own;
+/// bordered unknowns (after the sparse ones) are the same on every process. Norms and dot
+/// products then count each sparse unknown once, on its owner. Implementations are collective:
+/// every process must call them in the same order (they do: every decision Newton takes rests
+/// on these reductions, so all processes take the same).
+class VectorReduction {
+ public:
+  virtual ~VectorReduction() = default;
+  /// The entries of the sparse part this process owns (its leading ones).
+  [[nodiscard]] virtual Index owned() const = 0;
+  /// Replaces every value by its sum (`max` false) or maximum over the processes.
+  virtual void Reduce(std::span<double> values, bool max) const = 0;
 };
 
 /// Options. Plain struct. The defaults are the stated defaults of the scene key "newton".
@@ -213,6 +230,10 @@ class NewtonSolver {
   /// iterate (not converged).
   NewtonStats Solve(NonlinearSystem& system, VecX& d, SparseMatrix& J, StopToken stop = {});
 
+  /// Measures vectors with `reduction` (not owned; null: this process holds the whole system,
+  /// the default). Set before Prepare. The linear solver must then be one that solves the
+  /// split system (its vectors laid out the same way).
+  void SetReduction(const VectorReduction* reduction) { reduction_ = reduction; }
   [[nodiscard]] const NewtonOptions& options() const { return options_; }
   [[nodiscard]] LinearSolver& linear_solver() { return *linear_; }
   /// The residual at the last accepted iterate (valid unless fixed_iterations).
@@ -237,6 +258,7 @@ class NewtonSolver {
  private:
   NewtonOptions options_;
   std::unique_ptr<LinearSolver> linear_;
+  const VectorReduction* reduction_ = nullptr;
   VecX r_, r_trial_, delta_, d_trial_, rhs_, simplified_;
   Index sparse_size_ = 0;           // n: the iterate's unknowns in J (then num_bordered() scalars)
   VecX bordered_rhs_, bordered_x_;  // the sparse part of a bordered system's correction
@@ -268,6 +290,13 @@ class NewtonSolver {
   /// ‖r_u‖ (the line search's merit) and the convergence norm of r (the same without
   /// bordered unknowns; see NonlinearSystem::num_bordered).
   [[nodiscard]] double Norms(const NonlinearSystem& system, const VecX& r, double& merit) const;
+  /// a·b over the first n entries, ‖a‖ (every entry: the sparse ones then the bordered ones)
+  /// and ‖a‖∞, each unknown counted once (VectorReduction); Eigen's own with no reduction.
+  [[nodiscard]] double Dot(Eigen::Ref<const VecX> a, Eigen::Ref<const VecX> b, Index n) const;
+  [[nodiscard]] double Norm(const VecX& a) const;
+  [[nodiscard]] double NormInf(const VecX& a) const;
+  /// Whether every process's `ok` is true.
+  [[nodiscard]] bool All(bool ok) const;
   /// Applies the low-rank terms to x = J⁻¹ rhs (Woodbury); false if a solve fails. `kept`:
   /// with the b_k and J⁻¹ b_k kept with the factorisation (KeepLowRank).
   bool ApplyLowRank(NonlinearSystem& system, NewtonStats& stats, VecX& x, bool kept = false);

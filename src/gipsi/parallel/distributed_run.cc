@@ -23,11 +23,9 @@ class PetscRun final : public DistributedRun {
   [[nodiscard]] int rank() const override { return ParallelSession::rank(world()); }
   [[nodiscard]] int size() const override { return ParallelSession::size(world()); }
   void RegisterTypes(TypeRegistry& registry) const override {
-    RegisterDistributedTypes(registry, world());
+    RegisterDistributedTypes(registry, world(), split_);
   }
-  [[nodiscard]] std::vector<std::string> type_names() const override {
-    return DistributedTypeNames();
-  }
+  [[nodiscard]] std::vector<std::string> split_objects() const override { return *split_; }
   void Barrier() const override { MPI_Barrier(world()); }
   [[noreturn]] void Abort(int code) const override {
     MPI_Abort(world(), code);
@@ -55,6 +53,7 @@ class PetscRun final : public DistributedRun {
   static MPI_Comm world() { return ParallelSession::world(); }
   ParallelSession session_;
   MPI_Comm failures_ = MPI_COMM_NULL;  // AgreeOnFailure's alone
+  std::shared_ptr<std::vector<std::string>> split_ = std::make_shared<std::vector<std::string>>();
 };
 
 }  // namespace

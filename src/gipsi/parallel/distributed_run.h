@@ -24,8 +24,9 @@ class DistributedRun {
   [[nodiscard]] virtual int size() const = 0;
   /// Replaces the factories of the distributed types (distributed_types.h).
   virtual void RegisterTypes(TypeRegistry& registry) const = 0;
-  /// The type names RegisterTypes replaces.
-  [[nodiscard]] virtual std::vector<std::string> type_names() const = 0;
+  /// The objects the replaced factories have split over the ranks so far, as "name (Type)"
+  /// (a FemSolid with cavities, for one, still runs whole on every rank).
+  [[nodiscard]] virtual std::vector<std::string> split_objects() const = 0;
   /// Waits until every rank has called it.
   virtual void Barrier() const = 0;
   /// Ends every rank with `code` (MPI_Abort): for a failure one rank meets alone.

@@ -3,16 +3,24 @@
 
 #include "gipsi/parallel/distributed_types.h"
 
+#include <fmt/format.h>
+
 #include "gipsi/base/error.h"
 #include "gipsi/models/ep/ep_tissue_json.h"
+#include "gipsi/models/fem/fem_solid.h"
 #include "gipsi/parallel/distributed_monodomain.h"
+#include "gipsi/parallel/distributed_solid.h"
 #include "gipsi/parallel/whole_domain_view.h"
 
 namespace gipsi {
 
-void RegisterDistributedTypes(TypeRegistry& registry, MPI_Comm comm) {
+void RegisterDistributedTypes(TypeRegistry& registry, MPI_Comm comm,
+                              std::shared_ptr<std::vector<std::string>> split) {
+  auto note = [split](const std::string& name, const char* type) {
+    if (split) split->push_back(fmt::format("{} ({})", name, type));
+  };
   registry.objects.Replace(
-      "Monodomain", [comm](const ObjectBuildContext& ctx) -> std::unique_ptr<SimObject> {
+      "Monodomain", [comm, note](const ObjectBuildContext& ctx) -> std::unique_ptr<SimObject> {
         CheckEpTissueKeys(ctx, {"parallel"});
         EpTissueParams params = ParseEpTissueParams(ctx);
         std::shared_ptr<const Mesh> whole = ctx.DomainMesh();
@@ -20,13 +28,49 @@ void RegisterDistributedTypes(TypeRegistry& registry, MPI_Comm comm) {
           auto part =
               std::make_unique<DistributedMonodomain>(ctx.name, *whole, std::move(params), comm);
           const MeshPart& mesh_part = part->part();
+          note(ctx.name, "Monodomain");
           return std::make_unique<WholeDomainView>(std::move(part), mesh_part, whole, comm);
         } catch (const InputError& e) {
           ctx.params.Fail(e.what());
         }
       });
+  // A FemSolid with what its split version does not take yet (Newmark, an explicit integrator)
+  // runs whole on every rank, as every object did before.
+  const ObjectFactory* found = registry.objects.Find("FemSolid");
+  GIPSI_CHECK(found != nullptr);
+  registry.objects.Replace(
+      "FemSolid",
+      [comm, note,
+       whole_solid = *found](const ObjectBuildContext& ctx) -> std::unique_ptr<SimObject> {
+        FemSolidSpec spec = ParseFemSolidSpec(ctx);
+        if (spec.ode || spec.params.scheme == ImplicitSchemeKind::kNewmark) return whole_solid(ctx);
+        spec.params.linear_solver = spec.distributed_linear;
+        std::shared_ptr<const Mesh> whole = ctx.DomainMesh();
+        try {
+          auto distribution = std::make_shared<DistributedSolid>(whole, comm);
+          spec.params.distribution = distribution;
+          const MeshPart& mesh_part = distribution->part();
+          auto solid =
+              spec.ode
+                  ? std::make_unique<FemSolid>(ctx.name, mesh_part.mesh, std::move(spec.params),
+                                               std::move(spec.ode))
+                  : std::make_unique<FemSolid>(ctx.name, mesh_part.mesh, std::move(spec.params));
+          if (spec.fibre_rule) {  // evaluated on the whole mesh, kept for the local tets
+            const Points all = MakeTransmuralFibres(*whole, *spec.fibre_rule).fibre;
+            Points local(3, static_cast<Index>(mesh_part.whole_tet.size()));
+            for (std::size_t e = 0; e < mesh_part.whole_tet.size(); ++e)
+              local.col(static_cast<Index>(e)) = all.col(mesh_part.whole_tet[e]);
+            solid->WriteField(solid->FindField("fibre"), local);
+          }
+          note(ctx.name, "FemSolid");
+          return std::make_unique<WholeDomainView>(
+              std::move(solid), mesh_part, whole, comm,
+              WholeDomainView::BoundaryMap{distribution->whole_boundary_vertex(),
+                                           distribution->whole_boundary_face()});
+        } catch (const InputError& e) {
+          ctx.params.Fail(e.what());
+        }
+      });
 }
-
-std::vector<std::string> DistributedTypeNames() { return {"Monodomain"}; }
 
 }  // namespace gipsi

@@ -5,6 +5,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <array>
 #include <numeric>
 
@@ -35,7 +36,8 @@ WholeDomainView::Layout WholeDomainView::MakeLayout(const std::vector<int>& whol
 }
 
 WholeDomainView::WholeDomainView(std::unique_ptr<SimObject> part, const MeshPart& mesh_part,
-                                 std::shared_ptr<const Mesh> whole, MPI_Comm comm)
+                                 std::shared_ptr<const Mesh> whole, MPI_Comm comm,
+                                 std::optional<BoundaryMap> boundary)
     : SimObject(std::string(part->name())),
       part_(std::move(part)),
       mesh_part_(mesh_part),
@@ -67,6 +69,7 @@ WholeDomainView::WholeDomainView(std::unique_ptr<SimObject> part, const MeshPart
   add(-1);
   for (const int i : mesh_part_.whole_tet) add(i);
   partition_fingerprint_ = h;
+  if (boundary) MapBoundary(std::move(*boundary));
 }
 
 void WholeDomainView::SaveObjectState(StateWriter& out) const {
@@ -118,12 +121,110 @@ void WholeDomainView::RestoreObjectState(StateReader& in) {
         name(), low[0], high[0], low[1], high[1]));
 }
 
+std::vector<std::string> WholeDomainView::cavity_names() const {
+  const auto* wall = dynamic_cast<const CavityWall*>(part_.get());
+  return wall != nullptr ? wall->cavity_names() : std::vector<std::string>{};
+}
+
+void WholeDomainView::AttachCavityLaw(std::string_view cavity, CavityLaw* law) {
+  auto* wall = dynamic_cast<CavityWall*>(part_.get());
+  if (wall == nullptr)
+    throw InputError(fmt::format("object '{}' ({}) has no cavities", name(), type_name()));
+  wall->AttachCavityLaw(cavity, law);
+}
+
 void WholeDomainView::BeginMacroStep() {
   SimObject::BeginMacroStep();
   part_->BeginMacroStep();
 }
 
+void WholeDomainView::MapBoundary(BoundaryMap map) {
+  GIPSI_CHECK(static_cast<Index>(map.vertex.size()) == part_->boundary().num_vertices() &&
+              static_cast<Index>(map.face.size()) == part_->boundary().num_triangles());
+  bc_vertex_ = std::move(map.vertex);
+  bc_face_ = std::move(map.face);
+  forward_bcs_ = true;
+  // A boundary vertex is owned with its node; the owned nodes come first, and so do their
+  // boundary vertices. Every face belongs to one tet, so to one rank.
+  const std::vector<int>& v2n = part_->boundary().vertex_to_node;
+  const auto owned_vertices = static_cast<std::int64_t>(std::count_if(
+      v2n.begin(), v2n.end(), [this](int node) { return node < mesh_part_.num_owned; }));
+  boundary_vertices_ = MakeLayout(bc_vertex_, owned_vertices, comm_);
+  boundary_faces_ = MakeLayout(bc_face_, static_cast<std::int64_t>(bc_face_.size()), comm_);
+  for (std::size_t f = 0; f < part_->fields().size(); ++f) {
+    const FieldInfo& info = part_->fields()[f];
+    if (info.location != FieldLocation::kBoundaryVertex &&
+        info.location != FieldLocation::kBoundaryFace)
+      continue;
+    DeclareField(info);
+    part_field_.emplace_back(static_cast<std::int64_t>(f));
+  }
+}
+
+const WholeDomainView::Layout& WholeDomainView::LayoutOf(FieldLocation location) const {
+  switch (location) {
+    case FieldLocation::kNode:
+      return nodes_;
+    case FieldLocation::kBoundaryVertex:
+      return boundary_vertices_;
+    case FieldLocation::kBoundaryFace:
+      return boundary_faces_;
+    default:
+      return elements_;
+  }
+}
+
+const std::vector<int>& WholeDomainView::WholeOfLocal(FieldLocation location) const {
+  switch (location) {
+    case FieldLocation::kNode:
+      return mesh_part_.whole_node;
+    case FieldLocation::kBoundaryVertex:
+      return bc_vertex_;
+    case FieldLocation::kBoundaryFace:
+      return bc_face_;
+    default:
+      return mesh_part_.whole_tet;
+  }
+}
+
+void WholeDomainView::CopyBoundaryConditions() {
+  const BoundaryConditions& from = boundary_conditions();
+  BoundaryConditions& to = part_->boundary_conditions();
+  // The applied part when it changed. Its copy takes the view's stamp: the part's conditions
+  // are a function of the view's, so equal stamps still mean equal contents.
+  if (to.applied().stamp != from.applied().stamp) {
+    BoundaryConditions::Applied applied = to.applied();
+    const BoundaryConditions::Applied& whole = from.applied();
+    for (std::size_t v = 0; v < bc_vertex_.size(); ++v) {
+      const auto w = static_cast<std::size_t>(bc_vertex_[v]);
+      for (std::size_t a = 0; a < 3; ++a) applied.kind[3 * v + a] = whole.kind[3 * w + a];
+      applied.value.col(static_cast<Index>(v)) = whole.value.col(static_cast<Index>(w));
+      applied.force.col(static_cast<Index>(v)) = whole.force.col(static_cast<Index>(w));
+    }
+    for (std::size_t f = 0; f < bc_face_.size(); ++f) {
+      const auto w = static_cast<Index>(bc_face_[f]);
+      applied.traction.col(static_cast<Index>(f)) = whole.traction.col(w);
+      applied.pressure[static_cast<Index>(f)] = whole.pressure[w];
+    }
+    applied.stamp = whole.stamp;
+    to.SetApplied(applied);
+  }
+  // The coupling loads (connectors'), every step.
+  to.ClearCouplingLoads();
+  for (std::size_t v = 0; v < bc_vertex_.size(); ++v) {
+    const Index w = bc_vertex_[v];
+    const Vec3 coupling = from.force(w) - Vec3(from.applied().force.col(w));
+    if (coupling.squaredNorm() > 0) to.AddCouplingForce(static_cast<Index>(v), coupling);
+  }
+  for (std::size_t f = 0; f < bc_face_.size(); ++f) {
+    const Index w = bc_face_[f];
+    const double coupling = from.pressure(w) - from.applied().pressure[w];
+    if (coupling != 0) to.AddCouplingPressure(static_cast<Index>(f), coupling);
+  }
+}
+
 StepStatus WholeDomainView::DoStep(double t, double dt) {
+  if (forward_bcs_) CopyBoundaryConditions();
   part_->SetTime(t);  // the view's clock is the kernel's
   return part_->Step(dt);
 }
@@ -135,7 +236,7 @@ void WholeDomainView::DoReadField(FieldId id, Eigen::Ref<Eigen::MatrixXd> out) c
     part_->ReadField(part_id, out);
     return;
   }
-  const Layout& layout = info.location == FieldLocation::kNode ? nodes_ : elements_;
+  const Layout& layout = LayoutOf(info.location);
   const int c = info.components;
   local_.resize(c, part_->FieldCount(part_id));
   part_->ReadField(part_id, local_);
@@ -159,7 +260,7 @@ void WholeDomainView::DoReadFieldItems(FieldId id, std::span<const int> items,
                                        Eigen::Ref<Eigen::MatrixXd> out) const {
   const FieldId part_id = part_field_[static_cast<std::size_t>(id.value())];
   const FieldInfo& info = part_->field_info(part_id);
-  const Layout& layout = info.location == FieldLocation::kNode ? nodes_ : elements_;
+  const Layout& layout = LayoutOf(info.location);
   const int c = info.components;
   local_.resize(c, part_->FieldCount(part_id));
   part_->ReadField(part_id, local_);
@@ -203,8 +304,7 @@ void WholeDomainView::DoWriteField(FieldId id, const Eigen::Ref<const Eigen::Mat
     part_->WriteField(part_id, in);
     return;
   }
-  const std::vector<int>& whole_of_local =
-      info.location == FieldLocation::kNode ? mesh_part_.whole_node : mesh_part_.whole_tet;
+  const std::vector<int>& whole_of_local = WholeOfLocal(info.location);
   local_.resize(info.components, static_cast<Index>(whole_of_local.size()));
   for (std::size_t i = 0; i < whole_of_local.size(); ++i)
     local_.col(static_cast<Index>(i)) = in.col(whole_of_local[i]);

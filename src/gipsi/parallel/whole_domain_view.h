@@ -7,13 +7,14 @@
 /// or element field gathers every rank's owned values into the whole mesh's order on every
 /// rank (MPI_Allgatherv: collective, and O(whole mesh) per rank per read), writing one keeps
 /// this rank's entries; global fields are the part's (its own reductions). Boundary fields are
-/// not offered. Steps, stop requests, profiles and failure details go to the part; the part's
-/// state is the view's. Step retries take the part's own snapshots (no communication). A
-/// checkpoint holds this rank's part after the rank count, the rank and a fingerprint of the
-/// partition (every rank writes its own file, docs/scale-out.md); a restore checks them on
-/// every rank together and, once read, that every rank's part is at the same time and step,
-/// so a checkpoint restores only on the rank count and partition that wrote it, and a set of
-/// files from different checkpoints (a run stopped while writing them) is refused.
+/// offered once the part's boundary is mapped to the whole mesh's (ForwardBoundaryConditions),
+/// a shared boundary vertex's value read from its node's owner. Steps, stop requests, profiles and
+/// failure details go to the part; the part's state is the view's. Step retries take the part's own
+/// snapshots (no communication). A checkpoint holds this rank's part after the rank count, the rank
+/// and a fingerprint of the partition (every rank writes its own file, docs/scale-out.md); a
+/// restore checks them on every rank together and, once read, that every rank's part is at the same
+/// time and step, so a checkpoint restores only on the rank count and partition that wrote it, and
+/// a set of files from different checkpoints (a run stopped while writing them) is refused.
 ///
 /// Every rank must make the same calls in the same order (they do when every rank runs the
 /// same kernel on the same scene). The whole-field gathers make ReadField the simple path, not
@@ -25,23 +26,37 @@
 
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "gipsi/base/export.h"
+#include "gipsi/core/cavity_law.h"
 #include "gipsi/core/sim_object.h"
 #include "gipsi/parallel/mesh_partition.h"
 
 GIPSI_EXPORT_BEGIN
 namespace gipsi {
 
-/// Not copyable or movable (a SimObject).
-class WholeDomainView final : public SimObject {
+/// Not copyable or movable (a SimObject). A CavityWall when its part is one (a FemSolid with
+/// cavities): the calls go to the part.
+class WholeDomainView final : public SimObject, public CavityWall {
  public:
+  /// Where the part's boundary lies on the whole mesh's (MakeBoundary): the whole boundary
+  /// vertex of each part boundary vertex, the whole face of each part face. Plain struct.
+  struct BoundaryMap {
+    std::vector<int> vertex, face;
+  };
   /// `part` is this rank's object on `mesh_part.mesh` (`mesh_part` must outlive the view: the
-  /// part usually owns it), `whole` the mesh it was cut from. Collective.
+  /// part usually owns it), `whole` the mesh it was cut from. Collective. With `boundary`,
+  /// before each step the view's boundary conditions (on the whole mesh's boundary, where
+  /// scenes, events and connectors write them) are copied to the part's, part vertex v taking
+  /// whole vertex boundary.vertex[v]'s constraints and loads, part face f whole face
+  /// boundary.face[f]'s (the part counts a nodal force on the node's owner only), and the
+  /// part's boundary fields are the view's.
   WholeDomainView(std::unique_ptr<SimObject> part, const MeshPart& mesh_part,
-                  std::shared_ptr<const Mesh> whole, MPI_Comm comm);
+                  std::shared_ptr<const Mesh> whole, MPI_Comm comm,
+                  std::optional<BoundaryMap> boundary = std::nullopt);
 
   [[nodiscard]] std::string_view type_name() const override { return part_->type_name(); }
   [[nodiscard]] const Points& domain_positions() const override { return domain().nodes; }
@@ -63,6 +78,10 @@ class WholeDomainView final : public SimObject {
     return {part_.get(), mesh_part_.rank, mesh_part_.size};
   }
   [[nodiscard]] const SimObject& part() const { return *part_; }
+  /// The part's cavities (none if it is not a CavityWall).
+  [[nodiscard]] std::vector<std::string> cavity_names() const override;
+  /// The part's; throws InputError if it is not a CavityWall.
+  void AttachCavityLaw(std::string_view cavity, CavityLaw* law) override;
 
  protected:
   StepStatus DoStep(double t, double dt) override;
@@ -85,11 +104,21 @@ class WholeDomainView final : public SimObject {
   static Layout MakeLayout(const std::vector<int>& whole_of_local, std::int64_t owned,
                            MPI_Comm comm);
 
+  // The layouts of the part's boundary items, and its boundary fields declared (BoundaryMap).
+  void MapBoundary(BoundaryMap map);
+  // Copies the view's boundary conditions to the part's (BoundaryMap).
+  void CopyBoundaryConditions();
+
   std::unique_ptr<SimObject> part_;
   const MeshPart& mesh_part_;
+  std::vector<int> bc_vertex_, bc_face_;  // BoundaryMap
+  bool forward_bcs_ = false;
   MPI_Comm comm_;
   std::vector<FieldId> part_field_;  // the part's field behind each of the view's
-  Layout nodes_, elements_;
+  [[nodiscard]] const Layout& LayoutOf(FieldLocation location) const;
+  [[nodiscard]] const std::vector<int>& WholeOfLocal(FieldLocation location) const;
+
+  Layout nodes_, elements_, boundary_vertices_, boundary_faces_;
   std::uint64_t partition_fingerprint_ = 0;  // of the whole-mesh indices of the local nodes/tets
   // Buffers of the gathers, kept between reads (no allocation once sized).
   mutable std::vector<double> receive_;

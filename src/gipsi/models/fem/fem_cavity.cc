@@ -64,11 +64,7 @@ bool FemSolid::AddCoupledCavityLoads(const double* u) {
     Cavity& cavity = cavities_[c];
     FemCavityState& cs = state_.cavities[c];
     if (cavity.law == nullptr) continue;
-    for (std::size_t k = 0; k < cavity.nodes.size(); ++k) {
-      const auto node = static_cast<Index>(cavity.nodes[k]);
-      cavity.positions.col(static_cast<Index>(k)) =
-          rest_.segment<3>(3 * node) + Eigen::Map<const Vec3>(u + 3 * node);
-    }
+    CavityPositions(cavity, u);
     const double v = cavity.volume.Compute(cavity.positions, &cavity.local_gradient);
     const double p = cs.pressure;  // the iterate's (FemSolid::Increment sets it)
     double vb = 0;
@@ -87,11 +83,17 @@ bool FemSolid::AddCoupledCavityLoads(const double* u) {
     }
     cavity.gradient.setZero();
     for (std::size_t k = 0; k < cavity.nodes.size(); ++k) {
-      const auto node = static_cast<Index>(cavity.nodes[k]);
-      cavity.gradient.segment<3>(3 * node) += cavity.local_gradient.col(static_cast<Index>(k));
+      const int node = CavityNode(cavity, k);
+      if (node >= 0)
+        cavity.gradient.segment<3>(3 * node) += cavity.local_gradient.col(static_cast<Index>(k));
     }
     for (int dof : constrained_dofs_) cavity.gradient[dof] = 0;
-    f_ext_ += p * cavity.gradient;
+    if (!dist_) {
+      f_ext_ += p * cavity.gradient;
+    } else {  // the whole gradient at every local node: its load counts on the owner alone
+      const Index owned = dist_->owned();
+      f_ext_.head(owned) += p * cavity.gradient.head(owned);
+    }
   }
   return true;
 }
@@ -115,13 +117,37 @@ void FemSolid::AddCoupledCavityForces(VecX& f) const {
   for (std::size_t c = 0; c < cavities_.size(); ++c) {
     const Cavity& cavity = cavities_[c];
     if (cavity.law == nullptr) continue;
-    for (std::size_t k = 0; k < cavity.nodes.size(); ++k)
-      cavity.positions.col(static_cast<Index>(k)) = positions_.col(cavity.nodes[k]);
+    if (dist_) {
+      CavityPositions(cavity, u().data());
+    } else {
+      for (std::size_t k = 0; k < cavity.nodes.size(); ++k)
+        cavity.positions.col(static_cast<Index>(k)) = positions_.col(cavity.nodes[k]);
+    }
     cavity.volume.Compute(cavity.positions, &cavity.local_gradient);
+    // (Distributed: on owned nodes, the forces being summed over the processes after.)
+    const Index owned = dist_ ? dist_->num_owned_nodes() : num_nodes();
     for (std::size_t k = 0; k < cavity.nodes.size(); ++k)
-      f.segment<3>(3 * static_cast<Index>(cavity.nodes[k])) +=
-          state_.cavities[c].pressure * cavity.local_gradient.col(static_cast<Index>(k));
+      if (const int node = CavityNode(cavity, k); node >= 0 && node < owned)
+        f.segment<3>(3 * static_cast<Index>(node)) +=
+            state_.cavities[c].pressure * cavity.local_gradient.col(static_cast<Index>(k));
   }
+}
+
+void FemSolid::CavityPositions(const Cavity& cavity, const double* u) const {
+  if (!dist_) {
+    for (std::size_t k = 0; k < cavity.nodes.size(); ++k) {
+      const auto node = static_cast<Index>(cavity.nodes[k]);
+      cavity.positions.col(static_cast<Index>(k)) =
+          rest_.segment<3>(3 * node) + Eigen::Map<const Vec3>(u + 3 * node);
+    }
+    return;
+  }
+  // The same rest positions and gathered displacements on every process: the same volume.
+  cavity.gather->Gather(u, cavity_u_);
+  const Points& whole = dist_->whole_mesh().nodes;
+  for (std::size_t k = 0; k < cavity.nodes.size(); ++k)
+    cavity.positions.col(static_cast<Index>(k)) =
+        whole.col(cavity.nodes[k]) + cavity_u_.col(static_cast<Index>(k));
 }
 
 void FemSolid::RestoreCavityPressures() {

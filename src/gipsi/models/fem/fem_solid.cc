@@ -1,6 +1,7 @@
 #include "gipsi/models/fem/fem_solid.h"
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <cmath>
 #include <limits>
@@ -26,13 +27,21 @@ double Seconds(Clock::time_point since) {
 }  // namespace
 
 FemSolid::FemSolid(std::string name, std::shared_ptr<const Mesh> domain, FemParams params)
-    : SimObject(std::move(name)), params_(std::move(params)), assembly_(*domain) {
+    : SimObject(std::move(name)),
+      params_(std::move(params)),
+      dist_(params_.distribution.get()),
+      assembly_(*domain) {
   if (!params_.material)
     throw InputError(fmt::format("object '{}': FemSolid needs a material", this->path()));
   if (!(params_.density > 0))
     throw InputError(fmt::format("object '{}': density must be positive", this->path()));
   law_ = params_.material.get();
-  SetGeometry(domain, MakeBoundary(*domain));
+  if (dist_ && params_.scheme == ImplicitSchemeKind::kNewmark)
+    throw InputError(fmt::format(
+        "object '{}': a FemSolid split over MPI ranks does not take the Newmark scheme yet "
+        "(docs/scale-out.md): run the scene serially",
+        this->path()));
+  SetGeometry(domain, dist_ ? dist_->boundary() : MakeBoundary(*domain));
   const Index n = domain->num_nodes();
   const Index ne = assembly_.num_elements();
 
@@ -62,7 +71,10 @@ FemSolid::FemSolid(std::string name, std::shared_ptr<const Mesh> domain, FemPara
   state_.scheme = ImplicitScheme(params_.scheme, params_.newmark_beta, params_.newmark_gamma);
   state_.scheme.Reset(VecX::Zero(3 * n), VecX::Zero(3 * n), VecX::Zero(3 * n));
   saved_scheme_ = begin_scheme_ = state_.scheme;
-  newton_ = std::make_unique<NewtonSolver>(params_.newton, MakeLinearSolver(params_.linear_solver));
+  newton_ = std::make_unique<NewtonSolver>(
+      params_.newton, dist_ ? dist_->MakeLinearSolver(params_.linear_solver, rest_)
+                            : MakeLinearSolver(params_.linear_solver));
+  newton_->SetReduction(dist_);
   // Rigid-body modes of the rest shape: what an AMG preconditioner coarsens (others ignore it).
   newton_->linear_solver().SetNearNullSpace(RigidBodyModes(rest_));
   newton_->Prepare(jac_);
@@ -115,10 +127,30 @@ FemSolid::FemSolid(std::string name, std::shared_ptr<const Mesh> domain, FemPara
   f_volume_ = DeclareField({"volume", L::kGlobal, 1, "m^3", A::kRead,
                             "current volume (the sum of the tets' signed volumes)"});
   for (WallCavity& wall : MakeWallCavities(
-           this->name(), params_.cavities, *domain, bnd,
+           this->name(), params_.cavities, dist_ ? dist_->whole_mesh() : *domain,
+           dist_ ? dist_->whole_boundary() : bnd,
            [this](FieldInfo info) { return DeclareField(std::move(info)); },
            "pressure in the cavity, acting on its faces (follower load)"))
     cavities_.emplace_back(std::move(wall)).gradient = VecX::Zero(3 * n);
+  if (dist_) {
+    // The whole cavity's surface on every process; its faces on this one, in part numbering.
+    std::vector<int> local_of(static_cast<std::size_t>(dist_->whole_mesh().num_nodes()), -1);
+    const std::span<const int> whole_node = dist_->whole_node();
+    for (std::size_t i = 0; i < whole_node.size(); ++i)
+      local_of[static_cast<std::size_t>(whole_node[i])] = static_cast<int>(i);
+    const std::span<const int> whole_face = dist_->whole_face();
+    for (Cavity& cavity : cavities_) {
+      std::vector<int> whole_faces = cavity.faces, faces;
+      std::sort(whole_faces.begin(), whole_faces.end());
+      for (std::size_t f = 0; f < whole_face.size(); ++f)
+        if (std::binary_search(whole_faces.begin(), whole_faces.end(), whole_face[f]))
+          faces.push_back(static_cast<int>(f));
+      cavity.faces = std::move(faces);
+      for (int node : cavity.nodes)
+        cavity.local_node.push_back(local_of[static_cast<std::size_t>(node)]);
+      cavity.gather = dist_->MakeNodeGather(cavity.nodes);
+    }
+  }
   state_.cavities.resize(cavities_.size());
   BindState(state_);
 }
@@ -218,16 +250,35 @@ bool FemSolid::AssembleElements(const double* u, VecX& f, double* k_values) cons
   // Assembling contributions of magnitude |f| into a residual loses ~ε|f| each, and forces
   // evaluated at a displacement u carry ~ε ‖K‖ ‖u‖: 100 ε times their sum bounds what any
   // iterate's residual can be told apart from zero (still ~1e-14 of the element forces).
-  residual_floor_ = 100 * std::numeric_limits<double>::epsilon() *
-                    (element_force_sum_.sum() +
-                     state_.jacobian_norm * Eigen::Map<const VecX>(u, f.size()).norm());
-  if (any_invalid.load()) {
+  bool invalid = any_invalid.load();
+  if (!dist_) {
+    residual_floor_ = 100 * std::numeric_limits<double>::epsilon() *
+                      (element_force_sum_.sum() +
+                       state_.jacobian_norm * Eigen::Map<const VecX>(u, f.size()).norm());
+  } else {
+    // The same floor and verdict on every process: sums over the ranks (u over owned nodes).
+    std::array<double, 3> sums{element_force_sum_.sum(),
+                               Eigen::Map<const VecX>(u, dist_->owned()).squaredNorm(),
+                               invalid ? 1.0 : 0.0};
+    dist_->Reduce(sums, false);
+    residual_floor_ = 100 * std::numeric_limits<double>::epsilon() *
+                      (sums[0] + state_.jacobian_norm * std::sqrt(sums[1]));
+    invalid = sums[2] > 0;
+  }
+  if (invalid) {
     first_invalid_ = -1;
     for (Index e = 0; e < num_elements(); ++e)
       if (invalid_[static_cast<std::size_t>(e)]) {
         first_invalid_ = e;
         break;
       }
+    invalid_id_ = first_invalid_ >= 0 ? domain().TetId(first_invalid_) : -1;
+    if (dist_) {  // the smallest identifier over the processes names the element
+      double negated = first_invalid_ >= 0 ? -static_cast<double>(dist_->WholeTetId(first_invalid_))
+                                           : -std::numeric_limits<double>::max();
+      dist_->Reduce({&negated, 1}, true);
+      invalid_id_ = static_cast<std::int64_t>(-negated);
+    }
     return false;
   }
   return true;
@@ -267,6 +318,7 @@ void FemSolid::AssembleExternal(const double* u, double s) const {
 }
 
 void FemSolid::FinishResidual(const VecX& d, VecX& r) {
+  // (Distributed: every term is a sum over the part's tets and owned nodes, made whole below.)
   r = f_int_ - f_ext_;
   if (params_.scheme != ImplicitSchemeKind::kStatic) {
     // Inertia M a and damping α M v + β K_n v.
@@ -287,6 +339,7 @@ void FemSolid::FinishResidual(const VecX& d, VecX& r) {
       r += params_.rayleigh_stiffness * work_;
     }
   }
+  if (dist_) dist_->SumShared(r);
   for (int dof : constrained_dofs_) r[dof] = 0;
 }
 
@@ -395,9 +448,21 @@ bool FemSolid::IncrementResidual(double s, const VecX& d, VecX& r) {
 }
 
 double FemSolid::AppliedLoadNorm() const {
+  if (dist_) return WholeNorm(f_ext_, true);
   double sum = f_ext_.squaredNorm();
   for (int dof : constrained_dofs_) sum -= f_ext_[dof] * f_ext_[dof];
   return std::sqrt(std::max(sum, 0.0));
+}
+
+double FemSolid::WholeNorm(const VecX& v, bool free_only) const {
+  if (!dist_) return v.norm();
+  whole_work_ = v;
+  dist_->SumShared(whole_work_);
+  if (free_only)
+    for (int dof : constrained_dofs_) whole_work_[dof] = 0;
+  double sum = whole_work_.head(dist_->owned()).squaredNorm();
+  dist_->Reduce({&sum, 1}, false);
+  return std::sqrt(sum);
 }
 
 bool FemSolid::IncrementResidualAndJacobian(double s, const VecX& d, VecX& r, SparseMatrix& J,
@@ -456,13 +521,16 @@ bool FemSolid::IncrementResidualAndJacobian(double s, const VecX& d, VecX& r, Sp
   for (int index : assembly_.diagonal_index()) diag_sum += std::abs(with_inertia(index));
   const double unit = diag_sum > 0 ? diag_sum / static_cast<double>(ncols) : 1.0;
   const std::uint8_t* constraint = constraint_.data();
+  // Distributed, only the owner puts a shared dof's unit on the diagonal (the processes'
+  // matrices are summed).
+  const int owned = dist_ ? static_cast<int>(dist_->owned()) : ncols;
   double max_row_sum = 0;
   auto finish_column = [&](int c) {  // returns the column's absolute sum
     const bool fixed_col = constraint[c] != 0;
     double row_sum = 0;
     for (int j = outer[c]; j < outer[c + 1]; ++j) {
       double v = with_inertia(j);
-      if (fixed_col || constraint[inner[j]] != 0) v = inner[j] == c ? unit : 0.0;
+      if (fixed_col || constraint[inner[j]] != 0) v = inner[j] == c && c < owned ? unit : 0.0;
       jv[j] = v;
       row_sum += std::abs(v);
     }
@@ -476,6 +544,7 @@ bool FemSolid::IncrementResidualAndJacobian(double s, const VecX& d, VecX& r, Sp
   } else {
     for (int c = 0; c < ncols; ++c) max_row_sum = std::max(max_row_sum, finish_column(c));
   }
+  Reduce({&max_row_sum, 1}, true);
   state_.jacobian_norm = max_row_sum;
   FinishResidual(d, r);
   profile_.assembly_seconds += Seconds(start);
@@ -508,11 +577,17 @@ void FemSolid::GatherTargets() {
   const Index n = num_nodes();
   const BoundarySurface& bnd = boundary();
   const BoundaryConditions& bcs = boundary_conditions();
+  // Nodal forces count once: distributed, on the node's owner (the lumped mass is the part's
+  // share, so its weight adds up over the processes).
+  const Index owned = dist_ ? dist_->num_owned_nodes() : n;
   for (Index i = 0; i < n; ++i)
     f_nodal_new_.segment<3>(3 * i) =
-        lumped_mass_[i] * params_.gravity + state_.external_force.get().col(i);
-  for (Index j = 0; j < bnd.num_vertices(); ++j)
-    f_nodal_new_.segment<3>(3 * bnd.vertex_to_node[static_cast<std::size_t>(j)]) += bcs.force(j);
+        lumped_mass_[i] * params_.gravity +
+        (i < owned ? Vec3(state_.external_force.get().col(i)) : Vec3::Zero());
+  for (Index j = 0; j < bnd.num_vertices(); ++j) {
+    const int node = bnd.vertex_to_node[static_cast<std::size_t>(j)];
+    if (node < owned) f_nodal_new_.segment<3>(3 * node) += bcs.force(j);
+  }
   for (Index f = 0; f < bnd.num_triangles(); ++f) {
     pressure_new_[f] = bcs.pressure(f);
     traction_new_.col(f) = bcs.traction(f);
@@ -602,8 +677,8 @@ StepStatus FemSolid::Advance(double s0, double s1, double dt, int depth) {
       else
         d_[dof] = state_.scheme.IncrementForVelocity(dof, target_[dof]);
     }
-    Increment increment(*this, s1,
-                        (state_.f_nodal_prev + s1 * (f_nodal_new_ - state_.f_nodal_prev)).norm());
+    work2_ = state_.f_nodal_prev + s1 * (f_nodal_new_ - state_.f_nodal_prev);
+    Increment increment(*this, s1, WholeNorm(work2_, false));
     if (bordered_ == 0) {
       state_.last_newton = newton_->Solve(increment, d_, jac_, stop_token());
     } else {
@@ -650,15 +725,14 @@ StepStatus FemSolid::Advance(double s0, double s1, double dt, int depth) {
         "its volume does not fall as the pressure rises (is the blood object stepped right after "
         "this one?)",
         params_.cavities[static_cast<std::size_t>(failed_cavity_)].name);
-  if (state_.last_newton.inadmissible && first_invalid_ >= 0)
-    failure_detail_ += fmt::format("; {} is outside its law's domain (det F <= 0?)",
-                                   domain().TetName(first_invalid_));
+  if (state_.last_newton.inadmissible && invalid_id_ >= 0)
+    failure_detail_ += fmt::format("; tet {} ({}) is outside its law's domain (det F <= 0?)",
+                                   invalid_id_, domain().TetIdKind());
   if (state_.last_newton.inadmissible && failed_cavity_ >= 0)
     return StepStatus::Failed("the blood coupled to a cavity could not answer; cavity",
                               failed_cavity_);
   if (state_.last_newton.inadmissible)
-    return StepStatus::Failed("no admissible state: an element inverted; tet",
-                              domain().TetId(first_invalid_));
+    return StepStatus::Failed("no admissible state: an element inverted; tet", invalid_id_);
   if (state_.last_newton.linear_failure)
     return StepStatus::Failed(
         state_.last_newton.linear_failure_kind == LinearFailure::kNotConverged
@@ -723,6 +797,7 @@ double FemSolid::StrainEnergy() const {
   for (Index e = 0; e < num_elements(); ++e)
     energy += assembly_.volume(e) *
               law_->Energy(assembly_.DeformationGradient(e, u().data()), PointOf(e));
+  Reduce({&energy, 1});
   return energy;
 }
 
@@ -731,28 +806,39 @@ double FemSolid::KineticEnergy() const {
     double e = 0;
     for (Index i = 0; i < num_nodes(); ++i)
       e += 0.5 * lumped_mass_[i] * v().segment<3>(3 * i).squaredNorm();
+    Reduce({&e, 1});
     return e;
   }
   SymmetricSpMV(mass_, v(), work_);
-  return 0.5 * v().dot(work_);
+  double e = 0.5 * v().dot(work_);  // distributed: vᵀ (the part's M) v, summed
+  Reduce({&e, 1});
+  return e;
 }
 
 double FemSolid::GravityEnergy() const {
   double e = 0;
   for (Index i = 0; i < num_nodes(); ++i)
     e -= lumped_mass_[i] * params_.gravity.dot(u().segment<3>(3 * i));
+  Reduce({&e, 1});
   return e;
 }
 
 double FemSolid::CavityVolume(std::size_t i) const {
   GIPSI_CHECK(i < cavities_.size());
-  return cavities_[i].Volume(positions_);
+  if (!dist_) return cavities_[i].Volume(positions_);
+  CavityPositions(cavities_[i], u().data());
+  return cavities_[i].volume.Compute(cavities_[i].positions, nullptr);
 }
 
 Index FemSolid::CountInvertedElements() const {
   Index count = 0;
   for (Index e = 0; e < num_elements(); ++e)
     if (assembly_.DeformationGradient(e, u().data()).determinant() <= 0) ++count;
+  if (dist_) {
+    auto total = static_cast<double>(count);
+    dist_->Reduce({&total, 1}, false);
+    count = static_cast<Index>(total);
+  }
   return count;
 }
 
@@ -799,6 +885,7 @@ void FemSolid::DoReadField(FieldId id, Eigen::Ref<Eigen::MatrixXd> out) const {
         work2_ += work_;
       }
     }
+    if (dist_) dist_->SumShared(work2_);
     const BoundaryConditions& bcs = boundary_conditions();
     for (std::size_t j = 0; j < v2n.size(); ++j) {
       const auto col = static_cast<Index>(j);
@@ -837,6 +924,7 @@ void FemSolid::DoReadField(FieldId id, Eigen::Ref<Eigen::MatrixXd> out) const {
     for (Index e = 0; e < tets.cols(); ++e)
       v += TetSignedVolume(positions_.col(tets(0, e)), positions_.col(tets(1, e)),
                            positions_.col(tets(2, e)), positions_.col(tets(3, e)));
+    Reduce({&v, 1});
     out(0, 0) = v;
   } else {
     for (std::size_t i = 0; i < cavities_.size(); ++i) {

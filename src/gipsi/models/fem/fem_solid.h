@@ -28,6 +28,8 @@
 #include <array>
 #include <chrono>
 #include <memory>
+#include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -37,8 +39,10 @@
 #include "gipsi/geometry/enclosed_volume.h"
 #include "gipsi/geometry/region.h"
 #include "gipsi/models/fem/fem_state.h"
+#include "gipsi/models/fem/solid_distribution.h"
 #include "gipsi/models/fem/solid_material.h"
 #include "gipsi/models/fem/tet_assembly.h"
+#include "gipsi/models/fibres/rule_based_fibres.h"
 #include "gipsi/models/wall_cavity.h"
 #include "gipsi/numerics/implicit_scheme.h"
 #include "gipsi/numerics/newton.h"
@@ -77,6 +81,12 @@ struct FemParams {
   /// Cavities (wall_cavity.h): each one's volume is a field, and a pressure written to it acts
   /// as follower pressure on its faces.
   std::vector<CavitySpec> cavities;
+  /// Set: the object is one process's part of a solid split over processes
+  /// (solid_distribution.h; the domain mesh is the part). Implicit schemes other than Newmark
+  /// for now: the constructors refuse the rest (the distributed scene loader builds such a solid
+  /// whole on every rank instead). Cavities are selected on the whole mesh and their volume
+  /// computed on the whole cavity surface on every process (its vertices gathered).
+  std::shared_ptr<const SolidDistribution> distribution;
 };
 
 /// Time spent in one object's steps, for `gipsi run --profile`. Plain struct.
@@ -231,8 +241,16 @@ class FemSolid final : public SimObject, public CavityWall {
   /// Back to the pressures at the start of the step (after a failed Newton solve).
   void RestoreCavityPressures();
   void InitialAcceleration();
+  /// ‖v‖ of a vector of partial sums (3 per local node) made whole over the processes, over
+  /// the free unknowns when `free_only`; v.norm() when the object is not distributed.
+  [[nodiscard]] double WholeNorm(const VecX& v, bool free_only) const;
+  /// Sums `values` over the processes (`max`: their maximum) when distributed.
+  void Reduce(std::span<double> values, bool max = false) const {
+    if (dist_) dist_->Reduce(values, max);
+  }
 
   FemParams params_;
+  const SolidDistribution* dist_ = nullptr;  // params_.distribution
   TetAssembly assembly_;
   const SolidMaterial* law_ = nullptr;
   VecX lumped_mass_;   // per node
@@ -269,6 +287,8 @@ class FemSolid final : public SimObject, public CavityWall {
   mutable VecX element_force_sum_;             // per element Σ|f_e| (round-off floor)
   mutable double residual_floor_ = 0;
   mutable Index first_invalid_ = -1;
+  mutable std::int64_t invalid_id_ = -1;  // its identifier (the smallest over the processes)
+  mutable VecX whole_work_;               // WholeNorm's
   // The element loops of the residual and of the residual with the tangent, on the team or
   // serially, whichever has been faster lately (a busy neighbour makes each region wait).
   mutable AdaptiveParallel residual_team_, tangent_team_;
@@ -283,7 +303,20 @@ class FemSolid final : public SimObject, public CavityWall {
     double pressure_begin = 0;   // at the start of the step
     VecX gradient{};             // 3N: ∂V/∂x, zero on constrained dofs (coupled)
     double volume_residual = 0;  // V(u) − V_b(p) at the last residual (coupled) [m³]
+    // Distributed: `nodes` and the volume are the whole cavity's (whole-mesh nodes), `faces`
+    // the part's; the local node of each cavity vertex (-1: not on this rank), and the gather
+    // of the vertices' displacements from their owners.
+    std::vector<int> local_node;
+    std::shared_ptr<const NodeGather> gather;
   };
+  /// Cavity c's vertex positions at displacements u (3 per local node) into its `positions`;
+  /// distributed, gathered from the owners (collective).
+  void CavityPositions(const Cavity& cavity, const double* u) const;
+  /// The local node of cavity vertex k (-1: none on this rank).
+  [[nodiscard]] int CavityNode(const Cavity& cavity, std::size_t k) const {
+    return dist_ ? cavity.local_node[k] : cavity.nodes[k];
+  }
+  mutable Points cavity_u_;  // CavityPositions' gathered displacements
   std::vector<Cavity> cavities_;
   double step_time_ = 0, step_dt_ = 0;   // of the step in progress (the laws' interval)
   int failed_cavity_ = -1;               // whose law could not answer in the last solve
@@ -298,6 +331,21 @@ class FemSolid final : public SimObject, public CavityWall {
   FieldId f_fibre_, f_active_, f_nodal_active_, f_von_mises_, f_jacobian_, f_kinetic_,
       f_strain_energy_, f_newton_, f_inverted_, f_volume_;
 };
+
+/// A "FemSolid" object's scene keys, parsed (fem_solid_factory.cc; keys in
+/// docs/scene-format.md): the serial factory's and the distributed one's
+/// (parallel/distributed_types.cc). Movable.
+struct FemSolidSpec {
+  FemParams params;
+  std::unique_ptr<OdeIntegrator> ode;  ///< an explicit integrator; null: params.scheme steps
+  std::optional<TransmuralFibreRule> fibre_rule;
+  /// The solver of distributed runs: "linear_solver" with the "parallel" block's
+  /// "linear_solver" keys over it; CG with no preconditioner named in either takes "amg".
+  LinearSolverOptions distributed_linear;
+};
+/// Checks the object's keys and parses them; throws InputError naming the JSON path of a bad
+/// one.
+[[nodiscard]] FemSolidSpec ParseFemSolidSpec(const ObjectBuildContext& ctx);
 
 /// Registers "FemSolid".
 void RegisterFemSolid(TypeRegistry& registry);

@@ -92,6 +92,98 @@ void ParseLoadStepping(const JsonNode& object, int& load_steps, int& max_bisecti
   }
 }
 
+FemSolidSpec ParseFemSolidSpec(const ObjectBuildContext& ctx) {
+  const JsonNode& p = ctx.params;
+  ctx.CheckKeys({"density", "material", "mass", "damping", "gravity", "newmark", "newton",
+                 "linear_solver", "load_steps", "max_bisections", "predictor", "fibres", "cavities",
+                 "parallel"});
+  FemSolidSpec spec;
+  FemParams& params = spec.params;
+  std::unique_ptr<OdeIntegrator>& ode = spec.ode;
+  std::optional<TransmuralFibreRule>& fibre_rule = spec.fibre_rule;
+  params.density = p.Positive("density", params.density);
+  params.material = ctx.registry.CreateMaterialAs<SolidMaterial>(p.At("material"), "solid");
+  if (auto mass = p.Find("mass"))
+    params.lumped_mass = mass->AsChoice({"lumped", "consistent"}) == "lumped";
+  if (auto damping = p.Find("damping")) {
+    damping->CheckKeys({"mass", "stiffness"});
+    params.rayleigh_mass = damping->NonNegative("mass", 0);
+    params.rayleigh_stiffness = damping->NonNegative("stiffness", 0);
+  }
+  params.gravity = p.Vector3("gravity", params.gravity);
+  if (auto integrator = p.Find("integrator"))
+    ode = ParseIntegrator(*integrator, ctx.registry, params.scheme);
+  if (ode) {
+    if (!p.Has("mass")) params.lumped_mass = true;  // explicit dynamics' usual mass
+    // Keys of the implicit schemes would silently do nothing: refuse them.
+    for (const char* key :
+         {"newmark", "newton", "linear_solver", "load_steps", "max_bisections", "predictor"})
+      if (auto unused = p.Find(key))
+        unused->Fail(
+            fmt::format("has no effect with integrator '{}' (explicit dynamics through the ODE "
+                        "contract); remove it, or choose an implicit scheme (\"BackwardEuler\", "
+                        "\"BDF2\", \"Newmark\", \"Static\")",
+                        ode->name()));
+  }
+  if (auto newmark = p.Find("newmark")) {
+    newmark->CheckKeys({"beta", "gamma"});
+    params.newmark_beta = newmark->Positive("beta", params.newmark_beta);
+    params.newmark_gamma = newmark->Positive("gamma", params.newmark_gamma);
+    if (params.newmark_gamma < 0.5 || params.newmark_beta < 0.25 * params.newmark_gamma)
+      newmark->Fail(fmt::format(
+          "beta = {} and gamma = {} are not unconditionally stable; use gamma >= 1/2 and "
+          "beta >= gamma/4 (average acceleration: beta 0.25, gamma 0.5)",
+          params.newmark_beta, params.newmark_gamma));
+  }
+  if (auto newton = p.Find("newton")) params.newton = ParseNewtonOptions(*newton, params.newton);
+  if (auto solver = p.Find("linear_solver"))
+    params.linear_solver = ParseLinearSolverOptions(*solver);
+  ParseLoadStepping(p, params.load_steps, params.max_bisections);
+  params.predictor = ParsePredictor(p, params.predictor);
+  if (auto fibres = p.Find("fibres"); fibres && fibres->Has("rule")) {
+    fibre_rule = ParseTransmuralFibreRule(*fibres);
+  } else if (fibres) {
+    fibres->CheckKeys({"direction", "sheet"});
+    params.fibre = fibres->Vector3("direction");
+    params.sheet = fibres->Vector3("sheet", params.sheet);
+    if (params.fibre.norm() == 0) fibres->At("direction").Expected("a non-zero vector");
+  } else if (params.material->needs_fibres()) {
+    p.At("material")
+        .Fail(
+            fmt::format("law '{}' is anisotropic: give the object a fibre field, e.g. \"fibres\": "
+                        "{{\"direction\": [1, 0, 0]}}",
+                        params.material->law()));
+  }
+  if (auto cavities = p.Find("cavities")) params.cavities = ParseCavitySpecs(*cavities);
+  // The solver of distributed runs: linear_solver's, with the "parallel" block's keys over it
+  // (PETSc's: "amg" is GAMG, "hypre" BoomerAMG, the direct types MUMPS); CG without a
+  // preconditioner named anywhere takes GAMG (docs/scale-out.md). Checked in every run.
+  LinearSolverOptions distributed = params.linear_solver;
+  bool preconditioner_given = false;
+  if (auto solver = p.Find("linear_solver")) preconditioner_given = solver->Has("preconditioner");
+  if (auto parallel = p.Find("parallel")) {
+    parallel->CheckKeys({"linear_solver"});
+    const JsonNode solver = parallel->At("linear_solver");
+    solver.CheckKeys({"type", "preconditioner", "tolerance", "max_iterations"});
+    if (auto type = solver.Find("type"))
+      distributed.type = type->AsChoice({"cg", "cholmod", "ldlt", "umfpack"});
+    if (auto preconditioner = solver.Find("preconditioner")) {
+      distributed.preconditioner =
+          preconditioner->AsChoice({"none", "jacobi", "sgs", "amg", "hypre"});
+      preconditioner_given = true;
+    }
+    distributed.tolerance = solver.Positive("tolerance", distributed.tolerance);
+    if (auto max_iterations = solver.Find("max_iterations")) {
+      const std::int64_t n = max_iterations->AsInt();
+      if (n < 1 || n > 1000000) max_iterations->Expected("a number of iterations in [1, 1000000]");
+      distributed.max_iterations = static_cast<int>(n);
+    }
+  }
+  if (distributed.type == "cg" && !preconditioner_given) distributed.preconditioner = "amg";
+  spec.distributed_linear = distributed;
+  return spec;
+}
+
 void RegisterFemSolid(TypeRegistry& registry) {
   LocalModels(registry).Register(
       "FemSolid",
@@ -103,67 +195,10 @@ void RegisterFemSolid(TypeRegistry& registry) {
       "FemSolid",
       [](const ObjectBuildContext& ctx) -> std::unique_ptr<SimObject> {
         const JsonNode& p = ctx.params;
-        ctx.CheckKeys({"density", "material", "mass", "damping", "gravity", "newmark", "newton",
-                       "linear_solver", "load_steps", "max_bisections", "predictor", "fibres",
-                       "cavities"});
-        FemParams params;
-        params.density = p.Positive("density", params.density);
-        params.material = ctx.registry.CreateMaterialAs<SolidMaterial>(p.At("material"), "solid");
-        if (auto mass = p.Find("mass"))
-          params.lumped_mass = mass->AsChoice({"lumped", "consistent"}) == "lumped";
-        if (auto damping = p.Find("damping")) {
-          damping->CheckKeys({"mass", "stiffness"});
-          params.rayleigh_mass = damping->NonNegative("mass", 0);
-          params.rayleigh_stiffness = damping->NonNegative("stiffness", 0);
-        }
-        params.gravity = p.Vector3("gravity", params.gravity);
-        std::unique_ptr<OdeIntegrator> ode;
-        if (auto integrator = p.Find("integrator"))
-          ode = ParseIntegrator(*integrator, ctx.registry, params.scheme);
-        if (ode) {
-          if (!p.Has("mass")) params.lumped_mass = true;  // explicit dynamics' usual mass
-          // Keys of the implicit schemes would silently do nothing: refuse them.
-          for (const char* key :
-               {"newmark", "newton", "linear_solver", "load_steps", "max_bisections", "predictor"})
-            if (auto unused = p.Find(key))
-              unused->Fail(fmt::format(
-                  "has no effect with integrator '{}' (explicit dynamics through the ODE "
-                  "contract); remove it, or choose an implicit scheme (\"BackwardEuler\", "
-                  "\"BDF2\", \"Newmark\", \"Static\")",
-                  ode->name()));
-        }
-        if (auto newmark = p.Find("newmark")) {
-          newmark->CheckKeys({"beta", "gamma"});
-          params.newmark_beta = newmark->Positive("beta", params.newmark_beta);
-          params.newmark_gamma = newmark->Positive("gamma", params.newmark_gamma);
-          if (params.newmark_gamma < 0.5 || params.newmark_beta < 0.25 * params.newmark_gamma)
-            newmark->Fail(fmt::format(
-                "beta = {} and gamma = {} are not unconditionally stable; use gamma >= 1/2 and "
-                "beta >= gamma/4 (average acceleration: beta 0.25, gamma 0.5)",
-                params.newmark_beta, params.newmark_gamma));
-        }
-        if (auto newton = p.Find("newton"))
-          params.newton = ParseNewtonOptions(*newton, params.newton);
-        if (auto solver = p.Find("linear_solver"))
-          params.linear_solver = ParseLinearSolverOptions(*solver);
-        ParseLoadStepping(p, params.load_steps, params.max_bisections);
-        params.predictor = ParsePredictor(p, params.predictor);
-        std::optional<TransmuralFibreRule> fibre_rule;
-        if (auto fibres = p.Find("fibres"); fibres && fibres->Has("rule")) {
-          fibre_rule = ParseTransmuralFibreRule(*fibres);
-        } else if (fibres) {
-          fibres->CheckKeys({"direction", "sheet"});
-          params.fibre = fibres->Vector3("direction");
-          params.sheet = fibres->Vector3("sheet", params.sheet);
-          if (params.fibre.norm() == 0) fibres->At("direction").Expected("a non-zero vector");
-        } else if (params.material->needs_fibres()) {
-          p.At("material")
-              .Fail(fmt::format(
-                  "law '{}' is anisotropic: give the object a fibre field, e.g. \"fibres\": "
-                  "{{\"direction\": [1, 0, 0]}}",
-                  params.material->law()));
-        }
-        if (auto cavities = p.Find("cavities")) params.cavities = ParseCavitySpecs(*cavities);
+        FemSolidSpec spec = ParseFemSolidSpec(ctx);
+        FemParams& params = spec.params;
+        std::unique_ptr<OdeIntegrator>& ode = spec.ode;
+        const std::optional<TransmuralFibreRule>& fibre_rule = spec.fibre_rule;
         std::unique_ptr<FemSolid> solid;
         try {
           auto mesh = ctx.DomainMesh();

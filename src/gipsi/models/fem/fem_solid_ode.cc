@@ -26,6 +26,11 @@ FemSolid::FemSolid(std::string name, std::shared_ptr<const Mesh> domain, FemPara
                    std::unique_ptr<OdeIntegrator> integrator)
     : FemSolid(std::move(name), std::move(domain), std::move(params)) {
   GIPSI_CHECK(integrator != nullptr);
+  if (dist_)
+    throw InputError(fmt::format(
+        "object '{}': a FemSolid split over MPI ranks does not take integrator '{}' yet (only "
+        "the implicit schemes \"Static\", \"BackwardEuler\" and \"BDF2\"; docs/scale-out.md)",
+        this->path(), integrator->name()));
   if (!params_.lumped_mass)
     throw InputError(fmt::format(
         "object '{}': integrator '{}' steps the equations of motion as an ODE, which needs the "

@@ -1,0 +1,410 @@
+/// @file
+/// A FemSolid's part on one rank: partition, shared sums and the PETSc solve of its tangent.
+
+#include "gipsi/parallel/distributed_solid.h"
+
+#include <fmt/format.h>
+#include <petscksp.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "gipsi/base/error.h"
+#include "gipsi/parallel/petsc_check.h"
+
+namespace gipsi {
+namespace {
+
+// Global PETSc index of every local dof (3 per local node, node-major).
+std::vector<PetscInt> GlobalDofs(const MeshPart& part) {
+  std::vector<PetscInt> dofs;
+  dofs.reserve(3 * part.global.size());
+  for (const std::int64_t g : part.global)
+    for (int a = 0; a < 3; ++a) dofs.push_back(static_cast<PetscInt>(3 * g + a));
+  return dofs;
+}
+
+// A ghosted vector of 3 entries per node: owned nodes, then the shared ones.
+Vec MakeGhosted(const MeshPart& part, MPI_Comm comm) {
+  std::vector<PetscInt> ghosts;
+  for (std::size_t i = static_cast<std::size_t>(part.num_owned); i < part.global.size(); ++i)
+    ghosts.push_back(static_cast<PetscInt>(part.global[i]));
+  Vec v = nullptr;
+  GIPSI_PETSC(VecCreateGhostBlock(comm, 3, static_cast<PetscInt>(3 * part.num_owned),
+                                  static_cast<PetscInt>(3 * part.num_global_nodes),
+                                  static_cast<PetscInt>(ghosts.size()), ghosts.data(), &v));
+  return v;
+}
+
+// Copies `n` values between a ghosted vector's local form and `data` (to_vec: into it).
+void CopyLocalForm(Vec ghosted, double* data, std::size_t n, bool to_vec) {
+  Vec local = nullptr;
+  PetscScalar* array = nullptr;
+  GIPSI_PETSC(VecGhostGetLocalForm(ghosted, &local));
+  GIPSI_PETSC(VecGetArray(local, &array));
+  if (to_vec)
+    std::copy(data, data + n, array);
+  else
+    std::copy(array, array + n, data);
+  GIPSI_PETSC(VecRestoreArray(local, &array));
+  GIPSI_PETSC(VecGhostRestoreLocalForm(ghosted, &local));
+}
+
+/// The whole tangent as one PETSc system (distributed_solid.h says which KSP and PC).
+class PetscSolidSolver final : public LinearSolver {
+ public:
+  PetscSolidSolver(MPI_Comm comm, const MeshPart& part, LinearSolverOptions options,
+                   const VecX& rest)
+      : comm_(comm), part_(part), options_(std::move(options)), dofs_(GlobalDofs(part)) {
+    direct_ = options_.type != "cg";
+    GIPSI_PETSC(KSPCreate(comm_, &ksp_));
+    GIPSI_PETSC(KSPSetOptionsPrefix(ksp_, "solid_"));
+    GIPSI_PETSC(KSPSetType(ksp_, direct_ ? KSPPREONLY : KSPCG));
+    PC pc = nullptr;
+    GIPSI_PETSC(KSPGetPC(ksp_, &pc));
+    const std::string& pre = options_.preconditioner;
+    if (direct_) {
+      // The tangent gathered on every rank and factorised there by sequential MUMPS
+      // (PCREDUNDANT): MUMPS across ranks schedules its work dynamically and gave other bits in
+      // every run (the ventricle inflation on 2 ranks), so a checkpoint would not resume
+      // bitwise. The price: each rank holds the whole factorisation (docs/scale-out.md).
+      GIPSI_PETSC(PCSetType(pc, PCREDUNDANT));
+      KSP inner = nullptr;
+      PC inner_pc = nullptr;
+      GIPSI_PETSC(PCRedundantGetKSP(pc, &inner));
+      GIPSI_PETSC(KSPGetPC(inner, &inner_pc));
+      GIPSI_PETSC(PCSetType(inner_pc, options_.type == "umfpack" ? PCLU : PCCHOLESKY));
+      GIPSI_PETSC(PCFactorSetMatSolverType(inner_pc, MATSOLVERMUMPS));
+    } else if (pre == "amg") {
+      // The hierarchy is built anew for every tangent: reusing the prolongators (PETSc's
+      // default) kept stale smoother eigenvalue estimates, and CG met an indefinite
+      // preconditioner on the swinging cantilever on 4 ranks.
+      GIPSI_PETSC(PCSetType(pc, PCGAMG));
+      GIPSI_PETSC(PCGAMGSetReuseInterpolation(pc, PETSC_FALSE));
+    } else if (pre == "hypre") {
+      GIPSI_PETSC(PCSetType(pc, PCHYPRE));
+    } else if (pre == "jacobi") {
+      GIPSI_PETSC(PCSetType(pc, PCPBJACOBI));
+    } else if (pre == "sgs") {
+      GIPSI_PETSC(PCSetType(pc, PCSOR));
+      GIPSI_PETSC(PCSORSetSymmetric(pc, SOR_LOCAL_SYMMETRIC_SWEEP));
+    } else {
+      GIPSI_PETSC(PCSetType(pc, PCNONE));
+    }
+    GIPSI_PETSC(KSPSetTolerances(ksp_, options_.tolerance, 1e-300, PETSC_DEFAULT,
+                                 static_cast<PetscInt>(options_.max_iterations)));
+    if (!direct_) {
+      GIPSI_PETSC(KSPSetNormType(ksp_, KSP_NORM_UNPRECONDITIONED));
+      GIPSI_PETSC(KSPSetInitialGuessNonzero(ksp_, PETSC_TRUE));
+    }
+    GIPSI_PETSC(KSPSetFromOptions(ksp_));
+    solution_ = MakeGhosted(part_, comm_);
+    GIPSI_PETSC(VecDuplicate(solution_, &rhs_));
+    GIPSI_PETSC(VecDuplicate(solution_, &work_));
+    if (!direct_ && pre == "amg") {
+      // The rest positions of the owned nodes: GAMG's rigid-body near-null space.
+      Vec coords = nullptr;
+      GIPSI_PETSC(VecCreateMPI(comm_, static_cast<PetscInt>(3 * part_.num_owned), PETSC_DETERMINE,
+                               &coords));
+      GIPSI_PETSC(VecSetBlockSize(coords, 3));
+      PetscScalar* array = nullptr;
+      GIPSI_PETSC(VecGetArray(coords, &array));
+      std::copy(rest.data(), rest.data() + 3 * part_.num_owned, array);
+      GIPSI_PETSC(VecRestoreArray(coords, &array));
+      GIPSI_PETSC(MatNullSpaceCreateRigidBody(coords, &near_null_));
+      GIPSI_PETSC(VecDestroy(&coords));
+    }
+  }
+  ~PetscSolidSolver() override {
+    MatNullSpaceDestroy(&near_null_);
+    KSPDestroy(&ksp_);
+    MatDestroy(&matrix_);
+    VecDestroy(&work_);
+    VecDestroy(&rhs_);
+    VecDestroy(&solution_);
+  }
+
+  [[nodiscard]] std::string name() const override {
+    KSPType type = nullptr;
+    PCType pc_type = nullptr;
+    PC pc = nullptr;
+    KSPGetType(ksp_, &type);
+    KSPGetPC(ksp_, &pc);
+    PCGetType(pc, &pc_type);
+    if (direct_)
+      return fmt::format("petsc mumps {} (redundant)", options_.type == "umfpack" ? "lu" : "ldlt");
+    return fmt::format("petsc {}+{}", type != nullptr ? type : "?",
+                       pc_type != nullptr ? pc_type : "?");
+  }
+  // MUMPS factorises a symmetric matrix as LDLᵀ with pivoting: indefinite tangents too.
+  bool AcceptIndefinite() override { return direct_; }
+
+  void AnalyzePattern(const SparseMatrix& A) override {
+    GIPSI_CHECK(A.rows() == A.cols() && A.rows() == static_cast<Index>(dofs_.size()) &&
+                A.isCompressed());
+    const auto entries = static_cast<std::size_t>(A.nonZeros());
+    std::vector<PetscInt> rows(entries), cols(entries);
+    for (Index j = 0; j < A.outerSize(); ++j)
+      for (int at = A.outerIndexPtr()[j]; at < A.outerIndexPtr()[j + 1]; ++at) {
+        rows[static_cast<std::size_t>(at)] = dofs_[static_cast<std::size_t>(A.innerIndexPtr()[at])];
+        cols[static_cast<std::size_t>(at)] = dofs_[static_cast<std::size_t>(j)];
+      }
+    GIPSI_PETSC(MatDestroy(&matrix_));
+    GIPSI_PETSC(MatCreate(comm_, &matrix_));
+    const auto owned = static_cast<PetscInt>(3 * part_.num_owned);
+    const auto global = static_cast<PetscInt>(3 * part_.num_global_nodes);
+    GIPSI_PETSC(MatSetSizes(matrix_, owned, owned, global, global));
+    GIPSI_PETSC(MatSetType(matrix_, MATAIJ));
+    GIPSI_PETSC(MatSetBlockSize(matrix_, 3));
+    GIPSI_PETSC(MatSetOption(matrix_, MAT_SYMMETRIC, PETSC_TRUE));
+    GIPSI_PETSC(MatSetPreallocationCOO(matrix_, static_cast<PetscCount>(entries), rows.data(),
+                                       cols.data()));
+    if (near_null_ != nullptr) GIPSI_PETSC(MatSetNearNullSpace(matrix_, near_null_));
+    entries_ = A.nonZeros();
+    factorized_ = false;
+  }
+
+  bool Factorize(const SparseMatrix& A) override {
+    if (matrix_ == nullptr) AnalyzePattern(A);
+    GIPSI_CHECK(A.nonZeros() == entries_ && A.rows() == static_cast<Index>(dofs_.size()));
+    factorized_ = false;
+    refactorized_ = true;
+    double bad = Eigen::Map<const VecX>(A.valuePtr(), A.nonZeros()).allFinite() ? 0.0 : 1.0;
+    MPI_Allreduce(MPI_IN_PLACE, &bad, 1, MPI_DOUBLE, MPI_MAX, comm_);
+    if (bad > 0) return false;
+    GIPSI_PETSC(MatSetValuesCOO(matrix_, A.valuePtr(), INSERT_VALUES));
+    GIPSI_PETSC(KSPSetOperators(ksp_, matrix_, matrix_));
+    // A factorisation that fails (a singular tangent) is a failed Factorize, not an error.
+    PetscPushErrorHandler(PetscReturnErrorHandler, nullptr);
+    const PetscErrorCode code = KSPSetUp(ksp_);
+    PetscPopErrorHandler();
+    PC pc = nullptr;
+    PCFailedReason reason = PC_NOERROR;
+    GIPSI_PETSC(KSPGetPC(ksp_, &pc));
+    GIPSI_PETSC(PCGetFailedReasonRank(pc, &reason));
+    double failed = code != 0 || reason != PC_NOERROR ? 1.0 : 0.0;
+    MPI_Allreduce(MPI_IN_PLACE, &failed, 1, MPI_DOUBLE, MPI_MAX, comm_);
+    factorized_ = failed == 0;
+    return factorized_;
+  }
+
+  LinearSolveStats Solve(const VecX& b, VecX& x) override {
+    LinearSolveStats stats;
+    stats.refactorized = refactorized_;
+    refactorized_ = false;
+    const auto local = static_cast<std::size_t>(3 * part_.num_local());
+    GIPSI_CHECK(b.size() == static_cast<Index>(local),
+                "PETSc solve: a right-hand side of {} for {}", b.size(), local);
+    if (!factorized_) {
+      stats.relative_residual = std::numeric_limits<double>::infinity();
+      return stats;
+    }
+    CopyLocalForm(rhs_, const_cast<double*>(b.data()), local, true);
+    if (direct_ || x.size() != b.size())
+      GIPSI_PETSC(VecSet(solution_, 0.0));
+    else
+      CopyLocalForm(solution_, x.data(), local, true);
+    PetscReal b_norm = 0;
+    GIPSI_PETSC(VecNorm(rhs_, NORM_2, &b_norm));
+    x.resize(b.size());
+    if (b_norm == 0) {
+      x.setZero();
+      stats.converged = true;
+      return stats;
+    }
+    if (!std::isfinite(b_norm)) {
+      stats.relative_residual = b_norm;
+      return stats;
+    }
+    // KSP tests its recurrence's residual; the serial solvers promise the true one. Another
+    // round from the last iterate settles the rare solve that stops just above it.
+    double relative = std::numeric_limits<double>::infinity();
+    for (int round = 0; round < 3; ++round) {
+      KSPConvergedReason reason = KSP_CONVERGED_ITERATING;
+      PetscInt its = 0;
+      GIPSI_PETSC(KSPSolve(ksp_, rhs_, solution_));
+      GIPSI_PETSC(KSPGetConvergedReason(ksp_, &reason));
+      GIPSI_PETSC(KSPGetIterationNumber(ksp_, &its));
+      stats.iterations += static_cast<int>(its);
+      GIPSI_PETSC(MatMult(matrix_, solution_, work_));
+      GIPSI_PETSC(VecAYPX(work_, -1.0, rhs_));
+      PetscReal r_norm = 0;
+      GIPSI_PETSC(VecNorm(work_, NORM_2, &r_norm));
+      relative = r_norm / b_norm;
+      if (reason < 0 || !std::isfinite(relative) || relative <= options_.tolerance || direct_)
+        break;
+    }
+    stats.relative_residual = relative;
+    stats.converged = std::isfinite(relative) && relative <= options_.tolerance;
+    GIPSI_PETSC(VecGhostUpdateBegin(solution_, INSERT_VALUES, SCATTER_FORWARD));
+    GIPSI_PETSC(VecGhostUpdateEnd(solution_, INSERT_VALUES, SCATTER_FORWARD));
+    CopyLocalForm(solution_, x.data(), local, false);
+    return stats;
+  }
+
+ private:
+  MPI_Comm comm_;
+  const MeshPart& part_;
+  LinearSolverOptions options_;
+  std::vector<PetscInt> dofs_;  // global index of every local dof
+  bool direct_ = false;
+  KSP ksp_ = nullptr;
+  Mat matrix_ = nullptr;
+  MatNullSpace near_null_ = nullptr;
+  Vec solution_ = nullptr, rhs_ = nullptr, work_ = nullptr;
+  Index entries_ = 0;
+  bool factorized_ = false, refactorized_ = false;
+};
+
+}  // namespace
+
+struct DistributedSolid::Ghosts {
+  Vec v = nullptr;
+  ~Ghosts() { VecDestroy(&v); }
+};
+
+DistributedSolid::DistributedSolid(std::shared_ptr<const Mesh> whole_mesh, MPI_Comm comm)
+    : comm_(comm),
+      whole_(std::move(whole_mesh)),
+      part_(PartitionMesh(*whole_, comm)),
+      whole_boundary_(MakeBoundary(*whole_)),
+      ghosts_(std::make_unique<Ghosts>()) {
+  // The part's boundary: the whole boundary's faces of local tets, and every local node on the
+  // whole boundary as a vertex (in local order).
+  const Mesh& whole = *whole_;
+  const BoundarySurface& whole_boundary = whole_boundary_;
+  std::vector<int> whole_vertex_of_node(static_cast<std::size_t>(whole.num_nodes()), -1);
+  for (std::size_t v = 0; v < whole_boundary.vertex_to_node.size(); ++v)
+    whole_vertex_of_node[static_cast<std::size_t>(whole_boundary.vertex_to_node[v])] =
+        static_cast<int>(v);
+  std::vector<int> part_vertex(whole_boundary.vertex_to_node.size(), -1);
+  for (std::size_t i = 0; i < part_.whole_node.size(); ++i) {
+    const int v = whole_vertex_of_node[static_cast<std::size_t>(part_.whole_node[i])];
+    if (v < 0) continue;
+    part_vertex[static_cast<std::size_t>(v)] = static_cast<int>(whole_vertex_.size());
+    whole_vertex_.push_back(v);
+    boundary_.vertex_to_node.push_back(static_cast<int>(i));
+  }
+  std::vector<int> local_tet(static_cast<std::size_t>(whole.num_tets()), -1);
+  for (std::size_t e = 0; e < part_.whole_tet.size(); ++e)
+    local_tet[static_cast<std::size_t>(part_.whole_tet[e])] = static_cast<int>(e);
+  std::vector<int> faces;
+  for (Index f = 0; f < whole_boundary.num_triangles(); ++f) {
+    const int tet = local_tet[static_cast<std::size_t>(
+        whole_boundary.face_to_tet[static_cast<std::size_t>(f)])];
+    if (tet < 0) continue;
+    faces.push_back(static_cast<int>(f));
+    boundary_.face_to_tet.push_back(tet);
+  }
+  boundary_.triangles.resize(3, static_cast<Index>(faces.size()));
+  for (std::size_t k = 0; k < faces.size(); ++k)
+    for (int a = 0; a < 3; ++a)
+      boundary_.triangles(a, static_cast<Index>(k)) =
+          part_vertex[static_cast<std::size_t>(whole_boundary.triangles(a, faces[k]))];
+  whole_face_ = std::move(faces);
+  ghosts_->v = MakeGhosted(part_, comm_);
+}
+
+DistributedSolid::~DistributedSolid() = default;
+
+void DistributedSolid::Reduce(std::span<double> values, bool max) const {
+  MPI_Allreduce(MPI_IN_PLACE, values.data(), static_cast<int>(values.size()), MPI_DOUBLE,
+                max ? MPI_MAX : MPI_SUM, comm_);
+}
+
+void DistributedSolid::SumShared(VecX& v) const {
+  const auto local = static_cast<std::size_t>(3 * part_.num_local());
+  GIPSI_CHECK(v.size() == static_cast<Index>(local));
+  CopyLocalForm(ghosts_->v, v.data(), local, true);
+  // The shared copies' partial sums onto their owners, then the owners' totals back.
+  GIPSI_PETSC(VecGhostUpdateBegin(ghosts_->v, ADD_VALUES, SCATTER_REVERSE));
+  GIPSI_PETSC(VecGhostUpdateEnd(ghosts_->v, ADD_VALUES, SCATTER_REVERSE));
+  GIPSI_PETSC(VecGhostUpdateBegin(ghosts_->v, INSERT_VALUES, SCATTER_FORWARD));
+  GIPSI_PETSC(VecGhostUpdateEnd(ghosts_->v, INSERT_VALUES, SCATTER_FORWARD));
+  CopyLocalForm(ghosts_->v, v.data(), local, false);
+}
+
+std::unique_ptr<LinearSolver> DistributedSolid::MakeLinearSolver(const LinearSolverOptions& options,
+                                                                 const VecX& rest) const {
+  if (options.type == "cg" &&
+      (options.preconditioner == "ic" || options.preconditioner == "cholesky"))
+    throw InputError(fmt::format(
+        "preconditioner '{}' has no distributed version: use 'amg' (PETSc's GAMG, the default "
+        "under MPI), 'hypre', 'jacobi', 'sgs' or 'none', e.g. in the object's \"parallel\": "
+        "{{\"linear_solver\": {{...}}}} block",
+        options.preconditioner));
+  if (options.type == "schur_gmres")
+    throw InputError("linear_solver type 'schur_gmres' is a MixedSolid's, not a FemSolid's");
+  return std::make_unique<PetscSolidSolver>(comm_, part_, options, rest);
+}
+
+namespace {
+
+// Each rank sends the listed nodes it owns (their positions in the list and their values);
+// every rank receives all of them (MPI_Allgatherv of O(list)).
+class AllgatherNodes final : public NodeGather {
+ public:
+  AllgatherNodes(const MeshPart& part, std::vector<int> whole_nodes, MPI_Comm comm)
+      : comm_(comm), count_(whole_nodes.size()) {
+    std::vector<int> owned_local(static_cast<std::size_t>(part.num_global_nodes), -1);
+    for (std::int64_t i = 0; i < part.num_owned; ++i)
+      owned_local[static_cast<std::size_t>(part.whole_node[static_cast<std::size_t>(i)])] =
+          static_cast<int>(i);
+    for (std::size_t k = 0; k < whole_nodes.size(); ++k) {
+      const int local = owned_local[static_cast<std::size_t>(whole_nodes[k])];
+      if (local < 0) continue;
+      sent_at_.push_back(static_cast<int>(k));
+      sent_local_.push_back(local);
+    }
+    int size = 1;
+    MPI_Comm_size(comm_, &size);
+    counts_.resize(static_cast<std::size_t>(size));
+    offsets_.assign(static_cast<std::size_t>(size), 0);
+    const int mine = static_cast<int>(sent_at_.size());
+    MPI_Allgather(&mine, 1, MPI_INT, counts_.data(), 1, MPI_INT, comm_);
+    for (std::size_t r = 1; r < counts_.size(); ++r) offsets_[r] = offsets_[r - 1] + counts_[r - 1];
+    received_at_.resize(count_);
+    GIPSI_CHECK(static_cast<std::size_t>(offsets_.back() + counts_.back()) == count_,
+                "a node gather of {} nodes, {} owned by some rank", count_,
+                offsets_.back() + counts_.back());
+    MPI_Allgatherv(sent_at_.data(), mine, MPI_INT, received_at_.data(), counts_.data(),
+                   offsets_.data(), MPI_INT, comm_);
+    for (std::size_t r = 0; r < counts_.size(); ++r) {
+      counts_[r] *= 3;
+      offsets_[r] *= 3;
+    }
+    sent_.resize(3 * sent_at_.size());
+    received_.resize(3 * count_);
+  }
+  void Gather(const double* local, Points& out) const override {
+    for (std::size_t i = 0; i < sent_local_.size(); ++i)
+      for (std::size_t a = 0; a < 3; ++a)
+        sent_[3 * i + a] = local[3 * static_cast<std::size_t>(sent_local_[i]) + a];
+    MPI_Allgatherv(sent_.data(), static_cast<int>(sent_.size()), MPI_DOUBLE, received_.data(),
+                   counts_.data(), offsets_.data(), MPI_DOUBLE, comm_);
+    out.resize(3, static_cast<Index>(count_));
+    for (std::size_t i = 0; i < count_; ++i)
+      for (Index a = 0; a < 3; ++a)
+        out(a, received_at_[i]) = received_[3 * i + static_cast<std::size_t>(a)];
+  }
+
+ private:
+  MPI_Comm comm_;
+  std::size_t count_;
+  std::vector<int> sent_at_, sent_local_, received_at_, counts_, offsets_;
+  mutable std::vector<double> sent_, received_;
+};
+
+}  // namespace
+
+std::unique_ptr<NodeGather> DistributedSolid::MakeNodeGather(std::vector<int> whole_nodes) const {
+  return std::make_unique<AllgatherNodes>(part_, std::move(whole_nodes), comm_);
+}
+
+std::int64_t DistributedSolid::WholeTetId(Index local) const {
+  const Mesh& mesh = *part_.mesh;
+  return mesh.tet_ids.empty() ? part_.whole_tet[static_cast<std::size_t>(local)]
+                              : mesh.TetId(local);
+}
+
+}  // namespace gipsi
