@@ -1,6 +1,6 @@
 #pragma once
 // What the MPI benches share: the N-version slab (20 × 7 × 3 mm) and its size in hexahedra
-// (--cells NX NY NZ), a parse that
+// (--cells NX NY NZ), the peak resident memory and a median, a parse that
 // exits 2 with CLI11's message on a bad command line (0 after --help), and a main that reports
 // an error on every rank and ends them all.
 
@@ -8,15 +8,34 @@
 
 #include <mpi.h>
 
+#include <algorithm>
 #include <array>
 #include <cstdio>
 #include <cstdlib>
 #include <exception>
+#include <fstream>
+#include <string>
+#include <vector>
 
 #include "gipsi/geometry/generators.h"
 #include "gipsi/parallel/parallel_session.h"
 
 namespace gipsi::bench {
+
+// Peak resident memory of this process [bytes] (VmHWM of /proc/self/status).
+inline double PeakResidentBytes() {
+  std::ifstream status("/proc/self/status");
+  std::string line;
+  while (std::getline(status, line))
+    if (line.rfind("VmHWM:", 0) == 0) return 1024.0 * std::atof(line.c_str() + 6);
+  return 0;
+}
+
+// The median of `v` (the upper one of an even count; 0 for none).
+inline double Median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  return v.empty() ? 0 : v[v.size() / 2];
+}
 
 // Adds --cells NX NY NZ (hexahedra along the 20 × 7 × 3 mm slab, 6 tets each) into `cells`.
 inline void AddSlabCells(CLI::App& app, std::array<int, 3>& cells) {

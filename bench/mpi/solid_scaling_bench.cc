@@ -48,19 +48,8 @@ using gipsi::Index;
 
 constexpr double kLength = 0.1, kWidth = 0.01, kHeight = 0.01;  // m (scenes/cantilever.json)
 
-// Peak resident memory of this process [bytes] (VmHWM of /proc/self/status).
-double PeakResidentBytes() {
-  std::ifstream status("/proc/self/status");
-  std::string line;
-  while (std::getline(status, line))
-    if (line.rfind("VmHWM:", 0) == 0) return 1024.0 * std::atof(line.c_str() + 6);
-  return 0;
-}
-
-double Median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  return v.empty() ? 0 : v[v.size() / 2];
-}
+using gipsi::bench::Median;
+using gipsi::bench::PeakResidentBytes;
 
 struct Options {
   int nx = 80, ny = 8, nz = 8;

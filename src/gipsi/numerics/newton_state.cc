@@ -45,6 +45,7 @@ void NewtonSolver::SaveState(StateWriter& out, const SparseMatrix& J) const {
       out.WriteMatrix(aa_df_);
     }
   }
+  linear_->SaveState(out);  // the serial solvers write nothing
   out.EndSection();
 }
 
@@ -92,6 +93,7 @@ void NewtonSolver::RestoreState(StateReader& in, SparseMatrix& J) {
     }
     aa_count_ = static_cast<int>(count);
   }
+  linear_->RestoreState(in, J);
   in.EndSection();
 }
 

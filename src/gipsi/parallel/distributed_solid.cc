@@ -8,8 +8,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <span>
 
 #include "gipsi/base/error.h"
+#include "gipsi/base/state.h"
 #include "gipsi/parallel/petsc_check.h"
 
 namespace gipsi {
@@ -57,6 +59,7 @@ class PetscSolidSolver final : public LinearSolver {
                    const VecX& rest)
       : comm_(comm), part_(part), options_(std::move(options)), dofs_(GlobalDofs(part)) {
     direct_ = options_.type != "cg";
+    lagged_ = !direct_ && (options_.preconditioner == "amg" || options_.preconditioner == "hypre");
     GIPSI_PETSC(KSPCreate(comm_, &ksp_));
     GIPSI_PETSC(KSPSetOptionsPrefix(ksp_, "solid_"));
     GIPSI_PETSC(KSPSetType(ksp_, direct_ ? KSPPREONLY : KSPCG));
@@ -173,6 +176,22 @@ class PetscSolidSolver final : public LinearSolver {
     MPI_Allreduce(MPI_IN_PLACE, &bad, 1, MPI_DOUBLE, MPI_MAX, comm_);
     if (bad > 0) return false;
     GIPSI_PETSC(MatSetValuesCOO(matrix_, A.valuePtr(), INSERT_VALUES));
+    current_ = A.valuePtr();
+    if (lagged_ && have_pc_ && !rebuild_pending_) {  // the multigrid of an earlier tangent
+      GIPSI_PETSC(KSPSetReusePreconditioner(ksp_, PETSC_TRUE));
+      GIPSI_PETSC(KSPSetOperators(ksp_, matrix_, matrix_));
+      refactorized_ = false;
+      factorized_ = true;
+      return true;
+    }
+    factorized_ = Build();
+    return factorized_;
+  }
+
+  // Sets the preconditioner up for the matrix's current values (current_).
+  bool Build() {
+    have_pc_ = false;
+    GIPSI_PETSC(KSPSetReusePreconditioner(ksp_, PETSC_FALSE));
     GIPSI_PETSC(KSPSetOperators(ksp_, matrix_, matrix_));
     // A factorisation that fails (a singular tangent) is a failed Factorize, not an error.
     PetscPushErrorHandler(PetscReturnErrorHandler, nullptr);
@@ -184,8 +203,49 @@ class PetscSolidSolver final : public LinearSolver {
     GIPSI_PETSC(PCGetFailedReasonRank(pc, &reason));
     double failed = code != 0 || reason != PC_NOERROR ? 1.0 : 0.0;
     MPI_Allreduce(MPI_IN_PLACE, &failed, 1, MPI_DOUBLE, MPI_MAX, comm_);
-    factorized_ = failed == 0;
-    return factorized_;
+    have_pc_ = failed == 0;
+    rebuild_pending_ = false;
+    fresh_ = true;
+    if (lagged_ && have_pc_ && current_ != pc_source_.data())
+      pc_source_.assign(current_, current_ + entries_);
+    return have_pc_;
+  }
+
+  // A kept multigrid is saved as the values it was built from, and built again on restore
+  // (GAMG and BoomerAMG are deterministic on the same rank count), so a resumed run solves with
+  // the same preconditioner as the uninterrupted one.
+  void SaveState(StateWriter& out) const override {
+    out.BeginSection("PetscSolidSolver", 1);
+    out.WriteBool(lagged_ && have_pc_);
+    if (lagged_ && have_pc_) {
+      out.WriteArray(std::span<const double>(pc_source_));
+      out.WriteBool(rebuild_pending_);
+      out.WriteInt(baseline_);
+    }
+    out.EndSection();
+  }
+  void RestoreState(StateReader& in, const SparseMatrix& current) override {
+    in.BeginSection("PetscSolidSolver", 1);
+    if (in.ReadBool()) {
+      if (!lagged_) in.Fail("the checkpoint keeps a multigrid preconditioner this solver has not");
+      if (matrix_ == nullptr) AnalyzePattern(current);
+      pc_source_.resize(static_cast<std::size_t>(entries_));
+      in.ReadArrayExact(pc_source_, "the values the kept multigrid was built from");
+      GIPSI_PETSC(MatSetValuesCOO(matrix_, pc_source_.data(), INSERT_VALUES));
+      current_ = pc_source_.data();
+      if (!Build()) in.Fail("the saved multigrid cannot be built again");
+      fresh_ = false;
+      rebuild_pending_ = in.ReadBool();
+      baseline_ = static_cast<int>(in.ReadInt());
+      // The operator is the current matrix, with the kept preconditioner.
+      GIPSI_PETSC(MatSetValuesCOO(matrix_, current.valuePtr(), INSERT_VALUES));
+      current_ = current.valuePtr();
+      GIPSI_PETSC(KSPSetReusePreconditioner(ksp_, PETSC_TRUE));
+      GIPSI_PETSC(KSPSetOperators(ksp_, matrix_, matrix_));
+      factorized_ = true;
+      refactorized_ = false;
+    }
+    in.EndSection();
   }
 
   LinearSolveStats Solve(const VecX& b, VecX& x) override {
@@ -216,8 +276,40 @@ class PetscSolidSolver final : public LinearSolver {
       stats.relative_residual = b_norm;
       return stats;
     }
-    // KSP tests its recurrence's residual; the serial solvers promise the true one. Another
-    // round from the last iterate settles the rare solve that stops just above it.
+    // A lagged multigrid that fails is rebuilt for this matrix, and the solve runs again.
+    double relative = Iterate(b_norm, stats);
+    if (lagged_ && !fresh_ && !(relative <= options_.tolerance)) {
+      stats.refactorized = true;
+      if (Build()) {
+        GIPSI_PETSC(VecSet(solution_, 0.0));
+        relative = Iterate(b_norm, stats);
+      }
+    }
+    if (lagged_) {
+      // The serial "amg" rule (pcg.cc): a fresh multigrid sets the baseline; a lagged one is
+      // rebuilt at the next Factorize once CG needs more than refactor_iterations and more
+      // than 1.5 times (plus 2) the baseline, or fails.
+      if (fresh_)
+        baseline_ = stats.iterations;
+      else if (!(relative <= options_.tolerance) ||
+               (stats.iterations > options_.refactor_iterations &&
+                2 * stats.iterations > 3 * baseline_ + 4))
+        rebuild_pending_ = true;
+      fresh_ = false;
+    }
+    stats.relative_residual = relative;
+    stats.converged = std::isfinite(relative) && relative <= options_.tolerance;
+    GIPSI_PETSC(VecGhostUpdateBegin(solution_, INSERT_VALUES, SCATTER_FORWARD));
+    GIPSI_PETSC(VecGhostUpdateEnd(solution_, INSERT_VALUES, SCATTER_FORWARD));
+    CopyLocalForm(solution_, x.data(), local, false);
+    return stats;
+  }
+
+ private:
+  // KSP from solution_'s current values; the relative true residual at the end. KSP tests its
+  // recurrence's residual, and the serial solvers promise the true one: another round from the
+  // last iterate settles the rare solve that stops just above it.
+  double Iterate(PetscReal b_norm, LinearSolveStats& stats) {
     double relative = std::numeric_limits<double>::infinity();
     for (int round = 0; round < 3; ++round) {
       KSPConvergedReason reason = KSP_CONVERGED_ITERATING;
@@ -234,15 +326,9 @@ class PetscSolidSolver final : public LinearSolver {
       if (reason < 0 || !std::isfinite(relative) || relative <= options_.tolerance || direct_)
         break;
     }
-    stats.relative_residual = relative;
-    stats.converged = std::isfinite(relative) && relative <= options_.tolerance;
-    GIPSI_PETSC(VecGhostUpdateBegin(solution_, INSERT_VALUES, SCATTER_FORWARD));
-    GIPSI_PETSC(VecGhostUpdateEnd(solution_, INSERT_VALUES, SCATTER_FORWARD));
-    CopyLocalForm(solution_, x.data(), local, false);
-    return stats;
+    return relative;
   }
 
- private:
   MPI_Comm comm_;
   const MeshPart& part_;
   LinearSolverOptions options_;
@@ -254,6 +340,11 @@ class PetscSolidSolver final : public LinearSolver {
   Vec solution_ = nullptr, rhs_ = nullptr, work_ = nullptr;
   Index entries_ = 0;
   bool factorized_ = false, refactorized_ = false;
+  const double* current_ = nullptr;  // the matrix's values (the caller's, alive till Factorize)
+  // A multigrid ("amg", "hypre") kept across tangents while it works (Solve's rule).
+  bool lagged_ = false, have_pc_ = false, rebuild_pending_ = true, fresh_ = false;
+  int baseline_ = 0;               // CG iterations of the first solve with a fresh multigrid
+  std::vector<double> pc_source_;  // the values the kept multigrid was built from
 };
 
 }  // namespace

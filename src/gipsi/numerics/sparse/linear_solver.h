@@ -26,6 +26,9 @@
 GIPSI_EXPORT_BEGIN
 namespace gipsi {
 
+class StateReader;
+class StateWriter;
+
 /// Square sparse matrix, compressed columns, 32-bit indices. Symmetric matrices store both
 /// triangles, so a column is also a row (SpMV can run row-parallel).
 using SparseMatrix = Eigen::SparseMatrix<double, Eigen::ColMajor, int>;
@@ -146,6 +149,14 @@ class LinearSolver {
   /// have A's size (checked). b = 0 gives x = 0, converged. Non-finite values in b, x or along
   /// the iteration stop the solve (no hang) with `converged` false. Never throws.
   virtual LinearSolveStats Solve(const VecX& b, VecX& x) = 0;
+  /// Checkpoints: what the solver keeps from one Factorize for later ones besides the matrix
+  /// it is given (a preconditioner built from an earlier matrix, kept while it works), so that
+  /// a restored run solves with the same one. RestoreState is called after the matrix `current`
+  /// (the last one given to Factorize, or one a Factorize will replace) has its values back.
+  /// Default: nothing to save (the serial solvers; their lagged preconditioners are rebuilt
+  /// on resume, docs/robustness.md).
+  virtual void SaveState(StateWriter& /*out*/) const {}
+  virtual void RestoreState(StateReader& /*in*/, const SparseMatrix& /*current*/) {}
 };
 
 /// The 6 rigid-body modes (3 translations, 3 rotations about the centroid) of nodes at
