@@ -9,6 +9,8 @@
 #include <algorithm>
 #include <cmath>
 #include <span>
+#include <string>
+#include <string_view>
 
 #include "gipsi/base/error.h"
 #include "gipsi/base/state.h"
@@ -67,17 +69,25 @@ class PetscSolidSolver final : public LinearSolver {
     GIPSI_PETSC(KSPGetPC(ksp_, &pc));
     const std::string& pre = options_.preconditioner;
     if (direct_) {
-      // The tangent gathered on every rank and factorised there by sequential MUMPS
-      // (PCREDUNDANT): MUMPS across ranks schedules its work dynamically and gave other bits in
-      // every run (the ventricle inflation on 2 ranks), so a checkpoint would not resume
-      // bitwise. The price: each rank holds the whole factorisation (docs/scale-out.md).
+      // The tangent gathered on every rank and factorised there by a sequential solver
+      // (PCREDUNDANT): the serial object's own (CHOLMOD's supernodal LLᵀ, UMFPACK's LU), or
+      // MUMPS's LDLᵀ for "ldlt" and for an indefinite tangent (AcceptIndefinite). MUMPS across
+      // ranks schedules its work dynamically and gave other bits in every run (the ventricle
+      // inflation on 2 ranks), so a checkpoint would not resume bitwise. The price: each rank
+      // holds the whole factorisation (docs/scale-out.md).
       GIPSI_PETSC(PCSetType(pc, PCREDUNDANT));
-      KSP inner = nullptr;
-      PC inner_pc = nullptr;
-      GIPSI_PETSC(PCRedundantGetKSP(pc, &inner));
-      GIPSI_PETSC(KSPGetPC(inner, &inner_pc));
-      GIPSI_PETSC(PCSetType(inner_pc, options_.type == "umfpack" ? PCLU : PCCHOLESKY));
-      GIPSI_PETSC(PCFactorSetMatSolverType(inner_pc, MATSOLVERMUMPS));
+      factor_solver_ = options_.type == "cholmod"   ? MATSOLVERCHOLMOD
+                       : options_.type == "umfpack" ? MATSOLVERUMFPACK
+                                                    : MATSOLVERMUMPS;
+      // CHOLMOD's own report of an indefinite tangent would repeat, on every rank, what the
+      // object's warning says (Newton switches to LDLᵀ); PETSC_OPTIONS may still ask for it.
+      PetscBool given = PETSC_FALSE;
+      GIPSI_PETSC(
+          PetscOptionsHasName(nullptr, nullptr, "-solid_redundant_mat_cholmod_print", &given));
+      if (!given)
+        GIPSI_PETSC(PetscOptionsSetValue(nullptr, "-solid_redundant_mat_cholmod_print", "0"));
+      GIPSI_PETSC(PCSetType(InnerPc(), options_.type == "umfpack" ? PCLU : PCCHOLESKY));
+      GIPSI_PETSC(PCFactorSetMatSolverType(InnerPc(), factor_solver_.c_str()));
     } else if (pre == "amg") {
       // The hierarchy is built anew for every tangent: reusing the prolongators (PETSc's
       // default) kept stale smoother eigenvalue estimates, and CG met an indefinite
@@ -135,12 +145,24 @@ class PetscSolidSolver final : public LinearSolver {
     KSPGetPC(ksp_, &pc);
     PCGetType(pc, &pc_type);
     if (direct_)
-      return fmt::format("petsc mumps {} (redundant)", options_.type == "umfpack" ? "lu" : "ldlt");
+      return fmt::format("petsc {} (redundant)",
+                         factor_solver_ == MATSOLVERMUMPS ? "mumps ldlt" : factor_solver_);
     return fmt::format("petsc {}+{}", type != nullptr ? type : "?",
                        pc_type != nullptr ? pc_type : "?");
   }
-  // MUMPS factorises a symmetric matrix as LDLᵀ with pivoting: indefinite tangents too.
-  bool AcceptIndefinite() override { return direct_; }
+  // MUMPS factorises a symmetric matrix as LDLᵀ with pivoting: indefinite tangents too. CHOLMOD
+  // (LLᵀ) gives way to it, for good, as the serial "cholmod" gives way to its LDLᵀ.
+  bool AcceptIndefinite() override {
+    if (!direct_ || options_.type == "umfpack") return direct_;
+    if (factor_solver_ != std::string_view(MATSOLVERMUMPS)) {
+      PC pc = nullptr;
+      GIPSI_PETSC(KSPGetPC(ksp_, &pc));
+      GIPSI_PETSC(PCReset(pc));
+      factor_solver_ = MATSOLVERMUMPS;
+      GIPSI_PETSC(PCFactorSetMatSolverType(InnerPc(), factor_solver_.c_str()));
+    }
+    return true;
+  }
 
   void AnalyzePattern(const SparseMatrix& A) override {
     GIPSI_CHECK(A.rows() == A.cols() && A.rows() == static_cast<Index>(dofs_.size()) &&
@@ -334,6 +356,17 @@ class PetscSolidSolver final : public LinearSolver {
   LinearSolverOptions options_;
   std::vector<PetscInt> dofs_;  // global index of every local dof
   bool direct_ = false;
+  std::string factor_solver_ = MATSOLVERMUMPS;  // of the direct types
+
+  // The preconditioner of the redundant solve's inner KSP (direct types).
+  PC InnerPc() const {
+    PC pc = nullptr, inner_pc = nullptr;
+    KSP inner = nullptr;
+    GIPSI_PETSC(KSPGetPC(ksp_, &pc));
+    GIPSI_PETSC(PCRedundantGetKSP(pc, &inner));
+    GIPSI_PETSC(KSPGetPC(inner, &inner_pc));
+    return inner_pc;
+  }
   KSP ksp_ = nullptr;
   Mat matrix_ = nullptr;
   MatNullSpace near_null_ = nullptr;
