@@ -136,9 +136,10 @@ void HoldBase(SimObject& solid) {
       solid.boundary_conditions().Fix(v);
 }
 
-// The ventricle inflated to 10 kPa on the endocardium in 10 load increments, static. The split run
-// factorises with MUMPS, the serial one with CHOLMOD: direct solves, Newton to 1e-10, so the apex
-// agrees to 1e-8 of its 3 mm drop.
+// The ventricle inflated to 10 kPa on the endocardium in 10 load increments, static. Both runs
+// factorise with CHOLMOD until the tangent turns indefinite (half-way), then with an LDLᵀ (the
+// serial object's own, MUMPS's in the split run's redundant solve): direct solves, Newton to
+// 1e-10, so the apex agrees to 1e-8 of its 3 mm drop.
 TEST(DistributedSolid, InflatedVentricleAsTheSerialObject) {
   const auto whole = Ventricle();
   FemParams p = VentricleParams();
@@ -186,8 +187,8 @@ class FillingLaw final : public CavityLaw {
 // The ventricle above with its endocardial cavity coupled to blood (the heart's coupling: the
 // pressure a bordered Newton unknown, the cavity volume and its gradient over the whole
 // endocardium, whose vertices each rank gathers), filled by 2 mL in 0.1 s (backward Euler):
-// the split run (MUMPS) gives the serial run's (CHOLMOD) pressure, volume and displacements,
-// Newton converged to 1e-10 on both, so within 1e-8 relative.
+// the split run gives the serial run's pressure, volume and displacements (direct solves,
+// Newton converged to 1e-10 on both), so within 1e-8 relative.
 TEST(DistributedSolid, CoupledCavityFillsAsTheSerialObject) {
   const auto whole = Ventricle();
   FemParams p = VentricleParams();
