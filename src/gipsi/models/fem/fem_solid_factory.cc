@@ -69,6 +69,25 @@ NewtonOptions ParseNewtonOptions(const JsonNode& node, NewtonOptions options) {
   return options;
 }
 
+std::optional<TransmuralFibreRule> ParseSolidFibres(const JsonNode& object,
+                                                    const SolidMaterial& law, Vec3& fibre,
+                                                    Vec3& sheet) {
+  auto fibres = object.Find("fibres");
+  if (fibres && fibres->Has("rule")) return ParseTransmuralFibreRule(*fibres);
+  if (fibres) {
+    fibres->CheckKeys({"direction", "sheet"});
+    fibre = fibres->Vector3("direction");
+    sheet = fibres->Vector3("sheet", sheet);
+    if (fibre.norm() == 0) fibres->At("direction").Expected("a non-zero vector");
+  } else if (law.needs_fibres()) {
+    object.At("material")
+        .Fail(fmt::format("law '{}' is anisotropic: give the object a fibre direction, e.g. "
+                          "\"fibres\": {{\"direction\": [1, 0, 0]}}",
+                          law.law()));
+  }
+  return std::nullopt;
+}
+
 StepPredictor ParsePredictor(const JsonNode& object, StepPredictor fallback) {
   auto predictor = object.Find("predictor");
   if (!predictor) return fallback;
@@ -140,20 +159,7 @@ FemSolidSpec ParseFemSolidSpec(const ObjectBuildContext& ctx) {
     params.linear_solver = ParseLinearSolverOptions(*solver);
   ParseLoadStepping(p, params.load_steps, params.max_bisections);
   params.predictor = ParsePredictor(p, params.predictor);
-  if (auto fibres = p.Find("fibres"); fibres && fibres->Has("rule")) {
-    fibre_rule = ParseTransmuralFibreRule(*fibres);
-  } else if (fibres) {
-    fibres->CheckKeys({"direction", "sheet"});
-    params.fibre = fibres->Vector3("direction");
-    params.sheet = fibres->Vector3("sheet", params.sheet);
-    if (params.fibre.norm() == 0) fibres->At("direction").Expected("a non-zero vector");
-  } else if (params.material->needs_fibres()) {
-    p.At("material")
-        .Fail(
-            fmt::format("law '{}' is anisotropic: give the object a fibre field, e.g. \"fibres\": "
-                        "{{\"direction\": [1, 0, 0]}}",
-                        params.material->law()));
-  }
+  fibre_rule = ParseSolidFibres(p, *params.material, params.fibre, params.sheet);
   if (auto cavities = p.Find("cavities")) params.cavities = ParseCavitySpecs(*cavities);
   // The solver of distributed runs: linear_solver's, with the "parallel" block's keys over it
   // (PETSc's: "amg" is GAMG, "hypre" BoomerAMG, the direct types MUMPS); CG without a

@@ -64,20 +64,8 @@ void RegisterMixedSolid(TypeRegistry& registry) {
                 "block, which LDLT without pivoting cannot factorise");
         }
         ParseLoadStepping(p, params.load_steps, params.max_bisections);
-        std::optional<TransmuralFibreRule> fibre_rule;
-        if (auto fibres = p.Find("fibres"); fibres && fibres->Has("rule")) {
-          fibre_rule = ParseTransmuralFibreRule(*fibres);
-        } else if (auto fibres = p.Find("fibres")) {
-          fibres->CheckKeys({"direction", "sheet"});
-          params.fibre = fibres->Vector3("direction");
-          params.sheet = fibres->Vector3("sheet", params.sheet);
-          if (params.fibre.norm() == 0) fibres->At("direction").Expected("a non-zero vector");
-        } else if (params.material->needs_fibres()) {
-          p.At("material")
-              .Fail(fmt::format("law '{}' is anisotropic: give the object a fibre direction, "
-                                "e.g. \"fibres\": {{\"direction\": [1, 0, 0]}}",
-                                params.material->law()));
-        }
+        const std::optional<TransmuralFibreRule> fibre_rule =
+            ParseSolidFibres(p, *params.material, params.fibre, params.sheet);
         if (params.material->log_volumetric_modulus() <= 0)
           p.At("material")
               .Fail(fmt::format(

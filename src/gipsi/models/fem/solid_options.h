@@ -2,8 +2,12 @@
 /// @file
 /// Scene-file parsing shared by the solid objects' factories ("FemSolid", "MixedSolid").
 
+#include <optional>
+
 #include "gipsi/base/export.h"
 #include "gipsi/base/json_node.h"
+#include "gipsi/models/fem/solid_material.h"
+#include "gipsi/models/fibres/rule_based_fibres.h"
 #include "gipsi/numerics/implicit_scheme.h"
 #include "gipsi/numerics/newton.h"
 
@@ -18,6 +22,12 @@ namespace gipsi {
 /// each left as given when absent; throws InputError naming the JSON path of a bad value.
 void ParseLoadStepping(const JsonNode& object, int& load_steps, int& max_bisections);
 
+/// The object's "fibres": a transmural rule (returned; its fibres are made on the mesh later), or
+/// a uniform "direction" and "sheet" (into `fibre` and `sheet`). Without it, a law that needs
+/// fibres is refused at "material". Throws InputError naming the JSON path of a bad value.
+[[nodiscard]] std::optional<TransmuralFibreRule> ParseSolidFibres(const JsonNode& object,
+                                                                  const SolidMaterial& law,
+                                                                  Vec3& fibre, Vec3& sheet);
 /// The object's "predictor" ("none", "constant_velocity" or "constant_acceleration"); `fallback`
 /// when absent. Throws InputError naming the JSON path of a bad value.
 [[nodiscard]] StepPredictor ParsePredictor(const JsonNode& object, StepPredictor fallback);
