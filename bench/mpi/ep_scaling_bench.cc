@@ -4,7 +4,9 @@
 // figures: time per step (median, min and max over the timed steps, each ended by a barrier so
 // the slowest rank counts), its split (cell models, diffusion, tracking; rank 0's), diffusion
 // iterations per step, set-up time (partition + assembly), and the peak resident memory per
-// rank (VmHWM) with the bytes per tet it makes.
+// rank (VmHWM) with the bytes per tet it makes. Each rank makes only its block of the slab
+// (MakeTetBoxBlock) and the partitioner cuts it from the blocks, so no rank holds the whole
+// mesh; --whole-mesh makes the whole slab on every rank first (what a scene run does).
 //
 //   mpiexec -np 2 build/release/bench/ep_scaling_bench --cells 160 56 24 --steps 200
 //   build/release/bench/ep_scaling_bench --cells 160 56 24 --serial   (the serial Monodomain)
@@ -12,14 +14,15 @@
 // Options: --cells NX NY NZ (hexahedra along the slab, 6 tets each; default 80 28 12, 161k
 // tets), --steps N timed steps (default 100) after --warmup N (default 10), --pc jacobi|amg|
 // hypre (default jacobi), --tolerance (default 1e-8, the scenes'), --serial (one rank: the
-// serial object instead, for the baseline). Run with OMP_NUM_THREADS=1 per rank unless
-// measuring threads within ranks.
+// serial object instead, for the baseline), --whole-mesh. Run with OMP_NUM_THREADS=1 per rank
+// unless measuring threads within ranks.
 
 #include <mpi.h>
 
 #include <algorithm>
 #include <array>
 #include <chrono>
+#include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -29,9 +32,11 @@
 #include <vector>
 
 #include "gipsi/geometry/generators.h"
+#include "gipsi/geometry/mesh_block.h"
 #include "gipsi/models/ep/monodomain.h"
 #include "gipsi/models/ep/ten_tusscher_panfilov_2006.h"
 #include "gipsi/parallel/distributed_monodomain.h"
+#include "gipsi/parallel/mesh_partition.h"
 #include "gipsi/parallel/parallel_session.h"
 #include "slab_cli.h"
 
@@ -48,6 +53,7 @@ struct Options {
   std::string pc = "jacobi";
   double tolerance = 1e-8;
   bool serial = false;
+  bool whole_mesh = false;
 };
 
 // Exits 2 with CLI11's message on a bad command line (PETSc options such as -log_view pass
@@ -63,6 +69,8 @@ Options Parse(int argc, char** argv) {
   app.add_option("--pc", o.pc, "Preconditioner")->check(CLI::IsMember({"jacobi", "amg", "hypre"}));
   app.add_option("--tolerance", o.tolerance, "CG's relative residual")->check(CLI::PositiveNumber);
   app.add_flag("--serial", o.serial, "The serial Monodomain instead (one rank)");
+  app.add_flag("--whole-mesh", o.whole_mesh,
+               "Every rank makes the whole slab before the cut (as scene runs read meshes)");
   gipsi::bench::ParseOrExit(app, argc, argv);
   o.nx = cells[0];
   o.ny = cells[1];
@@ -99,8 +107,16 @@ int Main(int argc, char** argv) {
     return 2;
   }
   const double t0 = MPI_Wtime();
-  const auto whole = std::make_shared<gipsi::Mesh>(gipsi::bench::SlabMesh(o.nx, o.ny, o.nz));
+  std::shared_ptr<gipsi::Mesh> whole;
+  gipsi::MeshBlock block;
+  if (o.serial || o.whole_mesh)
+    whole = std::make_shared<gipsi::Mesh>(gipsi::bench::SlabMesh(o.nx, o.ny, o.nz));
+  else
+    block = gipsi::MakeTetBoxBlock(gipsi::Vec3::Zero(), gipsi::bench::kSlabSize, {o.nx, o.ny, o.nz},
+                                   gipsi::HexSplit::kSix, rank, size);
   const double t_mesh = MPI_Wtime() - t0;
+  const std::int64_t num_tets = whole ? whole->num_tets() : block.num_tets;
+  const std::int64_t num_nodes = whole ? whole->num_nodes() : block.num_nodes;
   std::unique_ptr<gipsi::EpTissue> tissue;
   std::string solver = "serial " + o.pc;
   if (o.serial) {
@@ -108,7 +124,11 @@ int Main(int argc, char** argv) {
     if (o.pc == "amg") p.linear.preconditioner = "jacobi";  // the serial AMG is for 3×3 blocks
     tissue = std::make_unique<gipsi::Monodomain>("slab", whole, p);
   } else {
-    auto d = std::make_unique<gipsi::DistributedMonodomain>("slab", *whole, SlabParams(o), world);
+    auto d =
+        whole ? std::make_unique<gipsi::DistributedMonodomain>("slab", *whole, SlabParams(o), world)
+              : std::make_unique<gipsi::DistributedMonodomain>(
+                    "slab", gipsi::PartitionMeshBlocks(block, world), SlabParams(o), world);
+    block = {};
     solver = d->solver_name();
     tissue = std::move(d);
   }
@@ -140,20 +160,20 @@ int Main(int argc, char** argv) {
   MPI_Allreduce(MPI_IN_PLACE, &memory[0], 1, MPI_DOUBLE, MPI_MAX, world);
   MPI_Allreduce(MPI_IN_PLACE, &memory[1], 1, MPI_DOUBLE, MPI_SUM, world);
   if (rank == 0) {
-    const double tets = static_cast<double>(whole->num_tets());
+    const auto tets = static_cast<double>(num_tets);
     std::printf(
         "ranks %d  tets %.0f  nodes %ld  solver %s  step median %.2f ms (min %.2f, max %.2f)  "
         "split (rank 0, all steps) cells %.1f%% diffusion %.1f%% tracking %.1f%%  "
-        "iterations/step %.2f  mesh %.2f s  setup %.2f s  peak RSS/rank %.0f MB (max), "
+        "iterations/step %.2f  mesh (%s) %.2f s  setup %.2f s  peak RSS/rank %.0f MB (max), "
         "%.0f B/tet over all ranks\n",
-        size, tets, static_cast<long>(whole->num_nodes()), solver.c_str(), 1e3 * Median(times),
+        size, tets, static_cast<long>(num_nodes), solver.c_str(), 1e3 * Median(times),
         1e3 * *std::min_element(times.begin(), times.end()),
         1e3 * *std::max_element(times.begin(), times.end()),
         100 * phases[0] / (phases[0] + phases[1] + phases[2]),
         100 * phases[1] / (phases[0] + phases[1] + phases[2]),
         100 * phases[2] / (phases[0] + phases[1] + phases[2]),
-        static_cast<double>(iterations) / o.steps, t_mesh, t_setup, memory[0] / 1e6,
-        memory[1] / tets);
+        static_cast<double>(iterations) / o.steps, whole ? "whole on every rank" : "in blocks",
+        t_mesh, t_setup, memory[0] / 1e6, memory[1] / tets);
   }
   tissue.reset();  // before PETSc finalises
   return 0;

@@ -43,9 +43,12 @@ inline void AddSlabCells(CLI::App& app, std::array<int, 3>& cells) {
       ->check(CLI::Range(1, 100000));
 }
 
+// The slab's size [m].
+inline const Vec3 kSlabSize{0.020, 0.007, 0.003};
+
 // The slab cut into nx × ny × nz hexahedra of 6 tets each.
 inline Mesh SlabMesh(int nx, int ny, int nz) {
-  return MakeTetBox(Vec3::Zero(), Vec3(0.020, 0.007, 0.003), {nx, ny, nz});
+  return MakeTetBox(Vec3::Zero(), kSlabSize, {nx, ny, nz});
 }
 
 inline void ParseOrExit(CLI::App& app, int argc, char** argv) {

@@ -4,8 +4,17 @@
 #include <gtest/gtest.h>
 #include <Eigen/Geometry>
 
+#include <algorithm>
+#include <array>
+#include <cstdint>
+#include <set>
+#include <string>
+#include <tuple>
+#include <vector>
+
 #include "gipsi/base/error.h"
 #include "gipsi/geometry/boundary.h"
+#include "gipsi/geometry/mesh_block.h"
 #include "gipsi/geometry/normals.h"
 #include "gipsi/geometry/quality.h"
 
@@ -152,6 +161,85 @@ TEST(Generators, RefuseAbsurdSizes) {
   EXPECT_THROW(
       (void)MakeTriangleSheet(Vec3::Zero(), Vec3::UnitX(), Vec3::UnitY(), {100000, 100000}),
       InputError);
+}
+
+}  // namespace
+}  // namespace gipsi
+
+namespace gipsi {
+namespace {
+
+// Outward boundary triangles as node triples rotated to start at their smallest node, with the
+// name of the group each is in.
+using NamedTriangle = std::tuple<int, int, int, std::string>;
+
+NamedTriangle Named(const Triangles& triangles, Index t, std::int64_t first,
+                    const std::vector<MeshGroup>& groups) {
+  std::array<int, 3> n{triangles(0, t), triangles(1, t), triangles(2, t)};
+  std::rotate(n.begin(), std::min_element(n.begin(), n.end()), n.end());
+  std::string name;
+  for (const MeshGroup& g : groups)
+    if (g.dim == 2 &&
+        std::find(g.items.begin(), g.items.end(), static_cast<int>(first + t)) != g.items.end())
+      name = g.name;
+  return {n[0], n[1], n[2], name};
+}
+
+// The blocks of a box, made one by one without the whole, put back together are the box: its
+// nodes and tets in order, its outward boundary triangles in their groups, each once.
+TEST(TetBoxBlock, TheBlocksTogetherAreTheWholeBox) {
+  for (HexSplit split : {HexSplit::kSix, HexSplit::kFive}) {
+    const Vec3 min(0, -1, 2), max(3, 1, 3);
+    const std::array<int, 3> cells{7, 3, 2};
+    const Mesh whole = MakeTetBox(min, max, cells, split);
+    std::multiset<NamedTriangle> expected, got;
+    for (Index t = 0; t < whole.num_triangles(); ++t)
+      expected.insert(Named(whole.triangles, t, 0, whole.groups));
+    const int size = 5;
+    Points nodes(3, 0);
+    Tets tets(4, 0);
+    std::int64_t next_triangle = 0;
+    std::int64_t volume = 0;
+    for (int rank = 0; rank < size; ++rank) {
+      const MeshBlock block = MakeTetBoxBlock(min, max, cells, split, rank, size);
+      EXPECT_EQ(block.num_nodes, whole.num_nodes());
+      EXPECT_EQ(block.num_tets, whole.num_tets());
+      EXPECT_EQ(block.num_triangles, whole.num_triangles());
+      EXPECT_EQ(block.first_triangle, next_triangle);
+      next_triangle += block.triangles.cols();
+      nodes.conservativeResize(3, nodes.cols() + block.nodes.cols());
+      nodes.rightCols(block.nodes.cols()) = block.nodes;
+      tets.conservativeResize(4, tets.cols() + block.tets.cols());
+      tets.rightCols(block.tets.cols()) = block.tets;
+      for (Index t = 0; t < block.triangles.cols(); ++t)
+        got.insert(Named(block.triangles, t, block.first_triangle, block.groups));
+      ASSERT_EQ(block.groups.back().name, "volume");
+      volume += static_cast<std::int64_t>(block.groups.back().items.size());
+    }
+    EXPECT_EQ(nodes, whole.nodes);
+    EXPECT_EQ(tets, whole.tets);
+    EXPECT_EQ(next_triangle, whole.num_triangles());
+    EXPECT_EQ(got, expected);
+    EXPECT_EQ(volume, whole.num_tets());
+  }
+}
+
+// A whole mesh's blocks slice its nodes, tets, triangles and group items by rank.
+TEST(TetBoxBlock, AWholeMeshSlicesIntoBlocks) {
+  const Mesh whole = MakeTetBox(Vec3::Zero(), Vec3::Ones(), {3, 2, 2});
+  const MeshBlock block = BlockOfMesh(whole, 1, 3);
+  const Index n0 = whole.num_nodes() / 3, e0 = whole.num_tets() / 3;
+  EXPECT_EQ(block.nodes, whole.nodes.middleCols(n0, 2 * whole.num_nodes() / 3 - n0));
+  EXPECT_EQ(block.tets, whole.tets.middleCols(e0, 2 * whole.num_tets() / 3 - e0));
+  EXPECT_EQ(block.first_triangle, whole.num_triangles() / 3);
+  for (const MeshGroup& g : block.groups)
+    for (int item : g.items) {
+      const Index count = g.dim == 0   ? whole.num_nodes()
+                          : g.dim == 2 ? whole.num_triangles()
+                                       : whole.num_tets();
+      EXPECT_GE(item, count / 3);
+      EXPECT_LT(item, 2 * count / 3);
+    }
 }
 
 }  // namespace

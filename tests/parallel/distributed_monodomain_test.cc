@@ -13,7 +13,9 @@
 #include <numeric>
 #include <set>
 
+#include "gipsi/base/error.h"
 #include "gipsi/geometry/generators.h"
+#include "gipsi/geometry/mesh_block.h"
 #include "gipsi/models/ep/monodomain.h"
 #include "gipsi/models/ep/ten_tusscher_panfilov_2006.h"
 #include "gipsi/parallel/distributed_monodomain.h"
@@ -66,58 +68,6 @@ std::shared_ptr<const Mesh> Slab(int cells_per_mm_x2) {
   const int n = cells_per_mm_x2;
   return std::make_shared<Mesh>(
       MakeTetBox(Vec3::Zero(), Vec3(0.020, 0.007, 0.003), {20 * n, 7 * n, 3 * n}));
-}
-
-TEST(MeshPartition, EveryTetOnceEveryNodeOwnedOnceAndTheTetsBalanced) {
-  const auto whole = Slab(2);
-  const MeshPart part = PartitionMesh(*whole, World());
-  // Tets and owned nodes add up; the owned blocks tile [0, N).
-  std::int64_t counts[2] = {static_cast<std::int64_t>(part.whole_tet.size()), part.num_owned};
-  MPI_Allreduce(MPI_IN_PLACE, counts, 2, MPI_INT64_T, MPI_SUM, World());
-  EXPECT_EQ(counts[0], whole->num_tets());
-  EXPECT_EQ(counts[1], whole->num_nodes());
-  std::int64_t next_first = part.first_owned + part.num_owned;
-  std::vector<std::int64_t> firsts(static_cast<std::size_t>(Size()));
-  MPI_Allgather(&part.first_owned, 1, MPI_INT64_T, firsts.data(), 1, MPI_INT64_T, World());
-  EXPECT_EQ(firsts[0], 0);
-  if (Rank() + 1 < Size()) {
-    EXPECT_EQ(firsts[static_cast<std::size_t>(Rank()) + 1], next_first);
-  }
-  // Every tet on exactly one rank: the sum of the ranks' tet-index sums is the whole one.
-  std::int64_t sum = std::accumulate(part.whole_tet.begin(), part.whole_tet.end(), std::int64_t{0});
-  MPI_Allreduce(MPI_IN_PLACE, &sum, 1, MPI_INT64_T, MPI_SUM, World());
-  const std::int64_t e = whole->num_tets();
-  EXPECT_EQ(sum, e * (e - 1) / 2);
-  // Local tets use the local copies of the whole mesh's nodes at the same positions.
-  for (Index t = 0; t < part.mesh->num_tets(); ++t)
-    for (int a = 0; a < 4; ++a) {
-      const int local = part.mesh->tets(a, t);
-      ASSERT_EQ(part.whole_node[static_cast<std::size_t>(local)],
-                whole->tets(a, part.whole_tet[static_cast<std::size_t>(t)]));
-    }
-  // Shared nodes belong to lower ranks (the owner is the lowest rank using the node).
-  std::vector<std::int64_t> first_of(firsts);
-  for (std::int64_t i = part.num_owned; i < part.num_local(); ++i) {
-    const std::int64_t g = part.global[static_cast<std::size_t>(i)];
-    EXPECT_LT(g, part.first_owned) << "shared node " << i << " owned by a higher rank";
-  }
-  // PT-Scotch balances the tet counts (asked for at most 1 % imbalance; 5 % allowed).
-  const double mean = static_cast<double>(e) / Size();
-  EXPECT_LT(std::abs(static_cast<double>(part.whole_tet.size()) - mean), 0.05 * mean);
-}
-
-// Checkpoints of a distributed run restore only on the cut that wrote them, so a second cut of
-// the same mesh must be the first: Scotch runs in its deterministic mode with a fixed seed.
-// (Its default mode, with Debian's threaded build, cut this slab differently in every call.)
-TEST(MeshPartition, CutsTheSameMeshTheSameWayEveryTime) {
-  const auto whole = Slab(2);
-  const MeshPart first = PartitionMesh(*whole, World());
-  for (int again = 0; again < 2; ++again) {
-    const MeshPart next = PartitionMesh(*whole, World());
-    EXPECT_EQ(next.whole_tet, first.whole_tet);
-    EXPECT_EQ(next.whole_node, first.whole_node);
-    EXPECT_EQ(next.num_owned, first.num_owned);
-  }
 }
 
 // Probes read a split object's items through its whole-mesh view, each item sent by the rank
@@ -198,6 +148,65 @@ TEST(DistributedMonodomain, BenchmarkSlabActivatesEveryNodeAtTheSerialTime) {
   }
   MPI_Bcast(&ok, 1, MPI_INT, 0, World());
   EXPECT_EQ(ok, 1);
+}
+
+// A slab made block by block (no rank holds it whole) runs bitwise as the whole slab cut on
+// every rank: the same parts, and the same stimulus nodes from a box, a triangle group and
+// whole-mesh node ids, selected by each rank among its own nodes.
+TEST(DistributedMonodomain, ASlabMadeInBlocksRunsAsTheWholeSlab) {
+  const auto whole = Slab(2);
+  EpTissueParams params = SlabParams("jacobi");
+  StimulusSpec face = params.stimuli.front();
+  face.name = "xmax face";
+  face.region = GroupRegion{"xmax"};
+  face.pulses.start = 5.0;
+  params.stimuli.push_back(face);
+  StimulusSpec node = face;
+  node.name = "one node";
+  node.region = NodeIdsRegion{{static_cast<int>(whole->num_nodes()) / 2}};
+  params.stimuli.push_back(node);
+  const double dt = 1e-5;
+  const long steps = 1500;  // 15 ms: the three stimuli have fired
+  DistributedMonodomain a("a", *whole, params, World());
+  DistributedMonodomain b(
+      "b",
+      PartitionMeshBlocks(MakeTetBoxBlock(Vec3::Zero(), Vec3(0.020, 0.007, 0.003), {40, 14, 6},
+                                          HexSplit::kSix, Rank(), Size()),
+                          World()),
+      params, World());
+  for (long s = 0; s < steps; ++s) {
+    ASSERT_TRUE(a.Step(dt).ok());
+    ASSERT_TRUE(b.Step(dt).ok());
+  }
+  ASSERT_EQ(a.part().whole_node, b.part().whole_node);
+  const VecX &ta = a.activation_time(), &tb = b.activation_time();
+  ASSERT_EQ(ta.size(), tb.size());
+  int activated = 0;
+  for (Index i = 0; i < ta.size(); ++i) {
+    ASSERT_EQ(std::bit_cast<std::uint64_t>(ta[i]), std::bit_cast<std::uint64_t>(tb[i]))
+        << "node " << i;
+    activated += ta[i] >= 0 ? 1 : 0;
+  }
+  // Every stimulus took: the front has left the corner, the xmax face and the middle node.
+  int activated_all = activated;
+  MPI_Allreduce(MPI_IN_PLACE, &activated_all, 1, MPI_INT, MPI_SUM, World());
+  EXPECT_GT(activated_all, static_cast<int>(whole->num_nodes()) / 10);
+}
+
+// A region that selects no node of a mesh made in blocks is refused on every rank, as on the
+// whole mesh.
+TEST(DistributedMonodomain, ARegionOutsideAMeshMadeInBlocksIsRefusedOnEveryRank) {
+  EpTissueParams params = SlabParams("jacobi");
+  params.stimuli.front().region = BoxRegion{Vec3::Constant(1.0), Vec3::Constant(2.0)};
+  auto build = [&] {
+    DistributedMonodomain tissue(
+        "tissue",
+        PartitionMeshBlocks(MakeTetBoxBlock(Vec3::Zero(), Vec3(0.020, 0.007, 0.003), {20, 7, 3},
+                                            HexSplit::kSix, Rank(), Size()),
+                            World()),
+        params, World());
+  };
+  EXPECT_THROW(build(), InputError);
 }
 
 // CG with PETSc's algebraic multigrid preconditioners (GAMG, hypre's BoomerAMG) or with Jacobi

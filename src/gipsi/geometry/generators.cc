@@ -5,7 +5,9 @@
 #include "gipsi/geometry/generators.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <cstdint>
 #include <string>
 
 #include <fmt/format.h>
@@ -13,6 +15,7 @@
 
 #include "gipsi/base/error.h"
 #include "gipsi/geometry/boundary.h"
+#include "gipsi/geometry/mesh_block.h"
 
 namespace gipsi {
 namespace {
@@ -37,86 +40,129 @@ constexpr int kKuhnTets[6][4] = {
 constexpr int kFiveTets[5][4] = {
     {0, 3, 5, 6}, {1, 0, 3, 5}, {2, 0, 6, 3}, {4, 0, 5, 6}, {7, 3, 6, 5}};
 
+// The lattice of a structured box (MakeTetBox): its nodes' positions and each tet's corners,
+// computed from the indices alone, so a block of the box is made without the whole.
+class BoxLattice {
+ public:
+  BoxLattice(const Vec3& min, const Vec3& max, const std::array<int, 3>& cells, HexSplit split)
+      : min_(min), max_(max), n_(cells), per_cell_(split == HexSplit::kSix ? 6 : 5) {
+    if (!min.allFinite() || !max.allFinite() || !(max.array() > min.array()).all())
+      ThrowInputError("", "tet box",
+                      fmt::format("max ({}, {}, {}) must exceed min ({}, {}, {}) on every axis",
+                                  max.x(), max.y(), max.z(), min.x(), min.y(), min.z()));
+    if (cells[0] < 1 || cells[1] < 1 || cells[2] < 1)
+      ThrowInputError("", "tet box",
+                      fmt::format("cells must be >= 1 on every axis, got {} x {} x {}", cells[0],
+                                  cells[1], cells[2]));
+    const double num_cells = double(cells[0]) * cells[1] * cells[2];
+    if (num_cells * per_cell_ > kMaxGeneratedElements)
+      ThrowInputError("", "tet box",
+                      fmt::format("{} x {} x {} cells would make more than {:.0e} tets", cells[0],
+                                  cells[1], cells[2], kMaxGeneratedElements));
+    h_ = (max - min).cwiseQuotient(Vec3(n_[0], n_[1], n_[2]));
+  }
+
+  [[nodiscard]] Index num_nodes() const { return Index(n_[0] + 1) * (n_[1] + 1) * (n_[2] + 1); }
+  [[nodiscard]] Index num_tets() const { return Index(per_cell_) * n_[0] * n_[1] * n_[2]; }
+  [[nodiscard]] int node(int i, int j, int k) const {
+    return i + (n_[0] + 1) * (j + (n_[1] + 1) * k);
+  }
+  /// Lattice coordinate of node n along `axis`.
+  [[nodiscard]] int lattice(int n, int axis) const {
+    if (axis == 0) return n % (n_[0] + 1);
+    if (axis == 1) return (n / (n_[0] + 1)) % (n_[1] + 1);
+    return n / ((n_[0] + 1) * (n_[1] + 1));
+  }
+  [[nodiscard]] int cells(int axis) const { return n_[std::size_t(axis)]; }
+  /// Node n's position; the last layer lies exactly on `max` (no round-off from min + n·h).
+  [[nodiscard]] Vec3 position(int n) const {
+    Vec3 p;
+    for (int a = 0; a < 3; ++a) {
+      const int l = lattice(n, a);
+      p[a] = l == n_[std::size_t(a)] ? max_[a] : min_[a] + l * h_[a];
+    }
+    return p;
+  }
+  /// The corners of tet e, positively oriented.
+  void Tet(Index e, int corners[4]) const {
+    const Index cell = e / per_cell_;
+    const int t = int(e % per_cell_);
+    const int i = int(cell % n_[0]), j = int((cell / n_[0]) % n_[1]);
+    const int k = int(cell / (Index(n_[0]) * n_[1]));
+    int corner[8];
+    for (int c = 0; c < 8; ++c) corner[c] = node(i + (c & 1), j + ((c >> 1) & 1), k + (c >> 2));
+    if (per_cell_ == 6) {
+      for (int a = 0; a < 4; ++a) corners[a] = corner[kKuhnTets[t][a]];
+      return;
+    }
+    const int flip = (i + j + k) % 2;  // odd cells mirror x
+    for (int a = 0; a < 4; ++a) corners[a] = corner[kFiveTets[t][a] ^ flip];
+    const Vec3 p0 = position(corners[0]);
+    const double vol =
+        (position(corners[1]) - p0).cross(position(corners[2]) - p0).dot(position(corners[3]) - p0);
+    if (vol < 0) std::swap(corners[2], corners[3]);
+  }
+  /// The boundary triangles of the cells before cell `cell` (each box face of a cell is cut
+  /// into two triangles by either split).
+  [[nodiscard]] std::int64_t TrianglesOfCellsBefore(Index cell) const {
+    std::int64_t count = 0;
+    for (Index c = 0; c < cell; ++c) {
+      const int i = int(c % n_[0]), j = int((c / n_[0]) % n_[1]);
+      const int k = int(c / (Index(n_[0]) * n_[1]));
+      count += 2 * ((i == 0) + (i == n_[0] - 1) + (j == 0) + (j == n_[1] - 1) + (k == 0) +
+                    (k == n_[2] - 1));
+    }
+    return count;
+  }
+  [[nodiscard]] int per_cell() const { return per_cell_; }
+
+ private:
+  Vec3 min_, max_, h_;
+  std::array<int, 3> n_;
+  int per_cell_;
+};
+
+const char* const kBoxFaceNames[6] = {"xmin", "xmax", "ymin", "ymax", "zmin", "zmax"};
+
+// The box face (0..5: xmin, xmax, ...) that the three nodes lie on, or -1.
+int BoxFaceOf(const BoxLattice& box, const int (&n)[3]) {
+  for (int face = 0; face < 6; ++face) {
+    const int axis = face / 2, value = face % 2 == 0 ? 0 : box.cells(axis);
+    if (box.lattice(n[0], axis) == value && box.lattice(n[1], axis) == value &&
+        box.lattice(n[2], axis) == value)
+      return face;
+  }
+  return -1;
+}
+
 }  // namespace
 
 Mesh MakeTetBox(const Vec3& min, const Vec3& max, const std::array<int, 3>& cells, HexSplit split) {
-  if (!min.allFinite() || !max.allFinite() || !(max.array() > min.array()).all())
-    ThrowInputError("", "tet box",
-                    fmt::format("max ({}, {}, {}) must exceed min ({}, {}, {}) on every axis",
-                                max.x(), max.y(), max.z(), min.x(), min.y(), min.z()));
-  if (cells[0] < 1 || cells[1] < 1 || cells[2] < 1)
-    ThrowInputError("", "tet box",
-                    fmt::format("cells must be >= 1 on every axis, got {} x {} x {}", cells[0],
-                                cells[1], cells[2]));
-  const double num_cells = double(cells[0]) * cells[1] * cells[2];
-  if (num_cells * (split == HexSplit::kSix ? 6 : 5) > kMaxGeneratedElements)
-    ThrowInputError("", "tet box",
-                    fmt::format("{} x {} x {} cells would make more than {:.0e} tets", cells[0],
-                                cells[1], cells[2], kMaxGeneratedElements));
-  const int nx = cells[0], ny = cells[1], nz = cells[2];
-  auto node = [&](int i, int j, int k) { return i + (nx + 1) * (j + (ny + 1) * k); };
+  const BoxLattice box(min, max, cells, split);
   Mesh mesh;
-  mesh.nodes.resize(3, Index(nx + 1) * (ny + 1) * (nz + 1));
-  const Vec3 h = (max - min).cwiseQuotient(Vec3(nx, ny, nz));
-  for (int k = 0; k <= nz; ++k)
-    for (int j = 0; j <= ny; ++j)
-      for (int i = 0; i <= nx; ++i) {
-        // The last layer is placed exactly on `max` (no round-off from min + n·h).
-        mesh.nodes.col(node(i, j, k)) =
-            Vec3(i == nx ? max.x() : min.x() + i * h.x(), j == ny ? max.y() : min.y() + j * h.y(),
-                 k == nz ? max.z() : min.z() + k * h.z());
-      }
-  const int per_cell = split == HexSplit::kSix ? 6 : 5;
-  mesh.tets.resize(4, Index(per_cell) * nx * ny * nz);
-  Index e = 0;
-  for (int k = 0; k < nz; ++k)
-    for (int j = 0; j < ny; ++j)
-      for (int i = 0; i < nx; ++i) {
-        int corner[8];
-        for (int c = 0; c < 8; ++c) corner[c] = node(i + (c & 1), j + ((c >> 1) & 1), k + (c >> 2));
-        if (split == HexSplit::kSix) {
-          for (const auto& tet : kKuhnTets) {
-            for (int a = 0; a < 4; ++a) mesh.tets(a, e) = corner[tet[a]];
-            ++e;
-          }
-          continue;
-        }
-        const int flip = (i + j + k) % 2;  // odd cells mirror x
-        for (const auto& tet : kFiveTets) {
-          for (int a = 0; a < 4; ++a) mesh.tets(a, e) = corner[tet[a] ^ flip];
-          const Vec3 p0 = mesh.nodes.col(mesh.tets(0, e));
-          const double vol = (mesh.nodes.col(mesh.tets(1, e)) - p0)
-                                 .cross(mesh.nodes.col(mesh.tets(2, e)) - p0)
-                                 .dot(mesh.nodes.col(mesh.tets(3, e)) - p0);
-          if (vol < 0) std::swap(mesh.tets(2, e), mesh.tets(3, e));
-          ++e;
-        }
-      }
+  mesh.nodes.resize(3, box.num_nodes());
+  for (Index n = 0; n < box.num_nodes(); ++n) mesh.nodes.col(n) = box.position(int(n));
+  mesh.tets.resize(4, box.num_tets());
+  for (Index e = 0; e < box.num_tets(); ++e) {
+    int corners[4];
+    box.Tet(e, corners);
+    for (int a = 0; a < 4; ++a) mesh.tets(a, e) = corners[a];
+  }
 
   // Boundary triangles (outward) grouped by the box face they lie on.
   const BoundarySurface boundary = ExtractTetBoundary(mesh.nodes, mesh.tets);
-  const char* kFaceNames[6] = {"xmin", "xmax", "ymin", "ymax", "zmin", "zmax"};
   std::vector<std::vector<int>> by_face(6);
   for (Index t = 0; t < boundary.num_triangles(); ++t) {
-    int ijk[3][3];  // [vertex][axis] lattice coordinates
-    for (int a = 0; a < 3; ++a) {
-      const int n = boundary.vertex_to_node[std::size_t(boundary.triangles(a, t))];
-      ijk[a][0] = n % (nx + 1);
-      ijk[a][1] = (n / (nx + 1)) % (ny + 1);
-      ijk[a][2] = n / ((nx + 1) * (ny + 1));
-    }
-    for (int face = 0; face < 6; ++face) {
-      const int axis = face / 2, value = face % 2 == 0 ? 0 : cells[std::size_t(axis)];
-      if (ijk[0][axis] == value && ijk[1][axis] == value && ijk[2][axis] == value) {
-        by_face[std::size_t(face)].push_back(int(t));
-        break;
-      }
-    }
+    int n[3];
+    for (int a = 0; a < 3; ++a)
+      n[a] = boundary.vertex_to_node[std::size_t(boundary.triangles(a, t))];
+    const int face = BoxFaceOf(box, n);
+    if (face >= 0) by_face[std::size_t(face)].push_back(int(t));
   }
   mesh.triangles.resize(3, boundary.num_triangles());
   Index next = 0;
   for (int face = 0; face < 6; ++face) {
-    MeshGroup group{kFaceNames[face], 2, {}};
+    MeshGroup group{kBoxFaceNames[face], 2, {}};
     for (int t : by_face[std::size_t(face)]) {
       for (int a = 0; a < 3; ++a)
         mesh.triangles(a, next) = boundary.vertex_to_node[std::size_t(boundary.triangles(a, t))];
@@ -129,6 +175,70 @@ Mesh MakeTetBox(const Vec3& min, const Vec3& max, const std::array<int, 3>& cell
   for (std::size_t i = 0; i < volume.items.size(); ++i) volume.items[i] = int(i);
   mesh.groups.push_back(std::move(volume));
   return mesh;
+}
+
+MeshBlock MakeTetBoxBlock(const Vec3& min, const Vec3& max, const std::array<int, 3>& cells,
+                          HexSplit split, int rank, int size) {
+  const BoxLattice box(min, max, cells, split);
+  GIPSI_CHECK(size >= 1 && rank >= 0 && rank < size);
+  MeshBlock block;
+  block.rank = rank;
+  block.size = size;
+  block.num_nodes = box.num_nodes();
+  block.num_tets = box.num_tets();
+  const std::int64_t nx = cells[0], ny = cells[1], nz = cells[2];
+  block.num_triangles = 4 * (nx * ny + ny * nz + nx * nz);
+  const Index node_begin = block.node_begin(),
+              node_end = BlockBegin(block.num_nodes, rank + 1, size);
+  block.nodes.resize(3, node_end - node_begin);
+  for (Index n = node_begin; n < node_end; ++n)
+    block.nodes.col(n - node_begin) = box.position(int(n));
+  const Index tet_begin = block.tet_begin(), tet_end = BlockBegin(block.num_tets, rank + 1, size);
+  block.tets.resize(4, tet_end - tet_begin);
+  // The triangles of the tets before this block: whole cells counted, then the partial one.
+  const Index first_cell = tet_begin / box.per_cell();
+  std::int64_t before = box.TrianglesOfCellsBefore(first_cell);
+  std::vector<std::array<int, 3>> triangles;
+  std::vector<int> face_of;
+  for (Index e = first_cell * box.per_cell(); e < tet_end; ++e) {
+    int corners[4];
+    box.Tet(e, corners);
+    if (e >= tet_begin)
+      for (int a = 0; a < 4; ++a) block.tets(a, e - tet_begin) = corners[a];
+    for (int skip = 0; skip < 4; ++skip) {
+      int n[3], k = 0;
+      for (int a = 0; a < 4; ++a)
+        if (a != skip) n[k++] = corners[a];
+      const int face = BoxFaceOf(box, n);
+      if (face < 0) continue;
+      if (e < tet_begin) {
+        ++before;
+        continue;
+      }
+      // Outward: away from the tet's fourth corner.
+      const Vec3 p0 = box.position(n[0]);
+      if ((box.position(n[1]) - p0)
+              .cross(box.position(n[2]) - p0)
+              .dot(box.position(corners[skip]) - p0) > 0)
+        std::swap(n[1], n[2]);
+      triangles.push_back({n[0], n[1], n[2]});
+      face_of.push_back(face);
+    }
+  }
+  block.first_triangle = before;
+  block.triangles.resize(3, Index(triangles.size()));
+  for (std::size_t t = 0; t < triangles.size(); ++t)
+    for (int a = 0; a < 3; ++a) block.triangles(a, Index(t)) = triangles[t][std::size_t(a)];
+  for (int face = 0; face < 6; ++face) {
+    MeshGroup group{kBoxFaceNames[face], 2, {}};
+    for (std::size_t t = 0; t < face_of.size(); ++t)
+      if (face_of[t] == face) group.items.push_back(int(before + std::int64_t(t)));
+    block.groups.push_back(std::move(group));
+  }
+  MeshGroup volume{"volume", 3, std::vector<int>(std::size_t(tet_end - tet_begin))};
+  for (std::size_t i = 0; i < volume.items.size(); ++i) volume.items[i] = int(tet_begin + Index(i));
+  block.groups.push_back(std::move(volume));
+  return block;
 }
 
 Mesh MakeTriangleSheet(const Vec3& origin, const Vec3& edge_u, const Vec3& edge_v,

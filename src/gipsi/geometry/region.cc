@@ -15,8 +15,7 @@ constexpr double kRelativeTolerance = 1e-9;
 
 double Tolerance(const Mesh& mesh) {
   if (mesh.num_nodes() == 0) return 0;
-  const Vec3 extent = mesh.nodes.rowwise().maxCoeff() - mesh.nodes.rowwise().minCoeff();
-  return kRelativeTolerance * extent.norm();
+  return RegionTolerance(mesh.nodes.rowwise().minCoeff(), mesh.nodes.rowwise().maxCoeff());
 }
 
 template <class Inside>
@@ -61,41 +60,39 @@ std::vector<int> GroupNodes(const Mesh& mesh, const MeshGroup& group) {
   return ids;
 }
 
-std::vector<int> Select(const AllRegion&, const Mesh& mesh) {
+std::vector<int> Select(const AllRegion&, const Mesh& mesh, double) {
   std::vector<int> ids(std::size_t(mesh.num_nodes()));
   for (std::size_t i = 0; i < ids.size(); ++i) ids[i] = int(i);
   return ids;
 }
 
-std::vector<int> Select(const BoxRegion& box, const Mesh& mesh) {
-  const double tol = Tolerance(mesh);
+std::vector<int> Select(const BoxRegion& box, const Mesh& mesh, double tol) {
   return SelectWhere(mesh, [&](const Vec3& x) {
     return (x.array() >= box.min.array() - tol).all() && (x.array() <= box.max.array() + tol).all();
   });
 }
 
-std::vector<int> Select(const HalfSpaceRegion& half, const Mesh& mesh) {
+std::vector<int> Select(const HalfSpaceRegion& half, const Mesh& mesh, double tol) {
   const double length = half.normal.norm();
   if (!(length > 0) || !half.normal.allFinite())
     ThrowInputError("", "half-space region", "normal must be a finite non-zero vector");
   const Vec3 n = half.normal / length;
-  const double tol = Tolerance(mesh);
   return SelectWhere(mesh, [&](const Vec3& x) { return (x - half.point).dot(n) >= -tol; });
 }
 
-std::vector<int> Select(const SphereRegion& sphere, const Mesh& mesh) {
+std::vector<int> Select(const SphereRegion& sphere, const Mesh& mesh, double tol) {
   if (!(sphere.radius >= 0))
     ThrowInputError("", "sphere region",
                     fmt::format("radius must be non-negative, got {}", sphere.radius));
-  const double limit = sphere.radius + Tolerance(mesh);
+  const double limit = sphere.radius + tol;
   return SelectWhere(mesh, [&](const Vec3& x) { return (x - sphere.center).norm() <= limit; });
 }
 
-std::vector<int> Select(const GroupRegion& group, const Mesh& mesh) {
+std::vector<int> Select(const GroupRegion& group, const Mesh& mesh, double) {
   return GroupNodes(mesh, FindGroupOrThrow(mesh, group.name));
 }
 
-std::vector<int> Select(const NodeIdsRegion& region, const Mesh& mesh) {
+std::vector<int> Select(const NodeIdsRegion& region, const Mesh& mesh, double) {
   for (std::size_t i = 0; i < region.ids.size(); ++i) {
     const int id = region.ids[i];
     if (id < 0 || id >= mesh.num_nodes())
@@ -109,8 +106,16 @@ std::vector<int> Select(const NodeIdsRegion& region, const Mesh& mesh) {
 
 }  // namespace
 
+double RegionTolerance(const Vec3& low, const Vec3& high) {
+  return kRelativeTolerance * (high - low).norm();
+}
+
+std::vector<int> SelectNodes(const Region& region, const Mesh& mesh, double tolerance) {
+  return std::visit([&](const auto& r) { return Select(r, mesh, tolerance); }, region);
+}
+
 std::vector<int> SelectNodes(const Region& region, const Mesh& mesh) {
-  return std::visit([&](const auto& r) { return Select(r, mesh); }, region);
+  return SelectNodes(region, mesh, Tolerance(mesh));
 }
 
 std::vector<int> SelectBoundaryVertices(const Region& region, const Mesh& mesh,

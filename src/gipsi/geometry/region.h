@@ -50,6 +50,13 @@ using Region =
 /// (listing the available ones), an out-of-range id, a zero half-space normal or a negative
 /// sphere radius.
 std::vector<int> SelectNodes(const Region& region, const Mesh& mesh);
+/// As above, the geometric tests (box, half-space, sphere) at the absolute `tolerance` instead of
+/// 1e-9 of `mesh`'s own diagonal: for one rank's part of a mesh, the whole mesh's
+/// RegionTolerance, so every part selects what the whole mesh would.
+std::vector<int> SelectNodes(const Region& region, const Mesh& mesh, double tolerance);
+/// The geometric regions' tolerance for a mesh whose bounding box is [low, high]: 1e-9 of its
+/// diagonal.
+double RegionTolerance(const Vec3& low, const Vec3& high);
 
 /// Boundary vertices (indices into `boundary.vertex_to_node`) whose domain node is in `region`.
 std::vector<int> SelectBoundaryVertices(const Region& region, const Mesh& mesh,

@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cstring>
+#include <limits>
 
 #include "gipsi/base/error.h"
 #include "gipsi/geometry/boundary.h"
@@ -52,6 +53,44 @@ void LocaliseRegions(EpTissueParams& params, const Mesh& whole, const MeshPart& 
   for (ClampSpec& c : params.clamps) localise(c.region, fmt::format("clamp '{}'", c.name));
 }
 
+// As LocaliseRegions, for a mesh no rank holds whole: each rank selects among its own nodes,
+// geometric regions at the whole mesh's tolerance (its bounding box reduced over the ranks),
+// node ids as whole-mesh indices; a region that selects no node on any rank is refused on
+// every rank.
+void LocaliseRegionsOnPart(EpTissueParams& params, const MeshPart& part, MPI_Comm comm) {
+  const Mesh& mesh = *part.mesh;
+  Vec3 low = Vec3::Constant(std::numeric_limits<double>::infinity()), high = -low;
+  if (mesh.num_nodes() > 0) {
+    low = mesh.nodes.rowwise().minCoeff();
+    high = mesh.nodes.rowwise().maxCoeff();
+  }
+  MPI_Allreduce(MPI_IN_PLACE, low.data(), 3, MPI_DOUBLE, MPI_MIN, comm);
+  MPI_Allreduce(MPI_IN_PLACE, high.data(), 3, MPI_DOUBLE, MPI_MAX, comm);
+  const double tolerance = RegionTolerance(low, high);
+  auto localise = [&](Region& region, const std::string& what) {
+    NodeIdsRegion ids;
+    if (const auto* whole_ids = std::get_if<NodeIdsRegion>(&region)) {
+      std::vector<int> wanted = whole_ids->ids;
+      for (std::size_t i = 0; i < wanted.size(); ++i)
+        if (wanted[i] < 0 || wanted[i] >= part.num_global_nodes)
+          throw InputError(fmt::format("{}: node id {} (ids[{}]) out of range [0, {})", what,
+                                       wanted[i], i, part.num_global_nodes));
+      std::sort(wanted.begin(), wanted.end());
+      for (std::size_t i = 0; i < part.whole_node.size(); ++i)
+        if (std::binary_search(wanted.begin(), wanted.end(), part.whole_node[i]))
+          ids.ids.push_back(static_cast<int>(i));
+    } else {
+      ids.ids = SelectNodes(region, mesh, tolerance);
+    }
+    int found = ids.ids.empty() ? 0 : 1;
+    MPI_Allreduce(MPI_IN_PLACE, &found, 1, MPI_INT, MPI_MAX, comm);
+    if (found == 0) throw InputError(fmt::format("{} selects no node of the domain", what));
+    region = std::move(ids);
+  };
+  for (StimulusSpec& s : params.stimuli) localise(s.region, fmt::format("stimulus '{}'", s.name));
+  for (ClampSpec& c : params.clamps) localise(c.region, fmt::format("clamp '{}'", c.name));
+}
+
 // The object's "parallel" solver, where the scene gives one, replaces the serial one.
 EpTissueParams UseDistributedSolver(EpTissueParams params) {
   if (params.distributed_linear) params.linear = *params.distributed_linear;
@@ -88,9 +127,24 @@ struct DistributedMonodomain::Petsc {
 
 DistributedMonodomain::DistributedMonodomain(std::string name, const Mesh& whole,
                                              EpTissueParams params, MPI_Comm comm)
-    : EpTissue(std::move(name), UseDistributedSolver(std::move(params))), comm_(comm) {
+    : DistributedMonodomain(std::move(name), std::move(params), comm,
+                            PartitionMesh(CheckedDomain(whole), comm), &whole) {}
+
+DistributedMonodomain::DistributedMonodomain(std::string name, MeshPart part, EpTissueParams params,
+                                             MPI_Comm comm)
+    : DistributedMonodomain(std::move(name), std::move(params), comm, std::move(part), nullptr) {}
+
+const Mesh& DistributedMonodomain::CheckedDomain(const Mesh& whole) {
   if (whole.tets.cols() == 0)
     throw InputError("the Monodomain object needs a tetrahedral domain mesh (this one has none)");
+  return whole;
+}
+
+DistributedMonodomain::DistributedMonodomain(std::string name, EpTissueParams params, MPI_Comm comm,
+                                             MeshPart part, const Mesh* whole)
+    : EpTissue(std::move(name), UseDistributedSolver(std::move(params))),
+      comm_(comm),
+      part_(std::move(part)) {
   if (params_.anisotropic() && !params_.fibre && !params_.fibre_rule)
     throw InputError(
         "the conductivity is anisotropic (longitudinal != transverse), so the object needs a "
@@ -109,13 +163,19 @@ DistributedMonodomain::DistributedMonodomain(std::string name, const Mesh& whole
         fmt::format("unknown preconditioner '{}' for the distributed monodomain; choices: 'none', "
                     "'jacobi', 'amg' (PETSc's GAMG), 'hypre' (BoomerAMG)",
                     linear.preconditioner));
-  part_ = PartitionMesh(whole, comm_);
-  LocaliseRegions(params_, whole, part_);
+  if (whole == nullptr && params_.fibre_rule)
+    throw InputError(
+        "a fibre rule needs the whole mesh, which a mesh split as it was read does not give: "
+        "give the fibres a direction");
+  if (whole != nullptr)
+    LocaliseRegions(params_, *whole, part_);
+  else
+    LocaliseRegionsOnPart(params_, part_, comm_);
   SetGeometry(part_.mesh, MakeBoundary(*part_.mesh));
   const Vec3 fibre = params_.fibre.value_or(Vec3::UnitX()).normalized();
   fibres_.resize(3, static_cast<Index>(part_.whole_tet.size()));
   if (params_.fibre_rule) {
-    const Points all = MakeTransmuralFibres(whole, *params_.fibre_rule).fibre;
+    const Points all = MakeTransmuralFibres(*whole, *params_.fibre_rule).fibre;
     for (std::size_t e = 0; e < part_.whole_tet.size(); ++e)
       fibres_.col(static_cast<Index>(e)) = all.col(part_.whole_tet[e]);
   } else {

@@ -42,6 +42,11 @@ class DistributedMonodomain final : public EpTissue {
   /// "parallel" block), else `params.linear`. Throws InputError as Monodomain does (a region
   /// that selects no node of the whole mesh, on every rank), PetscError if PETSc fails.
   DistributedMonodomain(std::string name, const Mesh& whole, EpTissueParams params, MPI_Comm comm);
+  /// Collective: on a mesh already cut (`part`, this rank's, e.g. from PartitionMeshBlocks, so
+  /// that no rank held the mesh whole). Each rank selects the region nodes among its own, the
+  /// geometric regions at the whole mesh's tolerance, node ids as whole-mesh indices. Throws
+  /// InputError as above, and for a fibre rule (it needs the whole mesh).
+  DistributedMonodomain(std::string name, MeshPart part, EpTissueParams params, MPI_Comm comm);
   ~DistributedMonodomain() override;
 
   [[nodiscard]] std::string_view type_name() const override { return "Monodomain"; }
@@ -65,6 +70,9 @@ class DistributedMonodomain final : public EpTissue {
 
  private:
   struct Petsc;
+  DistributedMonodomain(std::string name, EpTissueParams params, MPI_Comm comm, MeshPart part,
+                        const Mesh* whole);
+  static const Mesh& CheckedDomain(const Mesh& whole);
   void Assemble();
 
   MPI_Comm comm_;

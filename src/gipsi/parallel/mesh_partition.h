@@ -9,9 +9,12 @@
 /// them, and each rank's owned nodes take a contiguous block of the global (PETSc) numbering, in
 /// the whole mesh's order.
 ///
-/// Every rank reads the whole mesh first (the scene loader does), so the peak memory per rank
-/// is the whole mesh plus its part: about 100 bytes per tet for the mesh and 60 for the
-/// partitioning's graph (docs/scale-out.md). Reading a mesh in parallel is for later.
+/// The cut is made from blocks (PartitionMeshBlocks): each rank gives one contiguous block of
+/// the mesh's nodes, tets and triangles (geometry/mesh_block.h), the dual graph is built from
+/// them by exchanges between the ranks, and the parts are assembled from what the ranks send;
+/// no rank holds the whole mesh, so a reader or generator that makes only its block needs
+/// O(mesh / ranks) memory per rank. PartitionMesh cuts a mesh every rank already holds (the
+/// scene loader reads it whole on every rank) through the same path, into the same parts.
 
 #include <mpi.h>
 
@@ -21,6 +24,7 @@
 
 #include "gipsi/base/export.h"
 #include "gipsi/geometry/mesh.h"
+#include "gipsi/geometry/mesh_block.h"
 
 GIPSI_EXPORT_BEGIN
 namespace gipsi {
@@ -48,10 +52,18 @@ struct MeshPart {
   }
 };
 
-/// Splits `whole` (identical on every rank of `comm`) over the ranks (see the file comment).
-/// Collective. On one rank the part is the whole mesh in its own order. Throws InputError if
-/// the mesh has fewer tets than there are ranks, and std::runtime_error if PT-Scotch fails.
+/// Splits `whole` (identical on every rank of `comm`) over the ranks (see the file comment):
+/// PartitionMeshBlocks of its blocks (BlockOfMesh). Collective. On one rank the part is the whole
+/// mesh in its own order. Throws InputError if the mesh has fewer tets than there are ranks, and
+/// std::runtime_error if PT-Scotch fails.
 MeshPart PartitionMesh(const Mesh& whole, MPI_Comm comm);
+
+/// Splits a mesh given as one block per rank (geometry/mesh_block.h), which no rank holds whole,
+/// over the ranks of `comm` (see the file comment): the same parts as PartitionMesh of the
+/// whole mesh. Collective; each rank holds O(its block + its part). Throws InputError if the
+/// mesh has fewer tets than there are ranks, more than 2^31 - 1 items of a kind, or a tet or
+/// triangle naming a node it does not have, and std::runtime_error if PT-Scotch fails.
+MeshPart PartitionMeshBlocks(const MeshBlock& block, MPI_Comm comm);
 
 /// Every rank's owned values of a node field, gathered on rank 0 in the whole mesh's node order
 /// (`local`: one value per local node of `part`). Collective; ranks other than 0 get an empty
