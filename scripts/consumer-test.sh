@@ -21,12 +21,16 @@ if $deb; then
   (cd "$build_dir" && cpack -G DEB -B "$work/deb" > "$work/cpack.log") ||
     { cat "$work/cpack.log" >&2; exit 1; }
   package=$(ls "$work"/deb/gipsi_*.deb)
-  echo "built $(basename "$package") ($(du -k "$package" | cut -f1) kB)"
-  dpkg-deb --field "$package" Depends
+  # The distributed runs' package, from a build with PETSc.
+  mpi_package=$(ls "$work"/deb/gipsi-mpi_*.deb 2>/dev/null || true)
+  for p in $package $mpi_package; do
+    echo "built $(basename "$p") ($(du -k "$p" | cut -f1) kB)"
+    dpkg-deb --field "$p" Depends
+  done
   # Every dependency must resolve from the machine's apt sources (simulated; installs nothing).
-  apt-get install --simulate --no-install-recommends "$package" > "$work/apt.log" 2>&1 ||
-    { echo "consumer-test: apt cannot install $(basename "$package"):" >&2; cat "$work/apt.log" >&2; exit 1; }
-  dpkg-deb --extract "$package" "$work/root"
+  apt-get install --simulate --no-install-recommends $package $mpi_package > "$work/apt.log" 2>&1 ||
+    { echo "consumer-test: apt cannot install $(basename "$package") $mpi_package:" >&2; cat "$work/apt.log" >&2; exit 1; }
+  for p in $package $mpi_package; do dpkg-deb --extract "$p" "$work/root"; done
   prefix="$work/root/usr"
 else
   cmake --install "$build_dir" --prefix "$work/prefix" > "$work/install.log"
@@ -63,7 +67,8 @@ fi
 # same with COMPONENTS viz, and with a component that does not exist (must fail, naming it).
 project_dir="$work/my_project"
 mkdir -p "$project_dir"
-awk '/^```cmake$/{f=1; next} /^```$/{f=0} f' docs/install.md > "$project_dir/CMakeLists.txt"
+awk '/^## Use it from CMake/{s=1} s && /^```cmake$/{f=1; next} f && /^```$/{exit} f' docs/install.md \
+  > "$project_dir/CMakeLists.txt"
 cat > "$project_dir/main.cc" <<'CC'
 #include <cstdio>
 
@@ -110,6 +115,29 @@ sed "s|\"gipsi_example_plugin\"|\"$plugin_dir/build/my_plugin.so\"|" scenes/plug
 "$prefix/bin/gipsi" run "$work/oscillator.json" --until 0.05 --out "$work/oscillator" -q ||
   { echo "consumer-test: the oscillator scene did not run with the outside plugin" >&2; exit 1; }
 echo "outside plugin: built from docs/plugins.md and run"
+
+# The distributed runs from the installed packages (when the build has them): the installed tool
+# under mpiexec loads the installed libgipsi_parallel, and the docs/install.md program built
+# against COMPONENTS parallel cuts a box over two ranks.
+if [ -n "$(find "$prefix" -name 'libgipsi_parallel.so*' | head -1)" ]; then
+  export OMP_NUM_THREADS=1 OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMPI_MCA_mpi_yield_when_idle=1
+  mpiexec -np 2 "$prefix/bin/gipsi" run scenes/slab_ep_0.5mm.json --until 0.002 --out "$work/slab_mpi" \
+    > "$work/mpi_run.log" 2>&1 || { echo "consumer-test: the installed gipsi failed on 2 ranks:" >&2; cat "$work/mpi_run.log" >&2; exit 1; }
+  grep -q "split over them: tissue (Monodomain)" "$work/mpi_run.log" ||
+    { echo "consumer-test: the installed gipsi did not split the slab:" >&2; cat "$work/mpi_run.log" >&2; exit 1; }
+  mpi_dir="$work/my_partition"
+  mkdir -p "$mpi_dir"
+  awk '/^## The distributed runs/{s=1} s && /^```cmake$/{f=1; next} f && /^```$/{exit} f' docs/install.md > "$mpi_dir/CMakeLists.txt"
+  awk '/^## The distributed runs/{s=1} s && /^```cpp$/{f=1; next} f && /^```$/{exit} f' docs/install.md > "$mpi_dir/main.cc"
+  cmake -S "$mpi_dir" -B "$mpi_dir/build" -G Ninja -DCMAKE_PREFIX_PATH="$prefix" > /dev/null
+  cmake --build "$mpi_dir/build" > /dev/null
+  mpiexec -np 2 "$mpi_dir/build/my_partition" > "$work/my_partition.log" 2>&1
+  # Every node owned by one rank: the owned counts add up to the box's 41 x 15 x 7 nodes.
+  awk '/nodes owned of/ {sum += $(NF-4); total = $NF} END {exit !(NR == 2 && sum == total && total == 4305)}' \
+    "$work/my_partition.log" ||
+    { echo "consumer-test: the COMPONENTS parallel program's ranks do not own every node once:" >&2; cat "$work/my_partition.log" >&2; exit 1; }
+  echo "distributed runs: the installed gipsi split the slab over 2 ranks; COMPONENTS parallel built and ran"
+fi
 
 # The installed Python module, from the prefix alone (when the build has it).
 module=$(find "$prefix" -name 'gipsi.cpython-*.so' | head -1)
