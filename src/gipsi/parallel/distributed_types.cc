@@ -34,8 +34,8 @@ void RegisterDistributedTypes(TypeRegistry& registry, MPI_Comm comm,
           ctx.params.Fail(e.what());
         }
       });
-  // A FemSolid with what its split version does not take yet (Newmark, an explicit integrator)
-  // runs whole on every rank, as every object did before.
+  // A FemSolid with what its split version does not take yet (an explicit integrator) runs
+  // whole on every rank, as every object did before.
   const ObjectFactory* found = registry.objects.Find("FemSolid");
   GIPSI_CHECK(found != nullptr);
   registry.objects.Replace(
@@ -43,7 +43,7 @@ void RegisterDistributedTypes(TypeRegistry& registry, MPI_Comm comm,
       [comm, note,
        whole_solid = *found](const ObjectBuildContext& ctx) -> std::unique_ptr<SimObject> {
         FemSolidSpec spec = ParseFemSolidSpec(ctx);
-        if (spec.ode || spec.params.scheme == ImplicitSchemeKind::kNewmark) return whole_solid(ctx);
+        if (spec.ode) return whole_solid(ctx);
         spec.params.linear_solver = spec.distributed_linear;
         std::shared_ptr<const Mesh> whole = ctx.DomainMesh();
         try {

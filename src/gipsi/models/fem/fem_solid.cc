@@ -36,11 +36,6 @@ FemSolid::FemSolid(std::string name, std::shared_ptr<const Mesh> domain, FemPara
   if (!(params_.density > 0))
     throw InputError(fmt::format("object '{}': density must be positive", this->path()));
   law_ = params_.material.get();
-  if (dist_ && params_.scheme == ImplicitSchemeKind::kNewmark)
-    throw InputError(fmt::format(
-        "object '{}': a FemSolid split over MPI ranks does not take the Newmark scheme yet "
-        "(docs/scale-out.md): run the scene serially",
-        this->path()));
   SetGeometry(domain, dist_ ? dist_->boundary() : MakeBoundary(*domain));
   const Index n = domain->num_nodes();
   const Index ne = assembly_.num_elements();
@@ -633,7 +628,10 @@ void FemSolid::GatherTargets() {
 
 void FemSolid::InitialAcceleration() {
   // Newmark needs a_0 from M a_0 = f_ext − f_int − C v_0 (lumped: nodal division; consistent:
-  // solved with a direct factorisation of M, once).
+  // solved with a direct factorisation of M, once). Split over processes, the forces and the
+  // masses are the part's partial sums at shared nodes: the right-hand side is summed (every
+  // process then holds the whole one), the lumped masses too, and the consistent M is the
+  // processes' partial matrices, which the distributed solver sums.
   if (!AssembleElements(state_.scheme.x().data(), f_int_, nullptr)) return;
   AssembleExternal(state_.scheme.x().data(), 0.0);
   VecX rhs = f_ext_ - f_int_;
@@ -647,12 +645,16 @@ void FemSolid::InitialAcceleration() {
       rhs -= params_.rayleigh_mass * work_;
     }
   }
+  if (dist_) dist_->SumShared(rhs);
   VecX a0 = VecX::Zero(rhs.size());
   if (params_.lumped_mass) {
-    for (Index i = 0; i < num_nodes(); ++i)
-      a0.segment<3>(3 * i) = rhs.segment<3>(3 * i) / lumped_mass_[i];
+    VecX mass(rhs.size());
+    for (Index i = 0; i < num_nodes(); ++i) mass.segment<3>(3 * i).setConstant(lumped_mass_[i]);
+    if (dist_) dist_->SumShared(mass);
+    a0 = rhs.cwiseQuotient(mass);
   } else {
-    auto solver = MakeLinearSolver(LinearSolverOptions{.type = "ldlt"});
+    const LinearSolverOptions direct{.type = "ldlt"};
+    auto solver = dist_ ? dist_->MakeLinearSolver(direct, rest_) : MakeLinearSolver(direct);
     solver->AnalyzePattern(mass_);
     if (solver->Factorize(mass_)) solver->Solve(rhs, a0);
   }

@@ -82,9 +82,9 @@ struct FemParams {
   /// as follower pressure on its faces.
   std::vector<CavitySpec> cavities;
   /// Set: the object is one process's part of a solid split over processes
-  /// (solid_distribution.h; the domain mesh is the part). Implicit schemes other than Newmark
-  /// for now: the constructors refuse the rest (the distributed scene loader builds such a solid
-  /// whole on every rank instead). Cavities are selected on the whole mesh and their volume
+  /// (solid_distribution.h; the domain mesh is the part). Implicit schemes only for now: the
+  /// constructor with an ODE integrator refuses it (the distributed scene loader builds such a
+  /// solid whole on every rank instead). Cavities are selected on the whole mesh and their volume
   /// computed on the whole cavity surface on every process (its vertices gathered).
   std::shared_ptr<const SolidDistribution> distribution;
 };
