@@ -6,6 +6,8 @@
 #include <fmt/format.h>
 
 #include "gipsi/base/error.h"
+#include "gipsi/base/log.h"
+#include "gipsi/base/units.h"
 #include "gipsi/models/ep/ep_tissue_json.h"
 #include "gipsi/models/fem/fem_solid.h"
 #include "gipsi/parallel/distributed_monodomain.h"
@@ -34,8 +36,10 @@ void RegisterDistributedTypes(TypeRegistry& registry, MPI_Comm comm,
           ctx.params.Fail(e.what());
         }
       });
-  // A FemSolid with what its split version does not take yet (an explicit integrator) runs
-  // whole on every rank, as every object did before.
+  // A FemSolid with an ODE integrator other than the built-in fixed-step explicit ones (the
+  // implicit one's matrix-free Newton is serial; a plugin's might adapt its steps from a norm
+  // of the state, which would differ between ranks) runs whole on every rank, as every object
+  // did before.
   const ObjectFactory* found = registry.objects.Find("FemSolid");
   GIPSI_CHECK(found != nullptr);
   registry.objects.Replace(
@@ -43,7 +47,9 @@ void RegisterDistributedTypes(TypeRegistry& registry, MPI_Comm comm,
       [comm, note,
        whole_solid = *found](const ObjectBuildContext& ctx) -> std::unique_ptr<SimObject> {
         FemSolidSpec spec = ParseFemSolidSpec(ctx);
-        if (spec.ode) return whole_solid(ctx);
+        if (spec.ode && spec.ode->name() != "RK4" && spec.ode->name() != "SymplecticEuler" &&
+            spec.ode->name() != "ExplicitEuler")
+          return whole_solid(ctx);
         spec.params.linear_solver = spec.distributed_linear;
         std::shared_ptr<const Mesh> whole = ctx.DomainMesh();
         try {
@@ -61,6 +67,14 @@ void RegisterDistributedTypes(TypeRegistry& registry, MPI_Comm comm,
             for (std::size_t e = 0; e < mesh_part.whole_tet.size(); ++e)
               local.col(static_cast<Index>(e)) = all.col(mesh_part.whole_tet[e]);
             solid->WriteField(solid->FindField("fibre"), local);
+          }
+          if (auto dt = ctx.params.Find("dt"); dt && solid->ode_integrator()) {
+            const double value = ReadPositiveQuantity(*dt, "s");
+            const double limit = solid->stable_dt_estimate();  // collective
+            if (value > limit)
+              Log().warn(
+                  "{}: {}: dt = {:.3g} s exceeds the estimated explicit stability limit {:.3g} s",
+                  dt->file(), dt->path(), value, limit);
           }
           note(ctx.name, "FemSolid");
           return std::make_unique<WholeDomainView>(

@@ -253,7 +253,9 @@ class FemSolid final : public SimObject, public CavityWall {
   const SolidDistribution* dist_ = nullptr;  // params_.distribution
   TetAssembly assembly_;
   const SolidMaterial* law_ = nullptr;
-  VecX lumped_mass_;   // per node
+  VecX lumped_mass_;  // per node
+  // Split over processes (ODE path): the lumped mass summed over the processes at shared nodes.
+  VecX whole_lumped_mass_;
   SparseMatrix mass_;  // consistent mass (pattern layout); empty values if lumped
   SparseMatrix jac_;   // Newton matrix
   // K_n for Rayleigh β (implicit schemes); the stage tangent K(u) under an ODE integrator.

@@ -9,6 +9,10 @@
 /// velocity through the step (a displacement target u* gives (u* − u_n)/Δt) and do not accelerate;
 /// their end position is then set to the target exactly. Refused: a consistent mass (the ODE needs
 /// M⁻¹ cheaply) and cavities coupled to blood (their pressure is solved with the wall, monolithic).
+/// Split over processes (FemParams::distribution), the forces and lumped masses are summed at
+/// shared nodes, so every process computes the same accelerations there, and the step's verdicts
+/// (an inverted element, a non-finite state) are reductions; only explicit integrators (their
+/// stages need no norms or solves) are taken.
 
 #include <algorithm>
 #include <chrono>
@@ -26,10 +30,11 @@ FemSolid::FemSolid(std::string name, std::shared_ptr<const Mesh> domain, FemPara
                    std::unique_ptr<OdeIntegrator> integrator)
     : FemSolid(std::move(name), std::move(domain), std::move(params)) {
   GIPSI_CHECK(integrator != nullptr);
-  if (dist_)
+  if (dist_ && !integrator->is_explicit())
     throw InputError(fmt::format(
-        "object '{}': a FemSolid split over MPI ranks does not take integrator '{}' yet (only "
-        "the implicit schemes \"Static\", \"BackwardEuler\" and \"BDF2\"; docs/scale-out.md)",
+        "object '{}': a FemSolid split over MPI ranks does not take the implicit ODE integrator "
+        "'{}' (its solves are not distributed): use an explicit integrator or an implicit scheme "
+        "(\"Static\", \"BackwardEuler\", \"BDF2\", \"Newmark\"; docs/scale-out.md)",
         this->path(), integrator->name()));
   if (!params_.lumped_mass)
     throw InputError(fmt::format(
@@ -40,6 +45,13 @@ FemSolid::FemSolid(std::string name, std::shared_ptr<const Mesh> domain, FemPara
   ode_integrator_ = std::move(integrator);
   ode_integrator_->Prepare(ode_size());
   ode_y_ = VecX::Zero(ode_size());
+  if (dist_) {
+    VecX mass(3 * num_nodes());
+    for (Index i = 0; i < num_nodes(); ++i) mass.segment<3>(3 * i).setConstant(lumped_mass_[i]);
+    dist_->SumShared(mass);
+    whole_lumped_mass_.resize(num_nodes());
+    for (Index i = 0; i < num_nodes(); ++i) whole_lumped_mass_[i] = mass[3 * i];
+  }
 }
 
 void FemSolid::CalcDerivative(double t, Eigen::Ref<const VecX> y, Eigen::Ref<VecX> ydot) const {
@@ -61,10 +73,12 @@ void FemSolid::CalcDerivative(double t, Eigen::Ref<const VecX> y, Eigen::Ref<Vec
     SymmetricSpMV(damping_k_, work2_, work_);
     f_ext_ -= params_.rayleigh_stiffness * work_;
   }
+  if (dist_) dist_->SumShared(f_ext_);
+  const VecX& mass = dist_ ? whole_lumped_mass_ : lumped_mass_;
   auto acceleration = ydot.tail(n3);
   for (Index i = 0; i < num_nodes(); ++i)
-    acceleration.segment<3>(3 * i) = f_ext_.segment<3>(3 * i) / lumped_mass_[i] -
-                                     params_.rayleigh_mass * y.segment<3>(n3 + 3 * i);
+    acceleration.segment<3>(3 * i) =
+        f_ext_.segment<3>(3 * i) / mass[i] - params_.rayleigh_mass * y.segment<3>(n3 + 3 * i);
   for (int dof : constrained_dofs_) acceleration[dof] = 0;
 }
 
@@ -88,17 +102,22 @@ StepStatus FemSolid::StepOde(double t, double dt) {
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   ++profile_.steps;
   failure_detail_.clear();
-  if (ode_invalid_) {
-    failure_detail_ = fmt::format("{}: {} is outside its law's domain (det F <= 0?)",
-                                  ode_integrator_->name(), domain().TetName(first_invalid_));
+  if (ode_invalid_) {  // the same on every process (AssembleElements' verdict is reduced)
+    failure_detail_ = dist_
+                          ? fmt::format("{}: tet {} ({}) is outside its law's domain (det F <= 0?)",
+                                        ode_integrator_->name(), invalid_id_, domain().TetIdKind())
+                          : fmt::format("{}: {} is outside its law's domain (det F <= 0?)",
+                                        ode_integrator_->name(), domain().TetName(first_invalid_));
     return StepStatus::Failed("an element inverted in a stage of the step; tet",
-                              domain().TetId(first_invalid_));
+                              dist_ ? invalid_id_ : domain().TetId(first_invalid_));
   }
   if (!solved) {
     failure_detail_ = fmt::format("{}: {}", ode_integrator_->name(), ode_integrator_->failure());
     return StepStatus::Failed("the implicit integrator's solve failed (state left at the start)");
   }
-  if (!ode_y_.allFinite()) return StepStatus::Diverged("non-finite position or velocity");
+  double non_finite = ode_y_.allFinite() ? 0.0 : 1.0;
+  if (dist_) dist_->Reduce({&non_finite, 1}, true);  // one process's NaN stops every process
+  if (non_finite > 0) return StepStatus::Diverged("non-finite position or velocity");
   for (int dof : constrained_dofs_)
     if (constraint_[static_cast<std::size_t>(dof)] == 1) ode_y_[dof] = target_[dof];
   // The step's mean acceleration, (v_{n+1} − v_n)/Δt: what reaction forces and outputs read.
@@ -122,9 +141,12 @@ double FemSolid::stable_dt_estimate() const {
   VecX row_sum = VecX::Zero(k.rows());
   for (Index c = 0; c < k.outerSize(); ++c)
     for (SparseMatrix::InnerIterator it(k, c); it; ++it) row_sum[it.row()] += std::abs(it.value());
+  // Split: the row sums and masses of shared nodes summed, the bound's maximum over processes.
+  if (dist_) dist_->SumShared(row_sum);
+  const VecX& mass = dist_ && whole_lumped_mass_.size() > 0 ? whole_lumped_mass_ : lumped_mass_;
   double omega2 = 0;
-  for (Index i = 0; i < row_sum.size(); ++i)
-    omega2 = std::max(omega2, row_sum[i] / lumped_mass_[i / 3]);
+  for (Index i = 0; i < row_sum.size(); ++i) omega2 = std::max(omega2, row_sum[i] / mass[i / 3]);
+  if (dist_) dist_->Reduce({&omega2, 1}, true);
   return omega2 > 0 ? 2.0 / std::sqrt(omega2) : std::numeric_limits<double>::infinity();
 }
 
