@@ -44,6 +44,8 @@ class EnclosedVolume {
   [[nodiscard]] const std::vector<std::vector<std::pair<int, int>>>& loops() const {
     return loops_;
   }
+  /// The surface's triangles (3 by T, vertex indices).
+  [[nodiscard]] const Triangles& triangles() const { return triangles_; }
   /// Enclosed volume for vertex positions `x` (3 by num_vertices) [m³ if x in m]. If
   /// `gradient` is not null it is resized to 3 by num_vertices and receives ∂V/∂x.
   double Compute(const Points& x, Points* gradient = nullptr) const;

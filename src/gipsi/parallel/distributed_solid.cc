@@ -462,69 +462,6 @@ std::unique_ptr<LinearSolver> DistributedSolid::MakeLinearSolver(const LinearSol
   return std::make_unique<PetscSolidSolver>(comm_, part_, options, rest);
 }
 
-namespace {
-
-// Each rank sends the listed nodes it owns (their positions in the list and their values);
-// every rank receives all of them (MPI_Allgatherv of O(list)).
-class AllgatherNodes final : public NodeGather {
- public:
-  AllgatherNodes(const MeshPart& part, std::vector<int> whole_nodes, MPI_Comm comm)
-      : comm_(comm), count_(whole_nodes.size()) {
-    std::vector<int> owned_local(static_cast<std::size_t>(part.num_global_nodes), -1);
-    for (std::int64_t i = 0; i < part.num_owned; ++i)
-      owned_local[static_cast<std::size_t>(part.whole_node[static_cast<std::size_t>(i)])] =
-          static_cast<int>(i);
-    for (std::size_t k = 0; k < whole_nodes.size(); ++k) {
-      const int local = owned_local[static_cast<std::size_t>(whole_nodes[k])];
-      if (local < 0) continue;
-      sent_at_.push_back(static_cast<int>(k));
-      sent_local_.push_back(local);
-    }
-    int size = 1;
-    MPI_Comm_size(comm_, &size);
-    counts_.resize(static_cast<std::size_t>(size));
-    offsets_.assign(static_cast<std::size_t>(size), 0);
-    const int mine = static_cast<int>(sent_at_.size());
-    MPI_Allgather(&mine, 1, MPI_INT, counts_.data(), 1, MPI_INT, comm_);
-    for (std::size_t r = 1; r < counts_.size(); ++r) offsets_[r] = offsets_[r - 1] + counts_[r - 1];
-    received_at_.resize(count_);
-    GIPSI_CHECK(static_cast<std::size_t>(offsets_.back() + counts_.back()) == count_,
-                "a node gather of {} nodes, {} owned by some rank", count_,
-                offsets_.back() + counts_.back());
-    MPI_Allgatherv(sent_at_.data(), mine, MPI_INT, received_at_.data(), counts_.data(),
-                   offsets_.data(), MPI_INT, comm_);
-    for (std::size_t r = 0; r < counts_.size(); ++r) {
-      counts_[r] *= 3;
-      offsets_[r] *= 3;
-    }
-    sent_.resize(3 * sent_at_.size());
-    received_.resize(3 * count_);
-  }
-  void Gather(const double* local, Points& out) const override {
-    for (std::size_t i = 0; i < sent_local_.size(); ++i)
-      for (std::size_t a = 0; a < 3; ++a)
-        sent_[3 * i + a] = local[3 * static_cast<std::size_t>(sent_local_[i]) + a];
-    MPI_Allgatherv(sent_.data(), static_cast<int>(sent_.size()), MPI_DOUBLE, received_.data(),
-                   counts_.data(), offsets_.data(), MPI_DOUBLE, comm_);
-    out.resize(3, static_cast<Index>(count_));
-    for (std::size_t i = 0; i < count_; ++i)
-      for (Index a = 0; a < 3; ++a)
-        out(a, received_at_[i]) = received_[3 * i + static_cast<std::size_t>(a)];
-  }
-
- private:
-  MPI_Comm comm_;
-  std::size_t count_;
-  std::vector<int> sent_at_, sent_local_, received_at_, counts_, offsets_;
-  mutable std::vector<double> sent_, received_;
-};
-
-}  // namespace
-
-std::unique_ptr<NodeGather> DistributedSolid::MakeNodeGather(std::vector<int> whole_nodes) const {
-  return std::make_unique<AllgatherNodes>(part_, std::move(whole_nodes), comm_);
-}
-
 std::int64_t DistributedSolid::WholeTetId(Index local) const {
   const Mesh& mesh = *part_.mesh;
   return mesh.tet_ids.empty() ? part_.whole_tet[static_cast<std::size_t>(local)]

@@ -59,8 +59,6 @@ class DistributedSolid final : public SolidDistribution {
   [[nodiscard]] const BoundarySurface& whole_boundary() const override { return whole_boundary_; }
   [[nodiscard]] std::span<const int> whole_face() const override { return whole_face_; }
   [[nodiscard]] std::span<const int> whole_node() const override { return part_.whole_node; }
-  [[nodiscard]] std::unique_ptr<NodeGather> MakeNodeGather(
-      std::vector<int> whole_nodes) const override;
 
  private:
   MPI_Comm comm_;

@@ -64,8 +64,17 @@ bool FemSolid::AddCoupledCavityLoads(const double* u) {
     Cavity& cavity = cavities_[c];
     FemCavityState& cs = state_.cavities[c];
     if (cavity.law == nullptr) continue;
-    CavityPositions(cavity, u);
-    const double v = cavity.volume.Compute(cavity.positions, &cavity.local_gradient);
+    double v = 0;
+    if (dist_) {
+      v = SplitCavityVolume(cavity, u, &cavity.gradient);
+    } else {
+      CavityPositions(cavity, u);
+      v = cavity.volume.Compute(cavity.positions, &cavity.local_gradient);
+      cavity.gradient.setZero();
+      for (std::size_t k = 0; k < cavity.nodes.size(); ++k)
+        cavity.gradient.segment<3>(3 * static_cast<Index>(cavity.nodes[k])) +=
+            cavity.local_gradient.col(static_cast<Index>(k));
+    }
     const double p = cs.pressure;  // the iterate's (FemSolid::Increment sets it)
     double vb = 0;
     if (!cavity.law->EndVolume(step_time_, step_dt_, p, vb) || !std::isfinite(vb)) {
@@ -80,12 +89,6 @@ bool FemSolid::AddCoupledCavityLoads(const double* u) {
     if (!(cs.stiffness > 0)) {  // p would not be determined by the volume
       failed_cavity_ = static_cast<int>(c);
       return false;
-    }
-    cavity.gradient.setZero();
-    for (std::size_t k = 0; k < cavity.nodes.size(); ++k) {
-      const int node = CavityNode(cavity, k);
-      if (node >= 0)
-        cavity.gradient.segment<3>(3 * node) += cavity.local_gradient.col(static_cast<Index>(k));
     }
     for (int dof : constrained_dofs_) cavity.gradient[dof] = 0;
     if (!dist_) {
@@ -117,37 +120,91 @@ void FemSolid::AddCoupledCavityForces(VecX& f) const {
   for (std::size_t c = 0; c < cavities_.size(); ++c) {
     const Cavity& cavity = cavities_[c];
     if (cavity.law == nullptr) continue;
-    if (dist_) {
-      CavityPositions(cavity, u().data());
-    } else {
-      for (std::size_t k = 0; k < cavity.nodes.size(); ++k)
-        cavity.positions.col(static_cast<Index>(k)) = positions_.col(cavity.nodes[k]);
+    const double p = state_.cavities[c].pressure;
+    if (dist_) {  // the whole gradient on owned nodes, the forces being summed over the processes
+      SplitCavityVolume(cavity, u().data(), &cavity_gradient_);
+      const Index owned = dist_->owned();
+      f.head(owned) += p * cavity_gradient_.head(owned);
+      continue;
     }
-    cavity.volume.Compute(cavity.positions, &cavity.local_gradient);
-    // (Distributed: on owned nodes, the forces being summed over the processes after.)
-    const Index owned = dist_ ? dist_->num_owned_nodes() : num_nodes();
     for (std::size_t k = 0; k < cavity.nodes.size(); ++k)
-      if (const int node = CavityNode(cavity, k); node >= 0 && node < owned)
-        f.segment<3>(3 * static_cast<Index>(node)) +=
-            state_.cavities[c].pressure * cavity.local_gradient.col(static_cast<Index>(k));
+      cavity.positions.col(static_cast<Index>(k)) = positions_.col(cavity.nodes[k]);
+    cavity.volume.Compute(cavity.positions, &cavity.local_gradient);
+    for (std::size_t k = 0; k < cavity.nodes.size(); ++k)
+      f.segment<3>(3 * static_cast<Index>(cavity.nodes[k])) +=
+          p * cavity.local_gradient.col(static_cast<Index>(k));
   }
 }
 
 void FemSolid::CavityPositions(const Cavity& cavity, const double* u) const {
-  if (!dist_) {
-    for (std::size_t k = 0; k < cavity.nodes.size(); ++k) {
-      const auto node = static_cast<Index>(cavity.nodes[k]);
-      cavity.positions.col(static_cast<Index>(k)) =
-          rest_.segment<3>(3 * node) + Eigen::Map<const Vec3>(u + 3 * node);
-    }
-    return;
-  }
-  // The same rest positions and gathered displacements on every process: the same volume.
-  cavity.gather->Gather(u, cavity_u_);
-  const Points& whole = dist_->whole_mesh().nodes;
-  for (std::size_t k = 0; k < cavity.nodes.size(); ++k)
+  GIPSI_CHECK(!dist_);
+  for (std::size_t k = 0; k < cavity.nodes.size(); ++k) {
+    const auto node = static_cast<Index>(cavity.nodes[k]);
     cavity.positions.col(static_cast<Index>(k)) =
-        whole.col(cavity.nodes[k]) + cavity_u_.col(static_cast<Index>(k));
+        rest_.segment<3>(3 * node) + Eigen::Map<const Vec3>(u + 3 * node);
+  }
+}
+
+double FemSolid::SplitCavityVolume(const Cavity& cavity, const double* u, VecX* gradient) const {
+  // As EnclosedVolume::Compute, over this rank's triangles and rim half-edges.
+  auto x = [&](int vertex) -> Vec3 {
+    const int node = cavity.local_node[static_cast<std::size_t>(vertex)];
+    GIPSI_CHECK(node >= 0, "a cavity vertex of this rank's faces is not on this rank");
+    return rest_.segment<3>(3 * node) + Eigen::Map<const Vec3>(u + 3 * node);
+  };
+  auto add = [&](int vertex, const Vec3& g) {
+    const int node = cavity.local_node[static_cast<std::size_t>(vertex)];
+    gradient->segment<3>(3 * static_cast<Index>(node)) += g;
+  };
+  if (gradient) gradient->setZero(3 * num_nodes());
+  const Triangles& triangles = cavity.volume.triangles();
+  double volume = 0;
+  for (int k : cavity.my_triangles) {
+    const int i0 = triangles(0, k), i1 = triangles(1, k), i2 = triangles(2, k);
+    const Vec3 x0 = x(i0), x1 = x(i1), x2 = x(i2);
+    volume += x0.dot(x1.cross(x2)) / 6.0;
+    if (gradient) {
+      add(i0, x1.cross(x2) / 6.0);
+      add(i1, x2.cross(x0) / 6.0);
+      add(i2, x0.cross(x1) / 6.0);
+    }
+  }
+  // The rim centroids: each loop vertex starts one half-edge, on one rank.
+  const std::size_t loops = cavity.my_loops.size();
+  std::vector<double> sums(3 * loops + 1, 0.0);
+  for (std::size_t l = 0; l < loops; ++l)
+    for (const auto& edge : cavity.my_loops[l]) Eigen::Map<Vec3>(&sums[3 * l]) += x(edge.first);
+  dist_->Reduce({sums.data(), 3 * loops}, false);
+  std::vector<Vec3> centroid(loops);
+  for (std::size_t l = 0; l < loops; ++l)
+    centroid[l] =
+        Eigen::Map<const Vec3>(&sums[3 * l]) / static_cast<double>(cavity.volume.loops()[l].size());
+  // The caps: this rank's fan triangles (b, a, c), and its share of ∂V/∂c.
+  std::fill(sums.begin(), sums.end(), 0.0);
+  for (std::size_t l = 0; l < loops; ++l) {
+    const Vec3& c = centroid[l];
+    Eigen::Map<Vec3> dc(&sums[3 * l]);
+    for (const auto& [a, b] : cavity.my_loops[l]) {
+      const Vec3 xb = x(b), xa = x(a);
+      volume += xb.dot(xa.cross(c)) / 6.0;
+      if (gradient) {
+        add(b, xa.cross(c) / 6.0);
+        add(a, c.cross(xb) / 6.0);
+        dc += xb.cross(xa) / 6.0;
+      }
+    }
+  }
+  sums[3 * loops] = volume;
+  dist_->Reduce(sums, false);
+  volume = sums[3 * loops];
+  if (!gradient) return volume;
+  for (std::size_t l = 0; l < loops; ++l) {
+    const Vec3 share =
+        Eigen::Map<const Vec3>(&sums[3 * l]) / static_cast<double>(cavity.volume.loops()[l].size());
+    for (const auto& edge : cavity.my_loops[l]) add(edge.first, share);
+  }
+  dist_->SumShared(*gradient);
+  return volume;
 }
 
 void FemSolid::RestoreCavityPressures() {

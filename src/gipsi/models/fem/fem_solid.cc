@@ -134,8 +134,14 @@ FemSolid::FemSolid(std::string name, std::shared_ptr<const Mesh> domain, FemPara
     for (std::size_t i = 0; i < whole_node.size(); ++i)
       local_of[static_cast<std::size_t>(whole_node[i])] = static_cast<int>(i);
     const std::span<const int> whole_face = dist_->whole_face();
+    std::vector<int> my_whole_faces(whole_face.begin(), whole_face.end());
+    std::sort(my_whole_faces.begin(), my_whole_faces.end());
     for (Cavity& cavity : cavities_) {
+      // Surface triangle k is whole face cavity.faces[k] (MakeCavitySurface keeps the order).
       std::vector<int> whole_faces = cavity.faces, faces;
+      for (std::size_t k = 0; k < whole_faces.size(); ++k)
+        if (std::binary_search(my_whole_faces.begin(), my_whole_faces.end(), whole_faces[k]))
+          cavity.my_triangles.push_back(static_cast<int>(k));
       std::sort(whole_faces.begin(), whole_faces.end());
       for (std::size_t f = 0; f < whole_face.size(); ++f)
         if (std::binary_search(whole_faces.begin(), whole_faces.end(), whole_face[f]))
@@ -143,7 +149,18 @@ FemSolid::FemSolid(std::string name, std::shared_ptr<const Mesh> domain, FemPara
       cavity.faces = std::move(faces);
       for (int node : cavity.nodes)
         cavity.local_node.push_back(local_of[static_cast<std::size_t>(node)]);
-      cavity.gather = dist_->MakeNodeGather(cavity.nodes);
+      // A rim half-edge a → b runs along one surface triangle in that direction.
+      const Triangles& triangles = cavity.volume.triangles();
+      std::vector<std::pair<int, int>> my_edges;
+      for (int k : cavity.my_triangles)
+        for (int i = 0; i < 3; ++i)
+          my_edges.emplace_back(triangles(i, k), triangles((i + 1) % 3, k));
+      std::sort(my_edges.begin(), my_edges.end());
+      for (const auto& loop : cavity.volume.loops()) {
+        auto& mine = cavity.my_loops.emplace_back();
+        for (const auto& edge : loop)
+          if (std::binary_search(my_edges.begin(), my_edges.end(), edge)) mine.push_back(edge);
+      }
     }
   }
   state_.cavities.resize(cavities_.size());
@@ -828,8 +845,7 @@ double FemSolid::GravityEnergy() const {
 double FemSolid::CavityVolume(std::size_t i) const {
   GIPSI_CHECK(i < cavities_.size());
   if (!dist_) return cavities_[i].Volume(positions_);
-  CavityPositions(cavities_[i], u().data());
-  return cavities_[i].volume.Compute(cavities_[i].positions, nullptr);
+  return SplitCavityVolume(cavities_[i], u().data(), nullptr);
 }
 
 Index FemSolid::CountInvertedElements() const {

@@ -82,10 +82,10 @@ struct FemParams {
   /// as follower pressure on its faces.
   std::vector<CavitySpec> cavities;
   /// Set: the object is one process's part of a solid split over processes
-  /// (solid_distribution.h; the domain mesh is the part). Implicit schemes only for now: the
-  /// constructor with an ODE integrator refuses it (the distributed scene loader builds such a
-  /// solid whole on every rank instead). Cavities are selected on the whole mesh and their volume
-  /// computed on the whole cavity surface on every process (its vertices gathered).
+  /// (solid_distribution.h; the domain mesh is the part). Implicit schemes and explicit ODE
+  /// integrators: the constructor refuses an implicit ODE integrator (the distributed scene
+  /// loader builds such a solid whole on every rank instead). Cavities are selected on the whole
+  /// mesh; each process sums its faces' share of their volume and gradient (SplitCavityVolume).
   std::shared_ptr<const SolidDistribution> distribution;
 };
 
@@ -306,19 +306,27 @@ class FemSolid final : public SimObject, public CavityWall {
     VecX gradient{};             // 3N: ∂V/∂x, zero on constrained dofs (coupled)
     double volume_residual = 0;  // V(u) − V_b(p) at the last residual (coupled) [m³]
     // Distributed: `nodes` and the volume are the whole cavity's (whole-mesh nodes), `faces`
-    // the part's; the local node of each cavity vertex (-1: not on this rank), and the gather
-    // of the vertices' displacements from their owners.
+    // the part's; the local node of each cavity vertex (-1: not on this rank), the surface
+    // triangles of this rank's faces and, per rim loop, the rim half-edges of those triangles
+    // (each triangle and half-edge is on exactly one rank).
     std::vector<int> local_node;
-    std::shared_ptr<const NodeGather> gather;
+    std::vector<int> my_triangles;
+    std::vector<std::vector<std::pair<int, int>>> my_loops;
   };
-  /// Cavity c's vertex positions at displacements u (3 per local node) into its `positions`;
-  /// distributed, gathered from the owners (collective).
+  /// Cavity c's vertex positions at displacements u (3 per local node) into its `positions`.
+  /// Serial only.
   void CavityPositions(const Cavity& cavity, const double* u) const;
+  /// Distributed: the whole cavity's volume at displacements u (3 per local node) and, with
+  /// `gradient`, ∂V/∂x whole at every local node (3 per node). Each rank sums its faces and its
+  /// part of the rim caps; the rim centroids, the volume and ∂V/∂c are reductions and the
+  /// gradient is summed at shared nodes, so the ranks exchange O(rim loops) numbers, not the
+  /// surface. Collective.
+  double SplitCavityVolume(const Cavity& cavity, const double* u, VecX* gradient) const;
   /// The local node of cavity vertex k (-1: none on this rank).
   [[nodiscard]] int CavityNode(const Cavity& cavity, std::size_t k) const {
     return dist_ ? cavity.local_node[k] : cavity.nodes[k];
   }
-  mutable Points cavity_u_;  // CavityPositions' gathered displacements
+  mutable VecX cavity_gradient_;  // SplitCavityVolume's gradient for the forces
   std::vector<Cavity> cavities_;
   double step_time_ = 0, step_dt_ = 0;   // of the step in progress (the laws' interval)
   int failed_cavity_ = -1;               // whose law could not answer in the last solve

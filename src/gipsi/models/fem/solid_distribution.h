@@ -25,16 +25,6 @@
 GIPSI_EXPORT_BEGIN
 namespace gipsi {
 
-/// Values at a fixed list of the whole mesh's nodes, gathered on every process from the nodes'
-/// owners (SolidDistribution::MakeNodeGather). Abstract.
-class NodeGather {
- public:
-  virtual ~NodeGather() = default;
-  /// `local`: 3 values per local node; `out` (3 by the list's length) receives the values of the
-  /// listed nodes, the same on every process. Collective.
-  virtual void Gather(const double* local, Points& out) const = 0;
-};
-
 /// Abstract; implementations are collective where noted (every process calls them in the same
 /// order).
 class SolidDistribution : public VectorReduction {
@@ -64,10 +54,6 @@ class SolidDistribution : public VectorReduction {
   [[nodiscard]] virtual std::span<const int> whole_face() const = 0;
   /// The whole mesh's node of each local node.
   [[nodiscard]] virtual std::span<const int> whole_node() const = 0;
-  /// A gather of the values at `whole_nodes` (whole-mesh node indices, each held by some
-  /// process). Collective.
-  [[nodiscard]] virtual std::unique_ptr<NodeGather> MakeNodeGather(
-      std::vector<int> whole_nodes) const = 0;
   /// A local tet's identifier in the whole mesh (its Gmsh tag or whole-mesh index), for
   /// messages that every process gives alike.
   [[nodiscard]] virtual std::int64_t WholeTetId(Index local) const = 0;
