@@ -25,7 +25,8 @@ class DistributedRun {
   /// Replaces the factories of the distributed types (distributed_types.h).
   virtual void RegisterTypes(TypeRegistry& registry) const = 0;
   /// The objects the replaced factories have split over the ranks so far, as "name (Type)"
-  /// (a FemSolid with cavities, for one, still runs whole on every rank).
+  /// (a FemSolid with the ODE contract's implicit integrator, for one, still runs whole on every
+  /// rank).
   [[nodiscard]] virtual std::vector<std::string> split_objects() const = 0;
   /// Waits until every rank has called it.
   virtual void Barrier() const = 0;

@@ -3,9 +3,10 @@
 /// The object types a distributed scene run splits over the ranks (`mpirun -np N gipsi run
 /// SCENE`, docs/scale-out.md). Today: "Monodomain" (a DistributedMonodomain behind a
 /// WholeDomainView) and "FemSolid" (a FemSolid on each rank's part with a DistributedSolid,
-/// behind a WholeDomainView, cavities included; one with an explicit integrator still runs
-/// whole). Every other object of the scene runs whole on every rank, each rank
-/// computing the same steps, so connectors, events and outputs see the same values everywhere.
+/// behind a WholeDomainView, cavities included; one with the ODE contract's implicit integrator
+/// or a plugin's integrator still runs whole). Every other object of the scene runs whole on
+/// every rank, each rank computing the same steps, so connectors, events and outputs see the same
+/// values everywhere.
 
 #include <mpi.h>
 

@@ -27,7 +27,6 @@ struct Received {
 template <class T>
 Received<T> Exchange(const std::vector<std::vector<T>>& to, MPI_Comm comm) {
   static_assert(std::is_trivially_copyable_v<T>);
-  const int size = static_cast<int>(to.size());
   std::vector<int> send_counts(to.size()), send_offsets(to.size(), 0),
       receive_offsets(to.size(), 0);
   Received<T> out;
@@ -55,7 +54,6 @@ Received<T> Exchange(const std::vector<std::vector<T>>& to, MPI_Comm comm) {
   MPI_Alltoallv(send.data(), send_counts.data(), send_offsets.data(), record, out.items.data(),
                 out.counts.data(), receive_offsets.data(), record, comm);
   MPI_Type_free(&record);
-  (void)size;
   return out;
 }
 
