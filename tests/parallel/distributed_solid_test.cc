@@ -26,16 +26,22 @@ namespace {
 
 MPI_Comm World() { return ParallelSession::world(); }
 
-// The serial object, or the view on this rank's part, on the same whole mesh.
+// The serial object, or the view on this rank's part, on the same whole mesh; stepped by
+// `integrator` through the ODE contract when one is given.
 std::unique_ptr<SimObject> MakeSolid(std::shared_ptr<const Mesh> whole, FemParams params,
-                                     bool split) {
-  if (!split) return std::make_unique<FemSolid>("solid", whole, std::move(params));
+                                     bool split,
+                                     std::unique_ptr<OdeIntegrator> integrator = nullptr) {
+  auto make = [&](std::shared_ptr<const Mesh> mesh) {
+    return integrator ? std::make_unique<FemSolid>("solid", std::move(mesh), std::move(params),
+                                                   std::move(integrator))
+                      : std::make_unique<FemSolid>("solid", std::move(mesh), std::move(params));
+  };
+  if (!split) return make(whole);
   auto distribution = std::make_shared<DistributedSolid>(whole, World());
   params.distribution = distribution;
   const MeshPart& part = distribution->part();
-  auto solid = std::make_unique<FemSolid>("solid", part.mesh, std::move(params));
   return std::make_unique<WholeDomainView>(
-      std::move(solid), part, whole, World(),
+      make(part.mesh), part, whole, World(),
       WholeDomainView::BoundaryMap{distribution->whole_boundary_vertex(),
                                    distribution->whole_boundary_face()});
 }
@@ -149,23 +155,8 @@ TEST(DistributedSolid, CantileverSwingsAsTheSerialObjectWithRk4) {
   const auto whole = Cantilever();
   FemParams params = CantileverParams("sgs");
   params.lumped_mass = true;
-  auto make = [&](bool split, std::unique_ptr<OdeIntegrator> integrator) {
-    FemParams p = params;
-    if (!split)
-      return std::unique_ptr<SimObject>(
-          std::make_unique<FemSolid>("solid", whole, std::move(p), std::move(integrator)));
-    auto distribution = std::make_shared<DistributedSolid>(whole, World());
-    p.distribution = distribution;
-    const MeshPart& part = distribution->part();
-    auto solid =
-        std::make_unique<FemSolid>("solid", part.mesh, std::move(p), std::move(integrator));
-    return std::unique_ptr<SimObject>(std::make_unique<WholeDomainView>(
-        std::move(solid), part, whole, World(),
-        WholeDomainView::BoundaryMap{distribution->whole_boundary_vertex(),
-                                     distribution->whole_boundary_face()}));
-  };
-  auto serial = make(false, std::make_unique<RungeKutta4>());
-  auto split = make(true, std::make_unique<RungeKutta4>());
+  auto serial = MakeSolid(whole, params, false, std::make_unique<RungeKutta4>());
+  auto split = MakeSolid(whole, params, true, std::make_unique<RungeKutta4>());
   Clamp(*serial);
   Clamp(*split);
   for (int step = 0; step < 500; ++step) {
@@ -179,7 +170,7 @@ TEST(DistributedSolid, CantileverSwingsAsTheSerialObjectWithRk4) {
   }
   const double k = Read(*serial, "kinetic_energy")(0, 0);
   EXPECT_NEAR(Read(*split, "kinetic_energy")(0, 0), k, 1e-9 * k);
-  EXPECT_THROW(make(true, std::make_unique<BackwardEulerOde>()), InputError);
+  EXPECT_THROW(MakeSolid(whole, params, true, std::make_unique<BackwardEulerOde>()), InputError);
 }
 
 // Land et al.'s benchmark ventricle (2015, problem 2; scenes/lv_inflation.json) on a coarse
