@@ -186,5 +186,21 @@ TEST(MeshPartition, IdsGroupsAndUnusedNodesSurviveTheCut) {
   }
 }
 
+// A second-order (curved) mesh is cut on its corners: the split objects run on linear tets,
+// which see the corners either way (a quadratic MixedSolid is not split).
+TEST(MeshPartition, ASecondOrderMeshIsCutOnItsCorners) {
+  EllipsoidShellSpec spec;
+  spec.mesh_size = 3;
+  spec.order = 2;
+  const Mesh whole = MakeEllipsoidShell(spec);
+  ASSERT_GT(whole.edge_nodes.cols(), 0);
+  const MeshPart part = PartitionMesh(whole, World());
+  std::int64_t tets = part.mesh->num_tets();
+  MPI_Allreduce(MPI_IN_PLACE, &tets, 1, MPI_INT64_T, MPI_SUM, World());
+  EXPECT_EQ(tets, whole.num_tets());
+  for (std::size_t i = 0; i < part.whole_node.size(); ++i)
+    ASSERT_EQ(part.mesh->nodes.col(static_cast<Index>(i)), whole.nodes.col(part.whole_node[i]));
+}
+
 }  // namespace
 }  // namespace gipsi

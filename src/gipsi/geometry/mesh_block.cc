@@ -9,10 +9,6 @@ namespace gipsi {
 
 MeshBlock BlockOfMesh(const Mesh& whole, int rank, int size) {
   GIPSI_CHECK(size >= 1 && rank >= 0 && rank < size);
-  if (whole.edge_nodes.cols() > 0)
-    throw InputError(
-        "a mesh with second-order (curved) geometry cannot be split over ranks yet: its edge "
-        "nodes are not carried to the parts");
   MeshBlock block;
   block.rank = rank;
   block.size = size;

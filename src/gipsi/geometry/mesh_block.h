@@ -47,8 +47,8 @@ struct MeshBlock {
   [[nodiscard]] std::int64_t tet_begin() const { return BlockBegin(num_tets, rank, size); }
 };
 
-/// Rank `rank`'s block of `whole`. Throws InputError for second-order geometry
-/// (Mesh::edge_nodes), which blocks do not carry.
+/// Rank `rank`'s block of `whole`. Second-order geometry (Mesh::edge_nodes) is not carried:
+/// the objects that are split run on linear tets, which see the corners either way.
 MeshBlock BlockOfMesh(const Mesh& whole, int rank, int size);
 
 /// Rank `rank`'s block of MakeTetBox(min, max, cells, split), made without the whole mesh:
