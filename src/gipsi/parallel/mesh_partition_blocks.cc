@@ -22,6 +22,7 @@
 #include <cstdint>
 #include <limits>
 #include <numeric>
+#include <tuple>
 #include <vector>
 
 #include "gipsi/base/error.h"
@@ -198,51 +199,75 @@ MeshPart PartitionMeshBlocks(const MeshBlock& block, MPI_Comm comm) {
 
   // 2. The graph's rows of this block: each tet's neighbours in the order of its faces' nodes,
   // at most four (the whole mesh's sorted face list gave them in that order).
-  std::vector<std::vector<std::pair<Face, int>>> around(static_cast<std::size_t>(local_tets));
+  struct Neighbour {
+    int tet;  // local
+    Face face;
+    int other;
+    bool operator<(const Neighbour& o) const {
+      return std::tie(tet, face, other) < std::tie(o.tet, o.face, o.other);
+    }
+  };
+  std::vector<Neighbour> around;
+  around.reserve(edges.items.size());
   for (const Adjacency& a : edges.items) {
     const int e = a.tet - tet_begin;
-    around[static_cast<std::size_t>(e)].emplace_back(SortedFace(TetOf(block.tets, e), a.skip),
-                                                     a.other);
+    around.push_back({e, SortedFace(TetOf(block.tets, e), a.skip), a.other});
   }
   edges = {};
+  std::sort(around.begin(), around.end());
   std::vector<int> rows(static_cast<std::size_t>(local_tets) + 1, 0), columns;
   columns.reserve(4 * static_cast<std::size_t>(local_tets));
-  for (int e = 0; e < local_tets; ++e) {
-    auto& list = around[static_cast<std::size_t>(e)];
-    std::sort(list.begin(), list.end());
-    for (std::size_t k = 0; k < list.size() && k < 4; ++k) columns.push_back(list[k].second);
-    rows[static_cast<std::size_t>(e) + 1] = static_cast<int>(columns.size());
+  for (std::size_t k = 0, taken = 0; k < around.size(); ++k) {
+    taken = k > 0 && around[k - 1].tet == around[k].tet ? taken + 1 : 0;
+    if (taken >= 4) continue;
+    columns.push_back(around[k].other);
+    ++rows[static_cast<std::size_t>(around[k].tet) + 1];
   }
+  for (int e = 0; e < local_tets; ++e)
+    rows[static_cast<std::size_t>(e) + 1] += rows[static_cast<std::size_t>(e)];
   around = {};
   const std::vector<int> part = detail::ScotchPart(rows, columns, comm, size);
   rows = {};
   columns = {};
 
   // 3. Tets to their parts, with their ids and groups.
-  std::vector<std::vector<Membership>> tet_groups_of(static_cast<std::size_t>(local_tets));
-  std::vector<std::vector<Membership>> node_groups_of(static_cast<std::size_t>(block.nodes.cols()));
-  std::vector<std::vector<Membership>> triangle_groups_of(
-      static_cast<std::size_t>(block.triangles.cols()));
+  // Each kind's memberships of this block, sorted by item (then group).
+  std::vector<Membership> tet_groups_of, node_groups_of, triangle_groups_of;
   for (std::size_t g = 0; g < block.groups.size(); ++g) {
     const MeshGroup& group = block.groups[g];
-    auto& lists = group.dim == 0   ? node_groups_of
-                  : group.dim == 2 ? triangle_groups_of
-                                   : tet_groups_of;
+    auto& list = group.dim == 0   ? node_groups_of
+                 : group.dim == 2 ? triangle_groups_of
+                                  : tet_groups_of;
     const int begin = group.dim == 0 ? node_begin : group.dim == 2 ? first_triangle : tet_begin;
+    const Index count = group.dim == 0   ? block.nodes.cols()
+                        : group.dim == 2 ? block.triangles.cols()
+                                         : local_tets;
     for (int item : group.items) {
-      GIPSI_CHECK(item >= begin && item - begin < static_cast<int>(lists.size()),
+      GIPSI_CHECK(item >= begin && item - begin < count,
                   "a block's group lists an item outside the block");
-      lists[static_cast<std::size_t>(item - begin)].push_back({item, static_cast<int>(g)});
+      list.push_back({item, static_cast<int>(g)});
     }
   }
+  for (auto* list : {&tet_groups_of, &node_groups_of, &triangle_groups_of})
+    std::sort(list->begin(), list->end(), [](const Membership& a, const Membership& b) {
+      return std::tie(a.item, a.group) < std::tie(b.item, b.group);
+    });
+  // The memberships of `item` among a sorted list.
+  auto memberships = [](const std::vector<Membership>& list, int item) {
+    const auto first = std::lower_bound(list.begin(), list.end(), item,
+                                        [](const Membership& m, int i) { return m.item < i; });
+    auto last = first;
+    while (last != list.end() && last->item == item) ++last;
+    return std::pair{first, last};
+  };
   std::vector<std::vector<TetRecord>> tets_to(usize);
   std::vector<std::vector<Membership>> memberships_to(usize);
   for (int e = 0; e < local_tets; ++e) {
     const auto p = static_cast<std::size_t>(part[static_cast<std::size_t>(e)]);
     tets_to[p].push_back({tet_begin + e, TetOf(block.tets, e),
                           block.tet_ids.empty() ? 0 : block.tet_ids[static_cast<std::size_t>(e)]});
-    for (const Membership& m : tet_groups_of[static_cast<std::size_t>(e)])
-      memberships_to[p].push_back(m);
+    const auto [first, last] = memberships(tet_groups_of, tet_begin + e);
+    memberships_to[p].insert(memberships_to[p].end(), first, last);
   }
   tet_groups_of = {};
   std::vector<TetRecord> my_tets = Exchange(tets_to, comm).items;
@@ -299,7 +324,8 @@ MeshPart PartitionMeshBlocks(const MeshBlock& block, MPI_Comm comm) {
     const auto col = static_cast<Index>(i);
     nodes_to[r].push_back(
         {n, owner[i], global[i], {block.nodes(0, col), block.nodes(1, col), block.nodes(2, col)}});
-    for (const Membership& m : node_groups_of[i]) node_memberships_to[r].push_back(m);
+    const auto [first, last] = memberships(node_groups_of, n);
+    node_memberships_to[r].insert(node_memberships_to[r].end(), first, last);
   };
   {
     std::vector<unsigned char> was_asked(block_nodes, 0);
@@ -369,8 +395,9 @@ MeshPart PartitionMeshBlocks(const MeshBlock& block, MPI_Comm comm) {
     const auto col = static_cast<Index>(t);
     triangles_to[static_cast<std::size_t>(p)].push_back(
         {triangle, {block.triangles(0, col), block.triangles(1, col), block.triangles(2, col)}});
-    for (const Membership& m : triangle_groups_of[t])
-      triangle_memberships_to[static_cast<std::size_t>(p)].push_back(m);
+    const auto [first, last] = memberships(triangle_groups_of, triangle);
+    triangle_memberships_to[static_cast<std::size_t>(p)].insert(
+        triangle_memberships_to[static_cast<std::size_t>(p)].end(), first, last);
   }
   triangle_groups_of = {};
   std::vector<TriangleRecord> my_triangles = Exchange(triangles_to, comm).items;
