@@ -270,6 +270,96 @@ TEST(MixedSolid, IncompressibleActiveContractionMatchesTheClosedForm) {
   EXPECT_EQ(read(0, ne - 1), ta);
 }
 
+// The patch test for P2–P1: a homogeneous deformation x = X + A X + b (strains of 10 %, a 13 %
+// volume change), imposed on every boundary vertex of a distorted mesh, lies in the P2 space
+// (edge nodes held at the mean of their ends, exact for an affine field); its F and P are
+// constant and ∫ P ∇N_a vanishes at every interior node, and the pressure rows give p = κ ln J,
+// a constant in the P1 space. So the discrete solution is the homogeneous one, to round-off:
+// every node, edge nodes included, and every vertex pressure. Both laws (Guccione with oblique
+// fibres), at their own κ (κ/C = 100, ν = 0.45) and nearly incompressible (κ/C = 10⁵,
+// ν = 0.4999995, where p reaches 10⁵ times the shear modulus), in one load step.
+//
+// The linearised response to the held increment (PredictFromTargets) is the affine field
+// itself, so Newton needs one or two iterations. Without it Newton started with the held nodes
+// moved alone, and near incompressibility took 1,900 iterations for 1 % strains.
+TEST(MixedSolid, PassesThePatchTestOnADistortedMeshForEveryLawAndKappa) {
+  Mat3 a;
+  a << 0.10, 0.04, -0.03, 0.02, -0.05, 0.01, 0.03, 0.06, 0.08;
+  const Mat3 f = Mat3::Identity() + a;
+  const Vec3 b(1e-2, -2e-2, 3e-2);
+  for (const char* law :
+       {kGuccione, kNeoHookean,
+        R"({"law": "Guccione", "C": 2000, "bf": 8, "bt": 2, "bfs": 4, "bulk_modulus": 2e8})",
+        R"({"law": "NeoHookean", "youngs_modulus": 1e4, "poisson_ratio": 0.4999995})"}) {
+    auto params = Params(law, false);
+    const double kappa = params.material->log_volumetric_modulus();
+    SCOPED_TRACE(fmt::format("{} κ = {}", law, kappa));
+    const auto mesh = testing::DistortedBox(3);
+    MixedSolid solid("patch", mesh, params);
+    const auto& v2n = solid.boundary().vertex_to_node;
+    for (std::size_t j = 0; j < v2n.size(); ++j) {
+      const Vec3 x = mesh->nodes.col(v2n[j]);
+      solid.boundary_conditions().PrescribeDisplacement(static_cast<Index>(j), a * x + b);
+    }
+    ASSERT_TRUE(solid.Step(1).ok()) << solid.failure_detail();
+    EXPECT_LE(solid.total_newton_iterations(), 2);
+    const Points u = solid.NodeDisplacements();
+    const QuadraticTets& q = solid.quadratic_mesh();
+    double worst = 0;
+    for (Index n = 0; n < q.num_nodes(); ++n)
+      worst = std::max(worst, (u.col(n) - (a * q.rest.col(n) + b)).norm());
+    // Newton stops at 1e-11 of the residual's scale; the displacements are ~0.1 m.
+    EXPECT_LT(worst, 1e-10);
+    const double p_exact = kappa * std::log(f.determinant());
+    const VecX p = solid.Pressures();
+    EXPECT_LT((p.array() - p_exact).abs().maxCoeff(), 1e-9 * std::abs(p_exact));
+  }
+}
+
+// Uniaxial stretch λ along the fibres of an incompressible Guccione cube (C = 2 kPa, b_f 8,
+// b_t 2, b_fs 4, fibres along x), symmetry planes held and sides free: F = diag(λ, μ, μ) with
+// μ = λ^-½, E = diag((λ² − 1)/2, (μ² − 1)/2, (μ² − 1)/2), Q = b_f E_11² + 2 b_t E_22², and the
+// law's S̃ = C e^Q (b_f E_11, b_t E_22, b_t E_22) plus the pressure's p C⁻¹ (the p ln J term).
+// Free sides, S_22 = 0: p = −C e^Q b_t E_22 μ². The nominal stress on the stretched face is
+// P_11 = λ (S̃_11 + p / λ²). Nodes, pressures and the reaction, to the Newton tolerance.
+TEST(MixedSolid, IncompressibleGuccioneFibreStretchMatchesTheClosedFormStress) {
+  auto params = Params(kGuccione, true);
+  params.fibre = Vec3::UnitX();
+  params.load_steps = 3;
+  const double lambda = 1.15;
+  const double length = 1e-2;
+  MixedSolid solid("cube", Box(Vec3::Constant(length), {2, 2, 2}), params);
+  BoundaryConditions& bcs = solid.boundary_conditions();
+  const auto on = [&](int axis, double value) {
+    return VerticesWhere(solid, [=](const Vec3& x) { return std::abs(x[axis] - value) < 1e-12; });
+  };
+  for (int axis = 0; axis < 3; ++axis)
+    for (Index v : on(axis, 0)) bcs.Fix(v, static_cast<AxisMask>(1 << axis));
+  for (Index v : on(0, length)) bcs.PrescribeDisplacement(v, Vec3((lambda - 1) * length, 0, 0), 1);
+  ASSERT_TRUE(solid.Step(1).ok()) << solid.failure_detail();
+
+  const double c = 2000, bf = 8, bt = 2;
+  const double mu = 1 / std::sqrt(lambda);
+  const double e11 = (lambda * lambda - 1) / 2, e22 = (mu * mu - 1) / 2;
+  const double eq = std::exp(bf * e11 * e11 + 2 * bt * e22 * e22);
+  const double p_exact = -c * eq * bt * e22 * mu * mu;
+  const double nominal = lambda * (c * eq * bf * e11 + p_exact / (lambda * lambda));
+  const Points u = solid.NodeDisplacements();
+  const QuadraticTets& q = solid.quadratic_mesh();
+  for (Index n = 0; n < q.num_nodes(); ++n) {
+    const Vec3 X = q.rest.col(n);
+    const Vec3 expected((lambda - 1) * X.x(), (mu - 1) * X.y(), (mu - 1) * X.z());
+    EXPECT_LT((u.col(n) - expected).norm(), 1e-9 * length) << "node " << n;
+  }
+  const VecX p = solid.Pressures();
+  for (Index v = 0; v < p.size(); ++v) EXPECT_NEAR(p[v], p_exact, 1e-9 * c);
+  Eigen::MatrixXd reaction(3, solid.boundary().num_vertices());
+  solid.ReadField(solid.FindField("reaction_force"), reaction);
+  double total = 0;
+  for (Index v : on(0, length)) total += reaction(0, v);
+  EXPECT_NEAR(total, nominal * length * length, 1e-8 * c * length * length);
+}
+
 /// Land et al. 2015, problem 1: a 10 × 1 × 1 mm Guccione beam (C = 2 kPa, b_f 8, b_t 2,
 /// b_fs 4, fibres along x), clamped at x = 0, 4 Pa follower pressure on the bottom face z = 0,
 /// on 10n × n × n cubes of 6 tets. The z displacement of the tip point (10, 0.5, 1) mm [m]

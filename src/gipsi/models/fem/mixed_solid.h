@@ -34,7 +34,9 @@
 /// current area) act on the 6-node boundary faces; nodal forces act on the vertices. A step
 /// ramps the loads and prescribed displacements linearly from the previous step's values (zero
 /// before the first step) in `load_steps` increments, and bisects an increment whose Newton
-/// solve fails up to `max_bisections` times.
+/// solve fails up to `max_bisections` times. Where the held displacements move, Newton starts
+/// from the linearised response to them (PredictFromTargets), not from the held nodes moved
+/// alone.
 ///
 /// The vertex nodes are the domain mesh's nodes, so every node field, probe, boundary and
 /// display works on the linear mesh (they show the P2 solution's values at the vertices);
@@ -266,6 +268,12 @@ class MixedSolid final : public SimObject, public CavityWall {
   /// (which MixedSolid does not take), or -1.
   Index GatherLoads();
   void SetTargets(VecX& z, double s) const;
+  /// Quasi-static increments whose prescribed displacements move: z becomes the linearised
+  /// response at z (the tangent at z, the targets at s as its Dirichlet data), so the free
+  /// nodes follow the held ones before Newton starts. False (z unchanged) when nothing moves,
+  /// with cavities coupled or the "schur_gmres" solver, or if an element of the prediction is
+  /// outside its law's domain or the solve fails.
+  bool PredictFromTargets(VecX& z, double s);
   StepStatus Advance(double s0, double s1, int depth);
   void UpdatePositions();
   /// grad_ and weight_ of curved element e (isoparametric); throws InputError naming the tet
@@ -297,6 +305,8 @@ class MixedSolid final : public SimObject, public CavityWall {
   std::vector<std::uint8_t> constrained_;
   std::vector<int> constrained_dofs_;
   VecX target_prev_, target_new_;
+  // PredictFromTargets' own solver when Newton keeps its factorisation between solves.
+  std::unique_ptr<LinearSolver> predictor_solver_;
   // Loads at s = 0 and s = 1.
   VecX force_new_;  // 3 × vertices (the previous step's, s = 0, are state)
   VecX pressure_new_;
