@@ -365,12 +365,33 @@ void MixedSolid::CurvedElementGeometry(Index e, const Mesh& domain) {
 }
 
 double MixedSolid::CurrentVolume() const {
+  // The deformed body's volume exactly: x is quadratic on the reference tet (curved or not),
+  // so det ∂x/∂ξ is a cubic, which the degree-7 rule integrates exactly. (The stiffness's
+  // 4-point rule is not exact for it; near incompressibility, where J varies about 1 inside a
+  // tet while ln J vanishes on average, it would add ½ ∫ (ln J)² dV.)
+  static const std::vector<Eigen::Matrix<double, 10, 4>> kDerivatives = [] {
+    std::vector<Eigen::Matrix<double, 10, 4>> d;
+    for (const Eigen::Vector4d& point : TetRuleDegree7().points)
+      d.push_back(QuadraticTetShapeDerivatives(point));
+    return d;
+  }();
+  const std::vector<double>& weights = TetRuleDegree7().weights;
   double v = 0;
-  for (Index e = 0; e < mesh_.num_elements(); ++e)
-    for (int q = 0; q < kQuad; ++q) {
-      const Mat3 F = DeformationGradient(e, q, state_.z);
-      v += weight_[e * kQuad + q] * F.determinant();
+  for (Index e = 0; e < mesh_.num_elements(); ++e) {
+    Eigen::Matrix<double, 3, 10> x;
+    for (int a = 0; a < 10; ++a) {
+      const Index node = mesh_.elements(a, e);
+      x.col(a) = mesh_.rest.col(node) + state_.z.segment<3>(3 * node);
     }
+    double element = 0;
+    for (std::size_t q = 0; q < weights.size(); ++q) {
+      const Eigen::Matrix<double, 10, 4>& d = kDerivatives[q];
+      Mat3 dx;  // ∂x/∂ξ_k with ξ = (L_1, L_2, L_3), L_0 = 1 − Σ ξ
+      for (int k = 0; k < 3; ++k) dx.col(k) = x * (d.col(k + 1) - d.col(0));
+      element += weights[q] * dx.determinant();
+    }
+    v += element / 6;
+  }
   return v;
 }
 

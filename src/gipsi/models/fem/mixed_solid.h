@@ -42,7 +42,7 @@
 /// display works on the linear mesh (they show the P2 solution's values at the vertices);
 /// fields: the mechanical fields, "pressure" (node, Pa; the hydrostatic
 /// pressure p, positive in tension as p = κ ln J), "volume_ratio" (element, mean J over its
-/// quadrature points), "volume" (global, m³, ∫ J dV), "strain_energy" (global, J, ∫ W̃ dV +
+/// quadrature points), "volume" (global, m³, ∫ J dV integrated exactly), "strain_energy" (global, J, ∫ W̃ dV +
 /// ∫ κ/2 (ln J)² dV for finite κ), "newton_iterations" (global, last increment).
 ///
 /// Fields "fibre" and "active_tension" (element, read/write; "fibre" reads the first quadrature
