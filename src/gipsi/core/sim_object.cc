@@ -61,6 +61,15 @@ void SimObject::EmbedDisplay(const Points& rest_vertices, const Triangles& trian
   display_.triangles = triangles;
   display_.map = std::move(map);
   display_.positions = rest_vertices;
+  OnDisplayChanged();
+}
+
+void SimObject::SetDisplayGeometry(Triangles triangles, PointMap map, Points rest_positions) {
+  GIPSI_CHECK(map.num_targets() == rest_positions.cols());
+  display_.triangles = std::move(triangles);
+  display_.map = std::move(map);
+  display_.positions = std::move(rest_positions);
+  OnDisplayChanged();
 }
 
 void SimObject::UpdateDisplay() const {
@@ -70,6 +79,7 @@ void SimObject::UpdateDisplay() const {
   } else {
     boundary_.Gather(x, display_.positions);
   }
+  CorrectDisplayPositions(display_);
 }
 
 FieldId SimObject::DeclareField(FieldInfo info) {

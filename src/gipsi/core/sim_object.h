@@ -232,6 +232,17 @@ class SimObject {
   /// Sets the domain and boundary geometries and sizes the boundary conditions. The display
   /// geometry defaults to the boundary surface.
   void SetGeometry(std::shared_ptr<const Mesh> domain, BoundarySurface boundary);
+  /// Replaces the display geometry by `triangles` on vertices that `map` interpolates from the
+  /// domain nodes (`rest_positions` their rest positions): a default display other than the
+  /// boundary (MixedSolid's curved faces). EmbedDisplay may still replace it.
+  void SetDisplayGeometry(Triangles triangles, PointMap map, Points rest_positions);
+  /// Called by UpdateDisplay after the display positions were interpolated from the domain
+  /// positions: objects whose geometry is of higher order than the domain mesh add what that
+  /// interpolation misses (MixedSolid: the bow of its curved edges). Default: nothing.
+  virtual void CorrectDisplayPositions(DisplayGeometry& /*display*/) const {}
+  /// Called when the display geometry changes (SetDisplayGeometry, EmbedDisplay), for objects
+  /// that keep tables of it. Default: nothing.
+  virtual void OnDisplayChanged() {}
   /// Declares a field; returns its id. Call from the constructor only.
   FieldId DeclareField(FieldInfo info);
   /// Declares the mechanical fields (MechanicalFieldIds). Call from the constructor only.

@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <memory>
+#include <random>
 #include <string>
 
 #include <gmock/gmock.h>
@@ -165,6 +166,121 @@ TEST(CurvedMixedSolid, SecondOrderVentricleHasTheEllipsoidsVolume) {
   fmt::print("[ info     ] rest volume error: straight {:.2e}, curved {:.2e}\n", error[0],
              error[1]);
   EXPECT_LT(error[1], error[0] / 50);
+}
+
+// The default display of a MixedSolid is its boundary drawn from the quadratic mesh: each
+// 6-node face split at its edge nodes into four triangles. On the curved sphere octant its
+// vertices on the spheres lie on them at rest (the straight faces' midpoints would lie inside
+// by about h²/8R, ~1e-4 of the radius here), and after inflation the display's edge-node
+// vertices are the P2 solution's edge nodes, bitwise.
+TEST(CurvedMixedSolid, DisplayDrawsTheCurvedBoundaryAndFollowsTheP2Solution) {
+  Mesh mesh = ReadMesh(test::MeshData("thick_sphere_octant_0.7.msh"));
+  mesh.Transform(kInner, Vec3::Zero());
+  MixedSolidParams params;
+  params.material = Law(R"({"law": "NeoHookean", "youngs_modulus": 3e4, "poisson_ratio": 0.45})");
+  params.incompressible = true;
+  params.load_steps = 2;
+  MixedSolid solid("sphere", std::make_shared<const Mesh>(std::move(mesh)), params);
+  const DisplayGeometry& display = solid.display();
+  ASSERT_TRUE(display.map.has_value());
+  EXPECT_EQ(display.triangles.cols(), 4 * solid.boundary().num_triangles());
+  solid.UpdateDisplay();
+  int on_spheres = 0;
+  for (Index j = 0; j < display.positions.cols(); ++j)
+    for (double radius : {kInner, kOuter}) {
+      const double off = std::abs(display.positions.col(j).norm() - radius);
+      if (off > 0.02 * radius) continue;
+      EXPECT_LT(off, 1e-9 * radius) << "display vertex " << j;
+      ++on_spheres;
+    }
+  EXPECT_GT(on_spheres, 100);
+
+  BoundaryConditions& bcs = solid.boundary_conditions();
+  for (int axis = 0; axis < 3; ++axis)
+    for (Index v : VerticesWhere(solid, [=](const Vec3& x) { return std::abs(x[axis]) < 1e-9; }))
+      bcs.Fix(v, static_cast<AxisMask>(1 << axis));
+  for (Index f : FacesWhere(solid, [](const Vec3& x) { return x.norm() < 1.001 * kInner; }))
+    bcs.SetPressure(f, 3000);
+  ASSERT_TRUE(solid.Step(1).ok()) << solid.failure_detail();
+  solid.UpdateDisplay();
+  SimObject::QuadraticOutput quadratic;
+  ASSERT_TRUE(solid.GetQuadraticOutput(quadratic));
+  const Index nv = solid.quadratic_mesh().num_vertices;
+  int edge_vertices = 0;
+  for (Index j = 0; j < display.positions.cols(); ++j) {
+    const auto& w = display.map->weights().col(j);
+    if (w[0] != 0.5) continue;  // a boundary vertex (weight 1)
+    const int node =
+        solid.quadratic_mesh().EdgeNode(display.map->indices()(0, j), display.map->indices()(1, j));
+    ASSERT_GE(node, nv);
+    EXPECT_EQ(display.positions.col(j), quadratic.edge_positions.col(node - nv)) << j;
+    ++edge_vertices;
+  }
+  EXPECT_EQ(edge_vertices, display.positions.cols() - solid.boundary().num_vertices());
+}
+
+// A display surface embedded in a MixedSolid (here points inside a bent beam of straight
+// tets) follows the P2 solution: each vertex is Σ N_a(L) x_a over its tet's ten nodes, L its
+// barycentric coordinates, not the linear blend of the four vertices (which misses the bend's
+// curvature inside each tet).
+TEST(CurvedMixedSolid, AnEmbeddedDisplayFollowsTheQuadraticSolution) {
+  MixedSolidParams params;
+  params.material = Law(R"({"law": "NeoHookean", "youngs_modulus": 1e4, "poisson_ratio": 0.45})");
+  params.incompressible = true;
+  params.load_steps = 4;
+  auto mesh =
+      std::make_shared<const Mesh>(MakeTetBox(Vec3::Zero(), Vec3(0.01, 0.001, 0.001), {10, 1, 1}));
+  MixedSolid solid("beam", mesh, params);
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> unit(0.05, 0.95);
+  Points points(3, 200);
+  for (Index j = 0; j < points.cols(); ++j)
+    points.col(j) = Vec3(0.01 * unit(rng), 0.001 * unit(rng), 0.001 * unit(rng));
+  Triangles triangles(3, 1);
+  triangles << 0, 1, 2;
+  solid.EmbedDisplay(points, triangles, 1e-12);
+  BoundaryConditions& bcs = solid.boundary_conditions();
+  for (Index v : VerticesWhere(solid, [](const Vec3& x) { return x.x() < 1e-12; })) bcs.Fix(v);
+  for (Index f : FacesWhere(solid, [](const Vec3& x) { return x.z() < 1e-12; }))
+    bcs.SetPressure(f, 2.0);
+  ASSERT_TRUE(solid.Step(1).ok()) << solid.failure_detail();
+  solid.UpdateDisplay();
+
+  const QuadraticTets& q = solid.quadratic_mesh();
+  const Points u = solid.NodeDisplacements();
+  const PointMap& map = *solid.display().map;
+  double largest_bow = 0;
+  for (Index j = 0; j < points.cols(); ++j) {
+    // The tet whose four vertices the map blends, and L in its local order.
+    Index tet = -1;
+    Eigen::Vector4d l = Eigen::Vector4d::Zero();
+    for (Index e = 0; e < q.num_elements() && tet < 0; ++e) {
+      int found = 0;
+      for (int k = 0; k < 4; ++k)
+        for (int a = 0; a < 4; ++a)
+          if (map.weights()(k, j) != 0 && q.elements(a, e) == map.indices()(k, j)) {
+            l[a] = map.weights()(k, j);
+            ++found;
+          }
+      if (found == (map.weights().col(j).array() != 0).count())
+        tet = e;
+      else
+        l.setZero();
+    }
+    ASSERT_GE(tet, 0);
+    const Eigen::Matrix<double, 10, 1> n = QuadraticTetShape(l);
+    Vec3 p2 = Vec3::Zero(), linear = Vec3::Zero();
+    for (int a = 0; a < 10; ++a) {
+      const Index node = q.elements(a, tet);
+      p2 += n[a] * (q.rest.col(node) + u.col(node));
+    }
+    for (int a = 0; a < 4; ++a)
+      linear += l[a] * (q.rest.col(q.elements(a, tet)) + u.col(q.elements(a, tet)));
+    EXPECT_LT((solid.display().positions.col(j) - p2).norm(), 1e-15) << "vertex " << j;
+    largest_bow = std::max(largest_bow, (p2 - linear).norm());
+  }
+  // The beam bends by millimetres over 1 mm tets: the bow inside a tet is some micrometres.
+  EXPECT_GT(largest_bow, 1e-7);
 }
 
 // A curved tet whose map from the reference tet folds over (an edge node pulled past the

@@ -160,6 +160,8 @@ MixedSolid::MixedSolid(std::string name, std::shared_ptr<const Mesh> domain,
     }
   }
 
+  MakeCurvedDisplay();
+
   // Sparsity: unknowns 3·node + i (displacements), then 3·nodes + vertex (pressures).
   const Index nn = mesh_.num_nodes();
   const Index nv = mesh_.num_vertices;

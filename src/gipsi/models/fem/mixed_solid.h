@@ -38,8 +38,10 @@
 /// from the linearised response to them (PredictFromTargets), not from the held nodes moved
 /// alone.
 ///
-/// The vertex nodes are the domain mesh's nodes, so every node field, probe, boundary and
-/// display works on the linear mesh (they show the P2 solution's values at the vertices);
+/// The vertex nodes are the domain mesh's nodes, so every node field, probe and boundary works
+/// on the linear mesh (the P2 solution's values at the vertices). The display is the curved
+/// boundary: each 6-node face as four triangles through its edge nodes, which follow the P2
+/// solution, as do the vertices of an embedded display (mixed_display.cc);
 /// fields: the mechanical fields, "pressure" (node, Pa; the hydrostatic
 /// pressure p, positive in tension as p = κ ln J), "volume_ratio" (element, mean J over its
 /// quadrature points), "volume" (global, m³, ∫ J dV integrated exactly), "strain_energy" (global, J, ∫ W̃ dV +
@@ -276,6 +278,13 @@ class MixedSolid final : public SimObject, public CavityWall {
   bool PredictFromTargets(VecX& z, double s);
   StepStatus Advance(double s0, double s1, int depth);
   void UpdatePositions();
+  /// The default display: each boundary face split at its edge nodes into four triangles,
+  /// whose vertices follow the P2 solution (mixed_display.cc).
+  void MakeCurvedDisplay();
+  /// Adds each display vertex's share of the bows of the edges its map interpolates along
+  /// (x_e − (x_a + x_b)/2 times 4 w_a w_b, the P2 interpolation's difference from the linear).
+  void CorrectDisplayPositions(DisplayGeometry& display) const override;
+  void OnDisplayChanged() override;
   /// grad_ and weight_ of curved element e (isoparametric); throws InputError naming the tet
   /// of `domain` if its map from the reference tet is not positive.
   void CurvedElementGeometry(Index e, const Mesh& domain);
@@ -305,6 +314,9 @@ class MixedSolid final : public SimObject, public CavityWall {
   std::vector<std::uint8_t> constrained_;
   std::vector<int> constrained_dofs_;
   VecX target_prev_, target_new_;
+  // Per display vertex (CSR): the edge nodes whose bows its position takes, and their weights.
+  std::vector<int> display_bow_start_, display_bow_node_;
+  std::vector<double> display_bow_weight_;
   // PredictFromTargets' own solver when Newton keeps its factorisation between solves.
   std::unique_ptr<LinearSolver> predictor_solver_;
   // Loads at s = 0 and s = 1.

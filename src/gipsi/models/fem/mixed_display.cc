@@ -1,0 +1,94 @@
+// MixedSolid's display geometry: its curved boundary drawn from the quadratic mesh, and any
+// embedded display surface following the P2 solution rather than the vertices alone.
+
+#include <unordered_map>
+
+#include "gipsi/models/fem/mixed_solid.h"
+
+namespace gipsi {
+
+void MixedSolid::MakeCurvedDisplay() {
+  // Display vertices: the boundary vertices (in the boundary's numbering), then the edge nodes
+  // of the boundary faces. Each 6-node face (vertices 0..2, edge nodes 3 = (0,1), 4 = (1,2),
+  // 5 = (0,2)) becomes four triangles of its orientation.
+  const BoundarySurface& bnd = boundary();
+  const Index nb = bnd.num_vertices();
+  std::unordered_map<int, int> display_of_edge;  // P2 edge node → display vertex
+  std::vector<int> edge_nodes;
+  Triangles triangles(3, 4 * bnd.num_triangles());
+  for (Index f = 0; f < bnd.num_triangles(); ++f) {
+    int d[6];
+    for (int i = 0; i < 3; ++i) d[i] = bnd.triangles(i, f);
+    for (int k = 0; k < 3; ++k) {
+      const int node = faces_(3 + k, f);
+      const auto [it, added] =
+          display_of_edge.emplace(node, static_cast<int>(nb) + static_cast<int>(edge_nodes.size()));
+      if (added) edge_nodes.push_back(node);
+      d[3 + k] = it->second;
+    }
+    triangles.col(4 * f) << d[0], d[3], d[5];
+    triangles.col(4 * f + 1) << d[3], d[1], d[4];
+    triangles.col(4 * f + 2) << d[5], d[4], d[2];
+    triangles.col(4 * f + 3) << d[3], d[4], d[5];
+  }
+  // The map: a boundary vertex is its node; an edge node is the mean of its ends, to which
+  // CorrectDisplayPositions adds the edge's bow.
+  const Index n = nb + static_cast<Index>(edge_nodes.size());
+  Eigen::Matrix4Xi indices = Eigen::Matrix4Xi::Zero(4, n);
+  Eigen::Matrix4Xd weights = Eigen::Matrix4Xd::Zero(4, n);
+  Points rest(3, n);
+  for (Index j = 0; j < nb; ++j) {
+    indices(0, j) = bnd.vertex_to_node[static_cast<std::size_t>(j)];
+    weights(0, j) = 1;
+    rest.col(j) = mesh_.rest.col(indices(0, j));
+  }
+  for (std::size_t k = 0; k < edge_nodes.size(); ++k) {
+    const Index j = nb + static_cast<Index>(k);
+    const Index edge = edge_nodes[k] - mesh_.num_vertices;
+    indices.col(j).head<2>() = mesh_.edges.col(edge);
+    weights.col(j).head<2>().setConstant(0.5);
+    rest.col(j) = mesh_.rest.col(edge_nodes[k]);
+  }
+  SetDisplayGeometry(std::move(triangles),
+                     PointMap::FromWeights(std::move(indices), std::move(weights), 0),
+                     std::move(rest));
+}
+
+void MixedSolid::OnDisplayChanged() {
+  // For every display vertex, the edges between the nodes its map blends: the P2 position is
+  // the linear blend Σ w_a x_a plus Σ over edges (a, b) of 4 w_a w_b (x_ab − (x_a + x_b)/2)
+  // (N_a = L_a (2 L_a − 1), N_ab = 4 L_a L_b). Exact for targets inside a tet or on a face.
+  display_bow_start_.assign(1, 0);
+  display_bow_node_.clear();
+  display_bow_weight_.clear();
+  const PointMap& map = *display().map;
+  for (Index j = 0; j < map.num_targets(); ++j) {
+    for (int a = 0; a < 4; ++a)
+      for (int b = a + 1; b < 4; ++b) {
+        const double w = 4 * map.weights()(a, j) * map.weights()(b, j);
+        if (w == 0) continue;
+        const int node = mesh_.EdgeNode(map.indices()(a, j), map.indices()(b, j));
+        if (node < 0) continue;
+        display_bow_node_.push_back(node);
+        display_bow_weight_.push_back(w);
+      }
+    display_bow_start_.push_back(static_cast<int>(display_bow_node_.size()));
+  }
+}
+
+void MixedSolid::CorrectDisplayPositions(DisplayGeometry& display) const {
+  if (static_cast<Index>(display_bow_start_.size()) != display.positions.cols() + 1) return;
+  const Index nv = mesh_.num_vertices;
+  for (Index j = 0; j < display.positions.cols(); ++j)
+    for (int k = display_bow_start_[static_cast<std::size_t>(j)];
+         k < display_bow_start_[static_cast<std::size_t>(j) + 1]; ++k) {
+      const int node = display_bow_node_[static_cast<std::size_t>(k)];
+      const Index edge = node - nv;
+      const Vec3 x = mesh_.rest.col(node) + state_.z.segment<3>(3 * node);
+      const Vec3 mid = 0.5 * (vertex_positions_.col(mesh_.edges(0, edge)) +
+                              vertex_positions_.col(mesh_.edges(1, edge)));
+      display.positions.col(j) += display_bow_weight_[static_cast<std::size_t>(k)] * (x - mid);
+    }
+}
+
+}  // namespace gipsi
