@@ -41,11 +41,11 @@
 /// The vertex nodes are the domain mesh's nodes, so every node field, probe and boundary works
 /// on the linear mesh (the P2 solution's values at the vertices). The display is the curved
 /// boundary: each 6-node face as four triangles through its edge nodes, which follow the P2
-/// solution, as do the vertices of an embedded display (mixed_display.cc);
-/// fields: the mechanical fields, "pressure" (node, Pa; the hydrostatic
-/// pressure p, positive in tension as p = κ ln J), "volume_ratio" (element, mean J over its
-/// quadrature points), "volume" (global, m³, ∫ J dV integrated exactly), "strain_energy" (global, J, ∫ W̃ dV +
-/// ∫ κ/2 (ln J)² dV for finite κ), "newton_iterations" (global, last increment).
+/// solution, as do the vertices of an embedded display (mixed_display.cc). Fields: the
+/// mechanical fields, "pressure" (node, Pa; the hydrostatic pressure p, positive in tension as
+/// p = κ ln J), "volume_ratio" (element, mean J over its quadrature points), "volume" (global,
+/// m³, ∫ J dV integrated exactly), "strain_energy" (global, J, ∫ W̃ dV + ∫ κ/2 (ln J)² dV for
+/// finite κ), "newton_iterations" (global, last increment).
 ///
 /// Fields "fibre" and "active_tension" (element, read/write; "fibre" reads the first quadrature
 /// point's and writes all four, SetFibreAt sets one) give the material axes and
