@@ -170,6 +170,14 @@ class SimObject {
                                                Eigen::Ref<Eigen::MatrixXd> /*out*/) const {
     return false;
   }
+  /// Node field `id` at points: `at` (components by points) holds the blend Σ_k weights(k, j) ·
+  /// value(nodes(k, j)) of the node values (MapFromNodes' layout, node ids). An object whose
+  /// node fields are of higher order than its domain mesh adds what the blend misses
+  /// (MixedSolid: the P2 displacement's bow inside each tet), so probes at points read the
+  /// object's own interpolation. Default: nothing (the blend is the object's interpolation).
+  virtual void CorrectInterpolated(FieldId /*id*/, const Eigen::Matrix4Xi& /*nodes*/,
+                                   const Eigen::Matrix4Xd& /*weights*/,
+                                   Eigen::Ref<Eigen::MatrixXd> /*at*/) const {}
   /// Leaf objects for output (an aggregate returns its parts; a plain object returns itself).
   virtual void CollectLeaves(std::vector<const SimObject*>& out) const { out.push_back(this); }
   /// A part of an aggregate by (possibly dotted) name; plain objects have none (nullptr).

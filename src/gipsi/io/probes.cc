@@ -38,6 +38,7 @@ void Interpolate(const PointMap& map, const FieldInfo& info, const Eigen::Matrix
 /// the interpolation adds the same numbers as over the whole field.
 void UseOnlyTheMappedNodes(Probe& probe) {
   const PointMap& map = *probe.point;
+  probe.nodes = map.indices();
   const Eigen::Matrix4Xi& nodes = map.indices();
   probe.items.assign(nodes.data(), nodes.data() + nodes.size());
   std::sort(probe.items.begin(), probe.items.end());
@@ -87,6 +88,8 @@ void Probe::Sample(std::vector<double>& out) const {
       object->ReadFieldItems(id, items, values);
       Eigen::MatrixXd at_points(info.components, n);
       Interpolate(*point, info, values, at_points);
+      if (info.location == FieldLocation::kNode)
+        object->CorrectInterpolated(id, nodes, point->weights(), at_points);
       for (Index j = 0; j < n; ++j)
         for (int c = 0; c < info.components; ++c)
           out[width * std::size_t(j) + column + std::size_t(c)] = at_points(c, j);
@@ -107,6 +110,8 @@ void Probe::Sample(std::vector<double>& out) const {
     } else if (point) {
       Eigen::MatrixXd at(info.components, 1);
       Interpolate(*point, info, values, at);
+      if (info.location == FieldLocation::kNode)
+        object->CorrectInterpolated(id, nodes, point->weights(), at);
       for (int c = 0; c < info.components; ++c) out.push_back(at(c, 0));
     } else {
       for (int c = 0; c < info.components; ++c) {

@@ -47,6 +47,9 @@ struct Probe {
   /// Point and line probes: interpolation weights, over the columns of `items` (the nodes the
   /// points need, sorted): a sample reads those items only (SimObject::ReadFieldItems).
   std::optional<PointMap> point;
+  /// Point and line probes on node fields: the node ids of `point`'s slots, for the object's
+  /// correction of the blend (SimObject::CorrectInterpolated).
+  Eigen::Matrix4Xi nodes = Eigen::Matrix4Xi(4, 0);
   /// Line probes: the sample points (3 by n, rest coordinates) and distances from the first.
   Points line = Points(3, 0);
   std::vector<double> distance;

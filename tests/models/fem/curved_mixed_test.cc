@@ -14,7 +14,9 @@
 
 #include "gipsi/base/error.h"
 #include "gipsi/geometry/generators.h"
+#include "gipsi/io/builtins.h"
 #include "gipsi/io/mesh_io.h"
+#include "gipsi/io/scene.h"
 #include "gipsi/models/fem/mixed_solid.h"
 #include "gipsi/models/fem/quadratic_tets.h"
 #include "gipsi/models/fem/solid_laws.h"
@@ -281,6 +283,64 @@ TEST(CurvedMixedSolid, AnEmbeddedDisplayFollowsTheQuadraticSolution) {
   }
   // The beam bends by millimetres over 1 mm tets: the bow inside a tet is some micrometres.
   EXPECT_GT(largest_bow, 1e-7);
+}
+
+// A point probe in a MixedSolid reads the P2 displacement there, not the blend of its tet's
+// vertices: inside the bent beam (1 mm tets, tip down about 1.6 mm) the two differ by
+// micrometres, and the probe's value is Σ N_a(L) u_a over the ten nodes, to round-off.
+TEST(CurvedMixedSolid, APointProbeReadsTheQuadraticDisplacement) {
+  const std::string text = R"({"gipsi": 1,
+    "meshes": {"beam": {"generate": "box", "min": [0, 0, 0], "max": [0.01, 0.001, 0.001],
+                        "cells": [10, 1, 1]}},
+    "objects": {"beam": {"type": "MixedSolid", "domain": "beam", "dt": 1,
+      "material": {"law": "NeoHookean", "youngs_modulus": 1e4, "poisson_ratio": 0.45},
+      "incompressible": true, "load_steps": 4,
+      "boundary_conditions": [
+        {"name": "clamp", "region": {"group": "xmin"}, "fix": true},
+        {"name": "load", "region": {"group": "zmin"}, "pressure": 2}]}},
+    "schedule": {"end": 1},
+    "probes": {"inside": {"object": "beam", "point": [0.00737, 0.00031, 0.00062],
+                          "fields": ["displacement", "position", "pressure"]}}})";
+  TypeRegistry registry;
+  RegisterBuiltins(registry);
+  Scene scene = LoadSceneFromString(text, "beam.json", ".", registry);
+  ASSERT_TRUE(scene.kernel->Run(scene.end_time).ok());
+  const auto& solid = dynamic_cast<const MixedSolid&>(scene.kernel->FindObject("beam"));
+  std::vector<double> sample;
+  scene.probes.at(0).Sample(sample);
+  ASSERT_EQ(sample.size(), 7U);
+
+  const Vec3 point(0.00737, 0.00031, 0.00062);
+  const PointMap map = solid.MapFromNodes(point);
+  const QuadraticTets& q = solid.quadratic_mesh();
+  Index tet = -1;
+  Eigen::Vector4d l = Eigen::Vector4d::Zero();
+  for (Index e = 0; e < q.num_elements() && tet < 0; ++e) {
+    l.setZero();
+    int found = 0;
+    for (int k = 0; k < 4; ++k)
+      for (int a = 0; a < 4; ++a)
+        if (q.elements(a, e) == map.indices()(k, 0)) {
+          l[a] = map.weights()(k, 0);
+          ++found;
+        }
+    if (found == 4) tet = e;
+  }
+  ASSERT_GE(tet, 0);
+  const Points u = solid.NodeDisplacements();
+  const Eigen::Matrix<double, 10, 1> n = QuadraticTetShape(l);
+  Vec3 p2 = Vec3::Zero(), linear = Vec3::Zero();
+  for (int a = 0; a < 10; ++a) p2 += n[a] * u.col(q.elements(a, tet));
+  for (int a = 0; a < 4; ++a) linear += l[a] * u.col(q.elements(a, tet));
+  const Vec3 probed(sample[0], sample[1], sample[2]);
+  EXPECT_LT((probed - p2).norm(), 1e-15);
+  EXPECT_GT((p2 - linear).norm(), 1e-7);
+  EXPECT_LT((Vec3(sample[3], sample[4], sample[5]) - (point + p2)).norm(), 1e-15);
+  // The pressure is linear: the blend of the vertices' values.
+  double pressure = 0;
+  const VecX p = solid.Pressures();
+  for (int a = 0; a < 4; ++a) pressure += l[a] * p[q.elements(a, tet)];
+  EXPECT_NEAR(sample[6], pressure, 1e-12 * std::abs(pressure) + 1e-12);
 }
 
 // A curved tet whose map from the reference tet folds over (an edge node pulled past the

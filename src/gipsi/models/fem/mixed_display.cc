@@ -1,5 +1,6 @@
-// MixedSolid's display geometry: its curved boundary drawn from the quadratic mesh, and any
-// embedded display surface following the P2 solution rather than the vertices alone.
+// MixedSolid's display geometry — its curved boundary drawn from the quadratic mesh, and any
+// embedded display surface following the P2 solution rather than the vertices alone — and
+// the same quadratic interpolation for probes at points.
 
 #include <unordered_map>
 
@@ -89,6 +90,29 @@ void MixedSolid::CorrectDisplayPositions(DisplayGeometry& display) const {
                               vertex_positions_.col(mesh_.edges(1, edge)));
       display.positions.col(j) += display_bow_weight_[static_cast<std::size_t>(k)] * (x - mid);
     }
+}
+
+void MixedSolid::CorrectInterpolated(FieldId id, const Eigen::Matrix4Xi& nodes,
+                                     const Eigen::Matrix4Xd& weights,
+                                     Eigen::Ref<Eigen::MatrixXd> at) const {
+  const bool velocity = id == mech_.velocity;
+  if (id != mech_.displacement && id != mech_.position && !(velocity && dynamic())) return;
+  // The field at P2 node n: displacement and position differ by the rest position, whose bow
+  // (a curved edge's) the position keeps and the displacement does not.
+  const auto value = [&](Index n) -> Vec3 {
+    if (velocity) return state_.scheme.v().segment<3>(3 * n);
+    const Vec3 u = state_.z.segment<3>(3 * n);
+    return id == mech_.position ? Vec3(mesh_.rest.col(n) + u) : u;
+  };
+  for (Index j = 0; j < at.cols(); ++j)
+    for (int a = 0; a < 4; ++a)
+      for (int b = a + 1; b < 4; ++b) {
+        const double w = 4 * weights(a, j) * weights(b, j);
+        if (w == 0) continue;
+        const int node = mesh_.EdgeNode(nodes(a, j), nodes(b, j));
+        if (node < 0) continue;
+        at.col(j) += w * (value(node) - 0.5 * (value(nodes(a, j)) + value(nodes(b, j))));
+      }
 }
 
 }  // namespace gipsi

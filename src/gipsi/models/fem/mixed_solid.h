@@ -284,6 +284,11 @@ class MixedSolid final : public SimObject, public CavityWall {
   /// Adds each display vertex's share of the bows of the edges its map interpolates along
   /// (x_e − (x_a + x_b)/2 times 4 w_a w_b, the P2 interpolation's difference from the linear).
   void CorrectDisplayPositions(DisplayGeometry& display) const override;
+  /// Probes at points: the bows of displacement, position and velocity (P2 fields; the
+  /// pressure is P1, and nodal forces are not interpolated).
+  void CorrectInterpolated(FieldId id, const Eigen::Matrix4Xi& nodes,
+                           const Eigen::Matrix4Xd& weights,
+                           Eigen::Ref<Eigen::MatrixXd> at) const override;
   void OnDisplayChanged() override;
   /// grad_ and weight_ of curved element e (isoparametric); throws InputError naming the tet
   /// of `domain` if its map from the reference tet is not positive.
