@@ -107,10 +107,6 @@ struct DistributedMonodomain::Petsc {
   Vec v = nullptr;          // ghosted: owned entries, then the shared ones
   Vec rhs = nullptr, work = nullptr;
   KSP ksp = nullptr;
-  // The local operators' entries in COO order (global row, column) and their values.
-  std::vector<PetscScalar> k_values, m_values, system_values;
-  std::vector<PetscInt> diagonal;  // position of each local node's diagonal entry
-  VecX local_lumped;               // this rank's tets' share of the lumped mass
   double system_dt = -1;
 
   ~Petsc() {
@@ -194,44 +190,46 @@ DistributedMonodomain::~DistributedMonodomain() = default;
 void DistributedMonodomain::Assemble() {
   P1ScalarOperators ops = AssembleMonodomainOperators(domain(), fibres_, params_);
   Petsc& p = *petsc_;
+  // K and M go to PETSc by their COO entries (global row, column), summed over the ranks where
+  // nodes are shared; the system matrix M + θΔt K is then made from them on PETSc's side, so
+  // this rank keeps no copy of their values (it held five: Eigen's K and M, their values in
+  // COO order and the system's, about 130 B per tet).
   const SparseMatrix& k = ops.stiffness;
   const auto entries = static_cast<std::size_t>(k.nonZeros());
-  std::vector<PetscInt> rows(entries), cols(entries);
-  p.k_values.assign(k.valuePtr(), k.valuePtr() + entries);
-  p.diagonal.assign(static_cast<std::size_t>(k.cols()), -1);
-  for (Index j = 0; j < k.outerSize(); ++j)
-    for (int at = k.outerIndexPtr()[j]; at < k.outerIndexPtr()[j + 1]; ++at) {
-      const int i = k.innerIndexPtr()[at];
-      rows[static_cast<std::size_t>(at)] =
-          static_cast<PetscInt>(part_.global[static_cast<std::size_t>(i)]);
-      cols[static_cast<std::size_t>(at)] =
-          static_cast<PetscInt>(part_.global[static_cast<std::size_t>(j)]);
-      if (i == j) p.diagonal[static_cast<std::size_t>(j)] = at;
-    }
   if (!params_.lumped_mass) {
     const SparseMatrix& m = ops.consistent_mass;
     // Both come from every pair of nodes of every tet, so they share the pattern.
     if (m.nonZeros() != k.nonZeros() ||
         !std::equal(m.innerIndexPtr(), m.innerIndexPtr() + entries, k.innerIndexPtr()))
       throw std::logic_error("the P1 mass and stiffness matrices differ in pattern");
-    p.m_values.assign(m.valuePtr(), m.valuePtr() + entries);
   }
   const auto owned = static_cast<PetscInt>(part_.num_owned);
   const auto global = static_cast<PetscInt>(part_.num_global_nodes);
-  auto make_matrix = [&](Mat* out, const std::vector<PetscScalar>& values) {
+  // Each local operator goes to PETSc and is then freed, which keeps the set-up peak down.
+  auto make_matrix = [&](Mat* out, SparseMatrix& a) {
+    std::vector<PetscInt> rows(entries), cols(entries);
+    for (Index j = 0; j < a.outerSize(); ++j)
+      for (int at = a.outerIndexPtr()[j]; at < a.outerIndexPtr()[j + 1]; ++at) {
+        rows[static_cast<std::size_t>(at)] =
+            static_cast<PetscInt>(part_.global[static_cast<std::size_t>(a.innerIndexPtr()[at])]);
+        cols[static_cast<std::size_t>(at)] =
+            static_cast<PetscInt>(part_.global[static_cast<std::size_t>(j)]);
+      }
     GIPSI_PETSC(MatDestroy(out));
     GIPSI_PETSC(MatCreate(comm_, out));
     GIPSI_PETSC(MatSetSizes(*out, owned, owned, global, global));
     GIPSI_PETSC(MatSetType(*out, MATAIJ));
-    // MatSetPreallocationCOO may reorder the index arrays it is given: pass copies.
-    std::vector<PetscInt> r = rows, c = cols;
-    GIPSI_PETSC(MatSetPreallocationCOO(*out, static_cast<PetscCount>(entries), r.data(), c.data()));
-    if (!values.empty()) GIPSI_PETSC(MatSetValuesCOO(*out, values.data(), INSERT_VALUES));
+    GIPSI_PETSC(
+        MatSetPreallocationCOO(*out, static_cast<PetscCount>(entries), rows.data(), cols.data()));
+    GIPSI_PETSC(MatSetValuesCOO(*out, a.valuePtr(), INSERT_VALUES));
+    a = SparseMatrix();
   };
-  make_matrix(&p.stiffness, p.k_values);
-  if (!params_.lumped_mass) make_matrix(&p.mass, p.m_values);
-  make_matrix(&p.system, {});
-  p.system_values.resize(entries);
+  make_matrix(&p.stiffness, ops.stiffness);
+  if (!params_.lumped_mass) make_matrix(&p.mass, ops.consistent_mass);
+  // The system matrix has K's pattern (M's is the same): a copy of K's structure without its
+  // COO tables, filled by SolveDiffusion whenever Δt changes.
+  GIPSI_PETSC(MatDestroy(&p.system));
+  GIPSI_PETSC(MatDuplicate(p.stiffness, MAT_DO_NOT_COPY_VALUES, &p.system));
 
   GIPSI_PETSC(VecDestroy(&p.v));
   std::vector<PetscInt> ghosts;
@@ -251,7 +249,6 @@ void DistributedMonodomain::Assemble() {
                            ops.lumped_mass.data(), ADD_VALUES));
   GIPSI_PETSC(VecAssemblyBegin(p.lumped));
   GIPSI_PETSC(VecAssemblyEnd(p.lumped));
-  p.local_lumped = ops.lumped_mass;
 
   GIPSI_PETSC(KSPDestroy(&p.ksp));
   GIPSI_PETSC(KSPCreate(comm_, &p.ksp));
@@ -278,10 +275,9 @@ void DistributedMonodomain::Assemble() {
   GIPSI_PETSC(KSPSetInitialGuessNonzero(p.ksp, linear.type == "cg" ? PETSC_TRUE : PETSC_FALSE));
   GIPSI_PETSC(KSPSetFromOptions(p.ksp));
   p.system_dt = -1;
-  // The local operators also give the base class its (partial) lumped mass: the voltage
-  // integral is their sum over the ranks.
-  SetDiffusionOperator(std::move(ops.stiffness), std::move(ops.lumped_mass),
-                       std::move(ops.consistent_mass));
+  // The base class gets this rank's (partial) lumped mass: the voltage integral is its sum over
+  // the ranks. Its K and M are not used (SolveDiffusion is this class's), so none are kept.
+  SetDiffusionOperator(SparseMatrix(), std::move(ops.lumped_mass), SparseMatrix());
 }
 
 std::string DistributedMonodomain::solver_name() const {
@@ -299,16 +295,14 @@ StepStatus DistributedMonodomain::SolveDiffusion(double dt_ms, double* v, int& i
   Petsc& p = *petsc_;
   const double theta = params_.theta;
   if (dt_ms != p.system_dt) {
-    for (std::size_t a = 0; a < p.k_values.size(); ++a)
-      p.system_values[a] =
-          theta * dt_ms * p.k_values[a] + (p.m_values.empty() ? 0.0 : p.m_values[a]);
+    // M + θΔt K (or the lumped M on the diagonal), on the assembled matrices.
+    GIPSI_PETSC(MatCopy(p.stiffness, p.system, SAME_NONZERO_PATTERN));
+    GIPSI_PETSC(MatScale(p.system, theta * dt_ms));
     if (params_.lumped_mass) {
-      // The local (partial) lumped masses on the diagonal: summed over the ranks like K.
-      const VecX& m = p.local_lumped;
-      for (std::size_t i = 0; i < p.diagonal.size(); ++i)
-        p.system_values[static_cast<std::size_t>(p.diagonal[i])] += m[static_cast<Index>(i)];
+      GIPSI_PETSC(MatDiagonalSet(p.system, p.lumped, ADD_VALUES));
+    } else {
+      GIPSI_PETSC(MatAXPY(p.system, 1.0, p.mass, SAME_NONZERO_PATTERN));
     }
-    GIPSI_PETSC(MatSetValuesCOO(p.system, p.system_values.data(), INSERT_VALUES));
     GIPSI_PETSC(KSPSetOperators(p.ksp, p.system, p.system));
     p.system_dt = dt_ms;
   }
