@@ -573,7 +573,7 @@ TEST(MixedSolid, SceneErrorsNameThePathAndWhatWasExpected) {
                       "linear_solver": {"type": "ldlt"})",
                    "objects.s.linear_solver.type");
   ExpectSceneError(R"(, "material": {"law": "NeoHookean", "youngs_modulus": 1e4,
-                      "poisson_ratio": 0.3}, "integrator": "Newmark")",
+                      "poisson_ratio": 0.3}, "integrator": "RK4")",
                    "objects.s.integrator");
   ExpectSceneError(R"(, "material": {"law": "NeoHookean", "youngs_modulus": 1e4,
                       "poisson_ratio": 0.3}, "integrator": "BDF2", "load_steps": 4)",

@@ -48,11 +48,6 @@ MixedSolid::MixedSolid(std::string name, std::shared_ptr<const Mesh> domain,
   if (!(params_.density > 0) || !std::isfinite(params_.density))
     throw InputError(fmt::format("object '{}': the density must be positive, not {}", this->path(),
                                  params_.density));
-  if (params_.scheme == ImplicitSchemeKind::kNewmark)
-    throw InputError(fmt::format(
-        "object '{}': MixedSolid has no Newmark scheme yet (it needs the initial acceleration); "
-        "use \"BackwardEuler\" or \"BDF2\"",
-        this->path()));
   if (dynamic() && params_.load_steps != 1)
     throw InputError(fmt::format(
         "object '{}': load_steps {} with a dynamic scheme: a dynamic step is one solve at the "
@@ -881,6 +876,14 @@ StepStatus MixedSolid::DoStep(double t, double dt) {
   step_time_ = t;
   step_dt_ = dt;
   failed_cavity_ = -1;
+  if (params_.scheme == ImplicitSchemeKind::kNewmark && step_count() == 0) {
+    // The first step's constraints and loads (its velocity targets are set again after Begin).
+    static_cast<void>(GatherLoads());
+    if (!InitialAcceleration()) {
+      failure_detail_ = "Newmark's initial acceleration: " + failure_detail_;
+      return StepStatus::Failed("Newmark's initial acceleration could not be solved");
+    }
+  }
   if (dynamic()) state_.scheme.Begin(dt);  // before GatherLoads: prescribed velocities need it
   if (const Index v = GatherLoads(); v >= 0) {
     failure_detail_ = fmt::format(

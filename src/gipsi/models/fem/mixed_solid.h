@@ -77,8 +77,11 @@
 /// p ∂V/∂x has its exact tangent p ∂²V/∂x² on the faces (the rim caps' share is left out: exact
 /// when the rim is held).
 ///
-/// Not yet: Newmark (it needs the initial acceleration M⁻¹ r(u₀)), collision and haptic local
-/// models. Units: SI.
+/// Newmark (average acceleration) starts from the accelerations and pressure that the first
+/// step's loads give at rest: [[M, Bᵀ], [B, 0]] (a₀, p₀) = (f_ext − f̃_int − α M v₀, 0) when
+/// incompressible (B a₀ = 0: the constraint's second derivative, exact for a body at rest), and
+/// with p₀ = κ ln J otherwise (mixed_newmark.cc). Not yet: collision and haptic local models.
+/// Units: SI.
 
 #include <memory>
 #include <string>
@@ -110,7 +113,7 @@ struct MixedSolidParams {
   Vec3 sheet = Vec3::UnitY();  ///< uniform sheet direction (orthogonalised against the fibre)
   int load_steps = 1;          ///< increments per (quasi-static) step
   int max_bisections = 6;      ///< halvings of a failed increment before the step fails
-  /// kStatic (quasi-static), kBackwardEuler or kBdf2 (dynamic; kNewmark is refused).
+  /// kStatic (quasi-static), kBackwardEuler, kBdf2 or kNewmark (dynamic).
   ImplicitSchemeKind scheme = ImplicitSchemeKind::kStatic;
   double density = 1000;        ///< ρ [kg/m³], for the mass and gravity
   double rayleigh_mass = 0;     ///< α [1/s]: damping force α M v
@@ -134,9 +137,9 @@ struct MixedSolidParams {
 class MixedSolid final : public SimObject, public CavityWall {
  public:
   /// Throws InputError for a mesh without tets, inverted or degenerate tets, a missing law or
-  /// one without a split volumetric term, a zero fibre direction, a non-positive density, the
-  /// Newmark scheme, several load steps with a dynamic scheme, or a cavity whose region selects
-  /// no face or whose rim is not a set of simple loops.
+  /// one without a split volumetric term, a zero fibre direction, a non-positive density,
+  /// several load steps with a dynamic scheme, or a cavity whose region selects no face or whose
+  /// rim is not a set of simple loops.
   MixedSolid(std::string name, std::shared_ptr<const Mesh> domain, MixedSolidParams params);
 
   [[nodiscard]] std::string_view type_name() const override { return "MixedSolid"; }
@@ -277,6 +280,10 @@ class MixedSolid final : public SimObject, public CavityWall {
   /// outside its law's domain or the solve fails.
   bool PredictFromTargets(VecX& z, double s);
   StepStatus Advance(double s0, double s1, int depth);
+  /// Newmark's a₀ (mixed_newmark.cc): the accelerations of the first step's loads at the
+  /// current state, with the pressure that keeps them admissible; false (failure_detail_ set)
+  /// if an element is outside its law's domain or the solve fails.
+  bool InitialAcceleration();
   void UpdatePositions();
   /// The default display: each boundary face split at its edge nodes into four triangles,
   /// whose vertices follow the P2 solution (mixed_display.cc).

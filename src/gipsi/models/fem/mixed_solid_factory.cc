@@ -24,9 +24,11 @@ void RegisterMixedSolid(TypeRegistry& registry) {
           static_cast<void>(formulation->AsChoice({"P2-P1"}));
 
         if (auto integrator = p.Find("integrator")) {
-          const std::string kind = integrator->AsChoice({"Static", "BackwardEuler", "BDF2"});
+          const std::string kind =
+              integrator->AsChoice({"Static", "BackwardEuler", "BDF2", "Newmark"});
           params.scheme = kind == "BackwardEuler" ? ImplicitSchemeKind::kBackwardEuler
                           : kind == "BDF2"        ? ImplicitSchemeKind::kBdf2
+                          : kind == "Newmark"     ? ImplicitSchemeKind::kNewmark
                                                   : ImplicitSchemeKind::kStatic;
           if (params.scheme != ImplicitSchemeKind::kStatic && p.Has("load_steps"))
             p.At("load_steps")
