@@ -240,10 +240,11 @@ TEST(MixedDynamics, ADampedMotionSettlesOnTheQuasiStaticAnswer) {
 
 // Newmark's average acceleration conserves the energy of a linear system, and that of a
 // nonlinear one to O(Δt²): the same column, undamped, released from rest under its weight,
-// swings with kinetic + strain energy − the weight's work (0 at rest) conserved to 1.3e-3 of the
-// largest kinetic energy over 0.2 s with Δt = 2 ms, and 3.6e-4 with 1 ms (3.7 times less: O(Δt²),
-// asserted above 3), where BDF2 loses all of it. Newmark starts from its initial acceleration (the mass and
-// pressure solve), and the column's volume is held from the first step on.
+// swings with kinetic + strain energy − the weight's work (0 at rest) conserved to 1.3e-3 of
+// the largest kinetic energy over 0.2 s with Δt = 2 ms, and 3.6e-4 with 1 ms (3.7 times less:
+// O(Δt²), asserted above 3), where BDF2 loses all of it. Newmark starts from its initial
+// acceleration (the mass and pressure solve), and the column's volume is held from the first
+// step on.
 double SwingEnergyDrift(ImplicitSchemeKind scheme, double dt) {
   const Vec3 g(0, 0, -9.81);
   const Vec3 size(0.01, 0.01, 0.02);
