@@ -7,6 +7,25 @@
 #include "gipsi/models/fem/mixed_solid.h"
 
 namespace gipsi {
+namespace {
+
+/// Calls fn(edge node, w) for each edge between two nodes that target j's weights blend, with
+/// w = 4 w_a w_b: the P2 interpolation is the linear blend Σ w_a f_a plus Σ w (f_ab − (f_a +
+/// f_b)/2) over those edges (N_a = L_a (2 L_a − 1), N_ab = 4 L_a L_b), exact for a target
+/// inside a tet or on a face.
+template <typename Fn>
+void ForEachBow(const QuadraticTets& mesh, const Eigen::Matrix4Xi& nodes,
+                const Eigen::Matrix4Xd& weights, Index j, Fn&& fn) {
+  for (int a = 0; a < 4; ++a)
+    for (int b = a + 1; b < 4; ++b) {
+      const double w = 4 * weights(a, j) * weights(b, j);
+      if (w == 0) continue;
+      const int node = mesh.EdgeNode(nodes(a, j), nodes(b, j));
+      if (node >= 0) fn(node, w);
+    }
+}
+
+}  // namespace
 
 void MixedSolid::MakeCurvedDisplay() {
   // Display vertices: the boundary vertices (in the boundary's numbering), then the edge nodes
@@ -56,23 +75,16 @@ void MixedSolid::MakeCurvedDisplay() {
 }
 
 void MixedSolid::OnDisplayChanged() {
-  // For every display vertex, the edges between the nodes its map blends: the P2 position is
-  // the linear blend Σ w_a x_a plus Σ over edges (a, b) of 4 w_a w_b (x_ab − (x_a + x_b)/2)
-  // (N_a = L_a (2 L_a − 1), N_ab = 4 L_a L_b). Exact for targets inside a tet or on a face.
+  // For every display vertex, the edges whose bows its P2 position adds (ForEachBow).
   display_bow_start_.assign(1, 0);
   display_bow_node_.clear();
   display_bow_weight_.clear();
   const PointMap& map = *display().map;
   for (Index j = 0; j < map.num_targets(); ++j) {
-    for (int a = 0; a < 4; ++a)
-      for (int b = a + 1; b < 4; ++b) {
-        const double w = 4 * map.weights()(a, j) * map.weights()(b, j);
-        if (w == 0) continue;
-        const int node = mesh_.EdgeNode(map.indices()(a, j), map.indices()(b, j));
-        if (node < 0) continue;
-        display_bow_node_.push_back(node);
-        display_bow_weight_.push_back(w);
-      }
+    ForEachBow(mesh_, map.indices(), map.weights(), j, [&](int node, double w) {
+      display_bow_node_.push_back(node);
+      display_bow_weight_.push_back(w);
+    });
     display_bow_start_.push_back(static_cast<int>(display_bow_node_.size()));
   }
 }
@@ -104,15 +116,13 @@ void MixedSolid::CorrectInterpolated(FieldId id, const Eigen::Matrix4Xi& nodes,
     const Vec3 u = state_.z.segment<3>(3 * n);
     return id == mech_.position ? Vec3(mesh_.rest.col(n) + u) : u;
   };
+  const Index nv = mesh_.num_vertices;
   for (Index j = 0; j < at.cols(); ++j)
-    for (int a = 0; a < 4; ++a)
-      for (int b = a + 1; b < 4; ++b) {
-        const double w = 4 * weights(a, j) * weights(b, j);
-        if (w == 0) continue;
-        const int node = mesh_.EdgeNode(nodes(a, j), nodes(b, j));
-        if (node < 0) continue;
-        at.col(j) += w * (value(node) - 0.5 * (value(nodes(a, j)) + value(nodes(b, j))));
-      }
+    ForEachBow(mesh_, nodes, weights, j, [&](int node, double w) {
+      const Index edge = node - nv;
+      at.col(j) +=
+          w * (value(node) - 0.5 * (value(mesh_.edges(0, edge)) + value(mesh_.edges(1, edge))));
+    });
 }
 
 }  // namespace gipsi
