@@ -61,8 +61,12 @@ void RegisterDistributedTypes(TypeRegistry& registry, MPI_Comm comm,
                   ? std::make_unique<FemSolid>(ctx.name, mesh_part.mesh, std::move(spec.params),
                                                std::move(spec.ode))
                   : std::make_unique<FemSolid>(ctx.name, mesh_part.mesh, std::move(spec.params));
-          if (spec.fibre_rule) {  // evaluated on the whole mesh, kept for the local tets
-            const Points all = MakeTransmuralFibres(*whole, *spec.fibre_rule).fibre;
+          if (spec.fibre_rule.ellipsoidal)  // evaluated on the local tets alone
+            solid->WriteField(
+                solid->FindField("fibre"),
+                EllipsoidalFibresAtCentroids(*mesh_part.mesh, *spec.fibre_rule.ellipsoidal));
+          if (spec.fibre_rule.transmural) {  // evaluated on the whole mesh, kept for the local tets
+            const Points all = MakeTransmuralFibres(*whole, *spec.fibre_rule.transmural).fibre;
             Points local(3, static_cast<Index>(mesh_part.whole_tet.size()));
             for (std::size_t e = 0; e < mesh_part.whole_tet.size(); ++e)
               local.col(static_cast<Index>(e)) = all.col(mesh_part.whole_tet[e]);

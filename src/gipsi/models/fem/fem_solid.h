@@ -41,8 +41,8 @@
 #include "gipsi/models/fem/fem_state.h"
 #include "gipsi/models/fem/solid_distribution.h"
 #include "gipsi/models/fem/solid_material.h"
+#include "gipsi/models/fem/solid_options.h"
 #include "gipsi/models/fem/tet_assembly.h"
-#include "gipsi/models/fibres/rule_based_fibres.h"
 #include "gipsi/models/wall_cavity.h"
 #include "gipsi/numerics/implicit_scheme.h"
 #include "gipsi/numerics/newton.h"
@@ -348,7 +348,7 @@ class FemSolid final : public SimObject, public CavityWall {
 struct FemSolidSpec {
   FemParams params;
   std::unique_ptr<OdeIntegrator> ode;  ///< an explicit integrator; null: params.scheme steps
-  std::optional<TransmuralFibreRule> fibre_rule;
+  SolidFibreRule fibre_rule;
   /// The solver of distributed runs: "linear_solver" with the "parallel" block's
   /// "linear_solver" keys over it; CG with no preconditioner named in either takes "amg".
   LinearSolverOptions distributed_linear;

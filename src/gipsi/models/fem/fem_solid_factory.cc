@@ -69,11 +69,14 @@ NewtonOptions ParseNewtonOptions(const JsonNode& node, NewtonOptions options) {
   return options;
 }
 
-std::optional<TransmuralFibreRule> ParseSolidFibres(const JsonNode& object,
-                                                    const SolidMaterial& law, Vec3& fibre,
-                                                    Vec3& sheet) {
+SolidFibreRule ParseSolidFibres(const JsonNode& object, const SolidMaterial& law, Vec3& fibre,
+                                Vec3& sheet) {
   auto fibres = object.Find("fibres");
-  if (fibres && fibres->Has("rule")) return ParseTransmuralFibreRule(*fibres);
+  if (fibres && fibres->Has("rule")) {
+    if (fibres->At("rule").AsChoice({"transmural", "ellipsoidal"}) == "ellipsoidal")
+      return {.transmural = std::nullopt, .ellipsoidal = ParseEllipsoidalFibreRule(*fibres)};
+    return {.transmural = ParseTransmuralFibreRule(*fibres), .ellipsoidal = std::nullopt};
+  }
   if (fibres) {
     fibres->CheckKeys({"direction", "sheet"});
     fibre = fibres->Vector3("direction");
@@ -85,7 +88,7 @@ std::optional<TransmuralFibreRule> ParseSolidFibres(const JsonNode& object,
                           "\"fibres\": {{\"direction\": [1, 0, 0]}}",
                           law.law()));
   }
-  return std::nullopt;
+  return {};
 }
 
 StepPredictor ParsePredictor(const JsonNode& object, StepPredictor fallback) {
@@ -119,7 +122,7 @@ FemSolidSpec ParseFemSolidSpec(const ObjectBuildContext& ctx) {
   FemSolidSpec spec;
   FemParams& params = spec.params;
   std::unique_ptr<OdeIntegrator>& ode = spec.ode;
-  std::optional<TransmuralFibreRule>& fibre_rule = spec.fibre_rule;
+  SolidFibreRule& fibre_rule = spec.fibre_rule;
   params.density = p.Positive("density", params.density);
   params.material = ctx.registry.CreateMaterialAs<SolidMaterial>(p.At("material"), "solid");
   if (auto mass = p.Find("mass"))
@@ -204,16 +207,19 @@ void RegisterFemSolid(TypeRegistry& registry) {
         FemSolidSpec spec = ParseFemSolidSpec(ctx);
         FemParams& params = spec.params;
         std::unique_ptr<OdeIntegrator>& ode = spec.ode;
-        const std::optional<TransmuralFibreRule>& fibre_rule = spec.fibre_rule;
+        const SolidFibreRule& fibre_rule = spec.fibre_rule;
         std::unique_ptr<FemSolid> solid;
         try {
           auto mesh = ctx.DomainMesh();
           solid =
               ode ? std::make_unique<FemSolid>(ctx.name, mesh, std::move(params), std::move(ode))
                   : std::make_unique<FemSolid>(ctx.name, mesh, std::move(params));
-          if (fibre_rule)
+          if (fibre_rule.transmural)
             solid->WriteField(solid->FindField("fibre"),
-                              MakeTransmuralFibres(*mesh, *fibre_rule).fibre);
+                              MakeTransmuralFibres(*mesh, *fibre_rule.transmural).fibre);
+          if (fibre_rule.ellipsoidal)
+            solid->WriteField(solid->FindField("fibre"),
+                              EllipsoidalFibresAtCentroids(*mesh, *fibre_rule.ellipsoidal));
         } catch (const InputError& e) {
           p.Fail(e.what());
         }

@@ -399,6 +399,16 @@ void MixedSolid::SetFibreAt(Index e, int q, const Vec3& fibre) {
   axes = MaterialAxes(fibre, axes.col(1));
 }
 
+Vec3 MixedSolid::QuadraturePoint(Index e, int q) const {
+  GIPSI_CHECK(e >= 0 && e < mesh_.num_elements() && q >= 0 && q < kQuad,
+              "MixedSolid::QuadraturePoint({}, {}): no such point", e, q);
+  const Eigen::Matrix<double, 10, 1> n =
+      QuadraticTetShape(TetRuleDegree2().points[static_cast<std::size_t>(q)]);
+  Vec3 x = Vec3::Zero();
+  for (int a = 0; a < 10; ++a) x += n[a] * mesh_.rest.col(mesh_.elements(a, e));
+  return x;
+}
+
 const Mat3& MixedSolid::axes_at(Index e, int q) const {
   return state_.axes.get()[static_cast<std::size_t>(kQuad * e + q)];
 }

@@ -189,6 +189,9 @@ class MixedSolid final : public SimObject, public CavityWall {
   void SetFibreAt(Index e, int q, const Vec3& fibre);
   /// Material axes (columns fibre, sheet, normal) at quadrature point q of element e.
   [[nodiscard]] const Mat3& axes_at(Index e, int q) const;
+  /// Where quadrature point q (0..3) of element e lies at rest (on the curved element's own
+  /// map, Σ N_a X_a). Preconditions checked.
+  [[nodiscard]] Vec3 QuadraturePoint(Index e, int q) const;
   /// The current unknowns z.
   [[nodiscard]] const VecX& unknowns() const { return state_.z; }
 

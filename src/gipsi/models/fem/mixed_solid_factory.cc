@@ -66,7 +66,7 @@ void RegisterMixedSolid(TypeRegistry& registry) {
                 "block, which LDLT without pivoting cannot factorise");
         }
         ParseLoadStepping(p, params.load_steps, params.max_bisections);
-        const std::optional<TransmuralFibreRule> fibre_rule =
+        const SolidFibreRule fibre_rule =
             ParseSolidFibres(p, *params.material, params.fibre, params.sheet);
         if (params.material->log_volumetric_modulus() <= 0)
           p.At("material")
@@ -79,21 +79,30 @@ void RegisterMixedSolid(TypeRegistry& registry) {
         try {
           auto mesh = ctx.DomainMesh();
           auto solid = std::make_unique<MixedSolid>(ctx.name, mesh, std::move(params));
-          if (fibre_rule) {
-            // The rule at each quadrature point, with the transmural coordinate interpolated
-            // there: a 3 mm wall meshed with one or two tets across still sees its fibres turn.
-            const FibreField fibres = MakeTransmuralFibres(*mesh, *fibre_rule);
-            const TetQuadrature& rule = TetRuleDegree2();
+          // A rule's fibres at each quadrature point: a 3 mm wall meshed with one or two tets
+          // across still sees them turn. The Laplace rule's transmural coordinate is
+          // interpolated there; the ellipsoidal rule is evaluated at the point itself.
+          const TetQuadrature& rule = TetRuleDegree2();
+          if (fibre_rule.transmural) {
+            const FibreField fibres = MakeTransmuralFibres(*mesh, *fibre_rule.transmural);
             for (Index e = 0; e < mesh->num_tets(); ++e)
               for (int q = 0; q < 4; ++q) {
                 double coordinate = 0;
                 for (int b = 0; b < 4; ++b)
                   coordinate += rule.points[static_cast<std::size_t>(q)][b] *
                                 fibres.transmural[mesh->tets(b, e)];
-                solid->SetFibreAt(e, q,
-                                  TransmuralFibreAt(*fibre_rule, fibres.sheet.col(e), coordinate));
+                solid->SetFibreAt(
+                    e, q,
+                    TransmuralFibreAt(*fibre_rule.transmural, fibres.sheet.col(e), coordinate));
               }
           }
+          if (fibre_rule.ellipsoidal)
+            for (Index e = 0; e < mesh->num_tets(); ++e)
+              for (int q = 0; q < 4; ++q)
+                solid->SetFibreAt(
+                    e, q,
+                    EllipsoidalFibreAt(*fibre_rule.ellipsoidal, solid->QuadraturePoint(e, q))
+                        .fibre);
           if (active_tension > 0)
             solid->WriteField(solid->FindField("active_tension"),
                               Eigen::MatrixXd::Constant(1, mesh->num_tets(), active_tension));

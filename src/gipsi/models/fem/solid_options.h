@@ -7,6 +7,7 @@
 #include "gipsi/base/export.h"
 #include "gipsi/base/json_node.h"
 #include "gipsi/models/fem/solid_material.h"
+#include "gipsi/models/fibres/ellipsoidal_fibres.h"
 #include "gipsi/models/fibres/rule_based_fibres.h"
 #include "gipsi/numerics/implicit_scheme.h"
 #include "gipsi/numerics/newton.h"
@@ -22,12 +23,19 @@ namespace gipsi {
 /// each left as given when absent; throws InputError naming the JSON path of a bad value.
 void ParseLoadStepping(const JsonNode& object, int& load_steps, int& max_bisections);
 
-/// The object's "fibres": a transmural rule (returned; its fibres are made on the mesh later), or
-/// a uniform "direction" and "sheet" (into `fibre` and `sheet`). Without it, a law that needs
-/// fibres is refused at "material". Throws InputError naming the JSON path of a bad value.
-[[nodiscard]] std::optional<TransmuralFibreRule> ParseSolidFibres(const JsonNode& object,
-                                                                  const SolidMaterial& law,
-                                                                  Vec3& fibre, Vec3& sheet);
+/// A solid's fibre rule, if its fibres come from one: the Laplace rule ("transmural") or the
+/// benchmark ventricle's ("ellipsoidal"). Plain struct.
+struct SolidFibreRule {
+  std::optional<TransmuralFibreRule> transmural;
+  std::optional<EllipsoidalFibreRule> ellipsoidal;
+  explicit operator bool() const { return transmural || ellipsoidal; }
+};
+
+/// The object's "fibres": a rule (returned; its fibres are made on the mesh later), or a uniform
+/// "direction" and "sheet" (into `fibre` and `sheet`). Without it, a law that needs fibres is
+/// refused at "material". Throws InputError naming the JSON path of a bad value.
+[[nodiscard]] SolidFibreRule ParseSolidFibres(const JsonNode& object, const SolidMaterial& law,
+                                              Vec3& fibre, Vec3& sheet);
 /// The object's "predictor" ("none", "constant_velocity" or "constant_acceleration"); `fallback`
 /// when absent. Throws InputError naming the JSON path of a bad value.
 [[nodiscard]] StepPredictor ParsePredictor(const JsonNode& object, StepPredictor fallback);
