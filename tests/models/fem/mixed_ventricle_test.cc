@@ -2,8 +2,8 @@
 // "Verification of cardiac mechanics software: benchmark problems and solutions for testing
 // active and passive material behaviour", Proc. R. Soc. A 471, 2015), problems 2 (passive
 // inflation) and 3 (inflation and active contraction), on P2–P1 tets (MixedSolid): the shipped
-// scenes `scenes/lv_inflation_p2.json` and `scenes/lv_contraction_p2.json`, on coarser meshes
-// and with fewer load increments so that the suite runs them in seconds. They check what the
+// scenes `scenes/lv_inflation_p2.json` and `scenes/lv_contraction_p2.json`, mostly on coarser
+// meshes and with fewer load increments so that the suite runs them in seconds. They check what the
 // mixed element is for: the apex does not depend on κ (locking-free), incompressibility holds,
 // and refining the mesh moves the apex little. (The finer runs and their timings are in
 // docs/incompressible.md.)
@@ -100,29 +100,36 @@ TEST(MixedVentricle, InflationApexIsTheBenchmarksIndependentOfKappaAndConverges)
   }
 }
 
-// Problem 3 (approximately: our fibres come from the Laplace rule, docs/incompressible.md):
-// Guccione (C = 2 kPa, b_f 8, b_t 2, b_fs 4), fibres turning from +90° to −90° through the
-// wall, 15 kPa inside and 60 kPa of active tension. The apex rises 5.37 and 6.11 mm
-// (epicardium, endocardium) at 4 mm, 5.29 and 5.99 at 3 mm, 5.25 and 6.00 at 2.5 mm
-// (straight-sided tets, the shipped scene's). Asserted: it rises; 4 and 3 mm agree within 2 %
-// (they differ by 1.5 %: the wall is one or two tets thick at both sizes, so the fibres' turn
-// is not resolved yet); κ/C = 10⁴ and 10⁶ give the incompressible apex within 0.5 %. (The
-// active stress is 30 C, so κ/C = 10³ is a compressible wall here: 0.9 % off, and rightly.)
-// Not asserted: the wall's volume, which changes by 0.55 % at all three sizes: one tet across
-// the wall cannot follow the fibres' turn without local volume changes (±25 % per tet) that
-// the continuous pressure only cancels on average. See docs/incompressible.md.
-TEST(MixedVentricle, ContractionApexIsIndependentOfKappaAndConverges) {
+// Problem 3: Guccione (C = 2 kPa, b_f 8, b_t 2, b_fs 4), the benchmark's fibres (helix angle
+// +90° to −90° on the ellipsoidal coordinates), 15 kPa inside and 60 kPa of active tension.
+// On Gmsh's 4 mm mesh (one or two tets across the 3 mm wall) the answer is not converged (the
+// apex rises 4.62 mm; 4.92, 5.07 and 5.16 mm at 3, 2.5 and 2 mm; 4.48 mm once the wall is
+// resolved, below), but the formulation's independence of κ already shows: κ/C = 10⁴ and 10⁶
+// give the incompressible apex within 0.5 % (the issue's criterion). (The active stress is
+// 30 C, so κ/C = 10³ is a compressible wall here, and its apex rightly moves about 1 %.)
+TEST(MixedVentricle, ContractionApexIsIndependentOfKappa) {
   const std::string file = "lv_contraction_p2.json";
-  const Apex coarse = RunVentricle(file, 0.004, 10, 0);
-  const Apex fine = RunVentricle(file, 0.003, 10, 0);
-  EXPECT_GT(fine.epi, 4e-3);  // it rises, by about 5 mm
-  EXPECT_LT(Relative(fine.epi, coarse.epi), 0.02);
-  EXPECT_LT(Relative(fine.endo, coarse.endo), 0.02);
+  const Apex incompressible = RunVentricle(file, 0.004, 10, 0);
+  EXPECT_GT(incompressible.epi, 4e-3);  // it rises, by about 4.6 mm
   for (double kappa_over_c : {1e4, 1e6}) {
     const Apex penalty = RunVentricle(file, 0.004, 10, kappa_over_c);
-    EXPECT_LT(Relative(penalty.epi, coarse.epi), 0.005) << "κ/C " << kappa_over_c;
-    EXPECT_LT(Relative(penalty.endo, coarse.endo), 0.005) << "κ/C " << kappa_over_c;
+    EXPECT_LT(Relative(penalty.epi, incompressible.epi), 0.005) << "κ/C " << kappa_over_c;
+    EXPECT_LT(Relative(penalty.endo, incompressible.endo), 0.005) << "κ/C " << kappa_over_c;
   }
+}
+
+// Problem 3 on the shipped scene's 1.5 mm mesh (6k tets, two or three across the wall): the
+// wall keeps its volume to 0.1 % when incompressible (the issue's criterion; measured 0.067 %,
+// against 0.5 % on every mesh of 2 mm and coarser, where element-level J varies by ±25 % in
+// a pattern the linear pressure cannot see), and the apex is within 1 % of the 1.25 mm mesh's
+// (4.458 mm epicardium, 4.981 mm endocardium, run by hand: docs/incompressible.md; 1.5 mm
+// gives 4.478 and 4.945, differences of 0.45 % and 0.72 %). About 100 s on one core, so the
+// sanitizer stages skip it (scripts/test.sh).
+TEST(MixedVentricle, ContractionOnAResolvedWallKeepsItsVolumeAndIsMeshConverged) {
+  const Apex resolved = RunVentricle("lv_contraction_p2.json", 0.0015, 10, 0);
+  EXPECT_LT(resolved.volume_change, 1e-3);
+  EXPECT_LT(Relative(resolved.epi, 4.458e-3), 0.01);
+  EXPECT_LT(Relative(resolved.endo, 4.981e-3), 0.01);
 }
 
 }  // namespace
