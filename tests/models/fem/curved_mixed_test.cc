@@ -17,6 +17,8 @@
 #include "gipsi/io/builtins.h"
 #include "gipsi/io/mesh_io.h"
 #include "gipsi/io/scene.h"
+#include "gipsi/models/connectors/field_copy.h"
+#include "gipsi/models/fem/fem_solid.h"
 #include "gipsi/models/fem/mixed_solid.h"
 #include "gipsi/models/fem/quadratic_tets.h"
 #include "gipsi/models/fem/solid_laws.h"
@@ -341,6 +343,64 @@ TEST(CurvedMixedSolid, APointProbeReadsTheQuadraticDisplacement) {
   const VecX p = solid.Pressures();
   for (int a = 0; a < 4; ++a) pressure += l[a] * p[q.elements(a, tet)];
   EXPECT_NEAR(sample[6], pressure, 1e-12 * std::abs(pressure) + 1e-12);
+}
+
+// A FieldCopy from a MixedSolid's displacement maps the P2 field as a probe reads it: the
+// target's nodes (a box of 1 mm tets inside the bent beam, none at a beam vertex) get
+// Σ N_a(L) u_a over the ten nodes of the beam's tet, to round-off, not the blend of its four
+// vertices (micrometres apart).
+TEST(CurvedMixedSolid, AFieldCopyMapsTheQuadraticDisplacement) {
+  FemParams beam_params;
+  beam_params.material =
+      Law(R"({"law": "NeoHookean", "youngs_modulus": 1e4, "poisson_ratio": 0.45})");
+  MixedSolidParams params;
+  params.material = beam_params.material;
+  params.incompressible = true;
+  params.load_steps = 4;
+  auto mesh =
+      std::make_shared<const Mesh>(MakeTetBox(Vec3::Zero(), Vec3(0.01, 0.001, 0.001), {10, 1, 1}));
+  MixedSolid beam("beam", mesh, params);
+  BoundaryConditions& bcs = beam.boundary_conditions();
+  for (Index v : VerticesWhere(beam, [](const Vec3& x) { return x.x() < 1e-12; })) bcs.Fix(v);
+  for (Index f : FacesWhere(beam, [](const Vec3& x) { return x.z() < 1e-12; }))
+    bcs.SetPressure(f, 2.0);
+  ASSERT_TRUE(beam.Step(1).ok()) << beam.failure_detail();
+  auto inner = std::make_shared<const Mesh>(
+      MakeTetBox(Vec3(0.00013, 0.00021, 0.00017), Vec3(0.00983, 0.00077, 0.00088), {7, 1, 1}));
+  FemSolid target("target", inner, beam_params);
+  FieldCopy copy("copy", beam, beam.FindField("displacement"), target,
+                 target.FindField("external_force"), FieldCopy::Mapping::kBarycentric, 1.0, "N/m");
+  ASSERT_TRUE(copy.Fire(0).ok());
+  Eigen::MatrixXd copied(3, inner->num_nodes());
+  target.ReadField(target.FindField("external_force"), copied);
+
+  const QuadraticTets& q = beam.quadratic_mesh();
+  const Points u = beam.NodeDisplacements();
+  const PointMap map = beam.MapFromNodes(inner->nodes);
+  double largest_bow = 0;
+  for (Index j = 0; j < inner->num_nodes(); ++j) {
+    Index tet = -1;
+    Eigen::Vector4d l = Eigen::Vector4d::Zero();
+    for (Index e = 0; e < q.num_elements() && tet < 0; ++e) {
+      l.setZero();
+      int found = 0;
+      for (int k = 0; k < 4; ++k)
+        for (int a = 0; a < 4; ++a)
+          if (q.elements(a, e) == map.indices()(k, j)) {
+            l[a] = map.weights()(k, j);
+            ++found;
+          }
+      if (found == 4) tet = e;
+    }
+    ASSERT_GE(tet, 0) << "node " << j;
+    const Eigen::Matrix<double, 10, 1> n = QuadraticTetShape(l);
+    Vec3 p2 = Vec3::Zero(), linear = Vec3::Zero();
+    for (int a = 0; a < 10; ++a) p2 += n[a] * u.col(q.elements(a, tet));
+    for (int a = 0; a < 4; ++a) linear += l[a] * u.col(q.elements(a, tet));
+    EXPECT_LT((copied.col(j) - p2).norm(), 1e-15) << "node " << j;
+    largest_bow = std::max(largest_bow, (p2 - linear).norm());
+  }
+  EXPECT_GT(largest_bow, 1e-7);
 }
 
 // A curved tet whose map from the reference tet folds over (an edge node pulled past the

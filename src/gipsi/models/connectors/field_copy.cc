@@ -84,6 +84,10 @@ StepStatus FieldCopy::DoFire(double /*t*/) {
     map_->ApplyMarked(source_, target_, *marker);
   } else if (map_) {
     map_->Apply(source_, target_);
+    // The source's own interpolation where it is of higher order than the blend of the tet's
+    // vertices (a MixedSolid's quadratic displacement).
+    if (mapping_ == Mapping::kBarycentric)
+      from_.CorrectInterpolated(from_field_, map_->indices(), map_->weights(), target_);
   } else {
     target_ = source_;
   }
