@@ -287,6 +287,32 @@ TEST(CurvedMixedSolid, AnEmbeddedDisplayFollowsTheQuadraticSolution) {
   EXPECT_GT(largest_bow, 1e-7);
 }
 
+// The quadratic tet whose four vertices point j of `map` (MixedSolid::MapFromNodes) blends, and
+// its barycentric coordinates L in the tet's own vertex order; tet −1 if no tet has all four.
+struct TetPoint {
+  Index tet = -1;
+  Eigen::Vector4d l = Eigen::Vector4d::Zero();
+};
+TetPoint LocateInTet(const QuadraticTets& q, const PointMap& map, Index j) {
+  TetPoint at;
+  for (Index e = 0; e < q.num_elements(); ++e) {
+    at.l.setZero();
+    int found = 0;
+    for (int k = 0; k < 4; ++k)
+      for (int a = 0; a < 4; ++a)
+        if (q.elements(a, e) == map.indices()(k, j)) {
+          at.l[a] = map.weights()(k, j);
+          ++found;
+        }
+    if (found == 4) {
+      at.tet = e;
+      return at;
+    }
+  }
+  at.l.setZero();
+  return at;
+}
+
 // A point probe in a MixedSolid reads the P2 displacement there, not the blend of its tet's
 // vertices: inside the bent beam (1 mm tets, tip down about 1.6 mm) the two differ by
 // micrometres, and the probe's value is Σ N_a(L) u_a over the ten nodes, to round-off.
@@ -315,19 +341,7 @@ TEST(CurvedMixedSolid, APointProbeReadsTheQuadraticDisplacement) {
   const Vec3 point(0.00737, 0.00031, 0.00062);
   const PointMap map = solid.MapFromNodes(point);
   const QuadraticTets& q = solid.quadratic_mesh();
-  Index tet = -1;
-  Eigen::Vector4d l = Eigen::Vector4d::Zero();
-  for (Index e = 0; e < q.num_elements() && tet < 0; ++e) {
-    l.setZero();
-    int found = 0;
-    for (int k = 0; k < 4; ++k)
-      for (int a = 0; a < 4; ++a)
-        if (q.elements(a, e) == map.indices()(k, 0)) {
-          l[a] = map.weights()(k, 0);
-          ++found;
-        }
-    if (found == 4) tet = e;
-  }
+  const auto [tet, l] = LocateInTet(q, map, 0);
   ASSERT_GE(tet, 0);
   const Points u = solid.NodeDisplacements();
   const Eigen::Matrix<double, 10, 1> n = QuadraticTetShape(l);
@@ -379,19 +393,7 @@ TEST(CurvedMixedSolid, AFieldCopyMapsTheQuadraticDisplacement) {
   const PointMap map = beam.MapFromNodes(inner->nodes);
   double largest_bow = 0;
   for (Index j = 0; j < inner->num_nodes(); ++j) {
-    Index tet = -1;
-    Eigen::Vector4d l = Eigen::Vector4d::Zero();
-    for (Index e = 0; e < q.num_elements() && tet < 0; ++e) {
-      l.setZero();
-      int found = 0;
-      for (int k = 0; k < 4; ++k)
-        for (int a = 0; a < 4; ++a)
-          if (q.elements(a, e) == map.indices()(k, j)) {
-            l[a] = map.weights()(k, j);
-            ++found;
-          }
-      if (found == 4) tet = e;
-    }
+    const auto [tet, l] = LocateInTet(q, map, j);
     ASSERT_GE(tet, 0) << "node " << j;
     const Eigen::Matrix<double, 10, 1> n = QuadraticTetShape(l);
     Vec3 p2 = Vec3::Zero(), linear = Vec3::Zero();

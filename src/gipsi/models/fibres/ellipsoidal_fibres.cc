@@ -7,6 +7,8 @@
 #include <cmath>
 #include <numbers>
 
+#include "gipsi/models/fibres/rule_based_fibres.h"
+
 namespace gipsi {
 
 EllipsoidalFibre EllipsoidalFibreAt(const EllipsoidalFibreRule& rule, const Vec3& point) {
@@ -84,11 +86,7 @@ EllipsoidalFibreRule ParseEllipsoidalFibreRule(const JsonNode& node) {
   if (!(rule.epi_short > rule.endo_short && rule.epi_long > rule.endo_long))
     node.At("epi").Expected("radii larger than the endocardium's (the wall lies between them)");
   rule.centre = node.Vector3("centre", rule.centre);
-  rule.endo_angle = node.Number("endo_angle", rule.endo_angle);
-  rule.epi_angle = node.Number("epi_angle", rule.epi_angle);
-  for (const char* key : {"endo_angle", "epi_angle"})
-    if (auto a = node.Find(key); a && std::abs(a->AsNumber()) > 90)
-      a->Expected("a helix angle in degrees within [-90, 90]");
+  ParseHelixAngles(node, rule.endo_angle, rule.epi_angle);
   return rule;
 }
 

@@ -131,12 +131,16 @@ TransmuralFibreRule ParseTransmuralFibreRule(const JsonNode& node) {
   rule.epi = ParseRegion(node.At("epi"));
   rule.axis = node.Vector3("axis", rule.axis);
   if (rule.axis.norm() == 0) node.At("axis").Expected("a non-zero vector");
-  rule.endo_angle = node.Number("endo_angle", rule.endo_angle);
-  rule.epi_angle = node.Number("epi_angle", rule.epi_angle);
+  ParseHelixAngles(node, rule.endo_angle, rule.epi_angle);
+  return rule;
+}
+
+void ParseHelixAngles(const JsonNode& node, double& endo, double& epi) {
+  endo = node.Number("endo_angle", endo);
+  epi = node.Number("epi_angle", epi);
   for (const char* key : {"endo_angle", "epi_angle"})
     if (auto a = node.Find(key); a && std::abs(a->AsNumber()) > 90)
       a->Expected("a helix angle in degrees within [-90, 90]");
-  return rule;
 }
 
 }  // namespace gipsi

@@ -47,6 +47,11 @@ FibreField MakeTransmuralFibres(const Mesh& mesh, const TransmuralFibreRule& rul
 /// one or two tets thick still sees the fibre turn through it.
 [[nodiscard]] Vec3 TransmuralFibreAt(const TransmuralFibreRule& rule, const Vec3& t, double e);
 
+/// Reads the helix angles "endo_angle" and "epi_angle" of a fibre rule's `node` (degrees within
+/// ±90) into `endo` and `epi`, each left as given when absent; throws InputError naming the JSON
+/// path of a bad value.
+void ParseHelixAngles(const JsonNode& node, double& endo, double& epi);
+
 /// Reads {"rule": "transmural", "endo": region, "epi": region, "axis": [x, y, z],
 /// "endo_angle": degrees, "epi_angle": degrees}; throws InputError naming the JSON path.
 TransmuralFibreRule ParseTransmuralFibreRule(const JsonNode& node);
