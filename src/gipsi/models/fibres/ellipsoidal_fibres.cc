@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <utility>
 
 #include "gipsi/models/fibres/rule_based_fibres.h"
 
@@ -24,7 +25,8 @@ EllipsoidalFibre EllipsoidalFibreAt(const EllipsoidalFibreRule& rule, const Vec3
     const auto [rs, rl] = radii(t);
     return rho * rho / (rs * rs) + d.z() * d.z() / (rl * rl) - 1;
   };
-  // At most one wall thickness beyond each side, keeping both radii positive (epi > endo).
+  // At most one wall thickness beyond each side, keeping both radii positive (epi > endo, as
+  // ParseEllipsoidalFibreRule checks).
   double lo = std::max({-1.0, -0.9 * rule.endo_short / (rule.epi_short - rule.endo_short),
                         -0.9 * rule.endo_long / (rule.epi_long - rule.endo_long)});
   double hi = 2;
