@@ -2,7 +2,10 @@
 // embedded display surface following the P2 solution rather than the vertices alone — and
 // the same quadratic interpolation for probes at points.
 
+#include <cstdint>
 #include <unordered_map>
+
+#include <Eigen/LU>
 
 #include "gipsi/models/fem/mixed_solid.h"
 
@@ -102,6 +105,57 @@ void MixedSolid::CorrectDisplayPositions(DisplayGeometry& display) const {
                               vertex_positions_.col(mesh_.edges(1, edge)));
       display.positions.col(j) += display_bow_weight_[static_cast<std::size_t>(k)] * (x - mid);
     }
+}
+
+PointMap MixedSolid::MapFromNodes(const Points& targets) const {
+  PointMap straight = SimObject::MapFromNodes(targets);
+  if (mesh_.num_curved_edges == 0 || targets.cols() == 0) return straight;
+  // The straight map names its tet by the tet's four vertices in the domain's order, which is
+  // the quadratic element's (ElevateToQuadratic keeps both).
+  const Tets& tets = domain().tets;
+  auto key = [](const auto& v) {
+    std::uint64_t h = 0;
+    for (int k = 0; k < 4; ++k) h = h * 1000003ULL + static_cast<std::uint64_t>(v[k]);
+    return h;
+  };
+  std::unordered_multimap<std::uint64_t, Index> tet_of;
+  tet_of.reserve(static_cast<std::size_t>(tets.cols()));
+  for (Index e = 0; e < tets.cols(); ++e)
+    if (mesh_.IsCurved(e)) tet_of.emplace(key(tets.col(e)), e);
+  Eigen::Matrix4Xd weights = straight.weights();
+  const Points& x0 = mesh_.rest;
+  for (Index j = 0; j < targets.cols(); ++j) {
+    const auto column = straight.indices().col(j);
+    Index e = -1;
+    const auto [first, last] = tet_of.equal_range(key(column));
+    for (auto it = first; it != last && e < 0; ++it)
+      if (tets.col(it->second) == column) e = it->second;
+    if (e < 0) continue;  // a straight tet: its barycentrics are the map's own
+    Eigen::Matrix<double, 3, 10> x;
+    for (int a = 0; a < 10; ++a) x.col(a) = x0.col(mesh_.elements(a, e));
+    Eigen::Vector4d l = weights.col(j);
+    const Vec3 straight_point = x.leftCols<4>() * l;
+    const double size =
+        (x.col(1) - x.col(0)).norm() + (x.col(2) - x.col(0)).norm() + (x.col(3) - x.col(0)).norm();
+    if ((straight_point - targets.col(j)).norm() > 1e-12 * size) continue;  // outside, clamped
+    bool converged = false;
+    for (int it = 0; it < 30 && !converged; ++it) {
+      const Vec3 r = x * QuadraticTetShape(l) - targets.col(j);
+      if (r.norm() <= 1e-14 * size) {
+        converged = true;
+        break;
+      }
+      const Eigen::Matrix<double, 10, 4> d = QuadraticTetShapeDerivatives(l);
+      Mat3 jacobian;  // ∂x/∂ξ_k with ξ = (L_1, L_2, L_3), L_0 = 1 − Σ ξ
+      for (int k = 0; k < 3; ++k) jacobian.col(k) = x * (d.col(k + 1) - d.col(0));
+      const Vec3 step = jacobian.partialPivLu().solve(r);
+      if (!step.allFinite()) break;
+      l.tail<3>() -= step;
+      l[0] = 1 - l.tail<3>().sum();
+    }
+    if (converged) weights.col(j) = l;
+  }
+  return PointMap::FromWeights(straight.indices(), std::move(weights), straight.max_distance());
 }
 
 void MixedSolid::CorrectInterpolated(FieldId id, const Eigen::Matrix4Xi& nodes,

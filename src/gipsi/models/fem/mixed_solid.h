@@ -192,6 +192,12 @@ class MixedSolid final : public SimObject, public CavityWall {
   /// Where quadrature point q (0..3) of element e lies at rest (on the curved element's own
   /// map, Σ N_a X_a). Preconditions checked.
   [[nodiscard]] Vec3 QuadraturePoint(Index e, int q) const;
+  /// On a curved mesh, a target in a curved tet gets the reference point L of the tet's own
+  /// map (Σ N_a(L) X_a = target, by Newton from the straight tet's barycentrics) instead of the
+  /// straight barycentrics, so that probes, embedded displays and FieldCopy read the quadratic
+  /// field at the point itself. Straight tets, and targets outside the mesh (clamped), keep
+  /// the straight map's weights.
+  [[nodiscard]] PointMap MapFromNodes(const Points& targets) const override;
   /// The current unknowns z.
   [[nodiscard]] const VecX& unknowns() const { return state_.z; }
 
