@@ -406,11 +406,12 @@ TEST(CurvedMixedSolid, AFieldCopyMapsTheQuadraticDisplacement) {
 }
 
 // On a curved mesh a point is located on its curved tet's own map: at points Σ N_a(L) X_a of
-// the sphere octant's curved tets (random L inside each), the map's weights are L itself to
+// the sphere octant's curved tets (random L inside each, and L just inside each face, which
+// beside the bulging outer sphere lies outside the straight mesh), the map's weights are L to
 // 1e-10 and a probe of `position` at rest reads the point to 1e-12 of the radius. With the
 // straight tets' barycentrics the same probe is off by the curved tets' bows (3 % of the
-// inner radius on this coarse mesh, 38 points; asserted above 1e-7 of it, so the test sees
-// the difference).
+// inner radius on this coarse mesh; asserted above 1e-7 of it, so the test sees the
+// difference).
 TEST(CurvedMixedSolid, PointsAreLocatedOnTheCurvedTetsOwnMap) {
   Mesh mesh = ReadMesh(test::MeshData("thick_sphere_octant_0.7.msh"));
   mesh.Transform(kInner, Vec3::Zero());
@@ -424,9 +425,7 @@ TEST(CurvedMixedSolid, PointsAreLocatedOnTheCurvedTetsOwnMap) {
   std::vector<Index> tets;
   Eigen::Matrix4Xd ls(4, 0);
   Points points(3, 0);
-  for (Index e = 0; e < q.num_elements(); e += 3) {
-    if (!q.IsCurved(e)) continue;
-    Eigen::Vector4d l(unit(rng), unit(rng), unit(rng), unit(rng));
+  auto add = [&](Index e, Eigen::Vector4d l) {
     l /= l.sum();
     Vec3 x = Vec3::Zero();
     const Eigen::Matrix<double, 10, 1> n = QuadraticTetShape(l);
@@ -436,10 +435,23 @@ TEST(CurvedMixedSolid, PointsAreLocatedOnTheCurvedTetsOwnMap) {
     ls.col(ls.cols() - 1) = l;
     points.conservativeResize(3, points.cols() + 1);
     points.col(points.cols() - 1) = x;
-  }
+  };
+  for (Index e = 0; e < q.num_elements(); e += 3)
+    if (q.IsCurved(e)) add(e, Eigen::Vector4d(unit(rng), unit(rng), unit(rng), unit(rng)));
+  // Points just inside each face of the curved tets: beside the outer sphere's bulging faces
+  // they lie outside every straight tet (the straight map clamps them).
+  for (Index e = 1; e < q.num_elements(); e += 3)
+    if (q.IsCurved(e))
+      for (int face = 0; face < 4; ++face) {
+        Eigen::Vector4d l = Eigen::Vector4d::Constant(0.3);
+        l[face] = 0.002;
+        add(e, l);
+      }
   ASSERT_GT(points.cols(), 20);
   const PointMap map = solid.MapFromNodes(points);
   const PointMap straight = solid.SimObject::MapFromNodes(points);
+  EXPECT_GT(straight.max_distance(), 1e-6 * kInner);  // some points lie outside the straight tets
+  EXPECT_LT(map.max_distance(), 1e-12 * kInner);      // all of them on the curved ones
   Eigen::MatrixXd rest(3, solid.domain().num_nodes());
   solid.ReadField(solid.FindField("position"), rest);
   Eigen::MatrixXd curved_at(3, points.cols()), straight_at(3, points.cols());

@@ -124,20 +124,28 @@ PointMap MixedSolid::MapFromNodes(const Points& targets) const {
     if (mesh_.IsCurved(e)) tet_of.emplace(key(tets.col(e)), e);
   Eigen::Matrix4Xd weights = straight.weights();
   const Points& x0 = mesh_.rest;
+  const Points& corners = domain().nodes;
+  double max_distance = 0;
   for (Index j = 0; j < targets.cols(); ++j) {
     const auto column = straight.indices().col(j);
+    // How far the straight weights leave the target: zero inside the straight mesh, the
+    // clamping's offset outside it (where a curved boundary may still hold the target).
+    Vec3 straight_point = Vec3::Zero();
+    for (int k = 0; k < 4; ++k) straight_point += weights(k, j) * corners.col(column[k]);
+    const double straight_distance = (straight_point - targets.col(j)).norm();
     Index e = -1;
     const auto [first, last] = tet_of.equal_range(key(column));
     for (auto it = first; it != last && e < 0; ++it)
       if (tets.col(it->second) == column) e = it->second;
-    if (e < 0) continue;  // a straight tet: its barycentrics are the map's own
+    if (e < 0) {  // a straight tet: its barycentrics are the map's own
+      max_distance = std::max(max_distance, straight_distance);
+      continue;
+    }
     Eigen::Matrix<double, 3, 10> x;
     for (int a = 0; a < 10; ++a) x.col(a) = x0.col(mesh_.elements(a, e));
-    Eigen::Vector4d l = weights.col(j);
-    const Vec3 straight_point = x.leftCols<4>() * l;
     const double size =
         (x.col(1) - x.col(0)).norm() + (x.col(2) - x.col(0)).norm() + (x.col(3) - x.col(0)).norm();
-    if ((straight_point - targets.col(j)).norm() > 1e-12 * size) continue;  // outside, clamped
+    Eigen::Vector4d l = weights.col(j);
     bool converged = false;
     for (int it = 0; it < 30 && !converged; ++it) {
       const Vec3 r = x * QuadraticTetShape(l) - targets.col(j);
@@ -153,9 +161,18 @@ PointMap MixedSolid::MapFromNodes(const Points& targets) const {
       l.tail<3>() -= step;
       l[0] = 1 - l.tail<3>().sum();
     }
-    if (converged) weights.col(j) = l;
+    // Inside the straight mesh the curved tet's map holds the target (or, beside a curved face,
+    // its neighbour's, whose polynomial continues smoothly there); outside it, only a solution
+    // inside this curved tet is the target's, else the clamped straight weights stay.
+    const bool inside_straight = straight_distance <= 1e-12 * size;
+    if (converged && (inside_straight || l.minCoeff() >= -1e-9)) {
+      weights.col(j) = l;
+      max_distance = std::max(max_distance, (x * QuadraticTetShape(l) - targets.col(j)).norm());
+    } else {
+      max_distance = std::max(max_distance, straight_distance);
+    }
   }
-  return PointMap::FromWeights(straight.indices(), std::move(weights), straight.max_distance());
+  return PointMap::FromWeights(straight.indices(), std::move(weights), max_distance);
 }
 
 void MixedSolid::CorrectInterpolated(FieldId id, const Eigen::Matrix4Xi& nodes,

@@ -195,8 +195,9 @@ class MixedSolid final : public SimObject, public CavityWall {
   /// On a curved mesh, a target in a curved tet gets the reference point L of the tet's own
   /// map (Σ N_a(L) X_a = target, by Newton from the straight tet's barycentrics) instead of the
   /// straight barycentrics, so that probes, embedded displays and FieldCopy read the quadratic
-  /// field at the point itself. Straight tets, and targets outside the mesh (clamped), keep
-  /// the straight map's weights.
+  /// field at the point itself, also beside a curved boundary that bulges past the straight
+  /// tets. Straight tets, and targets outside the curved mesh (clamped), keep the straight
+  /// map's weights.
   [[nodiscard]] PointMap MapFromNodes(const Points& targets) const override;
   /// The current unknowns z.
   [[nodiscard]] const VecX& unknowns() const { return state_.z; }
