@@ -123,7 +123,7 @@ if [ -n "$(find "$prefix" -name 'libgipsi_parallel.so*' | head -1)" ]; then
   export OMP_NUM_THREADS=1 OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMPI_MCA_mpi_yield_when_idle=1
   mpiexec -np 2 "$prefix/bin/gipsi" run scenes/slab_ep_0.5mm.json --until 0.002 --out "$work/slab_mpi" \
     > "$work/mpi_run.log" 2>&1 || { echo "consumer-test: the installed gipsi failed on 2 ranks:" >&2; cat "$work/mpi_run.log" >&2; exit 1; }
-  grep -q "split over them: tissue (Monodomain)" "$work/mpi_run.log" ||
+  grep -q "split over them: tissue (Monodomain, in blocks)" "$work/mpi_run.log" ||
     { echo "consumer-test: the installed gipsi did not split the slab:" >&2; cat "$work/mpi_run.log" >&2; exit 1; }
   mpi_dir="$work/my_partition"
   mkdir -p "$mpi_dir"

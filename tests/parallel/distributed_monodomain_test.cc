@@ -11,11 +11,13 @@
 #include <cstdint>
 #include <memory>
 #include <numeric>
+#include <random>
 #include <set>
 
 #include "gipsi/base/error.h"
 #include "gipsi/geometry/generators.h"
 #include "gipsi/geometry/mesh_block.h"
+#include "gipsi/geometry/region.h"
 #include "gipsi/models/ep/monodomain.h"
 #include "gipsi/models/ep/ten_tusscher_panfilov_2006.h"
 #include "gipsi/parallel/distributed_monodomain.h"
@@ -107,6 +109,121 @@ TEST(WholeDomainView, ReadingItemsGivesTheWholeFieldsColumnsOnEveryRank) {
     ++checked;
   }
   EXPECT_GE(checked, 2);  // V and activation_time at least
+}
+
+// A part-only view (no whole mesh on any rank): a whole slab on every rank for reference, and
+// the view on the slab made in blocks.
+struct PartOnly {
+  std::shared_ptr<const Mesh> whole = Slab(1);
+  std::unique_ptr<WholeDomainView> view;
+  const MeshPart* part = nullptr;
+  PartOnly() {
+    auto tissue = std::make_unique<DistributedMonodomain>("tissue", SlabInBlocks(1),
+                                                          SlabParams("jacobi"), World());
+    part = &tissue->part();
+    view = std::make_unique<WholeDomainView>(std::move(tissue), *part, World());
+  }
+};
+
+// Points are located on the parts as on the whole mesh: inside (random, and the whole mesh's
+// nodes and face centroids, which lie on the parts' cuts), and outside (clamped to the nearest
+// point of the mesh). A linear field is interpolated exactly by any tet holding a point, so its
+// values tell whether the weights reproduce the serial map's; the maps are the same on every
+// rank.
+TEST(WholeDomainView, APartOnlyViewLocatesPointsAsTheWholeMesh) {
+  PartOnly s;
+  const Mesh& whole = *s.whole;
+  ASSERT_FALSE(s.view->holds_whole_domain());
+  EXPECT_EQ(s.view->domain().num_tets(), static_cast<Index>(s.part->whole_tet.size()));
+  const double diag = (whole.nodes.rowwise().maxCoeff() - whole.nodes.rowwise().minCoeff()).norm();
+  EXPECT_NEAR(s.view->WholeDiagonal(), diag, 1e-15 * diag);
+  std::mt19937 random(7);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  const Vec3 size(0.020, 0.007, 0.003);
+  Points inside(3, 0), outside(3, 6);
+  std::vector<Vec3> points;
+  for (int i = 0; i < 200; ++i)
+    points.emplace_back(size.cwiseProduct(Vec3(unit(random), unit(random), unit(random))));
+  for (Index v = 0; v < whole.num_nodes(); v += 37) points.emplace_back(whole.nodes.col(v));
+  for (Index e = 0; e < whole.num_tets(); e += 53)
+    points.emplace_back((whole.nodes.col(whole.tets(0, e)) + whole.nodes.col(whole.tets(1, e)) +
+                         whole.nodes.col(whole.tets(2, e))) /
+                        3);
+  inside.resize(3, static_cast<Index>(points.size()));
+  for (std::size_t j = 0; j < points.size(); ++j) inside.col(static_cast<Index>(j)) = points[j];
+  outside << -0.001, 0.021, 0.010, 0.005, 0.030, -0.002,  //
+      0.003, 0.004, -0.001, 0.008, 0.003, 0.009,          //
+      0.001, 0.001, 0.002, 0.0035, -0.001, 0.004;
+  const Vec3 gradient(1.0, -2.0, 3.0);
+  for (const Points* targets : {&inside, &outside}) {
+    const PointMap serial = PointMap::BarycentricInTets(whole.nodes, whole.tets, *targets);
+    const PointMap split = s.view->LocateWhole(*targets);
+    EXPECT_NEAR(split.max_distance(), serial.max_distance(), 1e-12 * diag);
+    for (Index j = 0; j < targets->cols(); ++j) {
+      Vec3 at_split = Vec3::Zero(), at_serial = Vec3::Zero();
+      for (int k = 0; k < 4; ++k) {
+        at_split += split.weights()(k, j) * whole.nodes.col(split.indices()(k, j));
+        at_serial += serial.weights()(k, j) * whole.nodes.col(serial.indices()(k, j));
+      }
+      EXPECT_LT((at_split - at_serial).norm(), 1e-12 * diag) << "point " << j;
+      EXPECT_NEAR(gradient.dot(at_split), gradient.dot(at_serial), 1e-12 * diag);
+    }
+    // The same map on every rank.
+    std::vector<double> mine(split.weights().data(),
+                             split.weights().data() + split.weights().size());
+    for (Index i = 0; i < split.indices().size(); ++i) mine.push_back(split.indices().data()[i]);
+    std::vector<double> low = mine, high = mine;
+    MPI_Allreduce(MPI_IN_PLACE, low.data(), static_cast<int>(low.size()), MPI_DOUBLE, MPI_MIN,
+                  World());
+    MPI_Allreduce(MPI_IN_PLACE, high.data(), static_cast<int>(high.size()), MPI_DOUBLE, MPI_MAX,
+                  World());
+    EXPECT_EQ(low, high);
+  }
+}
+
+// Regions select the whole mesh's nodes, on every rank the same sorted list, from the parts.
+TEST(WholeDomainView, APartOnlyViewSelectsTheWholeMeshsNodes) {
+  PartOnly s;
+  const std::vector<Region> regions = {
+      AllRegion{},
+      BoxRegion{Vec3(0.004, 0.001, 0.0), Vec3(0.011, 0.005, 0.0015)},
+      SphereRegion{Vec3(0.010, 0.0035, 0.0015), 0.003},
+      HalfSpaceRegion{Vec3(0.015, 0, 0), Vec3(1, 0.2, 0)},
+      GroupRegion{"xmax"},
+      NodeIdsRegion{{40, 3, 3, 7}}};
+  for (std::size_t r = 0; r < regions.size(); ++r) {
+    const std::vector<int> expected = SelectNodes(regions[r], *s.whole);
+    EXPECT_EQ(s.view->SelectWholeNodes(regions[r]), expected) << "region " << r;
+  }
+  EXPECT_THROW((void)s.view->SelectWholeNodes(NodeIdsRegion{{-1}}), InputError);
+  EXPECT_THROW((void)s.view->SelectWholeNodes(GroupRegion{"no such group"}), InputError);
+}
+
+// Reading whole-mesh nodes gives each node's value from its owner, on every rank: equal, bit for
+// bit, to the value any rank holding the node has (shared nodes are stepped alike).
+TEST(WholeDomainView, APartOnlyViewReadsEachNodeFromItsOwner) {
+  PartOnly s;
+  for (int step = 0; step < 300; ++step) ASSERT_TRUE(s.view->Step(1e-5).ok());  // an upstroke
+  const FieldId v = s.view->FindField("V");
+  std::vector<int> all(static_cast<std::size_t>(s.whole->num_nodes()));
+  std::iota(all.begin(), all.end(), 0);
+  std::reverse(all.begin(), all.end());
+  all.push_back(5);  // a repeated node
+  Eigen::MatrixXd values(1, static_cast<Index>(all.size()));
+  s.view->ReadWholeNodes(v, all, values);
+  Eigen::MatrixXd local(1, s.view->FieldCount(v));
+  s.view->ReadField(v, local);  // the part's own nodes
+  const auto n = static_cast<int>(s.whole->num_nodes());
+  for (std::size_t i = 0; i < s.part->whole_node.size(); ++i) {
+    const int node = s.part->whole_node[i];
+    EXPECT_EQ(std::bit_cast<std::uint64_t>(values(0, n - 1 - node)),
+              std::bit_cast<std::uint64_t>(local(0, static_cast<Index>(i))))
+        << "node " << node;
+  }
+  EXPECT_EQ(values(0, n), values(0, n - 1 - 5));
+  double low = values.minCoeff(), high = values.maxCoeff();
+  EXPECT_LT(low, -80);  // resting tissue, and
+  EXPECT_GT(high, 0);   // the stimulated corner's upstroke
 }
 
 // The headline check: the benchmark slab at 0.5 mm on 2 or 4 ranks activates every node at the

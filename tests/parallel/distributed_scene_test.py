@@ -12,7 +12,9 @@ Runs the N-version benchmark slab (scenes/slab_ep_0.5mm.json, its first 30 ms) s
     relative residual of 1e-8, which leaves at most 1e-3 ms in activation times against an
     exact solve on this slab (tests/parallel/distributed_monodomain_test.cc), so 2e-3 ms, and
     0.5 mV for V (an upstroke of at most ~250 mV/ms shifted by 2e-3 ms); measured: 1e-13;
-  - the summary names the ranks;
+  - the summary names the ranks, and that the slab is made in blocks (no rank holds it whole);
+  - region probes (a box's mean, a face group's largest activation time, a sum over node ids)
+    and a point probe where the parts meet give the serial values within those bounds;
   - the soft cantilever (scenes/cantilever.json), its FemSolid split over 2 and 4 ranks, gives
     the serial tip motion, clamp reaction and kinetic energy within 1e-6 of their scale (Newton
     to 1e-8, CG to 1e-6); measured 1e-8; and the cantilever integrated explicitly
@@ -161,7 +163,7 @@ with tempfile.TemporaryDirectory() as work:
         out = os.path.join(work, f"ranks{ranks}")
         code, text = run(ranks, out)
         check(code == 0, f"{ranks} ranks: exit {code}: {text}")
-        check(f"MPI ranks:        {ranks} (split over them: tissue (Monodomain))" in text,
+        check(f"MPI ranks:        {ranks} (split over them: tissue (Monodomain, in blocks))" in text,
               f"{ranks} ranks: the summary does not name the ranks:\n{text}")
         check(text.count("simulated time:") == 1, f"{ranks} ranks: more than one rank printed")
         expected = expected_files(files(serial), ranks)
@@ -298,6 +300,46 @@ with tempfile.TemporaryDirectory() as work:
     times = {ranks: [row[0] for row in table] for ranks, table in diverged.items()}
     check(times[1] == times[2] and len(times[1]) > 5,
           f"diverging clamp: probe rows at {times[2][-3:]} on 2 ranks, {times[1][-3:]} serially")
+    # Region probes on the slab, which no rank holds whole (nothing but probes reads it): a
+    # box's mean, the xmin face's largest activation time, a sum over node ids, and a point at
+    # the middle of the slab, where the parts meet; each within the bounds above of the serial
+    # run's (a sum of three V values: three times V's).
+    with open(SCENE) as f:
+        scene = json.load(f)
+    scene["probes"] = {
+        "box_mean": {"object": "tissue", "field": "V", "reduce": "mean",
+                     "region": {"box": {"min": [0.004, 0.001, 0], "max": [0.011, 0.005, 0.0015]}}},
+        "face_max": {"object": "tissue", "field": "activation_time", "reduce": "max",
+                     "region": {"group": "xmin"}},
+        "ids_sum": {"object": "tissue", "field": "V", "reduce": "sum",
+                    "region": {"nodes": [0, 1234, 4000]}},
+        "middle": {"object": "tissue", "fields": ["V", "activation_time"],
+                   "point": [0.01, 0.0035, 0.0015]}}
+    scene["outputs"].pop("plots", None)
+    regions = os.path.join(work, "regions.json")
+    with open(regions, "w") as f:
+        json.dump(scene, f)
+    region_runs = {}
+    for ranks in (1, 2, 4):
+        out = os.path.join(work, f"regions{ranks}")
+        code, text = run(ranks, out, "-q", scene=regions, until="0.03")
+        check(code == 0, f"region probes on {ranks} ranks: exit {code}: {text}")
+        region_runs[ranks] = out
+    for ranks in (2, 4):
+        for name in ("box_mean", "face_max", "ids_sum", "middle"):
+            a = rows(os.path.join(region_runs[1], "probes", name + ".csv"))
+            b = rows(os.path.join(region_runs[ranks], "probes", name + ".csv"))
+            check(a[0] == b[0] and len(a) == len(b) and len(a) > 2,
+                  f"{ranks} ranks, {name}: {len(b)} rows with {b[0]}, serial {len(a)} with {a[0]}")
+            worst = 0.0
+            for ra, rb in zip(a[1:], b[1:]):
+                check(ra[0] == rb[0], f"{ranks} ranks, {name}: time {rb[0]} vs serial {ra[0]}")
+                for column, x, y in zip(a[0][1:], ra[1:], rb[1:]):
+                    bound = BOUNDS[column] * (3 if name == "ids_sum" else 1)
+                    worst = max(worst, abs(float(x) - float(y)))
+                    check(abs(float(x) - float(y)) <= bound,
+                          f"{ranks} ranks, {name}.{column}: {y} vs serial {x}")
+            print(f"{ranks} ranks, region probe {name}: largest difference {worst:.3g}")
     # The object's "parallel" block chooses the distributed diffusion solver: BoomerAMG needs
     # one CG iteration per step, and fewer in all than the default Jacobi; the activated fraction
     # stays the serial one within one node of the 4,305 (the solves agree to their tolerance).

@@ -30,6 +30,11 @@ std::shared_ptr<const Mesh> ObjectBuildContext::DomainMesh() const {
   return meshes.GetMesh(node.AsString(), node);
 }
 
+MeshBlock ObjectBuildContext::DomainMeshBlock(int rank, int size) const {
+  JsonNode node = params.At("domain");
+  return meshes.GetMeshBlock(node.AsString(), node, rank, size);
+}
+
 void ConnectorBuildContext::CheckKeys(std::initializer_list<std::string_view> own) const {
   std::vector<std::string> allowed = {"type", "every", "description"};
   allowed.insert(allowed.end(), own.begin(), own.end());
@@ -87,10 +92,11 @@ std::vector<std::pair<std::string, std::string>> TypeRegistry::ListTable(
 std::unique_ptr<SimObject> TypeRegistry::CreateObject(const std::string& name,
                                                       const JsonNode& params,
                                                       const MeshProvider& meshes,
-                                                      const BuildObjectFn& build_object) const {
+                                                      const BuildObjectFn& build_object,
+                                                      bool standalone) const {
   JsonNode type = params.At("type");
   const ObjectFactory& factory = objects.Get(type.AsString(), type);
-  ObjectBuildContext context{name, params, *this, meshes, build_object};
+  ObjectBuildContext context{name, params, *this, meshes, build_object, standalone};
   auto object = factory(context);
   GIPSI_CHECK(object != nullptr, "factory for '{}' returned null", type.AsString());
   return object;

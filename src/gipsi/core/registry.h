@@ -19,6 +19,7 @@
 #include "gipsi/core/connector.h"
 #include "gipsi/core/material.h"
 #include "gipsi/core/sim_object.h"
+#include "gipsi/geometry/mesh_block.h"
 #include "gipsi/numerics/ode.h"
 
 /// Version of the plugin interface (the C++ classes and hooks a plugin builds on).
@@ -32,8 +33,10 @@
 /// Connector::failure_detail, and the ABI version tied to the package version; 12: state value
 /// types for connectors (Connector::BindState, BindNoState) and aggregates
 /// (AggregateObject::BindAggregateState, replacing SaveAggregateState), the HapticEndpoint
-/// capability; 13: SolidMaterial::ElementStressAndStiffnessBatch (a new virtual).
-#define GIPSI_PLUGIN_INTERFACE 13
+/// capability; 13: SolidMaterial::ElementStressAndStiffnessBatch (a new virtual); 14: meshes in
+/// blocks (MeshProvider::GetMeshBlock, ObjectBuildContext::standalone), the PartitionedObject
+/// capability.
+#define GIPSI_PLUGIN_INTERFACE 14
 /// What a plugin's gipsi_plugin_abi_version() returns and the loader requires: the package's
 /// major and minor version with the plugin interface, MAJOR·10⁶ + MINOR·10³ + INTERFACE. A
 /// plugin thus loads only into the release line it was built against (0.1.x, as the CMake
@@ -54,6 +57,14 @@ class MeshProvider {
   /// The mesh called `name`; throws InputError at `where` if there is none.
   [[nodiscard]] virtual std::shared_ptr<const Mesh> GetMesh(std::string_view name,
                                                             const JsonNode& where) const = 0;
+  /// Block `rank` of `size` of the mesh called `name` (geometry/mesh_block.h), for an object
+  /// split over processes. The default slices GetMesh's mesh (BlockOfMesh); the scene loader
+  /// makes a generated box's block without the whole box and does not keep a mesh it read only
+  /// to slice. Throws InputError at `where` as GetMesh.
+  [[nodiscard]] virtual MeshBlock GetMeshBlock(std::string_view name, const JsonNode& where,
+                                               int rank, int size) const {
+    return BlockOfMesh(*GetMesh(name, where), rank, size);
+  }
 };
 
 /// An object built from scene JSON with its time step (for aggregates that build their parts).
@@ -79,8 +90,16 @@ struct ObjectBuildContext {
   static const std::vector<std::string>& CommonKeys();
   /// Throws InputError for a key that is neither common nor in `own`.
   void CheckKeys(std::initializer_list<std::string_view> own) const;
+  /// Nothing else in the scene names this object (no connector, event or other object): only
+  /// probes and outputs read it, so a distributed run may split it without its whole domain
+  /// (gipsi/core/partitioned_object.h). Set by the scene loader for top-level objects; false for
+  /// the parts of aggregates.
+  bool standalone = false;
+
   /// The domain mesh named by params.domain (required).
   [[nodiscard]] std::shared_ptr<const Mesh> DomainMesh() const;
+  /// Block `rank` of `size` of that mesh (MeshProvider::GetMeshBlock).
+  [[nodiscard]] MeshBlock DomainMeshBlock(int rank, int size) const;
 };
 
 /// Everything a connector factory may use: its JSON and the objects in its scope (the scene, or
@@ -178,6 +197,12 @@ class TypeRegistry {
   FactoryTable<IntegratorFactory> integrators{"integrator"};
   FactoryTable<MaterialFactory> materials{"material law"};
 
+  /// Set by a distributed run (gipsi/parallel/): the scene loader then builds the domain mesh
+  /// of a standalone object (ObjectBuildContext::standalone) that nothing else uses only when
+  /// its factory asks for it, whole or in blocks (MeshProvider::GetMeshBlock), and keeps no
+  /// whole mesh it made only to cut blocks from. False: every mesh is built whole first.
+  bool meshes_in_blocks = false;
+
   /// The table of another kind of product, which the layer that defines the product declares
   /// (the kernel names no model concept): e.g. `CellModels(registry)` in
   /// gipsi/models/ep/cell_models.h is `registry.Table<CellModelFactory>("cell model")`. The
@@ -197,11 +222,13 @@ class TypeRegistry {
   [[nodiscard]] std::vector<std::pair<std::string, std::string>> ListTable(
       std::string_view kind) const;
 
-  /// Builds the object described by `params` (its "type" picks the factory).
+  /// Builds the object described by `params` (its "type" picks the factory);
+  /// `standalone` as ObjectBuildContext::standalone.
   [[nodiscard]] std::unique_ptr<SimObject> CreateObject(const std::string& name,
                                                         const JsonNode& params,
                                                         const MeshProvider& meshes,
-                                                        const BuildObjectFn& build_object) const;
+                                                        const BuildObjectFn& build_object,
+                                                        bool standalone = false) const;
   /// Builds the connector described by `params` within `scope`.
   [[nodiscard]] std::unique_ptr<Connector> CreateConnector(const std::string& name,
                                                            const JsonNode& params,

@@ -70,6 +70,13 @@ std::string Probe::Header() const {
   return header;
 }
 
+void Probe::ReadItems(FieldId id, Eigen::MatrixXd& values) const {
+  if (partitioned != nullptr)
+    partitioned->ReadWholeNodes(id, items, values);
+  else
+    object->ReadFieldItems(id, items, values);
+}
+
 void Probe::Sample(std::vector<double>& out) const {
   out.clear();
   if (is_line()) {
@@ -85,7 +92,7 @@ void Probe::Sample(std::vector<double>& out) const {
     for (FieldId id : fields) {
       const FieldInfo& info = object->field_info(id);
       Eigen::MatrixXd values(info.components, static_cast<Index>(items.size()));
-      object->ReadFieldItems(id, items, values);
+      ReadItems(id, values);
       Eigen::MatrixXd at_points(info.components, n);
       Interpolate(*point, info, values, at_points);
       if (info.location == FieldLocation::kNode)
@@ -104,7 +111,7 @@ void Probe::Sample(std::vector<double>& out) const {
     if (global)
       object->ReadField(id, values);
     else
-      object->ReadFieldItems(id, items, values);
+      ReadItems(id, values);
     if (global) {
       for (int c = 0; c < info.components; ++c) out.push_back(values(c, 0));
     } else if (point) {
@@ -161,6 +168,16 @@ Probe ParseProbe(const std::string& name, const JsonNode& node, const Kernel& ke
     object_node.Fail(e.what());
   }
   const SimObject& object = *probe.object;
+  // An object that holds only its part of the domain (a distributed run's) is addressed
+  // through its whole-domain calls.
+  const auto* split = dynamic_cast<const PartitionedObject*>(&object);
+  if (split != nullptr && split->holds_whole_domain()) split = nullptr;
+  probe.partitioned = split;
+  auto diagonal = [&object, split] {
+    if (split != nullptr) return split->WholeDiagonal();
+    const Mesh& mesh = object.domain();
+    return (mesh.nodes.rowwise().maxCoeff() - mesh.nodes.rowwise().minCoeff()).norm();
+  };
   std::vector<std::string> names;
   if (auto f = node.Find("field")) names.push_back(f->AsString());
   if (auto f = node.Find("fields")) {
@@ -199,10 +216,9 @@ Probe ParseProbe(const std::string& name, const JsonNode& node, const Kernel& ke
   if (auto p = node.Find("point")) {
     if (location != FieldLocation::kNode)
       p->Fail("point probes interpolate node fields; these fields are not node fields");
-    const Mesh& mesh = object.domain();
     Points target = p->AsVec3();
-    probe.point = object.MapFromNodes(target);
-    const double diag = (mesh.nodes.rowwise().maxCoeff() - mesh.nodes.rowwise().minCoeff()).norm();
+    probe.point = split != nullptr ? split->LocateWhole(target) : object.MapFromNodes(target);
+    const double diag = diagonal();
     if (probe.point->max_distance() > 1e-6 * diag)
       p->Fail(fmt::format("the point lies {:.4g} outside the domain of '{}'",
                           probe.point->max_distance(), object.path()));
@@ -230,9 +246,9 @@ Probe ParseProbe(const std::string& name, const JsonNode& node, const Kernel& ke
       probe.line.col(j) = (1 - s) * from + s * to;
       probe.distance[std::size_t(j)] = s * (to - from).norm();
     }
-    probe.point = object.MapFromNodes(probe.line);
-    const Mesh& mesh = object.domain();
-    const double diag = (mesh.nodes.rowwise().maxCoeff() - mesh.nodes.rowwise().minCoeff()).norm();
+    probe.point =
+        split != nullptr ? split->LocateWhole(probe.line) : object.MapFromNodes(probe.line);
+    const double diag = diagonal();
     if (probe.point->max_distance() > 1e-6 * diag)
       l->Fail(fmt::format("the line leaves the domain of '{}' (a point lies {:.4g} outside it)",
                           object.path(), probe.point->max_distance()));
@@ -252,9 +268,15 @@ Probe ParseProbe(const std::string& name, const JsonNode& node, const Kernel& ke
   } else if (auto r = node.Find("region")) {
     probe.region = true;
     Region region = ParseRegion(*r);
+    if (location == FieldLocation::kBoundaryVertex && split != nullptr)
+      r->Fail(fmt::format(
+          "region probes of boundary fields are not offered on '{}', split over the processes "
+          "without its whole mesh (probe a node field)",
+          object.path()));
     try {
       if (location == FieldLocation::kNode)
-        probe.items = SelectNodes(region, object.domain());
+        probe.items = split != nullptr ? split->SelectWholeNodes(region)
+                                       : SelectNodes(region, object.domain());
       else if (location == FieldLocation::kBoundaryVertex)
         probe.items = SelectBoundaryVertices(region, object.domain(), object.boundary());
       else

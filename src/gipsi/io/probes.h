@@ -33,6 +33,7 @@
 #include "gipsi/base/export.h"
 #include "gipsi/base/json_node.h"
 #include "gipsi/core/kernel.h"
+#include "gipsi/core/partitioned_object.h"
 #include "gipsi/geometry/mapping.h"
 
 GIPSI_EXPORT_BEGIN
@@ -56,6 +57,9 @@ struct Probe {
   /// Line probes: sample times [s], ascending; empty = once, at the end of the run.
   std::vector<double> at;
   std::vector<int> items;  ///< node or boundary-vertex ids read by each sample
+  /// Set when the object holds only its part of the domain (a distributed run's object without
+  /// its whole mesh): `items` and `point`'s nodes are then whole-domain node ids, read through it.
+  const PartitionedObject* partitioned = nullptr;
   bool region = false;
   Reduce reduce = Reduce::kMean;
   double every = 0;
@@ -67,6 +71,10 @@ struct Probe {
   /// Current values, one per column after time (line probes: all rows, row after row, each
   /// starting with distance, x, y, z).
   void Sample(std::vector<double>& out) const;
+
+ private:
+  // The values of field `id` at `items` (through `partitioned` when set).
+  void ReadItems(FieldId id, Eigen::MatrixXd& values) const;
 };
 
 /// Parses and resolves one probe; throws InputError naming the JSON path (unknown object or

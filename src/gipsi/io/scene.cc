@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cstdlib>
 #include <fstream>
+#include <functional>
+#include <set>
 #include <sstream>
 
 #include <fmt/format.h>
@@ -17,6 +19,28 @@
 namespace gipsi {
 namespace {
 
+/// The keys of a "meshes" entry, and the ones that exclude each other.
+void CheckMeshEntry(const JsonNode& node) {
+  node.CheckKeys({"file",         "generate", "scale",         "translate", "min",
+                  "max",          "cells",    "origin",        "u",         "v",
+                  "endo",         "epi",      "base_z",        "size",      "inner_radius",
+                  "outer_radius", "height",   "tets_per_cell", "surface",   "description",
+                  "nodes",        "tets",     "triangles",     "order"});
+  if (int(node.Has("file")) + int(node.Has("generate")) + int(node.Has("nodes")) != 1)
+    node.Fail("expected exactly one of 'file', 'generate', 'nodes'");
+  if (auto order = node.Find("order")) {
+    const auto gen = node.Find("generate");
+    const std::string kind = gen && gen->is_string() ? gen->AsString() : "";
+    if (kind != "ellipsoid_shell" && kind != "cylinder_shell")
+      order->Fail(
+          "only the generators \"ellipsoid_shell\" and \"cylinder_shell\" take 'order' (a "
+          "Gmsh file's elements have their own)");
+  }
+  if (!node.Has("nodes"))
+    for (const char* key : {"tets", "triangles"})
+      if (node.Has(key)) node.At(key).Fail("only a mesh given by its 'nodes' takes this key");
+}
+
 std::array<int, 3> Cells3(const JsonNode& node) {
   auto v = node.AsInts();
   if (v.size() != 3) node.Expected("an array of 3 positive integers");
@@ -29,20 +53,116 @@ std::array<int, 3> Cells3(const JsonNode& node) {
   return out;
 }
 
+/// The scene's meshes. Each is built whole when the "meshes" section is read, except, when the
+/// registry asks for meshes in blocks (a distributed run), the domain of a standalone object
+/// that nothing else uses: that one is built when its object asks for it, whole (GetMesh) or as
+/// one process's block (GetMeshBlock), and a block is made without keeping the whole mesh.
 class SceneMeshes final : public MeshProvider {
  public:
-  explicit SceneMeshes(const std::map<std::string, std::shared_ptr<const Mesh>>& meshes)
-      : meshes_(meshes) {}
+  using StageFn = std::function<void(const std::string& name, const JsonNode& node)>;
+  SceneMeshes(std::map<std::string, std::shared_ptr<const Mesh>>& meshes,
+              std::filesystem::path base_dir, const SceneLimits& limits, StageFn stage)
+      : meshes_(meshes),
+        base_dir_(std::move(base_dir)),
+        limits_(limits),
+        stage_(std::move(stage)) {}
+
+  /// Builds the mesh `name` now.
+  void Build(const std::string& name, const JsonNode& node) const {
+    stage_(name, node);
+    auto mesh = std::make_shared<const Mesh>(BuildMesh(node, base_dir_));
+    CheckSize(node, mesh->num_nodes(), mesh->num_tets() + mesh->num_triangles());
+    meshes_[name] = std::move(mesh);
+  }
+  /// Leaves the mesh `name` to be built when it is asked for.
+  void Defer(const std::string& name, const JsonNode& node) { deferred_.emplace(name, node); }
+  /// Builds the deferred meshes nobody asked for (so a mistake in them is still reported).
+  void BuildTheRest() {
+    for (const auto& [name, node] : deferred_)
+      if (!meshes_.count(name) && !in_blocks_.count(name)) Build(name, node);
+  }
+
   std::shared_ptr<const Mesh> GetMesh(std::string_view name, const JsonNode& where) const override {
     auto it = meshes_.find(std::string(name));
     if (it != meshes_.end()) return it->second;
-    std::vector<std::string> names;
-    for (const auto& [n, m] : meshes_) names.push_back(n);
-    where.Fail(fmt::format("no mesh named '{}'{} in 'meshes'", name, SuggestClosest(name, names)));
+    if (auto d = deferred_.find(std::string(name)); d != deferred_.end()) {
+      Build(d->first, d->second);
+      return meshes_.at(d->first);
+    }
+    FailUnknown(name, where);
+  }
+
+  MeshBlock GetMeshBlock(std::string_view name, const JsonNode& where, int rank,
+                         int size) const override {
+    auto d = deferred_.find(std::string(name));
+    if (d == deferred_.end() || meshes_.count(d->first))
+      return MeshProvider::GetMeshBlock(name, where, rank, size);
+    const JsonNode& node = d->second;
+    if (!in_blocks_.count(d->first)) stage_(d->first, node);
+    in_blocks_.insert(d->first);
+    MeshBlock block;
+    const auto generate = node.Find("generate");
+    if (generate && generate->is_string() && generate->AsString() == "box") {
+      block = BoxBlock(node, rank, size);
+    } else {  // read whole, sliced, not kept
+      const Mesh whole = BuildMesh(node, base_dir_);
+      CheckSize(node, whole.num_nodes(), whole.num_tets() + whole.num_triangles());
+      block = BlockOfMesh(whole, rank, size);
+    }
+    CheckSize(node, block.num_nodes, block.num_tets + block.num_triangles);
+    return block;
   }
 
  private:
-  const std::map<std::string, std::shared_ptr<const Mesh>>& meshes_;
+  [[noreturn]] void FailUnknown(std::string_view name, const JsonNode& where) const {
+    std::vector<std::string> names;
+    for (const auto& [n, m] : meshes_) names.push_back(n);
+    for (const auto& [n, m] : deferred_)
+      if (!meshes_.count(n)) names.push_back(n);
+    std::sort(names.begin(), names.end());
+    where.Fail(fmt::format("no mesh named '{}'{} in 'meshes'", name, SuggestClosest(name, names)));
+  }
+
+  // A generated box's block, made without the whole box (BuildMesh's box, then its transform).
+  MeshBlock BoxBlock(const JsonNode& node, int rank, int size) const {
+    CheckMeshEntry(node);
+    HexSplit split = HexSplit::kSix;
+    if (auto per_cell = node.Find("tets_per_cell")) {
+      const std::int64_t n = per_cell->AsInt();
+      if (n != 5 && n != 6) per_cell->Expected("5 or 6");
+      split = n == 5 ? HexSplit::kFive : HexSplit::kSix;
+    }
+    MeshBlock block;
+    try {
+      block = MakeTetBoxBlock(node.Vector3("min"), node.Vector3("max"), Cells3(node.At("cells")),
+                              split, rank, size);
+    } catch (const InputError& e) {
+      std::string what = e.what();
+      if (what.rfind(node.file(), 0) == 0) throw;  // already located
+      node.Fail(what);
+    }
+    const auto scale = node.Find("scale");
+    const auto translate = node.Find("translate");
+    if (scale || translate)
+      block.nodes = ((scale ? scale->AsPositive() : 1.0) * block.nodes).colwise() +
+                    (translate ? translate->AsVec3() : Vec3::Zero());
+    return block;
+  }
+
+  void CheckSize(const JsonNode& node, std::int64_t nodes, std::int64_t cells) const {
+    if (std::max(nodes, cells) > limits_.max_mesh_cells)
+      node.Fail(
+          fmt::format("the mesh has {} nodes and {} cells, over the limit of {} (raise it with "
+                      "`gipsi run --max-mesh-cells` if the scene is trusted)",
+                      nodes, cells, limits_.max_mesh_cells));
+  }
+
+  std::map<std::string, std::shared_ptr<const Mesh>>& meshes_;
+  std::filesystem::path base_dir_;
+  const SceneLimits& limits_;
+  StageFn stage_;
+  std::map<std::string, JsonNode> deferred_;
+  mutable std::set<std::string> in_blocks_;
 };
 
 /// Builds objects with the keys every object shares (dt, boundary_conditions, display).
@@ -54,10 +174,11 @@ class ObjectBuilder {
     fn_ = [this](const std::string& name, const JsonNode& node) { return Build(name, node); };
   }
 
-  BuiltObject Build(const std::string& name, const JsonNode& node) {
+  /// `standalone` as ObjectBuildContext::standalone (false for the parts of aggregates).
+  BuiltObject Build(const std::string& name, const JsonNode& node, bool standalone = false) {
     if (name.empty() || name.find_first_of("./ ") != std::string::npos)
       node.Fail(fmt::format("object name '{}' must be non-empty without '.', '/' or spaces", name));
-    auto object = registry_.CreateObject(name, node, meshes_, fn_);
+    auto object = registry_.CreateObject(name, node, meshes_, fn_, standalone);
     double dt = default_dt_;
     if (auto d = node.Find("dt")) dt = ReadPositiveQuantity(*d, "s");
     if (!(dt > 0)) node.Fail("missing required key 'dt' (and schedule.dt is not set)");
@@ -299,28 +420,70 @@ int GeneratedOrder(const JsonNode& node) {
   return static_cast<int>(value);
 }
 
+// Whether `node` holds, at any depth, a string that names the object `name` ("name", or a
+// dotted path from it: "name.field", "name.part.field").
+bool Names(const JsonNode& node, const std::string& name) {
+  if (node.is_string()) {
+    const std::string& s = node.raw().get_ref<const std::string&>();
+    return s == name || (s.size() > name.size() && s.compare(0, name.size(), name) == 0 &&
+                         s[name.size()] == '.');
+  }
+  if (node.is_object()) {
+    for (const auto& [key, value] : node.Members())
+      if (Names(value, name)) return true;
+  } else if (node.is_array()) {
+    for (const auto& item : node.Items())
+      if (Names(item, name)) return true;
+  }
+  return false;
+}
+
+// The top-level objects that no connector, event or other object names
+// (ObjectBuildContext::standalone): only probes, outputs and the schedule's order may name them.
+std::set<std::string> StandaloneObjects(const JsonNode& root) {
+  std::set<std::string> out;
+  const JsonNode objects = root.At("objects");
+  std::vector<JsonNode> others;
+  if (auto connectors = root.Find("connectors")) others.push_back(*connectors);
+  if (auto schedule = root.Find("schedule"); schedule && schedule->is_object())
+    if (auto events = schedule->Find("events")) others.push_back(*events);
+  for (const auto& [name, node] : objects.Members()) {
+    bool named = std::any_of(others.begin(), others.end(),
+                             [&name](const JsonNode& other) { return Names(other, name); });
+    for (const auto& [other, other_node] : objects.Members())
+      if (other != name && Names(other_node, name)) named = true;
+    if (!named) out.insert(name);
+  }
+  return out;
+}
+
+// The meshes that standalone objects alone use, as their "domain" only: a distributed run
+// builds them when their object asks for them (whole, or in blocks). A mesh any other key of any
+// object names (a display mesh, another object's domain) is built whole first.
+std::set<std::string> DeferrableMeshes(const JsonNode& objects,
+                                       const std::set<std::string>& standalone) {
+  std::set<std::string> out;
+  for (const auto& [name, node] : objects.Members()) {
+    if (!standalone.count(name) || !node.is_object() || !node.Has("domain") ||
+        !node.At("domain").is_string())
+      continue;
+    const std::string mesh = node.At("domain").AsString();
+    bool used_otherwise = false;
+    for (const auto& [other, other_node] : objects.Members()) {
+      if (!other_node.is_object()) continue;
+      for (const auto& [key, value] : other_node.Members())
+        if (!(other == name && key == "domain") && Names(value, mesh)) used_otherwise = true;
+    }
+    if (!used_otherwise) out.insert(mesh);
+  }
+  return out;
+}
+
 }  // namespace
 
 Mesh BuildMesh(const JsonNode& node, const std::filesystem::path& base_dir) {
-  node.CheckKeys({"file",         "generate", "scale",         "translate", "min",
-                  "max",          "cells",    "origin",        "u",         "v",
-                  "endo",         "epi",      "base_z",        "size",      "inner_radius",
-                  "outer_radius", "height",   "tets_per_cell", "surface",   "description",
-                  "nodes",        "tets",     "triangles",     "order"});
+  CheckMeshEntry(node);
   Mesh mesh;
-  if (int(node.Has("file")) + int(node.Has("generate")) + int(node.Has("nodes")) != 1)
-    node.Fail("expected exactly one of 'file', 'generate', 'nodes'");
-  if (auto order = node.Find("order")) {
-    const auto gen = node.Find("generate");
-    const std::string kind = gen && gen->is_string() ? gen->AsString() : "";
-    if (kind != "ellipsoid_shell" && kind != "cylinder_shell")
-      order->Fail(
-          "only the generators \"ellipsoid_shell\" and \"cylinder_shell\" take 'order' (a "
-          "Gmsh file's elements have their own)");
-  }
-  if (!node.Has("nodes"))
-    for (const char* key : {"tets", "triangles"})
-      if (node.Has(key)) node.At(key).Fail("only a mesh given by its 'nodes' takes this key");
   if (node.Has("nodes")) {
     mesh = InlineMesh(node);
   } else if (auto file = node.Find("file")) {
@@ -441,24 +604,29 @@ Scene LoadSceneFromString(std::string_view text, const std::string& name,
     }
   }
 
-  if (auto meshes = root.Find("meshes")) {
-    for (const auto& [mesh_name, node] : meshes->Members()) {
-      stage(fmt::format("mesh '{}'{}", mesh_name,
+  SceneMeshes mesh_provider(
+      scene.meshes, base_dir, limits, [&stage](const std::string& mesh_name, const JsonNode& node) {
+        stage(
+            fmt::format("mesh '{}'{}", mesh_name,
                         node.is_object() && node.Has("generate") && node.At("generate").is_string()
                             ? " (generate " + node.At("generate").AsString() + ")"
                             : ""));
-      auto mesh = std::make_shared<const Mesh>(BuildMesh(node, base_dir));
-      const std::int64_t cells = mesh->num_tets() + mesh->num_triangles();
-      const std::int64_t most = std::max<std::int64_t>(mesh->num_nodes(), cells);
-      if (most > limits.max_mesh_cells)
-        node.Fail(
-            fmt::format("the mesh has {} nodes and {} cells, over the limit of {} (raise it with "
-                        "`gipsi run --max-mesh-cells` if the scene is trusted)",
-                        mesh->num_nodes(), cells, limits.max_mesh_cells));
-      scene.meshes[mesh_name] = std::move(mesh);
+      });
+  // Top-level objects nothing else names; in a distributed run, the meshes only they use.
+  std::set<std::string> standalone;
+  std::set<std::string> deferrable;
+  if (auto objects = root.Find("objects"); objects && objects->is_object()) {
+    standalone = StandaloneObjects(root);
+    if (registry.meshes_in_blocks) deferrable = DeferrableMeshes(*objects, standalone);
+  }
+  if (auto meshes = root.Find("meshes")) {
+    for (const auto& [mesh_name, node] : meshes->Members()) {
+      if (deferrable.count(mesh_name))
+        mesh_provider.Defer(mesh_name, node);
+      else
+        mesh_provider.Build(mesh_name, node);
     }
   }
-  SceneMeshes mesh_provider(scene.meshes);
 
   JsonNode schedule = root.At("schedule");
   schedule.CheckKeys({"end", "dt", "order", "events", "on_failure"});
@@ -473,13 +641,14 @@ Scene LoadSceneFromString(std::string_view text, const std::string& name,
                       node.is_object() && node.Has("type") && node.At("type").is_string()
                           ? " (" + node.At("type").AsString() + ")"
                           : ""));
-    BuiltObject built = builder.Build(object_name, node);
+    BuiltObject built = builder.Build(object_name, node, standalone.count(object_name) > 0);
     try {
       scene.kernel->coordinator().AddObject(std::move(built.object), built.dt);
     } catch (const InputError& e) {
       node.Fail(e.what());
     }
   }
+  mesh_provider.BuildTheRest();
   stage("connectors");
   if (auto connectors = root.Find("connectors")) {
     for (const auto& [connector_name, node] : connectors->Members()) {

@@ -21,10 +21,35 @@ void RegisterDistributedTypes(TypeRegistry& registry, MPI_Comm comm,
   auto note = [split](const std::string& name, const char* type) {
     if (split) split->push_back(fmt::format("{} ({})", name, type));
   };
+  registry.meshes_in_blocks = true;
   registry.objects.Replace(
       "Monodomain", [comm, note](const ObjectBuildContext& ctx) -> std::unique_ptr<SimObject> {
         CheckEpTissueKeys(ctx, {"parallel"});
         EpTissueParams params = ParseEpTissueParams(ctx);
+        // Nothing but probes and outputs reads it: its mesh is made in blocks and no rank holds
+        // it whole (a Laplace fibre rule and an embedded display need the whole mesh).
+        const auto display = ctx.params.Find("display");
+        if (ctx.standalone && !params.fibre_rule && !ctx.params.Has("boundary_conditions") &&
+            !(display && display->is_object() && display->Has("mesh"))) {
+          int rank = 0, size = 1;
+          MPI_Comm_rank(comm, &rank);
+          MPI_Comm_size(comm, &size);
+          auto block = std::make_unique<MeshBlock>(ctx.DomainMeshBlock(rank, size));
+          try {
+            if (block->num_tets == 0)
+              throw InputError(
+                  "the Monodomain object needs a tetrahedral domain mesh (this one has none)");
+            MeshPart cut = PartitionMeshBlocks(*block, comm);
+            block.reset();  // before the object allocates its state
+            auto part = std::make_unique<DistributedMonodomain>(ctx.name, std::move(cut),
+                                                                std::move(params), comm);
+            const MeshPart& mesh_part = part->part();
+            note(ctx.name, "Monodomain, in blocks");
+            return std::make_unique<WholeDomainView>(std::move(part), mesh_part, comm);
+          } catch (const InputError& e) {
+            ctx.params.Fail(e.what());
+          }
+        }
         std::shared_ptr<const Mesh> whole = ctx.DomainMesh();
         try {
           auto part =

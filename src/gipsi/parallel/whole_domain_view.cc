@@ -7,11 +7,14 @@
 
 #include <algorithm>
 #include <array>
+#include <limits>
 #include <numeric>
+#include <variant>
 
 #include "gipsi/base/error.h"
 #include "gipsi/base/state.h"
 #include "gipsi/geometry/boundary.h"
+#include "gipsi/geometry/region.h"
 
 namespace gipsi {
 
@@ -55,6 +58,40 @@ WholeDomainView::WholeDomainView(std::unique_ptr<SimObject> part, const MeshPart
   // Every local tet is this rank's own (tets are not shared).
   elements_ = MakeLayout(mesh_part_.whole_tet,
                          static_cast<std::int64_t>(mesh_part_.whole_tet.size()), comm_);
+  Describe();
+  if (boundary) MapBoundary(std::move(*boundary));
+}
+
+WholeDomainView::WholeDomainView(std::unique_ptr<SimObject> part, const MeshPart& mesh_part,
+                                 MPI_Comm comm)
+    : SimObject(std::string(part->name())),
+      part_(std::move(part)),
+      mesh_part_(mesh_part),
+      comm_(comm),
+      part_only_(true) {
+  SetGeometry(mesh_part_.mesh, part_->boundary());
+  for (std::size_t f = 0; f < part_->fields().size(); ++f) {
+    DeclareField(part_->fields()[f]);
+    part_field_.emplace_back(static_cast<std::int64_t>(f));
+  }
+  // ReadWholeNodes finds the owned nodes by binary search in their whole-mesh indices.
+  GIPSI_CHECK(std::is_sorted(mesh_part_.whole_node.begin(),
+                             mesh_part_.whole_node.begin() + mesh_part_.num_owned),
+              "'{}': the owned nodes are not in the whole mesh's order", name());
+  Describe();
+}
+
+void WholeDomainView::Describe() {
+  const Points& x = mesh_part_.mesh->nodes;
+  Vec3 low = Vec3::Constant(std::numeric_limits<double>::infinity()), high = -low;
+  if (x.cols() > 0) {
+    low = x.rowwise().minCoeff();
+    high = x.rowwise().maxCoeff();
+  }
+  MPI_Allreduce(MPI_IN_PLACE, low.data(), 3, MPI_DOUBLE, MPI_MIN, comm_);
+  MPI_Allreduce(MPI_IN_PLACE, high.data(), 3, MPI_DOUBLE, MPI_MAX, comm_);
+  whole_diagonal_ = (high - low).norm();
+  region_tolerance_ = RegionTolerance(low, high);
   // FNV-1a over the local nodes' and tets' whole-mesh indices and the owned count: the same
   // number only for the same cut of the same mesh (checkpoints, RestoreObjectState).
   std::uint64_t h = 14695981039346656037ULL;
@@ -69,7 +106,111 @@ WholeDomainView::WholeDomainView(std::unique_ptr<SimObject> part, const MeshPart
   add(-1);
   for (const int i : mesh_part_.whole_tet) add(i);
   partition_fingerprint_ = h;
-  if (boundary) MapBoundary(std::move(*boundary));
+}
+
+PointMap WholeDomainView::LocateWhole(const Points& targets) const {
+  if (!part_only_) return MapFromNodes(targets);
+  const Mesh& mesh = *mesh_part_.mesh;
+  const PointMap local = PointMap::BarycentricInTets(mesh.nodes, mesh.tets, targets);
+  const Index n = targets.cols();
+  // Each point from the rank whose part is nearest to it (0 inside), the lowest on a tie.
+  struct Nearest {
+    double distance;
+    int rank;
+  };
+  std::vector<Nearest> nearest(static_cast<std::size_t>(n));
+  for (Index j = 0; j < n; ++j) {
+    Vec3 at = Vec3::Zero();
+    for (int k = 0; k < 4; ++k) at += local.weights()(k, j) * mesh.nodes.col(local.indices()(k, j));
+    nearest[static_cast<std::size_t>(j)] = {(at - targets.col(j)).norm(), mesh_part_.rank};
+  }
+  MPI_Allreduce(MPI_IN_PLACE, nearest.data(), static_cast<int>(n), MPI_DOUBLE_INT, MPI_MINLOC,
+                comm_);
+  // The chosen rank's weights and whole-mesh nodes, zero elsewhere: the sums are its values.
+  Eigen::Matrix4Xi nodes = Eigen::Matrix4Xi::Zero(4, n);
+  Eigen::Matrix4Xd weights = Eigen::Matrix4Xd::Zero(4, n);
+  double farthest = 0;
+  for (Index j = 0; j < n; ++j) {
+    const Nearest& p = nearest[static_cast<std::size_t>(j)];
+    farthest = std::max(farthest, p.distance);
+    if (p.rank != mesh_part_.rank) continue;
+    for (int k = 0; k < 4; ++k) {
+      nodes(k, j) = mesh_part_.whole_node[static_cast<std::size_t>(local.indices()(k, j))];
+      weights(k, j) = local.weights()(k, j);
+    }
+  }
+  MPI_Allreduce(MPI_IN_PLACE, nodes.data(), static_cast<int>(nodes.size()), MPI_INT, MPI_SUM,
+                comm_);
+  MPI_Allreduce(MPI_IN_PLACE, weights.data(), static_cast<int>(weights.size()), MPI_DOUBLE, MPI_SUM,
+                comm_);
+  return PointMap::FromWeights(std::move(nodes), std::move(weights), farthest);
+}
+
+std::vector<int> WholeDomainView::SelectWholeNodes(const Region& region) const {
+  if (!part_only_) return SelectNodes(region, domain());
+  if (const auto* ids = std::get_if<NodeIdsRegion>(&region)) {
+    std::vector<int> out = ids->ids;
+    for (std::size_t i = 0; i < out.size(); ++i)
+      if (out[i] < 0 || out[i] >= mesh_part_.num_global_nodes)
+        throw InputError(fmt::format("node id {} (ids[{}]) out of range [0, {})", out[i], i,
+                                     mesh_part_.num_global_nodes));
+    std::sort(out.begin(), out.end());
+    out.erase(std::unique(out.begin(), out.end()), out.end());
+    return out;
+  }
+  std::vector<int> mine;
+  for (const int node : SelectNodes(region, *mesh_part_.mesh, region_tolerance_))
+    if (node < mesh_part_.num_owned)  // each node from its owner
+      mine.push_back(mesh_part_.whole_node[static_cast<std::size_t>(node)]);
+  const int count = static_cast<int>(mine.size());
+  std::vector<int> counts(static_cast<std::size_t>(mesh_part_.size)),
+      offsets(static_cast<std::size_t>(mesh_part_.size), 0);
+  MPI_Allgather(&count, 1, MPI_INT, counts.data(), 1, MPI_INT, comm_);
+  std::partial_sum(counts.begin(), counts.end() - 1, offsets.begin() + 1);
+  std::vector<int> out(static_cast<std::size_t>(offsets.back() + counts.back()));
+  MPI_Allgatherv(mine.data(), count, MPI_INT, out.data(), counts.data(), offsets.data(), MPI_INT,
+                 comm_);
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+void WholeDomainView::ReadWholeNodes(FieldId id, std::span<const int> nodes,
+                                     Eigen::Ref<Eigen::MatrixXd> out) const {
+  if (!part_only_) {
+    ReadFieldItems(id, nodes, out);
+    return;
+  }
+  const FieldId part_id = part_field_[static_cast<std::size_t>(id.value())];
+  const FieldInfo& info = part_->field_info(part_id);
+  GIPSI_CHECK(info.location == FieldLocation::kNode, "'{}': field '{}' is not a node field", name(),
+              info.name);
+  const int c = info.components;
+  GIPSI_CHECK(out.rows() == c && out.cols() == static_cast<Index>(nodes.size()));
+  // The asked nodes this rank owns, read from the part; every other entry zero, so the sum
+  // over the ranks is each node's owner's value.
+  const auto owned_begin = mesh_part_.whole_node.begin();
+  const auto owned_end = owned_begin + mesh_part_.num_owned;
+  local_items_.clear();
+  positions_.clear();
+  for (std::size_t k = 0; k < nodes.size(); ++k) {
+    const auto it = std::lower_bound(owned_begin, owned_end, nodes[k]);
+    if (it == owned_end || *it != nodes[k]) continue;
+    local_items_.push_back(static_cast<int>(it - owned_begin));
+    positions_.push_back(static_cast<int>(k));
+  }
+  local_.resize(c, static_cast<Index>(local_items_.size()));
+  part_->ReadFieldItems(part_id, local_items_, local_);
+  receive_.assign(nodes.size() * static_cast<std::size_t>(c), 0.0);
+  for (std::size_t i = 0; i < positions_.size(); ++i)
+    for (int j = 0; j < c; ++j)
+      receive_[static_cast<std::size_t>(positions_[i]) * static_cast<std::size_t>(c) +
+               static_cast<std::size_t>(j)] = local_(j, static_cast<Index>(i));
+  MPI_Allreduce(MPI_IN_PLACE, receive_.data(), static_cast<int>(receive_.size()), MPI_DOUBLE,
+                MPI_SUM, comm_);
+  for (std::size_t k = 0; k < nodes.size(); ++k)
+    for (int j = 0; j < c; ++j)
+      out(j, static_cast<Index>(k)) =
+          receive_[k * static_cast<std::size_t>(c) + static_cast<std::size_t>(j)];
 }
 
 void WholeDomainView::SaveObjectState(StateWriter& out) const {
@@ -232,7 +373,7 @@ StepStatus WholeDomainView::DoStep(double t, double dt) {
 void WholeDomainView::DoReadField(FieldId id, Eigen::Ref<Eigen::MatrixXd> out) const {
   const FieldId part_id = part_field_[static_cast<std::size_t>(id.value())];
   const FieldInfo& info = part_->field_info(part_id);
-  if (info.location == FieldLocation::kGlobal) {
+  if (info.location == FieldLocation::kGlobal || part_only_) {
     part_->ReadField(part_id, out);
     return;
   }
@@ -259,6 +400,10 @@ void WholeDomainView::DoReadField(FieldId id, Eigen::Ref<Eigen::MatrixXd> out) c
 void WholeDomainView::DoReadFieldItems(FieldId id, std::span<const int> items,
                                        Eigen::Ref<Eigen::MatrixXd> out) const {
   const FieldId part_id = part_field_[static_cast<std::size_t>(id.value())];
+  if (part_only_) {
+    part_->ReadFieldItems(part_id, items, out);
+    return;
+  }
   const FieldInfo& info = part_->field_info(part_id);
   const Layout& layout = LayoutOf(info.location);
   const int c = info.components;
@@ -300,7 +445,7 @@ void WholeDomainView::DoReadFieldItems(FieldId id, std::span<const int> items,
 void WholeDomainView::DoWriteField(FieldId id, const Eigen::Ref<const Eigen::MatrixXd>& in) {
   const FieldId part_id = part_field_[static_cast<std::size_t>(id.value())];
   const FieldInfo& info = part_->field_info(part_id);
-  if (info.location == FieldLocation::kGlobal) {
+  if (info.location == FieldLocation::kGlobal || part_only_) {
     part_->WriteField(part_id, in);
     return;
   }

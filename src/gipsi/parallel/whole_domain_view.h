@@ -16,6 +16,12 @@
 /// time and step, so a checkpoint restores only on the rank count and partition that wrote it, and
 /// a set of files from different checkpoints (a run stopped while writing them) is refused.
 ///
+/// Without the whole mesh (the second constructor: a "part-only" view, for an object nothing
+/// but probes and outputs reads, ObjectBuildContext::standalone) the view's domain and boundary
+/// are the part's, its fields are the part's local ones, and probes address the whole mesh's
+/// nodes through its PartitionedObject calls (collective; the whole mesh's indices are the
+/// part's `whole_node`). No rank then holds anything of the size of the whole mesh.
+///
 /// Every rank must make the same calls in the same order (they do when every rank runs the
 /// same kernel on the same scene). The whole-field gathers make ReadField the simple path, not
 /// the scalable one: VTU series write the part as one piece per rank instead (output_piece),
@@ -32,6 +38,7 @@
 
 #include "gipsi/base/export.h"
 #include "gipsi/core/cavity_law.h"
+#include "gipsi/core/partitioned_object.h"
 #include "gipsi/core/sim_object.h"
 #include "gipsi/parallel/mesh_partition.h"
 
@@ -40,7 +47,7 @@ namespace gipsi {
 
 /// Not copyable or movable (a SimObject). A CavityWall when its part is one (a FemSolid with
 /// cavities): the calls go to the part.
-class WholeDomainView final : public SimObject, public CavityWall {
+class WholeDomainView final : public SimObject, public CavityWall, public PartitionedObject {
  public:
   /// Where the part's boundary lies on the whole mesh's (MakeBoundary): the whole boundary
   /// vertex of each part boundary vertex, the whole face of each part face. Plain struct.
@@ -57,6 +64,17 @@ class WholeDomainView final : public SimObject, public CavityWall {
   WholeDomainView(std::unique_ptr<SimObject> part, const MeshPart& mesh_part,
                   std::shared_ptr<const Mesh> whole, MPI_Comm comm,
                   std::optional<BoundaryMap> boundary = std::nullopt);
+  /// A part-only view (see the file comment): `part` on `mesh_part.mesh` (which must outlive
+  /// the view), no whole mesh on any rank. Collective.
+  WholeDomainView(std::unique_ptr<SimObject> part, const MeshPart& mesh_part, MPI_Comm comm);
+
+  /// PartitionedObject: false for a part-only view. The calls below work in both kinds.
+  [[nodiscard]] bool holds_whole_domain() const override { return !part_only_; }
+  [[nodiscard]] double WholeDiagonal() const override { return whole_diagonal_; }
+  [[nodiscard]] PointMap LocateWhole(const Points& targets) const override;
+  [[nodiscard]] std::vector<int> SelectWholeNodes(const Region& region) const override;
+  void ReadWholeNodes(FieldId id, std::span<const int> nodes,
+                      Eigen::Ref<Eigen::MatrixXd> out) const override;
 
   [[nodiscard]] std::string_view type_name() const override { return part_->type_name(); }
   [[nodiscard]] const Points& domain_positions() const override { return domain().nodes; }
@@ -120,12 +138,18 @@ class WholeDomainView final : public SimObject, public CavityWall {
 
   Layout nodes_, elements_, boundary_vertices_, boundary_faces_;
   std::uint64_t partition_fingerprint_ = 0;  // of the whole-mesh indices of the local nodes/tets
+  bool part_only_ = false;
+  double whole_diagonal_ = 0;    // of the whole mesh's bounding box
+  double region_tolerance_ = 0;  // RegionTolerance of the whole mesh
+  // The constructors' shared part: fingerprint, bounding box.
+  void Describe();
   // Buffers of the gathers, kept between reads (no allocation once sized).
   mutable std::vector<double> receive_;
   mutable std::vector<int> counts_, offsets_;
   mutable Eigen::MatrixXd local_;
   mutable std::vector<int> sent_items_, received_items_;
   mutable std::vector<double> sent_values_;
+  mutable std::vector<int> local_items_, positions_;
 };
 
 }  // namespace gipsi
