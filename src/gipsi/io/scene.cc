@@ -1,9 +1,11 @@
 #include "gipsi/io/scene.h"
 
 #include <algorithm>
+#include <cctype>
 #include <cstdlib>
 #include <fstream>
 #include <functional>
+#include <optional>
 #include <set>
 #include <sstream>
 
@@ -14,6 +16,7 @@
 #include "gipsi/base/log.h"
 #include "gipsi/base/units.h"
 #include "gipsi/geometry/generators.h"
+#include "gipsi/io/gmsh_block_reader.h"
 #include "gipsi/io/mesh_io.h"
 
 namespace gipsi {
@@ -100,17 +103,35 @@ class SceneMeshes final : public MeshProvider {
     const JsonNode& node = d->second;
     if (!in_blocks_.count(d->first)) stage_(d->first, node);
     in_blocks_.insert(d->first);
-    MeshBlock block;
+    std::optional<MeshBlock> block;
     const auto generate = node.Find("generate");
+    const auto file = node.Find("file");
     if (generate && generate->is_string() && generate->AsString() == "box") {
       block = BoxBlock(node, rank, size);
-    } else {  // read whole, sliced, not kept
+    } else if (file && file->is_string() && IsGmshFile(file->AsString())) {
+      CheckMeshEntry(node);
+      std::filesystem::path path = file->AsString();
+      if (path.is_relative()) path = base_dir_ / path;
+      try {
+        block = ReadGmshBlock(path, rank, size);
+      } catch (const InputError& e) {
+        file->Fail(e.what());
+      }
+      if (block)
+        Transform(node, *block);
+      else if (rank == 0)
+        Log().info(
+            "{}: {}: every process reads this Gmsh file whole to cut its block (format 4.1 "
+            "with linear elements is read in blocks)",
+            node.file(), file->path());
+    }
+    if (!block) {  // read whole, sliced, not kept
       const Mesh whole = BuildMesh(node, base_dir_);
       CheckSize(node, whole.num_nodes(), whole.num_tets() + whole.num_triangles());
       block = BlockOfMesh(whole, rank, size);
     }
-    CheckSize(node, block.num_nodes, block.num_tets + block.num_triangles);
-    return block;
+    CheckSize(node, block->num_nodes, block->num_tets + block->num_triangles);
+    return std::move(*block);
   }
 
  private:
@@ -141,12 +162,24 @@ class SceneMeshes final : public MeshProvider {
       if (what.rfind(node.file(), 0) == 0) throw;  // already located
       node.Fail(what);
     }
+    Transform(node, block);
+    return block;
+  }
+
+  // The entry's "scale" and "translate", as BuildMesh applies them.
+  static void Transform(const JsonNode& node, MeshBlock& block) {
     const auto scale = node.Find("scale");
     const auto translate = node.Find("translate");
     if (scale || translate)
       block.nodes = ((scale ? scale->AsPositive() : 1.0) * block.nodes).colwise() +
                     (translate ? translate->AsVec3() : Vec3::Zero());
-    return block;
+  }
+
+  static bool IsGmshFile(const std::string& name) {
+    std::string extension = std::filesystem::path(name).extension().string();
+    std::transform(extension.begin(), extension.end(), extension.begin(),
+                   [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+    return extension == ".msh";
   }
 
   void CheckSize(const JsonNode& node, std::int64_t nodes, std::int64_t cells) const {

@@ -1,0 +1,265 @@
+// Reading one block of a Gmsh 4.1 mesh without the whole mesh (io/gmsh_block_reader.h), against
+// the whole-file reader's mesh sliced into the same block.
+
+#include "gipsi/io/gmsh_block_reader.h"
+
+#include <cstdint>
+#include <cstring>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include <fmt/format.h>
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "gipsi/base/error.h"
+#include "gipsi/geometry/generators.h"
+#include "gipsi/io/mesh_io.h"
+#include "temp_dir.h"
+
+namespace gipsi {
+namespace {
+
+using ::testing::HasSubstr;
+
+// Writes Gmsh 4.1 text or binary records.
+class Writer {
+ public:
+  explicit Writer(bool binary) : binary_(binary) {}
+  void Line(const std::string& text) { out_ += text + "\n"; }
+  void Int(int v) { binary_ ? Raw(v) : Text(std::to_string(v)); }
+  void Size(std::uint64_t v) { binary_ ? Raw(v) : Text(std::to_string(v)); }
+  void Double(double v) { binary_ ? Raw(v) : Text(fmt::format("{:.17g}", v)); }
+  void EndRecord() {
+    if (!binary_) out_ += "\n";
+  }
+  void EndSection(const std::string& marker) {
+    if (binary_) out_ += "\n";
+    Line(marker);
+  }
+  const std::string& text() const { return out_; }
+
+ private:
+  template <class T>
+  void Raw(T v) {
+    char bytes[sizeof(T)];
+    std::memcpy(bytes, &v, sizeof(T));
+    out_.append(bytes, sizeof(T));
+  }
+  void Text(const std::string& v) {
+    if (!out_.empty() && out_.back() != '\n') out_ += ' ';
+    out_ += v;
+  }
+  bool binary_;
+  std::string out_;
+};
+
+// A box as Gmsh 4.1: the nodes in two blocks, with tags 1..N or 7, 10, 13, ... (`sparse`);
+// a point, two lines, the boundary triangles in two surfaces and the tets in one volume, with
+// physical groups: the volume "tissue" (10), surface 1 unnamed (20), surface 2 "tissue" too
+// (21, which ReadGmsh renames "tissue_dim2"), the curve unnamed (30) and the point "apex" (40).
+std::string BoxAsGmsh41(const Mesh& box, bool binary, bool sparse) {
+  Writer w(binary);
+  w.Line("$MeshFormat");
+  w.Line(binary ? "4.1 1 8" : "4.1 0 8");
+  if (binary) {
+    w.Int(1);
+    w.EndSection("$EndMeshFormat");
+  } else {
+    w.Line("$EndMeshFormat");
+  }
+  w.Line("$PhysicalNames");
+  w.Line("3");
+  w.Line("3 10 \"tissue\"");
+  w.Line("2 21 \"tissue\"");
+  w.Line("0 40 \"apex\"");
+  w.Line("$EndPhysicalNames");
+  w.Line("$Entities");
+  for (int count : {1, 1, 2, 1}) w.Size(static_cast<std::uint64_t>(count));
+  w.EndRecord();
+  auto entity = [&](int dim, int tag, int physical) {
+    w.Int(tag);
+    for (int k = 0; k < (dim == 0 ? 3 : 6); ++k) w.Double(0.0);
+    w.Size(physical != 0 ? 1 : 0);
+    if (physical != 0) w.Int(physical);
+    if (dim > 0) w.Size(0);
+    w.EndRecord();
+  };
+  entity(0, 1, 40);
+  entity(1, 1, 30);
+  entity(2, 1, 20);
+  entity(2, 2, 21);
+  entity(3, 1, 10);
+  w.EndSection("$EndEntities");
+
+  const auto n = static_cast<std::uint64_t>(box.num_nodes());
+  auto tag = [sparse](Index i) { return sparse ? 7 + 3 * static_cast<std::uint64_t>(i) : i + 1; };
+  w.Line("$Nodes");
+  w.Size(2);
+  w.Size(n);
+  w.Size(tag(0));
+  w.Size(tag(box.num_nodes() - 1));
+  w.EndRecord();
+  const Index half = box.num_nodes() / 2;
+  for (auto [first, last] : {std::pair<Index, Index>{0, half}, {half, box.num_nodes()}}) {
+    w.Int(first == 0 ? 3 : 2);
+    w.Int(1);
+    w.Int(0);
+    w.Size(static_cast<std::uint64_t>(last - first));
+    w.EndRecord();
+    for (Index i = first; i < last; ++i) {
+      w.Size(tag(i));
+      w.EndRecord();
+    }
+    for (Index i = first; i < last; ++i) {
+      for (int k = 0; k < 3; ++k) w.Double(box.nodes(k, i));
+      w.EndRecord();
+    }
+  }
+  w.EndSection("$EndNodes");
+
+  w.Line("$Elements");
+  const Index tris = box.num_triangles(), tri_half = tris / 2;
+  const auto all = static_cast<std::uint64_t>(3 + tris + box.num_tets());
+  w.Size(5);
+  w.Size(all);
+  w.Size(1);
+  w.Size(all);
+  w.EndRecord();
+  std::uint64_t element = 1;
+  auto block = [&](int dim, int entity_tag, int type,
+                   const std::vector<std::vector<Index>>& items) {
+    w.Int(dim);
+    w.Int(entity_tag);
+    w.Int(type);
+    w.Size(items.size());
+    w.EndRecord();
+    for (const auto& nodes : items) {
+      w.Size(element++);
+      for (Index v : nodes) w.Size(tag(v));
+      w.EndRecord();
+    }
+  };
+  block(0, 1, 15, {{0}});
+  block(1, 1, 1, {{0, 1}, {1, 2}});
+  std::vector<std::vector<Index>> first, second, tets;
+  for (Index t = 0; t < tris; ++t)
+    (t < tri_half ? first : second)
+        .push_back({box.triangles(0, t), box.triangles(1, t), box.triangles(2, t)});
+  for (Index e = 0; e < box.num_tets(); ++e)
+    tets.push_back({box.tets(0, e), box.tets(1, e), box.tets(2, e), box.tets(3, e)});
+  block(2, 1, 2, first);
+  block(2, 2, 2, second);
+  block(3, 1, 4, tets);
+  w.EndSection("$EndElements");
+  return w.text();
+}
+
+void ExpectSameBlock(const MeshBlock& a, const MeshBlock& b, const std::string& what) {
+  EXPECT_EQ(a.rank, b.rank) << what;
+  EXPECT_EQ(a.size, b.size) << what;
+  EXPECT_EQ(a.num_nodes, b.num_nodes) << what;
+  EXPECT_EQ(a.num_tets, b.num_tets) << what;
+  EXPECT_EQ(a.num_triangles, b.num_triangles) << what;
+  EXPECT_EQ(a.first_triangle, b.first_triangle) << what;
+  EXPECT_EQ(a.nodes, b.nodes) << what;
+  EXPECT_EQ(a.tets, b.tets) << what;
+  EXPECT_EQ(a.triangles, b.triangles) << what;
+  EXPECT_EQ(a.tet_ids, b.tet_ids) << what;
+  EXPECT_EQ(a.tet_id_kind, b.tet_id_kind) << what;
+  ASSERT_EQ(a.groups.size(), b.groups.size()) << what;
+  for (std::size_t g = 0; g < a.groups.size(); ++g) {
+    EXPECT_EQ(a.groups[g].name, b.groups[g].name) << what;
+    EXPECT_EQ(a.groups[g].dim, b.groups[g].dim) << what << ", group " << a.groups[g].name;
+    EXPECT_EQ(a.groups[g].items, b.groups[g].items) << what << ", group " << a.groups[g].name;
+  }
+}
+
+// Every block, on 1, 3 and 7 processes, of a box written as ASCII and binary Gmsh 4.1, with
+// node tags 1..N and with other tags, is the whole-file reader's mesh sliced into that block:
+// nodes, tets, triangles, element tags, and the groups with ReadGmsh's names.
+TEST(GmshBlockReader, EveryBlockIsTheWholeReadersSlice) {
+  const std::filesystem::path dir = testing::TestTempDir();
+  const Mesh box = MakeTetBox(Vec3::Zero(), Vec3(2, 1, 1), {4, 3, 2});
+  for (bool binary : {false, true}) {
+    for (bool sparse : {false, true}) {
+      const auto path = dir / fmt::format("box_{}_{}.msh", binary, sparse);
+      std::ofstream(path, std::ios::binary) << BoxAsGmsh41(box, binary, sparse);
+      const Mesh whole = ReadMesh(path);
+      ASSERT_EQ(whole.num_tets(), box.num_tets());
+      ASSERT_EQ(whole.groups.size(), 5U);
+      EXPECT_EQ(whole.groups[1].name, "tissue_dim2");
+      for (int size : {1, 3, 7}) {
+        for (int rank = 0; rank < size; ++rank) {
+          const auto block = ReadGmshBlock(path, rank, size);
+          ASSERT_TRUE(block.has_value());
+          ExpectSameBlock(
+              *block, BlockOfMesh(whole, rank, size),
+              fmt::format("binary {}, sparse tags {}, block {} of {}", binary, sparse, rank, size));
+        }
+      }
+    }
+  }
+}
+
+// Formats 1.0 and 2.x, and second-order elements, are not read in blocks (the caller reads the
+// whole file instead); mistakes are named with the file and the line or byte offset.
+TEST(GmshBlockReader, OtherFormatsAreLeftToTheWholeReaderAndMistakesAreNamed) {
+  const std::filesystem::path dir = testing::TestTempDir();
+  auto write = [&](const std::string& name, const std::string& text) {
+    const auto path = dir / name;
+    std::ofstream(path, std::ios::binary) << text;
+    return path;
+  };
+  const auto v2 =
+      write("v2.msh", "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n1\n1 0 0 0\n$EndNodes\n");
+  EXPECT_FALSE(ReadGmshBlock(v2, 0, 2).has_value());
+  const auto v1 = write("v1.msh", "$NOD\n1\n1 0 0 0\n$ENDNOD\n");
+  EXPECT_FALSE(ReadGmshBlock(v1, 0, 2).has_value());
+  const std::string head =
+      "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$Nodes\n1 4 1 4\n3 1 0 4\n1\n2\n3\n4\n"
+      "0 0 0\n1 0 0\n0 1 0\n0 0 1\n$EndNodes\n";
+  const auto second = write("p2.msh", head +
+                                          "$Elements\n1 1 1 1\n3 1 11 1\n"
+                                          "1 1 2 3 4 1 2 3 4 1 2\n$EndElements\n");
+  EXPECT_FALSE(ReadGmshBlock(second, 0, 2).has_value());
+
+  // The block reader's message, which must be the whole reader's.
+  auto error = [](const std::filesystem::path& path) {
+    std::string block = "no error", whole = "no error";
+    try {
+      (void)ReadGmshBlock(path, 1, 2);
+    } catch (const InputError& e) {
+      block = e.what();
+    }
+    try {
+      (void)ReadMesh(path);
+    } catch (const InputError& e) {
+      whole = e.what();
+    }
+    EXPECT_EQ(block, whole);
+    return block;
+  };
+  const auto undefined =
+      write("undefined.msh", head + "$Elements\n1 1 1 1\n3 1 4 1\n9 1 2 3 5\n$EndElements\n");
+  EXPECT_THAT(error(undefined), HasSubstr("undefined.msh: line 19: element 9 refers to "
+                                          "undefined node 5"));
+  const auto truncated = write("truncated.msh", head + "$Elements\n1 1 1 1\n3 1 4 1\n");
+  EXPECT_THAT(error(truncated), HasSubstr("truncated.msh: line 18: declares 1 elements"));
+  const auto short_line =
+      write("short.msh", head + "$Elements\n1 1 1 1\n3 1 4 1\n9 1 2 3\n$EndElements\n");
+  EXPECT_THAT(error(short_line),
+              HasSubstr("short.msh: line 19: expected 4 node indices for a tetrahedron, got 3"));
+  const auto nan = write("nan.msh",
+                         "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$Nodes\n1 1 1 1\n"
+                         "3 1 0 1\n1\n0 nan 0\n$EndNodes\n");
+  EXPECT_THAT(error(nan), HasSubstr("nan.msh: line 8: expected a y coordinate"));
+  EXPECT_THAT(error(dir / "missing.msh"),
+              HasSubstr("missing.msh: cannot open mesh file for reading"));
+  std::filesystem::create_directory(dir / "folder.msh");
+  EXPECT_THAT(error(dir / "folder.msh"), HasSubstr("is a directory, expected a mesh file"));
+}
+
+}  // namespace
+}  // namespace gipsi
