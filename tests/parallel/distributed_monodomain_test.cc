@@ -189,7 +189,13 @@ TEST(WholeDomainView, APartOnlyViewSelectsTheWholeMeshsNodes) {
       BoxRegion{Vec3(0.004, 0.001, 0.0), Vec3(0.011, 0.005, 0.0015)},
       SphereRegion{Vec3(0.010, 0.0035, 0.0015), 0.003},
       HalfSpaceRegion{Vec3(0.015, 0, 0), Vec3(1, 0.2, 0)},
+      GroupRegion{"xmin"},
       GroupRegion{"xmax"},
+      GroupRegion{"ymin"},
+      GroupRegion{"ymax"},
+      GroupRegion{"zmin"},
+      GroupRegion{"zmax"},
+      GroupRegion{"volume"},
       NodeIdsRegion{{40, 3, 3, 7}}};
   for (std::size_t r = 0; r < regions.size(); ++r) {
     const std::vector<int> expected = SelectNodes(regions[r], *s.whole);
@@ -312,6 +318,45 @@ TEST(DistributedMonodomain, ASlabMadeInBlocksRunsAsTheWholeSlab) {
   int activated_all = activated;
   MPI_Allreduce(MPI_IN_PLACE, &activated_all, 1, MPI_INT, MPI_SUM, World());
   EXPECT_GT(activated_all, static_cast<int>(whole->num_nodes()) / 10);
+}
+
+// A stimulus on a face group of a mesh made in blocks drives every copy of the face's nodes:
+// a rank that holds a node of the face but none of its triangles takes it too (shared nodes
+// are stepped alike on every rank only if they are driven alike).
+TEST(DistributedMonodomain, AFaceGroupStimulusDrivesEveryCopyOfItsNodes) {
+  // Coarse boxes of five tets per cell: their parts' cuts meet the faces at irregular lines.
+  const Vec3 size(0.020, 0.007, 0.003);
+  int without_triangle = 0;
+  for (const std::array<int, 3> cells : {std::array<int, 3>{6, 3, 2}, {5, 4, 3}, {7, 2, 3}})
+    for (const char* face : {"xmin", "xmax", "ymin", "ymax", "zmin", "zmax"}) {
+      const Mesh whole = MakeTetBox(Vec3::Zero(), size, cells, HexSplit::kFive);
+      EpTissueParams params = SlabParams("jacobi");
+      params.stimuli.front().region = GroupRegion{face};
+      DistributedMonodomain tissue(
+          "tissue",
+          PartitionMeshBlocks(
+              MakeTetBoxBlock(Vec3::Zero(), size, cells, HexSplit::kFive, Rank(), Size()), World()),
+          params, World());
+      const MeshPart& part = tissue.part();
+      const std::vector<int> expected = SelectNodes(GroupRegion{face}, whole);
+      without_triangle += static_cast<int>(SelectNodes(GroupRegion{face}, *part.mesh).size());
+      std::vector<int> driven;
+      for (const int i : tissue.stimulus_nodes().front())
+        driven.push_back(part.whole_node[static_cast<std::size_t>(i)]);
+      std::sort(driven.begin(), driven.end());
+      std::vector<int> held;  // this part's nodes of the face
+      for (const int w : part.whole_node)
+        if (std::binary_search(expected.begin(), expected.end(), w)) held.push_back(w);
+      std::sort(held.begin(), held.end());
+      EXPECT_EQ(driven, held) << face;
+      without_triangle -= static_cast<int>(held.size());
+    }
+  // The case the gathering is for: on 4 ranks some rank holds face nodes that its own
+  // triangles do not name (the 2-way cuts of these boxes are clean: no such node).
+  MPI_Allreduce(MPI_IN_PLACE, &without_triangle, 1, MPI_INT, MPI_MIN, World());
+  if (Size() >= 4) {
+    EXPECT_LT(without_triangle, 0);
+  }
 }
 
 // A region that selects no node of a mesh made in blocks is refused on every rank, as on the

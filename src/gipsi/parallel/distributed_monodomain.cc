@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cstring>
 #include <limits>
+#include <variant>
 
 #include "gipsi/base/error.h"
 #include "gipsi/geometry/boundary.h"
@@ -79,6 +80,11 @@ void LocaliseRegionsOnPart(EpTissueParams& params, const MeshPart& part, MPI_Com
       for (std::size_t i = 0; i < part.whole_node.size(); ++i)
         if (std::binary_search(wanted.begin(), wanted.end(), part.whole_node[i]))
           ids.ids.push_back(static_cast<int>(i));
+    } else if (std::holds_alternative<GroupRegion>(region)) {
+      // A triangle or tet group names a node only on the ranks that hold its triangle or tet:
+      // every rank that holds the node takes it.
+      ids.ids =
+          LocalNodesOf(part, GatherSelectedNodes(part, SelectNodes(region, mesh, tolerance), comm));
     } else {
       ids.ids = SelectNodes(region, mesh, tolerance);
     }

@@ -44,7 +44,9 @@ class DistributedMonodomain final : public EpTissue {
   DistributedMonodomain(std::string name, const Mesh& whole, EpTissueParams params, MPI_Comm comm);
   /// Collective: on a mesh already cut (`part`, this rank's, e.g. from PartitionMeshBlocks, so
   /// that no rank held the mesh whole). Each rank selects the region nodes among its own, the
-  /// geometric regions at the whole mesh's tolerance, node ids as whole-mesh indices. Throws
+  /// geometric regions at the whole mesh's tolerance, node ids as whole-mesh indices, and a
+  /// group's nodes as every rank found them (a rank may hold a node of a face group without
+  /// the face's triangle). Throws
   /// InputError as above, and for a fibre rule (it needs the whole mesh).
   DistributedMonodomain(std::string name, MeshPart part, EpTissueParams params, MPI_Comm comm);
   ~DistributedMonodomain() override;

@@ -116,4 +116,37 @@ std::vector<double> GatherNodeValues(const MeshPart& part, const double* local, 
   return out;
 }
 
+std::vector<int> GatherSelectedNodes(const MeshPart& part, std::span<const int> local,
+                                     MPI_Comm comm) {
+  std::vector<int> mine;
+  mine.reserve(local.size());
+  for (const int i : local) mine.push_back(part.whole_node[static_cast<std::size_t>(i)]);
+  const int count = static_cast<int>(mine.size());
+  std::vector<int> counts(static_cast<std::size_t>(part.size)),
+      offsets(static_cast<std::size_t>(part.size), 0);
+  MPI_Allgather(&count, 1, MPI_INT, counts.data(), 1, MPI_INT, comm);
+  std::partial_sum(counts.begin(), counts.end() - 1, offsets.begin() + 1);
+  std::vector<int> all(static_cast<std::size_t>(offsets.back() + counts.back()));
+  MPI_Allgatherv(mine.data(), count, MPI_INT, all.data(), counts.data(), offsets.data(), MPI_INT,
+                 comm);
+  std::sort(all.begin(), all.end());
+  all.erase(std::unique(all.begin(), all.end()), all.end());
+  return all;
+}
+
+std::vector<int> LocalNodesOf(const MeshPart& part, std::span<const int> whole) {
+  std::vector<std::pair<int, int>> by_whole;  // (whole index, local index)
+  by_whole.reserve(part.whole_node.size());
+  for (std::size_t i = 0; i < part.whole_node.size(); ++i)
+    by_whole.emplace_back(part.whole_node[i], static_cast<int>(i));
+  std::sort(by_whole.begin(), by_whole.end());
+  std::vector<int> out;
+  for (const int w : whole) {
+    const auto it = std::lower_bound(by_whole.begin(), by_whole.end(), std::make_pair(w, -1));
+    if (it != by_whole.end() && it->first == w) out.push_back(it->second);
+  }
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
 }  // namespace gipsi

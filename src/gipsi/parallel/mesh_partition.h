@@ -20,6 +20,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <span>
 #include <vector>
 
 #include "gipsi/base/export.h"
@@ -64,6 +65,15 @@ MeshPart PartitionMesh(const Mesh& whole, MPI_Comm comm);
 /// mesh has fewer tets than there are ranks, more than 2^31 - 1 items of a kind, or a tet or
 /// triangle naming a node it does not have, and std::runtime_error if PT-Scotch fails.
 MeshPart PartitionMeshBlocks(const MeshBlock& block, MPI_Comm comm);
+
+/// The whole-mesh indices of the nodes any rank selected (`local`: this rank's selection, local
+/// node indices), sorted and unique, the same on every rank. A region selected on each rank's
+/// part may miss a node that the part holds: a triangle or tet group names the node only where
+/// the group's triangle or tet is, which may be another rank's. Collective; O(selected).
+std::vector<int> GatherSelectedNodes(const MeshPart& part, std::span<const int> local,
+                                     MPI_Comm comm);
+/// The local indices, ascending, of the whole-mesh nodes `whole` that this part holds.
+std::vector<int> LocalNodesOf(const MeshPart& part, std::span<const int> whole);
 
 /// Every rank's owned values of a node field, gathered on rank 0 in the whole mesh's node order
 /// (`local`: one value per local node of `part`). Collective; ranks other than 0 get an empty

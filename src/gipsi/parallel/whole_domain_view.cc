@@ -158,20 +158,10 @@ std::vector<int> WholeDomainView::SelectWholeNodes(const Region& region) const {
     out.erase(std::unique(out.begin(), out.end()), out.end());
     return out;
   }
-  std::vector<int> mine;
-  for (const int node : SelectNodes(region, *mesh_part_.mesh, region_tolerance_))
-    if (node < mesh_part_.num_owned)  // each node from its owner
-      mine.push_back(mesh_part_.whole_node[static_cast<std::size_t>(node)]);
-  const int count = static_cast<int>(mine.size());
-  std::vector<int> counts(static_cast<std::size_t>(mesh_part_.size)),
-      offsets(static_cast<std::size_t>(mesh_part_.size), 0);
-  MPI_Allgather(&count, 1, MPI_INT, counts.data(), 1, MPI_INT, comm_);
-  std::partial_sum(counts.begin(), counts.end() - 1, offsets.begin() + 1);
-  std::vector<int> out(static_cast<std::size_t>(offsets.back() + counts.back()));
-  MPI_Allgatherv(mine.data(), count, MPI_INT, out.data(), counts.data(), offsets.data(), MPI_INT,
-                 comm_);
-  std::sort(out.begin(), out.end());
-  return out;
+  // Every rank's selection: a triangle or tet group names a node only on the ranks that hold
+  // its triangle or tet.
+  return GatherSelectedNodes(mesh_part_, SelectNodes(region, *mesh_part_.mesh, region_tolerance_),
+                             comm_);
 }
 
 void WholeDomainView::ReadWholeNodes(FieldId id, std::span<const int> nodes,
