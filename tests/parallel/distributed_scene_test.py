@@ -28,7 +28,8 @@ Runs the N-version benchmark slab (scenes/slab_ep_0.5mm.json, its first 30 ms) s
     PV loop and beat
     summary within 1e-4 relative (activation times within 2e-3 ms shift the active tension by
     that; at the steepest pressure rise, ~200 kPa/s, that is 0.4 Pa of ~10 kPa); measured 3e-14;
-  - an earlier run's pieces are refused, or deleted with --overwrite;
+  - an earlier run's pieces are refused, or deleted with --overwrite; the output limit
+    (--max-output) estimates the split slab's frames as the serial run does;
   - a divergence on one rank's part (a 5 V clamp at the far corner from 5 ms) stops every rank
     at the serial run's step, exit 3, with the probe rows recorded until then;
   - checkpoints: written per rank, and a run resumed from them on 2 ranks writes the
@@ -211,6 +212,16 @@ with tempfile.TemporaryDirectory() as work:
                         check(False, f"{ranks} ranks, {name}.{column}: {y} vs serial {x}")
                         break
             print(f"{ranks} ranks, {name}: largest differences {worst}")
+    # The output limit counts the split slab's whole frames, as serially: the same estimate,
+    # the same refusal, on 2 ranks.
+    refusals = {}
+    for ranks in (1, 2):
+        code, text = run(ranks, os.path.join(work, f"limited{ranks}"), "--max-output", "100000")
+        check(code != 0 and "over the limit of" in text,
+              f"--max-output on {ranks} ranks: exit {code}: {text}")
+        refusals[ranks] = re.findall(r"would write about [^,]*", text)[:1]
+    check(refusals[1] and refusals[1] == refusals[2],
+          f"--max-output: serially {refusals[1]}, on 2 ranks {refusals[2]}")
     # An earlier distributed run's series (4 pieces per frame) is refused, or with --overwrite
     # cleared (pieces and .pvtu files included) before a run on 2 ranks writes its own.
     again = os.path.join(work, "ranks4")

@@ -12,6 +12,7 @@
 /// Every process must make the same calls in the same order (they do when every process runs
 /// the same kernel on the same scene).
 
+#include <cstdint>
 #include <span>
 #include <vector>
 
@@ -32,6 +33,9 @@ class PartitionedObject {
   [[nodiscard]] virtual bool holds_whole_domain() const = 0;
   /// The whole domain's bounding-box diagonal. Collective.
   [[nodiscard]] virtual double WholeDiagonal() const = 0;
+  /// The whole domain's node and tet counts (output estimates).
+  [[nodiscard]] virtual std::int64_t whole_num_nodes() const = 0;
+  [[nodiscard]] virtual std::int64_t whole_num_tets() const = 0;
   /// MapFromNodes on the whole domain: interpolation weights at `targets` over whole-domain node
   /// indices, the same on every process; a point on several processes' parts is taken from the
   /// lowest of them, one outside the domain from the part nearest to it (max_distance() as

@@ -8,6 +8,7 @@
 #include "gipsi/base/error.h"
 
 #include "gipsi/base/state.h"
+#include "gipsi/core/partitioned_object.h"
 #include "gipsi/io/sample_times.h"
 
 namespace gipsi {
@@ -272,7 +273,12 @@ std::uintmax_t FrameBytes(const SimObject& object, bool display) {
   }
   std::uintmax_t bytes = 0;
   SimObject::QuadraticOutput quadratic;
-  if (mesh.num_tets() > 0 && object.GetQuadraticOutput(quadratic)) {
+  const auto* split = dynamic_cast<const PartitionedObject*>(&object);
+  if (split != nullptr && !split->holds_whole_domain() && mesh.num_tets() > 0) {
+    // Its pieces: the whole mesh's nodes and tets (and the nodes the parts share once more).
+    bytes =
+        VtuFileBytes(split->whole_num_nodes(), split->whole_num_tets(), 0, point_data, cell_data);
+  } else if (mesh.num_tets() > 0 && object.GetQuadraticOutput(quadratic)) {
     bytes =
         QuadraticVtuFileBytes(object.domain_positions().cols() + quadratic.edge_positions.cols(),
                               quadratic.tets.cols(), point_data, cell_data);

@@ -480,7 +480,8 @@ std::set<std::string> StandaloneObjects(const JsonNode& root) {
   if (auto connectors = root.Find("connectors")) others.push_back(*connectors);
   if (auto schedule = root.Find("schedule"); schedule && schedule->is_object())
     if (auto events = schedule->Find("events")) others.push_back(*events);
-  for (const auto& [name, node] : objects.Members()) {
+  for (const auto& member : objects.Members()) {
+    const std::string& name = member.first;
     bool named = std::any_of(others.begin(), others.end(),
                              [&name](const JsonNode& other) { return Names(other, name); });
     for (const auto& [other, other_node] : objects.Members())

@@ -183,6 +183,9 @@ DistributedMonodomain::DistributedMonodomain(std::string name, EpTissueParams pa
   } else {
     fibres_.colwise() = fibre;
   }
+  // As the serial object's, read-only: a written fibre would need the operator assembled anew.
+  f_fibre_ = DeclareField({"fibre", FieldLocation::kElement, 3, "1", FieldAccess::kRead,
+                           "fibre direction per element"});
   f_activated_ = FindField("activated_fraction");
   f_integral_ = FindField("voltage_integral");
   f_iterations_ = FindField("diffusion_iterations");
@@ -386,6 +389,8 @@ void DistributedMonodomain::DoReadField(FieldId id, Eigen::Ref<Eigen::MatrixXd> 
     for (Index i = 0; i < part_.num_owned; ++i) counts[0] += activation_time()[i] >= 0 ? 1 : 0;
     MPI_Allreduce(MPI_IN_PLACE, counts, 2, MPI_DOUBLE, MPI_SUM, comm_);
     out(0, 0) = counts[1] > 0 ? counts[0] / counts[1] : 0.0;
+  } else if (id == f_fibre_) {
+    out = fibres_;
   } else if (id == f_integral_) {
     double integral = VoltageIntegral();  // this rank's tets
     MPI_Allreduce(MPI_IN_PLACE, &integral, 1, MPI_DOUBLE, MPI_SUM, comm_);

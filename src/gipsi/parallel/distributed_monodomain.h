@@ -14,7 +14,8 @@
 /// serial object. PETSc options with the prefix `ep_` (e.g. -ep_ksp_monitor, -ep_pc_type)
 /// override them.
 ///
-/// Node fields (V, activation_time, ...) are per local node; the global fields
+/// Node fields (V, activation_time, ...) are per local node, the element field `fibre` per local
+/// tet (read-only, unlike the serial object's); the global fields
 /// (activated_fraction, voltage_integral, diffusion_iterations) are reductions over the ranks,
 /// so reading them is collective. A step that fails or diverges on one rank fails on every
 /// rank (the others report which rank failed), so a coordinator that runs on every rank takes
@@ -81,7 +82,7 @@ class DistributedMonodomain final : public EpTissue {
   MeshPart part_;
   Points fibres_;
   std::unique_ptr<Petsc> petsc_;
-  FieldId f_activated_, f_integral_, f_iterations_;
+  FieldId f_fibre_, f_activated_, f_integral_, f_iterations_;
 };
 
 }  // namespace gipsi

@@ -71,6 +71,10 @@ class WholeDomainView final : public SimObject, public CavityWall, public Partit
   /// PartitionedObject: false for a part-only view. The calls below work in both kinds.
   [[nodiscard]] bool holds_whole_domain() const override { return !part_only_; }
   [[nodiscard]] double WholeDiagonal() const override { return whole_diagonal_; }
+  [[nodiscard]] std::int64_t whole_num_nodes() const override {
+    return mesh_part_.num_global_nodes;
+  }
+  [[nodiscard]] std::int64_t whole_num_tets() const override { return mesh_part_.num_global_tets; }
   [[nodiscard]] PointMap LocateWhole(const Points& targets) const override;
   [[nodiscard]] std::vector<int> SelectWholeNodes(const Region& region) const override;
   void ReadWholeNodes(FieldId id, std::span<const int> nodes,
