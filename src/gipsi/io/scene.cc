@@ -453,13 +453,13 @@ int GeneratedOrder(const JsonNode& node) {
   return static_cast<int>(value);
 }
 
-// Whether `node` holds, at any depth, a string that names the object `name` ("name", or a
-// dotted path from it: "name.field", "name.part.field").
+// Whether `node` holds, at any depth, a string that names the object `name` ("name", a dotted
+// path from it: "name.field", "name.part.field", or one of its conditions: "name/clamp").
 bool Names(const JsonNode& node, const std::string& name) {
   if (node.is_string()) {
     const std::string& s = node.raw().get_ref<const std::string&>();
     return s == name || (s.size() > name.size() && s.compare(0, name.size(), name) == 0 &&
-                         s[name.size()] == '.');
+                         (s[name.size()] == '.' || s[name.size()] == '/'));
   }
   if (node.is_object()) {
     for (const auto& [key, value] : node.Members())

@@ -1,0 +1,147 @@
+// Reading a Gmsh 4.1 mesh whole (ReadMesh: the file held in memory, one pass) against reading
+// one process's block of it (ReadGmshBlock: two streaming passes through a 1 MiB buffer, the
+// block kept; io/gmsh_block_reader.h), ASCII and binary, on the 0.2 mm N-version slab (315 k
+// tets) written to a temporary file. Run:
+//   ./build/release/bench/mesh_io_bench --benchmark_repetitions=3
+//     --benchmark_report_aggregates_only=true
+
+#include <benchmark/benchmark.h>
+#include <unistd.h>
+
+#include <cstdint>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include <fmt/format.h>
+
+#include "gipsi/geometry/generators.h"
+#include "gipsi/io/gmsh_block_reader.h"
+#include "gipsi/io/mesh_io.h"
+
+namespace gipsi {
+namespace {
+
+// The slab as Gmsh 4.1: its nodes in one block, its tets in one block (no groups).
+std::string SlabAsGmsh41(bool binary) {
+  const Mesh slab = MakeTetBox(Vec3::Zero(), Vec3(0.020, 0.007, 0.003), {100, 35, 15});
+  std::string out = fmt::format("$MeshFormat\n4.1 {} 8\n", binary ? 1 : 0);
+  auto raw = [&out](auto v) {
+    char bytes[sizeof(v)];
+    std::memcpy(bytes, &v, sizeof(v));
+    out.append(bytes, sizeof(v));
+  };
+  auto size = [&](std::uint64_t v) {
+    if (binary)
+      raw(v);
+    else
+      out += fmt::format("{} ", v);
+  };
+  auto end_line = [&] {
+    if (!binary) out += '\n';
+  };
+  if (binary) {
+    raw(std::int32_t{1});
+    out += '\n';
+  }
+  out += "$EndMeshFormat\n$Nodes\n";
+  const auto n = static_cast<std::uint64_t>(slab.num_nodes());
+  const auto m = static_cast<std::uint64_t>(slab.num_tets());
+  for (std::uint64_t v : {std::uint64_t{1}, n, std::uint64_t{1}, n}) size(v);
+  end_line();
+  if (binary) {
+    raw(std::int32_t{3});
+    raw(std::int32_t{1});
+    raw(std::int32_t{0});
+    raw(n);
+  } else {
+    out += fmt::format("3 1 0 {}\n", n);
+  }
+  for (std::uint64_t i = 1; i <= n; ++i) {
+    size(i);
+    end_line();
+  }
+  for (Index i = 0; i < slab.num_nodes(); ++i) {
+    for (int k = 0; k < 3; ++k) {
+      if (binary)
+        raw(slab.nodes(k, i));
+      else
+        out += fmt::format("{:.17g} ", slab.nodes(k, i));
+    }
+    end_line();
+  }
+  if (binary) out += '\n';
+  out += "$EndNodes\n$Elements\n";
+  for (std::uint64_t v : {std::uint64_t{1}, m, std::uint64_t{1}, m}) size(v);
+  end_line();
+  if (binary) {
+    raw(std::int32_t{3});
+    raw(std::int32_t{1});
+    raw(std::int32_t{4});
+    raw(m);
+  } else {
+    out += fmt::format("3 1 4 {}\n", m);
+  }
+  for (Index e = 0; e < slab.num_tets(); ++e) {
+    size(static_cast<std::uint64_t>(e + 1));
+    for (int k = 0; k < 4; ++k) size(static_cast<std::uint64_t>(slab.tets(k, e) + 1));
+    end_line();
+  }
+  if (binary) out += '\n';
+  out += "$EndElements\n";
+  return out;
+}
+
+// The file, written once per process and format.
+const std::filesystem::path& SlabFile(bool binary) {
+  static const std::filesystem::path files[2] = {
+      [] {
+        const auto path = std::filesystem::temp_directory_path() /
+                          fmt::format("gipsi_mesh_io_bench_{}_ascii.msh", ::getpid());
+        std::ofstream(path, std::ios::binary) << SlabAsGmsh41(false);
+        return path;
+      }(),
+      [] {
+        const auto path = std::filesystem::temp_directory_path() /
+                          fmt::format("gipsi_mesh_io_bench_{}_binary.msh", ::getpid());
+        std::ofstream(path, std::ios::binary) << SlabAsGmsh41(true);
+        return path;
+      }()};
+  return files[binary ? 1 : 0];
+}
+
+void BM_ReadMeshWhole(benchmark::State& state) {
+  const auto& path = SlabFile(state.range(0) != 0);
+  Index tets = 0;
+  for (auto _ : state) tets = ReadMesh(path).num_tets();
+  state.counters["tets"] = static_cast<double>(tets);
+  state.counters["MB"] = static_cast<double>(std::filesystem::file_size(path)) / 1e6;
+  state.SetLabel(state.range(0) != 0 ? "binary" : "ascii");
+}
+
+// Rank 0 of 2's block: the same work as any rank's (both passes read the whole file).
+void BM_ReadGmshBlock(benchmark::State& state) {
+  const auto& path = SlabFile(state.range(0) != 0);
+  std::int64_t tets = 0;
+  for (auto _ : state) tets = ReadGmshBlock(path, 0, 2)->tets.cols();
+  state.counters["block_tets"] = static_cast<double>(tets);
+  state.SetLabel(state.range(0) != 0 ? "binary" : "ascii");
+}
+
+BENCHMARK(BM_ReadMeshWhole)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_ReadGmshBlock)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
+
+// The temporary files go when the benchmark ends.
+struct Cleanup {
+  ~Cleanup() {
+    std::error_code ignored;
+    for (const char* kind : {"ascii", "binary"})
+      std::filesystem::remove(std::filesystem::temp_directory_path() /
+                                  fmt::format("gipsi_mesh_io_bench_{}_{}.msh", ::getpid(), kind),
+                              ignored);
+  }
+} cleanup;
+
+}  // namespace
+}  // namespace gipsi
