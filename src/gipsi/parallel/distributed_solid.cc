@@ -11,6 +11,7 @@
 #include <span>
 #include <string>
 #include <string_view>
+#include <utility>
 
 #include "gipsi/base/error.h"
 #include "gipsi/base/state.h"
@@ -429,7 +430,25 @@ DistributedSolid::DistributedSolid(std::shared_ptr<const Mesh> whole_mesh, MPI_C
   ghosts_->v = MakeGhosted(part_, comm_);
 }
 
+DistributedSolid::DistributedSolid(MeshPart part, MPI_Comm comm)
+    : comm_(comm),
+      part_(std::move(part)),
+      boundary_(PartBoundary(part_, comm)),
+      ghosts_(std::make_unique<Ghosts>()) {
+  ghosts_->v = MakeGhosted(part_, comm_);
+}
+
 DistributedSolid::~DistributedSolid() = default;
+
+const Mesh& DistributedSolid::whole_mesh() const {
+  GIPSI_CHECK(whole_ != nullptr, "a FemSolid split from mesh blocks has no whole mesh");
+  return *whole_;
+}
+
+const BoundarySurface& DistributedSolid::whole_boundary() const {
+  GIPSI_CHECK(whole_ != nullptr, "a FemSolid split from mesh blocks has no whole mesh");
+  return whole_boundary_;
+}
 
 void DistributedSolid::Reduce(std::span<double> values, bool max) const {
   MPI_Allreduce(MPI_IN_PLACE, values.data(), static_cast<int>(values.size()), MPI_DOUBLE,

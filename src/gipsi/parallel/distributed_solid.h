@@ -37,6 +37,10 @@ class DistributedSolid final : public SolidDistribution {
   /// cavities of the solid are computed on it). Throws InputError (fewer tets than ranks),
   /// PetscError if PETSc fails.
   DistributedSolid(std::shared_ptr<const Mesh> whole, MPI_Comm comm);
+  /// Collective: on a mesh already cut (`part`, this rank's, e.g. from PartitionMeshBlocks),
+  /// which no rank holds whole: the part's boundary is found by exchanges (PartBoundary), and
+  /// there is no whole mesh, so the solid may have no cavities (whole_mesh() aborts).
+  DistributedSolid(MeshPart part, MPI_Comm comm);
   ~DistributedSolid() override;
   DistributedSolid(const DistributedSolid&) = delete;
   DistributedSolid& operator=(const DistributedSolid&) = delete;
@@ -44,7 +48,7 @@ class DistributedSolid final : public SolidDistribution {
   [[nodiscard]] const MeshPart& part() const { return part_; }
   [[nodiscard]] MPI_Comm comm() const { return comm_; }
   /// For each vertex of boundary(), its vertex in the whole mesh's boundary (MakeBoundary);
-  /// for each face, its face there (whole_face()).
+  /// for each face, its face there (whole_face()). Empty without the whole mesh.
   [[nodiscard]] const std::vector<int>& whole_boundary_vertex() const { return whole_vertex_; }
   [[nodiscard]] const std::vector<int>& whole_boundary_face() const { return whole_face_; }
 
@@ -55,8 +59,8 @@ class DistributedSolid final : public SolidDistribution {
   [[nodiscard]] std::unique_ptr<LinearSolver> MakeLinearSolver(const LinearSolverOptions& options,
                                                                const VecX& rest) const override;
   [[nodiscard]] std::int64_t WholeTetId(Index local) const override;
-  [[nodiscard]] const Mesh& whole_mesh() const override { return *whole_; }
-  [[nodiscard]] const BoundarySurface& whole_boundary() const override { return whole_boundary_; }
+  [[nodiscard]] const Mesh& whole_mesh() const override;
+  [[nodiscard]] const BoundarySurface& whole_boundary() const override;
   [[nodiscard]] std::span<const int> whole_face() const override { return whole_face_; }
   [[nodiscard]] std::span<const int> whole_node() const override { return part_.whole_node; }
 

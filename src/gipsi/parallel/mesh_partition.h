@@ -24,6 +24,7 @@
 #include <vector>
 
 #include "gipsi/base/export.h"
+#include "gipsi/geometry/boundary.h"
 #include "gipsi/geometry/mesh.h"
 #include "gipsi/geometry/mesh_block.h"
 
@@ -74,6 +75,13 @@ std::vector<int> GatherSelectedNodes(const MeshPart& part, std::span<const int> 
                                      MPI_Comm comm);
 /// The local indices, ascending, of the whole-mesh nodes `whole` that this part holds.
 std::vector<int> LocalNodesOf(const MeshPart& part, std::span<const int> whole);
+
+/// The whole mesh's boundary on this rank's part, found without the whole mesh: the whole
+/// boundary's faces of local tets (outward, in the order of their tets), and every local node on
+/// the whole boundary as a vertex (in local order), also one that only another part's faces
+/// touch. The same surface as the whole mesh's boundary (MakeBoundary) restricted to the part.
+/// Collective; O(part) per rank.
+BoundarySurface PartBoundary(const MeshPart& part, MPI_Comm comm);
 
 /// Every rank's owned values of a node field, gathered on rank 0 in the whole mesh's node order
 /// (`local`: one value per local node of `part`). Collective; ranks other than 0 get an empty

@@ -34,6 +34,7 @@ namespace {
 
 using detail::BlockRank;
 using detail::Exchange;
+using detail::FaceRank;
 using detail::Received;
 
 using Face = std::array<int, 3>;
@@ -72,21 +73,6 @@ struct TriangleRecord {
 struct Membership {
   int item, group;
 };
-
-// The rank a face's records meet on: a hash of its sorted nodes (splitmix64's finaliser).
-int FaceRank(const Face& f, int size) {
-  std::uint64_t h = 0x9E3779B97F4A7C15ULL;
-  for (int n : f) {
-    h ^= static_cast<std::uint64_t>(static_cast<std::uint32_t>(n)) + 0x9E3779B97F4A7C15ULL +
-         (h << 6) + (h >> 2);
-    h ^= h >> 30;
-    h *= 0xBF58476D1CE4E5B9ULL;
-    h ^= h >> 27;
-    h *= 0x94D049BB133111EBULL;
-    h ^= h >> 31;
-  }
-  return static_cast<int>(h % static_cast<std::uint64_t>(size));
-}
 
 Face SortedFace(const std::array<int, 4>& tet, int skip) {
   Face f{};

@@ -5,6 +5,7 @@
 
 #include <mpi.h>
 
+#include <array>
 #include <cstdint>
 #include <numeric>
 #include <type_traits>
@@ -55,6 +56,21 @@ Received<T> Exchange(const std::vector<std::vector<T>>& to, MPI_Comm comm) {
                 out.counts.data(), receive_offsets.data(), record, comm);
   MPI_Type_free(&record);
   return out;
+}
+
+/// The rank a face's records meet on: a hash of its sorted nodes (splitmix64's finaliser).
+inline int FaceRank(const std::array<int, 3>& f, int size) {
+  std::uint64_t h = 0x9E3779B97F4A7C15ULL;
+  for (int n : f) {
+    h ^= static_cast<std::uint64_t>(static_cast<std::uint32_t>(n)) + 0x9E3779B97F4A7C15ULL +
+         (h << 6) + (h >> 2);
+    h ^= h >> 30;
+    h *= 0xBF58476D1CE4E5B9ULL;
+    h ^= h >> 27;
+    h *= 0x94D049BB133111EBULL;
+    h ^= h >> 31;
+  }
+  return static_cast<int>(h % static_cast<std::uint64_t>(size));
 }
 
 /// The rank whose block (BlockBegin) holds item `item` of `count` split over `size` ranks.

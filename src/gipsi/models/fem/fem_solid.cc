@@ -121,13 +121,16 @@ FemSolid::FemSolid(std::string name, std::shared_ptr<const Mesh> domain, FemPara
       {"inverted_elements", L::kGlobal, 1, "1", A::kRead, "number of elements with det F <= 0"});
   f_volume_ = DeclareField({"volume", L::kGlobal, 1, "m^3", A::kRead,
                             "current volume (the sum of the tets' signed volumes)"});
-  for (WallCavity& wall : MakeWallCavities(
-           this->name(), params_.cavities, dist_ ? dist_->whole_mesh() : *domain,
-           dist_ ? dist_->whole_boundary() : bnd,
-           [this](FieldInfo info) { return DeclareField(std::move(info)); },
-           "pressure in the cavity, acting on its faces (follower load)"))
-    cavities_.emplace_back(std::move(wall)).gradient = VecX::Zero(3 * n);
-  if (dist_) {
+  // A split solid's cavities are selected on the whole mesh (one split from mesh blocks has
+  // none, and no whole mesh).
+  if (!params_.cavities.empty())
+    for (WallCavity& wall : MakeWallCavities(
+             this->name(), params_.cavities, dist_ ? dist_->whole_mesh() : *domain,
+             dist_ ? dist_->whole_boundary() : bnd,
+             [this](FieldInfo info) { return DeclareField(std::move(info)); },
+             "pressure in the cavity, acting on its faces (follower load)"))
+      cavities_.emplace_back(std::move(wall)).gradient = VecX::Zero(3 * n);
+  if (dist_ && !cavities_.empty()) {
     // The whole cavity's surface on every process; its faces on this one, in part numbering.
     std::vector<int> local_of(static_cast<std::size_t>(dist_->whole_mesh().num_nodes()), -1);
     const std::span<const int> whole_node = dist_->whole_node();
