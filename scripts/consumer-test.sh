@@ -129,9 +129,11 @@ if [ -n "$(find "$prefix" -name 'libgipsi_parallel.so*' | head -1)" ]; then
   mkdir -p "$mpi_dir"
   awk '/^## The distributed runs/{s=1} s && /^```cmake$/{f=1; next} f && /^```$/{exit} f' docs/install.md > "$mpi_dir/CMakeLists.txt"
   awk '/^## The distributed runs/{s=1} s && /^```cpp$/{f=1; next} f && /^```$/{exit} f' docs/install.md > "$mpi_dir/main.cc"
-  cmake -S "$mpi_dir" -B "$mpi_dir/build" -G Ninja -DCMAKE_PREFIX_PATH="$prefix" > /dev/null
-  cmake --build "$mpi_dir/build" > /dev/null
-  mpiexec -np 2 "$mpi_dir/build/my_partition" > "$work/my_partition.log" 2>&1
+  { cmake -S "$mpi_dir" -B "$mpi_dir/build" -G Ninja -DCMAKE_PREFIX_PATH="$prefix" &&
+    cmake --build "$mpi_dir/build"; } > "$work/my_partition_build.log" 2>&1 ||
+    { echo "consumer-test: the docs/install.md COMPONENTS parallel program did not build:" >&2; cat "$work/my_partition_build.log" >&2; exit 1; }
+  mpiexec -np 2 "$mpi_dir/build/my_partition" > "$work/my_partition.log" 2>&1 ||
+    { echo "consumer-test: the COMPONENTS parallel program failed on 2 ranks:" >&2; cat "$work/my_partition.log" >&2; exit 1; }
   # Every node owned by one rank: the owned counts add up to the box's 41 x 15 x 7 nodes.
   awk '/nodes owned of/ {sum += $(NF-4); total = $NF} END {exit !(NR == 2 && sum == total && total == 4305)}' \
     "$work/my_partition.log" ||
