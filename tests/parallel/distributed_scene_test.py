@@ -158,6 +158,23 @@ def compare_probes(label, serial_dir, split_dir, names, scale=None):
         print(f"{label}, {name}: largest difference {worst:.3g}")
 
 
+def run_variant(label, scene, *extra):
+    """Writes `scene` (a dict) into the work folder and runs it serially and on 2 and 4 ranks
+    (to 30 ms); returns each run's output folder by rank count."""
+    path = os.path.join(work, label + ".json")
+    with open(path, "w") as f:
+        json.dump(scene, f)
+    outs = {}
+    for ranks in (1, 2, 4):
+        outs[ranks] = os.path.join(work, f"{label}{ranks}")
+        code, text = run(ranks, outs[ranks], *extra, scene=path)
+        check(code == 0, f"{label} on {ranks} ranks: exit {code}: {text}")
+        if ranks > 1:
+            check("(split over them: tissue (Monodomain, in blocks))" in text or "-q" in extra,
+                  f"{label} on {ranks} ranks: the slab is not made in blocks:\n{text}")
+    return outs
+
+
 def resumes_bitwise(label, scene, every, stop, end):
     """On 2 ranks, a run checkpointed every `every` s up to `stop` and resumed to `end` writes the
     uninterrupted run's files byte for byte."""
@@ -346,67 +363,24 @@ with tempfile.TemporaryDirectory() as work:
         "middle": {"object": "tissue", "fields": ["V", "activation_time"],
                    "point": [0.01, 0.0035, 0.0015]}}
     scene["outputs"].pop("plots", None)
-    regions = os.path.join(work, "regions.json")
-    with open(regions, "w") as f:
-        json.dump(scene, f)
-    region_runs = {}
-    for ranks in (1, 2, 4):
-        out = os.path.join(work, f"regions{ranks}")
-        code, text = run(ranks, out, "-q", scene=regions, until="0.03")
-        check(code == 0, f"region probes on {ranks} ranks: exit {code}: {text}")
-        region_runs[ranks] = out
+    region_runs = run_variant("regions", scene)
     for ranks in (2, 4):
         compare_probes(f"region probes on {ranks} ranks", region_runs[1], region_runs[ranks],
                        ("box_mean", "face_max", "ids_sum", "middle"), {"ids_sum": 3})
-    # The slab's box as a Gmsh 4.1 file (another tet mesh of it: six tets per cell, each
-    # cell cut along its main diagonal), which each rank reads in blocks: the serial run's
-    # probes, within the bounds above, on 2 and 4 ranks.
-    nx, ny, nz = 40, 14, 6
-    def vertex(i, j, k):
-        return i + (nx + 1) * (j + (ny + 1) * k)
-    points = [(0.020 * i / nx, 0.007 * j / ny, 0.003 * k / nz)
-              for k in range(nz + 1) for j in range(ny + 1) for i in range(nx + 1)]
-    tets = []
-    for k in range(nz):
-        for j in range(ny):
-            for i in range(nx):
-                for order in ((0, 1, 2), (0, 2, 1), (1, 0, 2), (1, 2, 0), (2, 0, 1), (2, 1, 0)):
-                    at, tet = [i, j, k], [vertex(i, j, k)]
-                    for axis in order:
-                        at[axis] += 1
-                        tet.append(vertex(*at))
-                    a, b, c, d = (points[v] for v in tet)
-                    u, v, w = ([q[m] - a[m] for m in range(3)] for q in (b, c, d))
-                    det = (u[0] * (v[1] * w[2] - v[2] * w[1]) - u[1] * (v[0] * w[2] - v[2] * w[0])
-                           + u[2] * (v[0] * w[1] - v[1] * w[0]))
-                    if det < 0:
-                        tet[2], tet[3] = tet[3], tet[2]
-                    tets.append(tet)
+    # The slab's box as a Gmsh 4.1 file (another tet mesh of it, written by
+    # bench/mpi/slab_msh.py: six tets per cell, each cell cut along its main diagonal), which
+    # each rank reads in blocks: the serial run's probes, within the bounds above, on 2 and 4
+    # ranks.
+    written = subprocess.run([sys.executable, os.path.join(SOURCE, "bench", "mpi", "slab_msh.py"),
+                              "40", "14", "6", os.path.join(work, "slab")],
+                             capture_output=True, text=True, timeout=60)
+    check(written.returncode == 0, f"slab_msh.py: {written.stdout}{written.stderr}")
     gmsh = os.path.join(work, "slab.msh")
-    with open(gmsh, "w") as f:
-        n, m = len(points), len(tets)
-        f.write(f"$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$Nodes\n1 {n} 1 {n}\n3 1 0 {n}\n")
-        f.write("".join(f"{t + 1}\n" for t in range(n)))
-        f.write("".join(f"{x!r} {y!r} {z!r}\n" for x, y, z in points))
-        f.write(f"$EndNodes\n$Elements\n1 {m} 1 {m}\n3 1 4 {m}\n")
-        f.write("".join(f"{e + 1} {' '.join(str(v + 1) for v in t)}\n" for e, t in enumerate(tets)))
-        f.write("$EndElements\n")
     with open(SCENE) as f:
         scene = json.load(f)
     scene["meshes"]["slab"] = {"file": gmsh}
     scene["outputs"].pop("plots", None)
-    from_file = os.path.join(work, "from_file.json")
-    with open(from_file, "w") as f:
-        json.dump(scene, f)
-    file_runs = {}
-    for ranks in (1, 2, 4):
-        out = os.path.join(work, f"from_file{ranks}")
-        code, text = run(ranks, out, scene=from_file)
-        check(code == 0, f"the slab from a Gmsh file on {ranks} ranks: exit {code}: {text}")
-        if ranks > 1:
-            check("(split over them: tissue (Monodomain, in blocks))" in text,
-                  f"the slab from a Gmsh file on {ranks} ranks is not read in blocks:\n{text}")
-        file_runs[ranks] = out
+    file_runs = run_variant("from_file", scene)
     for ranks in (2, 4):
         compare_probes(f"the slab from a Gmsh file on {ranks} ranks", file_runs[1],
                        file_runs[ranks], ("far_corner", "activated", "diagonal"))
