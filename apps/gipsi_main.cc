@@ -208,6 +208,8 @@ struct Ranks {
   /// Ends every rank with `code` (a rank that stops alone would leave the others waiting).
   std::function<void(int)> abort;
   std::function<void()> barrier;
+  /// DistributedRun::SetCheckpointFiles.
+  std::function<void(std::vector<std::filesystem::path>)> set_checkpoint_files;
   /// DistributedRun::AgreeOnFailure.
   std::function<std::optional<std::string>(const std::string&)> agree_on_failure;
   /// The objects split over the ranks, as "name (Type)" (once the scene is loaded).
@@ -354,38 +356,37 @@ std::filesystem::path RankFile(const std::filesystem::path& file, int rank) {
   return file.parent_path() / name;
 }
 
-/// Before a resume: a serial run's checkpoint named for a distributed run, or the reverse,
-/// gets a message that says which run wrote it (a missing file is left to the reader).
-void CheckResumeFiles(const std::filesystem::path& resume, const Ranks& ranks) {
+/// Before a resume: the files of a distributed checkpoint (`<stem>_p0`, `_p1`, ... that exist),
+/// which a distributed run reads whatever its rank count (rank q reads rank q % N's file of N,
+/// and split objects read the others' parts, docs/scale-out.md); a serial run's checkpoint
+/// named for a distributed run, or the reverse, gets a message that says which run wrote it (a
+/// missing file is left to the reader).
+std::vector<std::filesystem::path> CheckResumeFiles(const std::filesystem::path& resume,
+                                                    const Ranks& ranks) {
   std::error_code error;
-  int pieces = 0;  // the files _p0, _p1, ... that exist
-  while (std::filesystem::exists(RankFile(resume, pieces), error)) ++pieces;
+  std::vector<std::filesystem::path> pieces;  // the files _p0, _p1, ... that exist
+  while (std::filesystem::exists(RankFile(resume, static_cast<int>(pieces.size())), error))
+    pieces.push_back(RankFile(resume, static_cast<int>(pieces.size())));
   if (ranks.distributed()) {
     // Every rank looks at the same files and refuses alike (a rank whose file exists would
-    // otherwise wait for the others; more files than ranks are refused by their contents).
-    if (pieces >= ranks.size) return;
-    if (pieces == 0 && std::filesystem::is_regular_file(resume, error))
+    // otherwise wait for the others).
+    if (!pieces.empty()) return pieces;
+    if (std::filesystem::is_regular_file(resume, error))
       gipsi::ThrowInputError(
           "command line", "--resume",
           fmt::format("{} is the checkpoint of a run on one process, and this run has {} ranks "
                       "(which would read {}): resume it without mpirun",
                       resume.string(), ranks.size, RankFile(resume, ranks.rank).string()));
-    if (pieces > 0)
-      gipsi::ThrowInputError(
-          "command line", "--resume",
-          fmt::format("{} to {} are the checkpoint of a run on {} MPI ranks, and this run has {} "
-                      "(which would also read {}): resume it with mpirun -np {}",
-                      RankFile(resume, 0).string(), RankFile(resume, pieces - 1).string(), pieces,
-                      ranks.size, RankFile(resume, ranks.size - 1).string(), pieces));
-    return;
+    return {RankFile(resume, ranks.rank)};  // missing: the reader says so
   }
-  if (std::filesystem::exists(resume, error) || pieces == 0) return;
+  if (std::filesystem::exists(resume, error) || pieces.empty()) return {};
   gipsi::ThrowInputError(
       "command line", "--resume",
       fmt::format("{} does not exist, and {} to {} are the checkpoint of a run on {} MPI ranks: "
-                  "resume it with mpirun -np {} (docs/scale-out.md)",
-                  resume.string(), RankFile(resume, 0).string(),
-                  RankFile(resume, pieces - 1).string(), pieces, pieces));
+                  "resume it with mpirun -np {} (or on another count of 2 or more ranks if the "
+                  "objects split over them are Monodomains; docs/scale-out.md)",
+                  resume.string(), pieces.front().string(), pieces.back().string(), pieces.size(),
+                  pieces.size()));
 }
 
 /// Options of `gipsi run` about checkpoints.
@@ -400,7 +401,8 @@ int Run(const std::string& file, const std::string& out_dir, double until, bool 
         const CheckpointOptions& checkpoints, const gipsi::SceneLimits& limits,
         const Ranks& ranks = {}) {
   StopSignals signals;  // while building: exit 130 at once; then: stop the run cleanly
-  if (!checkpoints.resume.empty()) CheckResumeFiles(checkpoints.resume, ranks);
+  std::vector<std::filesystem::path> resume_files;  // a distributed checkpoint's, rank 0's first
+  if (!checkpoints.resume.empty()) resume_files = CheckResumeFiles(checkpoints.resume, ranks);
   const bool lead = ranks.rank == 0;  // writes files and prints
   if (!lead) quiet = true;
   gipsi::TypeRegistry registry;
@@ -452,8 +454,20 @@ int Run(const std::string& file, const std::string& out_dir, double until, bool 
   gipsi::AttachOutputs(scene, out, !checkpoints.resume.empty(),
                        lead ? gipsi::OutputFiles::kWrite : gipsi::OutputFiles::kReadOnly);
   if (!checkpoints.resume.empty()) {
-    kernel.ReadCheckpoint(ranks.distributed() ? RankFile(checkpoints.resume, ranks.rank)
-                                              : std::filesystem::path(checkpoints.resume));
+    if (ranks.distributed()) {
+      // On another rank count than wrote the checkpoint, rank q reads rank q % N's file for
+      // what every rank holds alike, and split objects read their parts from all N.
+      if (ranks.set_checkpoint_files) ranks.set_checkpoint_files(resume_files);
+      kernel.ReadCheckpoint(
+          resume_files[static_cast<std::size_t>(ranks.rank) % resume_files.size()]);
+      if (resume_files.size() != static_cast<std::size_t>(ranks.size))
+        gipsi::Log().info(
+            "the checkpoint was written on {} ranks: the split objects' state has "
+            "moved to this run's {} (docs/scale-out.md, Checkpoints)",
+            resume_files.size(), ranks.size);
+    } else {
+      kernel.ReadCheckpoint(checkpoints.resume);
+    }
     const double tolerance = 1e-9 * kernel.macro_dt();
     if (scene.end_time <= kernel.time() + tolerance)
       gipsi::ThrowInputError(
@@ -892,6 +906,9 @@ int main(int argc, char** argv) {
     ranks.split_objects = [&mpi] { return mpi->split_objects(); };
     ranks.abort = [&mpi](int code) { mpi->Abort(code); };
     ranks.barrier = [&mpi] { mpi->Barrier(); };
+    ranks.set_checkpoint_files = [&mpi](std::vector<std::filesystem::path> files) {
+      mpi->SetCheckpointFiles(std::move(files));
+    };
     // How long a rank that met an error waits for the others to report one too before it
     // ends them all: they read the same scene, so a bad one fails every rank within this; a
     // rank that fails alone costs this much more before the abort.

@@ -230,5 +230,81 @@ TEST(StateValue, AMatrixWithInlineStorageRefusesASizeItCannotHold) {
   EXPECT_EQ(read.v.size(), 3);
 }
 
+// Two shares of one problem (another rank's checkpoint: the same entries, arrays of other
+// lengths): a position taken in one finds the same entry in the other.
+std::string Share(int nodes, double marker) {
+  StateWriter out;
+  out.WriteString("kernel");
+  out.BeginSection("Objects", 3);
+  out.WriteInt(2);
+  out.BeginSection("First", 1);
+  out.WriteArray(std::vector<double>(static_cast<std::size_t>(nodes), 1.0));
+  out.WriteMatrix(Points::Ones(3, nodes));
+  out.EndSection();
+  out.WriteString(std::string(static_cast<std::size_t>(nodes), 'x'));
+  out.BeginSection("Second", 2);
+  out.WriteDouble(0.5);
+  out.BeginSection("Part", 1);
+  out.WriteDouble(marker);
+  out.WriteArray(std::vector<int>(static_cast<std::size_t>(nodes), 7));
+  out.EndSection();
+  out.WriteInt(9);
+  out.EndSection();
+  out.EndSection();
+  return out.TakeBytes();
+}
+
+TEST(StateReader, APositionFindsTheSameEntryInAnotherShare) {
+  StateReader mine(Share(3, 1.0), "p0.gck");
+  (void)mine.ReadString();
+  mine.BeginSection("Objects", 3);
+  (void)mine.ReadInt();
+  mine.BeginSection("First", 1);
+  mine.SkipRestOfSection();
+  mine.EndSection();
+  (void)mine.ReadString();
+  mine.BeginSection("Second", 2);
+  (void)mine.ReadDouble();
+  const StateReader::Position at = mine.position();
+  ASSERT_EQ(at.index, (std::vector<std::uint64_t>{1, 3, 1}));
+  ASSERT_EQ(at.tags, (std::vector<std::string>{"Objects", "Second"}));
+
+  StateReader other(Share(1000, 2.0), "p1.gck");
+  other.Seek(at);
+  other.BeginSection("Part", 1);
+  EXPECT_EQ(other.ReadDouble(), 2.0);
+  std::vector<int> ids;
+  other.ReadArray(ids);
+  EXPECT_EQ(ids.size(), 1000U);
+  other.EndSection();
+  EXPECT_EQ(other.ReadInt(), 9);
+  EXPECT_EQ(other.position().index, (std::vector<std::uint64_t>{1, 3, 3}));
+}
+
+TEST(StateReader, SeekIntoAnotherLayoutIsRefusedByName) {
+  StateReader mine(Share(3, 1.0), "p0.gck");
+  (void)mine.ReadString();
+  mine.BeginSection("Objects", 3);
+  const StateReader::Position at = mine.position();
+  StateWriter other_layout;
+  other_layout.WriteString("kernel");
+  other_layout.BeginSection("Scene", 3);
+  other_layout.EndSection();
+  StateReader other(other_layout.TakeBytes(), "p1.gck");
+  try {
+    other.Seek(at);
+    FAIL() << "a position found in another layout";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("p1.gck: expected state of 'Objects' but the checkpoint "
+                                         "has 'Scene' here"),
+              std::string::npos)
+        << e.what();
+  }
+  StateWriter short_one;
+  short_one.WriteString("kernel");
+  StateReader truncated(short_one.TakeBytes(), "p2.gck");
+  EXPECT_THROW(truncated.Seek(at), InputError);
+}
+
 }  // namespace
 }  // namespace gipsi

@@ -157,6 +157,7 @@ std::uint64_t StateReader::ReadU64() {
 void StateReader::Expect(char code, std::string_view what) {
   char got = 0;
   ReadBytes(&got, 1);
+  ++(open_.empty() ? top_entries_ : open_.back().entries);
   if (got != code)
     Fail(
         fmt::format("expected {} ({}) but found {}; the checkpoint is from another scene or "
@@ -182,7 +183,7 @@ void StateReader::BeginSection(std::string_view tag, std::uint32_t version) {
   const std::uint64_t length = ReadU64();
   const std::size_t limit = open_.empty() ? bytes_.size() : open_.back().end;
   if (length > limit - pos_) Fail(fmt::format("section '{}' is truncated", tag));
-  open_.push_back({std::string(tag), pos_ + static_cast<std::size_t>(length)});
+  open_.push_back({std::string(tag), pos_ + static_cast<std::size_t>(length), version, 0});
 }
 
 void StateReader::EndSection() {
@@ -193,6 +194,75 @@ void StateReader::EndSection() {
                     "another scene or version",
                     open_.back().end - pos_));
   open_.pop_back();
+}
+
+void StateReader::SkipBytes(std::uint64_t size) {
+  const std::size_t limit = open_.empty() ? bytes_.size() : open_.back().end;
+  if (size > limit - pos_) Fail("the data ends early (truncated or from another scene)");
+  pos_ += static_cast<std::size_t>(size);
+}
+
+void StateReader::SkipRestOfSection() {
+  GIPSI_CHECK(!open_.empty(), "StateReader::SkipRestOfSection outside a section");
+  pos_ = open_.back().end;
+}
+
+void StateReader::SkipEntry() {
+  char code = 0;
+  ReadBytes(&code, 1);
+  ++(open_.empty() ? top_entries_ : open_.back().entries);
+  // A count of values times their size, refused before it could overflow.
+  auto product = [&](std::uint64_t a, std::uint64_t b) {
+    if (a != 0 && b > (bytes_.size() - pos_) / a) Fail("an entry runs past the end of the data");
+    return a * b;
+  };
+  switch (code) {
+    case kSection: {
+      SkipBytes(ReadU64());  // the tag
+      (void)ReadU64();       // the version
+      SkipBytes(ReadU64());
+      return;
+    }
+    case kDouble:
+    case kInt:
+      return SkipBytes(8);
+    case kString:
+      return SkipBytes(ReadU64());
+    case kArray: {
+      const std::uint64_t size = ReadU64();
+      return SkipBytes(product(size, ReadU64()));
+    }
+    case kMatrix: {
+      const std::uint64_t size = ReadU64();
+      const std::uint64_t rows = ReadU64();
+      return SkipBytes(product(size, product(rows, ReadU64())));
+    }
+    default:
+      Fail(
+          fmt::format("an unknown entry (code {}); the data is corrupted", static_cast<int>(code)));
+  }
+}
+
+StateReader::Position StateReader::position() const {
+  Position at;
+  for (std::size_t i = 0; i < open_.size(); ++i) {
+    // A section counts as read in its parent once entered.
+    at.index.push_back((i == 0 ? top_entries_ : open_[i - 1].entries) - 1);
+    at.tags.push_back(open_[i].tag);
+    at.versions.push_back(open_[i].version);
+  }
+  at.index.push_back(open_.empty() ? top_entries_ : open_.back().entries);
+  return at;
+}
+
+void StateReader::Seek(const Position& at) {
+  GIPSI_CHECK(pos_ == 0 && open_.empty() && top_entries_ == 0, "StateReader::Seek after reading");
+  GIPSI_CHECK(at.index.size() == at.tags.size() + 1 && at.tags.size() == at.versions.size(),
+              "StateReader::Seek: a malformed position");
+  for (std::size_t i = 0; i < at.index.size(); ++i) {
+    for (std::uint64_t k = 0; k < at.index[i]; ++k) SkipEntry();
+    if (i < at.tags.size()) BeginSection(at.tags[i], at.versions[i]);
+  }
 }
 
 double StateReader::ReadDouble() {

@@ -121,6 +121,23 @@ class StateReader {
 
   /// True when everything has been read.
   [[nodiscard]] bool at_end() const { return pos_ == bytes_.size(); }
+  /// Skips the rest of the open section (the next call is its EndSection).
+  void SkipRestOfSection();
+
+  /// Where the reader is, as entries rather than bytes: the sections it is in (by their index
+  /// among their parent's entries, their tag and version) and how many entries of the innermost
+  /// it has read. Data written by the same code for another share of a problem (another MPI
+  /// rank's checkpoint, whose arrays have other lengths) has the same entries up to a point
+  /// where the shares differ in content only: Seek finds that point there. Plain struct.
+  struct Position {
+    std::vector<std::uint64_t> index;  ///< per open section, then the entries read in the last
+    std::vector<std::string> tags;
+    std::vector<std::uint32_t> versions;
+  };
+  [[nodiscard]] Position position() const;
+  /// From the start of the data (nothing read yet): skips to `at`, entering its sections (each
+  /// checked like BeginSection: a data of another layout throws InputError).
+  void Seek(const Position& at);
   /// Throws InputError(source: section path: what).
   [[noreturn]] void Fail(std::string_view what) const;
 
@@ -130,6 +147,10 @@ class StateReader {
   [[noreturn]] void ShapeError(std::string_view what, std::size_t rows, std::size_t cols,
                                std::size_t got_rows, std::size_t got_cols) const;
   void Expect(char code, std::string_view what);
+  // Skips one entry of any kind.
+  void SkipEntry();
+  // Skips `size` bytes of the current section.
+  void SkipBytes(std::uint64_t size);
   void ReadBytes(void* out, std::size_t size);
   std::uint64_t ReadU64();
 
@@ -139,8 +160,11 @@ class StateReader {
   struct Open {
     std::string tag;
     std::size_t end;
+    std::uint32_t version = 0;
+    std::uint64_t entries = 0;  // read in this section so far
   };
   std::vector<Open> open_;
+  std::uint64_t top_entries_ = 0;  // read outside every section so far
 };
 
 /// A new process-wide stamp, never 0 (thread-safe): marks the contents of a rarely written

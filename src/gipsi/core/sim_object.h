@@ -4,6 +4,7 @@
 /// named fields, boundary conditions and a `Step`. The GiPSi simulation API.
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <span>
@@ -199,6 +200,23 @@ class SimObject {
   /// identically. Throw InputError for state from another scene or object type.
   void SaveState(StateWriter& out) const;
   void RestoreState(StateReader& in);
+  /// What SaveState wrote around the type's state, read without the object: a checkpoint of
+  /// another partition's part of a split object (gipsi/parallel/). Plain struct.
+  struct SavedHeader {
+    std::string name, type;
+    double time = 0;
+    std::int64_t steps = 0;
+  };
+  /// Reads what SaveState wrote for an object whose boundary had `boundary_vertices` vertices
+  /// and `boundary_faces` faces: the header, the applied boundary conditions (dropped: they
+  /// are on that boundary) and, through `read_own`, the type's state.
+  static SavedHeader ReadSavedState(StateReader& in, Index boundary_vertices, Index boundary_faces,
+                                    const std::function<void(StateReader&)>& read_own);
+  /// RestoreState of what SaveState would write with clock `time`, `steps`, this object's
+  /// applied boundary conditions and the type's state written by `write_own` (a split object's
+  /// part restored from another partition's checkpoint, in this part's layout).
+  void RestoreStateFrom(double time, std::int64_t steps,
+                        const std::function<void(StateWriter&)>& write_own);
   /// Everything of the subclass that influences the future (state, integrator history, event
   /// logs), and the solver caches a bitwise continuation needs (a kept factorisation). The
   /// defaults write and read the state bound by BindState, and throw InputError("object type X

@@ -12,17 +12,29 @@
 
 namespace gipsi {
 
-void SimObject::SaveState(StateWriter& out) const {
+namespace {
+
+// SaveState's layout: the header, the applied boundary conditions, the type's state.
+void WriteSaved(StateWriter& out, std::string_view name, std::string_view type, double time,
+                std::int64_t steps, const BoundaryConditions& bcs,
+                const std::function<void(StateWriter&)>& write_own) {
   out.BeginSection("SimObject", 2);
-  out.WriteString(name_);
-  out.WriteString(type_name());
-  out.WriteDouble(time_);
-  out.WriteInt(step_count_);
-  bcs_.SaveApplied(out);  // the coupling loads are not state: the next macro step clears them
-  out.BeginSection(type_name(), 1);
-  SaveObjectState(out);
+  out.WriteString(name);
+  out.WriteString(type);
+  out.WriteDouble(time);
+  out.WriteInt(steps);
+  bcs.SaveApplied(out);  // the coupling loads are not state: the next macro step clears them
+  out.BeginSection(type, 1);
+  write_own(out);
   out.EndSection();
   out.EndSection();
+}
+
+}  // namespace
+
+void SimObject::SaveState(StateWriter& out) const {
+  WriteSaved(out, name_, type_name(), time_, step_count_, bcs_,
+             [this](StateWriter& w) { SaveObjectState(w); });
 }
 
 void SimObject::RestoreState(StateReader& in) {
@@ -41,6 +53,31 @@ void SimObject::RestoreState(StateReader& in) {
   in.EndSection();
   time_ = time;
   step_count_ = steps;
+}
+
+SimObject::SavedHeader SimObject::ReadSavedState(
+    StateReader& in, Index boundary_vertices, Index boundary_faces,
+    const std::function<void(StateReader&)>& read_own) {
+  SavedHeader header;
+  in.BeginSection("SimObject", 2);
+  header.name = in.ReadString();
+  header.type = in.ReadString();
+  header.time = in.ReadDouble();
+  header.steps = in.ReadInt();
+  BoundaryConditions(boundary_vertices, boundary_faces).RestoreApplied(in);
+  in.BeginSection(header.type, 1);
+  read_own(in);
+  in.EndSection();
+  in.EndSection();
+  return header;
+}
+
+void SimObject::RestoreStateFrom(double time, std::int64_t steps,
+                                 const std::function<void(StateWriter&)>& write_own) {
+  StateWriter out;
+  WriteSaved(out, name_, type_name(), time, steps, bcs_, write_own);
+  StateReader in(out.TakeBytes(), fmt::format("object '{}' moved to this partition", name_));
+  RestoreState(in);
 }
 
 namespace {

@@ -12,6 +12,7 @@
 #include <variant>
 
 #include "gipsi/base/error.h"
+#include "gipsi/base/state_binding.h"
 #include "gipsi/geometry/boundary.h"
 #include "gipsi/models/ep/monodomain.h"
 #include "gipsi/parallel/petsc_check.h"
@@ -381,6 +382,26 @@ StepStatus DistributedMonodomain::DoStep(double t, double dt) {
     default:
       return StepStatus::Stopped();
   }
+}
+
+void DistributedMonodomain::ReadNodeRows(StateReader& in, std::int64_t num_nodes,
+                                         std::vector<double>& rows,
+                                         std::vector<double>& shared) const {
+  // What SaveObjectState writes: the bound EpState and no cache.
+  EpState read = EpState::Sized(cell(), static_cast<std::size_t>(num_nodes));
+  BindStateValue(read)->Read(in, {});
+  rows = read.ToRows();
+  shared.assign(1, static_cast<double>(read.last_iterations));
+}
+
+void DistributedMonodomain::WriteNodeRows(StateWriter& out, std::span<const double> rows,
+                                          std::span<const double> shared) const {
+  GIPSI_CHECK(shared.size() == 1, "a Monodomain part's shared state is 1 value, not {}",
+              shared.size());
+  EpState written = EpState::Sized(cell(), static_cast<std::size_t>(num_nodes()));
+  written.FromRows(rows);
+  written.last_iterations = static_cast<int>(shared[0]);
+  BindStateValue(written)->Write(out);
 }
 
 void DistributedMonodomain::DoReadField(FieldId id, Eigen::Ref<Eigen::MatrixXd> out) const {

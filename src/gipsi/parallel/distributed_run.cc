@@ -7,9 +7,11 @@
 
 #include <chrono>
 #include <thread>
+#include <utility>
 
 #include "gipsi/parallel/distributed_types.h"
 #include "gipsi/parallel/parallel_session.h"
+#include "gipsi/parallel/whole_domain_view.h"
 
 namespace gipsi {
 namespace {
@@ -26,6 +28,9 @@ class PetscRun final : public DistributedRun {
     RegisterDistributedTypes(registry, world(), split_);
   }
   [[nodiscard]] std::vector<std::string> split_objects() const override { return *split_; }
+  void SetCheckpointFiles(std::vector<std::filesystem::path> files) const override {
+    WholeDomainView::SetCheckpointFiles(std::move(files));
+  }
   void Barrier() const override { MPI_Barrier(world()); }
   [[noreturn]] void Abort(int code) const override {
     MPI_Abort(world(), code);

@@ -5,6 +5,7 @@
 /// every build neither load nor start MPI (linking PETSc made every start of the tool 0.12 s
 /// and 22 MB heavier). This header names no MPI type.
 
+#include <filesystem>
 #include <optional>
 #include <string>
 #include <vector>
@@ -28,6 +29,9 @@ class DistributedRun {
   /// (a FemSolid with the ODE contract's implicit integrator, for one, still runs whole on every
   /// rank).
   [[nodiscard]] virtual std::vector<std::string> split_objects() const = 0;
+  /// The files of the checkpoint a run resumes from, every rank's, rank 0's first: a split
+  /// object restores from them on another rank count (WholeDomainView::SetCheckpointFiles).
+  virtual void SetCheckpointFiles(std::vector<std::filesystem::path> files) const = 0;
   /// Waits until every rank has called it.
   virtual void Barrier() const = 0;
   /// Ends every rank with `code` (MPI_Abort): for a failure one rank meets alone.

@@ -13,8 +13,12 @@
 /// snapshots (no communication). A checkpoint holds this rank's part after the rank count, the rank
 /// and a fingerprint of the partition (every rank writes its own file, docs/scale-out.md); a
 /// restore checks them on every rank together and, once read, that every rank's part is at the same
-/// time and step, so a checkpoint restores only on the rank count and partition that wrote it, and
-/// a set of files from different checkpoints (a run stopped while writing them) is refused.
+/// time and step, so a checkpoint restores bitwise on the rank count and partition that wrote it,
+/// and a set of files from different checkpoints (a run stopped while writing them) is refused.
+/// On another rank count a part whose state is per node (NodeStatePart) is restored from every
+/// file's part: each rank reads some of the files (rank q those of ranks q, q + M, ...), and the
+/// owned nodes' rows move to the new parts (MoveNodeRows); the run then goes on within the
+/// solvers' tolerance of the uninterrupted one (another cut sums in another order).
 ///
 /// Without the whole mesh (the second constructor: a "part-only" view, for an object nothing
 /// but probes and outputs reads, ObjectBuildContext::standalone) the view's domain and boundary
@@ -31,12 +35,14 @@
 #include <mpi.h>
 
 #include <cstdint>
+#include <filesystem>
 #include <memory>
 #include <optional>
 #include <string>
 #include <vector>
 
 #include "gipsi/base/export.h"
+#include "gipsi/base/state.h"
 #include "gipsi/core/cavity_law.h"
 #include "gipsi/core/partitioned_object.h"
 #include "gipsi/core/sim_object.h"
@@ -87,8 +93,13 @@ class WholeDomainView final : public SimObject, public CavityWall, public Partit
     return part_->ProfileBreakdown();
   }
   void SaveObjectState(StateWriter& out) const override;
-  /// Collective: every rank must restore its own rank's file.
+  /// Collective: every rank restores its own rank's file; on another rank count (a part that is
+  /// a NodeStatePart, with SetCheckpointFiles) rank q reads rank q % N's file of N.
   void RestoreObjectState(StateReader& in) override;
+  /// The files of the distributed checkpoint being resumed, rank 0's first (the tool sets them
+  /// before Kernel::ReadCheckpoint): a restore on another rank count reads the parts in them.
+  /// Empty (the default): a restore accepts only the rank count that wrote the checkpoint.
+  static void SetCheckpointFiles(std::vector<std::filesystem::path> files);
   [[nodiscard]] std::unique_ptr<ObjectState> NewObjectState() const override {
     return part_->NewSnapshot();
   }
@@ -147,6 +158,18 @@ class WholeDomainView final : public SimObject, public CavityWall, public Partit
   double region_tolerance_ = 0;  // RegionTolerance of the whole mesh
   // The constructors' shared part: fingerprint, bounding box.
   void Describe();
+  // What a checkpoint's DistributedPart section holds before the part's state.
+  struct SavedPart {
+    std::int64_t size = 0, rank = 0, whole_nodes = 0, local_nodes = 0;
+    std::uint64_t fingerprint = 0;
+    Index boundary_vertices = 0, boundary_faces = 0;
+    std::vector<int> owned;  // whole-mesh indices of the owned nodes (local [0, owned))
+  };
+  static SavedPart ReadSavedPart(StateReader& in);
+  // RestoreObjectState from a checkpoint of `saved.size` ranks, another count (`at`: where the
+  // DistributedPart section starts in `in`, to find it in the other ranks' files).
+  void RestoreOnAnotherRankCount(StateReader& in, const StateReader::Position& at,
+                                 const SavedPart& saved);
   // Buffers of the gathers, kept between reads (no allocation once sized).
   mutable std::vector<double> receive_;
   mutable std::vector<int> counts_, offsets_;

@@ -23,6 +23,7 @@
 #include <cstdint>
 #include <memory>
 #include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -132,6 +133,18 @@ struct EpState {
     v("depolarised", s.depolarised, Shape::kFixed);
     v("last_iterations", s.last_iterations);
   }
+
+  /// The state as one row per node, for a split monodomain's state moved to another partition
+  /// (a checkpoint restored on another rank count, gipsi/parallel/). Node i's row holds its
+  /// cell's state variables in the model's order, then activation_time, last_activation, apd,
+  /// v_min, v_peak and depolarised (0 or 1): RowWidth values.
+  [[nodiscard]] static int RowWidth(const CellModel& cell) { return cell.num_states() + 6; }
+  /// A state of `num_nodes` cells of `cell` at rest, no activation: the shape to read into.
+  [[nodiscard]] static EpState Sized(const CellModel& cell, std::size_t num_nodes);
+  /// The rows of every node, node after node.
+  [[nodiscard]] std::vector<double> ToRows() const;
+  /// Sets every node from `rows` (num_nodes() rows of RowWidth; the state is sized already).
+  void FromRows(std::span<const double> rows);
 };
 
 /// Base of the monodomain objects (see the file comment). Not copyable or movable.

@@ -1,0 +1,287 @@
+// A split monodomain's checkpoint restored on another rank count (WholeDomainView,
+// NodeStatePart, MoveNodeRows): written by the first N ranks of MPI_COMM_WORLD, restored by the
+// first M. Runs under `mpiexec -np 2` and `-np 4 --oversubscribe`; every test is collective.
+
+#include <fmt/format.h>
+#include <gtest/gtest.h>
+#include <mpi.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <array>
+#include <bit>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "gipsi/base/error.h"
+#include "gipsi/base/state.h"
+#include "gipsi/geometry/generators.h"
+#include "gipsi/geometry/mesh_block.h"
+#include "gipsi/geometry/region.h"
+#include "gipsi/models/ep/ten_tusscher_panfilov_2006.h"
+#include "gipsi/parallel/distributed_monodomain.h"
+#include "gipsi/parallel/mesh_partition.h"
+#include "gipsi/parallel/parallel_session.h"
+#include "gipsi/parallel/whole_domain_view.h"
+
+namespace gipsi {
+namespace {
+
+MPI_Comm World() { return ParallelSession::world(); }
+int Rank(MPI_Comm comm) { return ParallelSession::rank(comm); }
+int Size(MPI_Comm comm) { return ParallelSession::size(comm); }
+
+// The first `ranks` ranks of the world (MPI_COMM_NULL on the others). Freed with the object.
+class FirstRanks {
+ public:
+  explicit FirstRanks(int ranks) {
+    MPI_Comm_split(World(), Rank(World()) < ranks ? 0 : MPI_UNDEFINED, Rank(World()), &comm_);
+  }
+  ~FirstRanks() {
+    if (comm_ != MPI_COMM_NULL) MPI_Comm_free(&comm_);
+  }
+  FirstRanks(const FirstRanks&) = delete;
+  FirstRanks& operator=(const FirstRanks&) = delete;
+  [[nodiscard]] MPI_Comm comm() const { return comm_; }
+  [[nodiscard]] bool member() const { return comm_ != MPI_COMM_NULL; }
+
+ private:
+  MPI_Comm comm_ = MPI_COMM_NULL;
+};
+
+// The N-version benchmark slab (scenes/slab_ep_0.5mm.json: 0.5 mm; coarser meshes block the front),
+// its solver at 1e-11 (see distributed_monodomain_test.cc), stimulated at the corner.
+EpTissueParams SlabParams() {
+  EpTissueParams p;
+  p.cell = std::make_shared<TenTusscherPanfilov2006>();
+  p.sigma_longitudinal = 0.17 * 0.62 / (0.17 + 0.62);
+  p.sigma_transverse = 0.019 * 0.24 / (0.019 + 0.24);
+  p.fibre = Vec3::UnitX();
+  p.linear.preconditioner = "jacobi";
+  p.linear.tolerance = 1e-11;
+  StimulusSpec corner;
+  corner.name = "corner";
+  corner.region = BoxRegion{Vec3::Constant(-1e-6), Vec3::Constant(0.0015001)};
+  corner.amplitude = 50000.0 / 1400.0;
+  corner.pulses.duration = 2.0;
+  p.stimuli.push_back(corner);
+  return p;
+}
+
+const Vec3 kSize(0.020, 0.007, 0.003);
+constexpr double kDt = 1e-5;  // s
+
+// The slab split over `comm`: part-only (made in blocks) or with the whole mesh on every rank.
+struct SplitSlab {
+  std::shared_ptr<const Mesh> whole;
+  std::unique_ptr<WholeDomainView> view;
+  DistributedMonodomain* tissue = nullptr;
+  SplitSlab(MPI_Comm comm, bool part_only, std::array<int, 3> cells = {40, 14, 6}) {
+    std::unique_ptr<DistributedMonodomain> part;
+    if (part_only) {
+      part = std::make_unique<DistributedMonodomain>(
+          "slab",
+          PartitionMeshBlocks(
+              MakeTetBoxBlock(Vec3::Zero(), kSize, cells, HexSplit::kSix, Rank(comm), Size(comm)),
+              comm),
+          SlabParams(), comm);
+    } else {
+      whole = std::make_shared<Mesh>(MakeTetBox(Vec3::Zero(), kSize, cells));
+      part = std::make_unique<DistributedMonodomain>("slab", *whole, SlabParams(), comm);
+    }
+    tissue = part.get();
+    const MeshPart& mesh_part = tissue->part();
+    view = part_only ? std::make_unique<WholeDomainView>(std::move(part), mesh_part, comm)
+                     : std::make_unique<WholeDomainView>(std::move(part), mesh_part, whole, comm);
+  }
+  void Run(long steps) const {
+    for (long s = 0; s < steps; ++s) ASSERT_TRUE(view->Step(kDt).ok());
+  }
+  // The state's rows of every node, whole-mesh order, on rank 0 of the object's ranks.
+  [[nodiscard]] std::vector<double> Rows() const {
+    const int width = EpState::RowWidth(tissue->cell());
+    const std::vector<double> local = tissue->state().ToRows();
+    std::vector<double> all;
+    for (int j = 0; j < width; ++j) {
+      std::vector<double> column(static_cast<std::size_t>(tissue->num_nodes()));
+      for (std::size_t i = 0; i < column.size(); ++i)
+        column[i] = local[i * static_cast<std::size_t>(width) + static_cast<std::size_t>(j)];
+      const std::vector<double> gathered = tissue->Gather(column.data());
+      all.insert(all.end(), gathered.begin(), gathered.end());
+    }
+    return all;  // column after column
+  }
+};
+
+// A folder of checkpoint files every rank of the world names alike.
+std::filesystem::path Folder(const std::string& name) {
+  int id = Rank(World()) == 0 ? static_cast<int>(::getpid()) : 0;
+  MPI_Bcast(&id, 1, MPI_INT, 0, World());
+  const auto folder =
+      std::filesystem::temp_directory_path() / fmt::format("gipsi_ranks_{}_{}", name, id);
+  if (Rank(World()) == 0) std::filesystem::create_directories(folder);
+  MPI_Barrier(World());
+  return folder;
+}
+
+// Every rank of `comm` writes the view's checkpoint to folder/p<rank>; returns every name.
+std::vector<std::filesystem::path> Write(const WholeDomainView& view, MPI_Comm comm,
+                                         const std::filesystem::path& folder) {
+  StateWriter out;
+  view.SaveState(out);
+  std::vector<std::filesystem::path> files;
+  for (int r = 0; r < Size(comm); ++r) files.push_back(folder / fmt::format("p{}", r));
+  WriteCheckpointFile(files[static_cast<std::size_t>(Rank(comm))], out.bytes());
+  return files;
+}
+
+// Restores `view` on its ranks from `files` (rank q reads file q % N, as the tool does).
+void Restore(WholeDomainView& view, MPI_Comm comm,
+             const std::vector<std::filesystem::path>& files) {
+  WholeDomainView::SetCheckpointFiles(files);
+  const auto& mine = files[static_cast<std::size_t>(Rank(comm)) % files.size()];
+  StateReader in(ReadCheckpointFile(mine), mine.string());
+  try {
+    view.RestoreState(in);
+  } catch (...) {
+    WholeDomainView::SetCheckpointFiles({});
+    throw;
+  }
+  WholeDomainView::SetCheckpointFiles({});
+}
+
+struct Move {
+  int from, to;
+  bool part_only;
+};
+
+// Checkpointed at 10 ms on N ranks and restored on M: the restored state is the written one,
+// bit for bit, at every node; run on to 30 ms (the front has since reached several times as
+// many nodes, across the cuts of both partitions),
+// the activation times and voltages agree with the uninterrupted run on N within what the
+// solver's tolerance allows (1e-5 ms, as distributed_monodomain_test.cc argues; 1e-2 mV: the
+// steepest upstroke, ~300 mV/ms, over that shift), not bitwise: the other cut sums in another
+// order.
+void MovesAndRunsOn(const Move& move, const std::string& label) {
+  const std::filesystem::path folder = Folder(label);
+  const long before = 1000, after = 2000;
+  std::vector<std::filesystem::path> files;
+  std::vector<double> written, reference;
+  {
+    const FirstRanks writers(move.from);
+    if (writers.member()) {
+      const SplitSlab slab(writers.comm(), move.part_only);
+      slab.Run(before);
+      files = Write(*slab.view, writers.comm(), folder);
+      written = slab.Rows();
+      slab.Run(after);
+      reference = slab.Rows();
+    }
+  }
+  int count = static_cast<int>(files.size());
+  MPI_Bcast(&count, 1, MPI_INT, 0, World());
+  files.clear();
+  for (int r = 0; r < count; ++r) files.push_back(folder / fmt::format("p{}", r));
+  const FirstRanks readers(move.to);
+  if (readers.member()) {
+    const SplitSlab slab(readers.comm(), move.part_only);
+    Restore(*slab.view, readers.comm(), files);
+    EXPECT_NEAR(slab.view->time(), before * kDt, 1e-15);
+    EXPECT_EQ(slab.tissue->step_count(), before);
+    const std::vector<double> restored = slab.Rows();
+    slab.Run(after);
+    const std::vector<double> continued = slab.Rows();
+    if (Rank(World()) == 0) {
+      ASSERT_EQ(restored.size(), written.size());
+      for (std::size_t i = 0; i < written.size(); ++i)
+        ASSERT_EQ(std::bit_cast<std::uint64_t>(restored[i]),
+                  std::bit_cast<std::uint64_t>(written[i]))
+            << label << ": value " << i;
+      const int width = EpState::RowWidth(slab.tissue->cell());
+      const std::size_t nodes = written.size() / static_cast<std::size_t>(width);
+      const int k = slab.tissue->cell().num_states();
+      const std::size_t v = static_cast<std::size_t>(slab.tissue->cell().v_index()) * nodes;
+      const std::size_t activation = static_cast<std::size_t>(k) * nodes;
+      double worst_t = 0, worst_v = 0;
+      int activated = 0, activated_before = 0;
+      for (std::size_t i = 0; i < nodes; ++i) activated_before += written[activation + i] >= 0;
+      for (std::size_t i = 0; i < nodes; ++i) {
+        worst_v = std::max(worst_v, std::abs(continued[v + i] - reference[v + i]));
+        ASSERT_EQ(continued[activation + i] >= 0, reference[activation + i] >= 0) << "node " << i;
+        if (reference[activation + i] < 0) continue;
+        ++activated;
+        worst_t =
+            std::max(worst_t, std::abs(continued[activation + i] - reference[activation + i]));
+      }
+      EXPECT_LE(worst_t, 1e-5) << label;
+      EXPECT_LE(worst_v, 1e-2) << label;
+      EXPECT_GT(activated, 3 * activated_before) << label;
+      std::printf(
+          "[ %s ] %d of %zu nodes activated (%d at the checkpoint); largest differences %.3g ms, "
+          "%.3g mV\n",
+          label.c_str(), activated, nodes, activated_before, worst_t, worst_v);
+    }
+  }
+  MPI_Barrier(World());
+  if (Rank(World()) == 0) std::filesystem::remove_all(folder);
+}
+
+TEST(CheckpointRanks, ASlabsStateMovesToMoreRanksAndRunsOn) {
+  const int world = Size(World());
+  MovesAndRunsOn({world / 2, world, true}, "part-only, fewer to more");
+  MovesAndRunsOn({world / 2, world, false}, "whole view, fewer to more");
+}
+
+TEST(CheckpointRanks, ASlabsStateMovesToFewerRanksAndRunsOn) {
+  const int world = Size(World());
+  MovesAndRunsOn({world, world - 1, true}, "part-only, more to fewer");
+  if (world > 2) MovesAndRunsOn({world - 1, world / 2, false}, "whole view, 3 to 2");
+}
+
+// A set of files that is not one checkpoint of this mesh is refused on every rank, by a message
+// that says what is wrong: one file too many, or another mesh's.
+TEST(CheckpointRanks, FilesOfAnotherMeshOrAnIncompleteSetAreRefused) {
+  const int world = Size(World());
+  const std::filesystem::path folder = Folder("refused");
+  std::vector<std::filesystem::path> files;
+  {
+    const FirstRanks writers(world == 2 ? 1 : 3);
+    if (writers.member()) {
+      const SplitSlab slab(writers.comm(), true, {40, 14, 7});  // another mesh
+      slab.Run(5);
+      files = Write(*slab.view, writers.comm(), folder);
+    }
+  }
+  int count = static_cast<int>(files.size());
+  MPI_Bcast(&count, 1, MPI_INT, 0, World());
+  files.clear();
+  for (int r = 0; r < count; ++r) files.push_back(folder / fmt::format("p{}", r));
+  const FirstRanks readers(2);  // another count than the writers'
+  if (readers.member()) {
+    const SplitSlab slab(readers.comm(), true);
+    auto refused = [&](const std::vector<std::filesystem::path>& set, const std::string& what) {
+      try {
+        Restore(*slab.view, readers.comm(), set);
+        ADD_FAILURE() << "restored: " << what;
+      } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find(what), std::string::npos) << e.what();
+      }
+    };
+    std::vector<std::filesystem::path> too_many = files;
+    too_many.push_back(files.front());
+    refused(too_many, "the checkpoint's parts were written on");
+    refused(files, "nodes, and this scene's has");
+    EXPECT_EQ(slab.view->time(), 0.0);  // nothing restored
+  }
+  MPI_Barrier(World());
+  if (Rank(World()) == 0) std::filesystem::remove_all(folder);
+}
+
+}  // namespace
+}  // namespace gipsi
