@@ -6,6 +6,7 @@
 #include <mpi.h>
 
 #include <algorithm>
+#include <array>
 #include <bit>
 #include <cmath>
 #include <cstdint>
@@ -203,6 +204,40 @@ TEST(WholeDomainView, APartOnlyViewSelectsTheWholeMeshsNodes) {
   }
   EXPECT_THROW((void)s.view->SelectWholeNodes(NodeIdsRegion{{-1}}), InputError);
   EXPECT_THROW((void)s.view->SelectWholeNodes(GroupRegion{"no such group"}), InputError);
+
+  // Region probes reduce where the nodes are owned: the owners' selections, of a part-only view
+  // and of a view with the whole mesh, put together are the whole mesh's, each node once.
+  auto tissue =
+      std::make_unique<DistributedMonodomain>("whole", *s.whole, SlabParams("jacobi"), World());
+  const MeshPart& cut = tissue->part();
+  const WholeDomainView whole_view(std::move(tissue), cut, s.whole, World());
+  for (const WholeDomainView* view :
+       {static_cast<const WholeDomainView*>(s.view.get()), &whole_view}) {
+    const MeshPart& part = view == s.view.get() ? *s.part : cut;
+    for (std::size_t r = 0; r < regions.size(); ++r) {
+      std::vector<int> mine;
+      for (const int i : view->SelectOwnedNodes(regions[r])) {
+        ASSERT_LT(i, part.num_owned) << "region " << r;
+        mine.push_back(part.whole_node[static_cast<std::size_t>(i)]);
+      }
+      int count = static_cast<int>(mine.size());
+      std::vector<int> counts(static_cast<std::size_t>(Size())),
+          offsets(static_cast<std::size_t>(Size()), 0);
+      MPI_Allgather(&count, 1, MPI_INT, counts.data(), 1, MPI_INT, World());
+      std::partial_sum(counts.begin(), counts.end() - 1, offsets.begin() + 1);
+      std::vector<int> all(static_cast<std::size_t>(offsets.back() + counts.back()));
+      MPI_Allgatherv(mine.data(), count, MPI_INT, all.data(), counts.data(), offsets.data(),
+                     MPI_INT, World());
+      std::sort(all.begin(), all.end());  // repeated nodes stay: each must come once
+      EXPECT_EQ(all, SelectNodes(regions[r], *s.whole)) << "region " << r;
+    }
+    EXPECT_THROW((void)view->SelectOwnedNodes(NodeIdsRegion{{-1}}), InputError);
+  }
+  std::array<double, 3> values{static_cast<double>(Rank()), 1.0, -static_cast<double>(Rank())};
+  whole_view.CombineAcross(values, PartitionedObject::Combine::kSum);
+  EXPECT_EQ(values[1], Size());
+  whole_view.CombineAcross(values, PartitionedObject::Combine::kMax);
+  EXPECT_EQ(values[0], Size() * (Size() - 1) / 2);
 }
 
 // Reading whole-mesh nodes gives each node's value from its owner, on every rank: equal, bit for

@@ -4,7 +4,8 @@
 /// (gipsi/parallel/) that may hold only its own part of the domain. Such an object's domain()
 /// is then this process's part (local node numbering), and what needs the whole domain goes
 /// through the collective calls below, on the whole domain's node indices, which every process
-/// knows without holding the whole mesh. Probes use them (io/probes.h); other consumers of the
+/// knows without holding the whole mesh. Probes use them (io/probes.h; region probes reduce
+/// through them on whole objects too, so no process gathers a region); other consumers of the
 /// object's fields (connectors, events) are not offered such an object: the scene loader gives
 /// an object its whole domain when anything else in the scene names it
 /// (ObjectBuildContext::standalone).
@@ -50,6 +51,23 @@ class PartitionedObject {
   /// Collective: O(items) sent and received per process.
   virtual void ReadWholeNodes(FieldId id, std::span<const int> nodes,
                               Eigen::Ref<Eigen::MatrixXd> out) const = 0;
+
+  // Reductions over a region without moving its values: each process reduces the nodes it
+  // owns, then the partial results are combined (region probes; whole or part-only objects).
+  /// The local indices of the nodes this process owns among SelectWholeNodes(region): every
+  /// node of the whole domain's selection on exactly one process. A group region's nodes are
+  /// gathered (a triangle or tet group names a node only where its triangle or tet is); other
+  /// regions are decided where the nodes are, with no communication. Collective; throws
+  /// InputError on every process as SelectNodes does.
+  [[nodiscard]] virtual std::vector<int> SelectOwnedNodes(const Region& region) const = 0;
+  /// ReadFieldItems of a node field at local nodes (from SelectOwnedNodes). Not collective.
+  virtual void ReadOwnedNodes(FieldId id, std::span<const int> local,
+                              Eigen::Ref<Eigen::MatrixXd> out) const = 0;
+  /// How CombineAcross combines.
+  enum class Combine { kSum, kMin, kMax };
+  /// Replaces every entry of `values` by its sum, minimum or maximum over the processes.
+  /// Collective: O(values.size()) per process.
+  virtual void CombineAcross(std::span<double> values, Combine how) const = 0;
 };
 
 }  // namespace gipsi

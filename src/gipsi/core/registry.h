@@ -35,8 +35,9 @@
 /// (AggregateObject::BindAggregateState, replacing SaveAggregateState), the HapticEndpoint
 /// capability; 13: SolidMaterial::ElementStressAndStiffnessBatch (a new virtual); 14: meshes in
 /// blocks (MeshProvider::GetMeshBlock, ObjectBuildContext::standalone), the PartitionedObject
-/// capability.
-#define GIPSI_PLUGIN_INTERFACE 14
+/// capability; 15: PartitionedObject's reductions where the nodes are owned (SelectOwnedNodes,
+/// ReadOwnedNodes, CombineAcross).
+#define GIPSI_PLUGIN_INTERFACE 15
 /// What a plugin's gipsi_plugin_abi_version() returns and the loader requires: the package's
 /// major and minor version with the plugin interface, MAJOR·10⁶ + MINOR·10³ + INTERFACE. A
 /// plugin thus loads only into the release line it was built against (0.1.x, as the CMake

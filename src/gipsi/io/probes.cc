@@ -4,6 +4,7 @@
 #include <cstring>
 
 #include <algorithm>
+#include <array>
 #include <limits>
 
 #include <fmt/format.h>
@@ -71,7 +72,9 @@ std::string Probe::Header() const {
 }
 
 void Probe::ReadItems(FieldId id, Eigen::MatrixXd& values) const {
-  if (partitioned != nullptr)
+  if (owners != nullptr)
+    owners->ReadOwnedNodes(id, items, values);
+  else if (partitioned != nullptr)
     partitioned->ReadWholeNodes(id, items, values);
   else
     object->ReadFieldItems(id, items, values);
@@ -121,27 +124,38 @@ void Probe::Sample(std::vector<double>& out) const {
         object->CorrectInterpolated(id, nodes, point->weights(), at);
       for (int c = 0; c < info.components; ++c) out.push_back(at(c, 0));
     } else {
-      for (int c = 0; c < info.components; ++c) {
-        double acc = reduce == Reduce::kMin   ? std::numeric_limits<double>::infinity()
-                     : reduce == Reduce::kMax ? -std::numeric_limits<double>::infinity()
-                                              : 0.0;
-        std::size_t counted = 0;
+      // Per component: the reduction and how many values it took (no-data values skipped).
+      const auto c = static_cast<std::size_t>(info.components);
+      std::vector<double> acc(c, reduce == Reduce::kMin   ? std::numeric_limits<double>::infinity()
+                                 : reduce == Reduce::kMax ? -std::numeric_limits<double>::infinity()
+                                                          : 0.0);
+      std::vector<double> counted(c, 0.0);
+      for (std::size_t k = 0; k < c; ++k) {
         for (Index i = 0; i < values.cols(); ++i) {
-          const double v = values(c, i);
+          const double v = values(static_cast<Index>(k), i);
           if (info.no_data && v == *info.no_data) continue;
-          ++counted;
+          ++counted[k];
           if (reduce == Reduce::kMin)
-            acc = std::min(acc, v);
+            acc[k] = std::min(acc[k], v);
           else if (reduce == Reduce::kMax)
-            acc = std::max(acc, v);
+            acc[k] = std::max(acc[k], v);
           else
-            acc += v;
+            acc[k] += v;
         }
-        if (counted == 0 && info.no_data)
-          acc = *info.no_data;
+      }
+      if (owners != nullptr) {  // this process's nodes of the region: combine with the others'
+        using Combine = PartitionedObject::Combine;
+        owners->CombineAcross(acc, reduce == Reduce::kMin   ? Combine::kMin
+                                   : reduce == Reduce::kMax ? Combine::kMax
+                                                            : Combine::kSum);
+        owners->CombineAcross(counted, Combine::kSum);
+      }
+      for (std::size_t k = 0; k < c; ++k) {
+        if (counted[k] == 0 && info.no_data)
+          acc[k] = *info.no_data;
         else if (reduce == Reduce::kMean)
-          acc /= static_cast<double>(counted);
-        out.push_back(acc);
+          acc[k] /= counted[k];
+        out.push_back(acc[k]);
       }
     }
   }
@@ -273,10 +287,20 @@ Probe ParseProbe(const std::string& name, const JsonNode& node, const Kernel& ke
           "region probes of boundary fields are not offered on '{}', split over the processes "
           "without its whole mesh (probe a node field)",
           object.path()));
+    // A split object's nodes are reduced where they are owned (whole mesh or not).
+    bool anywhere = false;  // some process owns a node of the region
+    const auto* owners = location == FieldLocation::kNode
+                             ? dynamic_cast<const PartitionedObject*>(&object)
+                             : nullptr;
     try {
-      if (location == FieldLocation::kNode)
-        probe.items = split != nullptr ? split->SelectWholeNodes(region)
-                                       : SelectNodes(region, object.domain());
+      if (owners != nullptr) {
+        probe.owners = owners;
+        probe.items = owners->SelectOwnedNodes(region);
+        std::array<double, 1> selected{static_cast<double>(probe.items.size())};
+        owners->CombineAcross(selected, PartitionedObject::Combine::kSum);
+        anywhere = selected[0] > 0;
+      } else if (location == FieldLocation::kNode)
+        probe.items = SelectNodes(region, object.domain());
       else if (location == FieldLocation::kBoundaryVertex)
         probe.items = SelectBoundaryVertices(region, object.domain(), object.boundary());
       else
@@ -284,7 +308,8 @@ Probe ParseProbe(const std::string& name, const JsonNode& node, const Kernel& ke
     } catch (const InputError& e) {
       r->Fail(e.what());
     }
-    if (probe.items.empty()) r->Fail("the region selects nothing");
+    if (probe.owners == nullptr ? probe.items.empty() : !anywhere)
+      r->Fail("the region selects nothing");
     if (auto reduce = node.Find("reduce")) {
       std::string s = reduce->AsChoice({"mean", "sum", "min", "max"});
       probe.reduce = s == "sum"   ? Probe::Reduce::kSum

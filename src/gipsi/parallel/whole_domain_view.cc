@@ -167,6 +167,34 @@ std::vector<int> WholeDomainView::SelectWholeNodes(const Region& region) const {
                              comm_);
 }
 
+std::vector<int> WholeDomainView::SelectOwnedNodes(const Region& region) const {
+  std::vector<int> local;
+  if (std::holds_alternative<NodeIdsRegion>(region)) {  // whole-mesh indices, range-checked
+    local = LocalNodesOf(mesh_part_,
+                         part_only_ ? SelectWholeNodes(region) : SelectNodes(region, domain()));
+  } else if (std::holds_alternative<GroupRegion>(region)) {  // gathered: see SelectWholeNodes
+    local = LocalNodesOf(
+        mesh_part_,
+        GatherSelectedNodes(mesh_part_, SelectNodes(region, *mesh_part_.mesh, region_tolerance_),
+                            comm_));
+  } else {  // decided by each node's position, at the whole mesh's tolerance
+    local = SelectNodes(region, *mesh_part_.mesh, region_tolerance_);
+  }
+  std::erase_if(local, [this](int i) { return i >= mesh_part_.num_owned; });
+  return local;
+}
+
+void WholeDomainView::ReadOwnedNodes(FieldId id, std::span<const int> local,
+                                     Eigen::Ref<Eigen::MatrixXd> out) const {
+  part_->ReadFieldItems(part_field_[static_cast<std::size_t>(id.value())], local, out);
+}
+
+void WholeDomainView::CombineAcross(std::span<double> values, Combine how) const {
+  const MPI_Op op = how == Combine::kSum ? MPI_SUM : how == Combine::kMin ? MPI_MIN : MPI_MAX;
+  MPI_Allreduce(MPI_IN_PLACE, values.data(), static_cast<int>(values.size()), MPI_DOUBLE, op,
+                comm_);
+}
+
 void WholeDomainView::ReadWholeNodes(FieldId id, std::span<const int> nodes,
                                      Eigen::Ref<Eigen::MatrixXd> out) const {
   if (!part_only_) {

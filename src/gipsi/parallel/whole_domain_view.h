@@ -85,6 +85,10 @@ class WholeDomainView final : public SimObject, public CavityWall, public Partit
   [[nodiscard]] std::vector<int> SelectWholeNodes(const Region& region) const override;
   void ReadWholeNodes(FieldId id, std::span<const int> nodes,
                       Eigen::Ref<Eigen::MatrixXd> out) const override;
+  [[nodiscard]] std::vector<int> SelectOwnedNodes(const Region& region) const override;
+  void ReadOwnedNodes(FieldId id, std::span<const int> local,
+                      Eigen::Ref<Eigen::MatrixXd> out) const override;
+  void CombineAcross(std::span<double> values, Combine how) const override;
 
   [[nodiscard]] std::string_view type_name() const override { return part_->type_name(); }
   [[nodiscard]] const Points& domain_positions() const override { return domain().nodes; }
