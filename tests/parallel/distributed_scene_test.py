@@ -444,9 +444,12 @@ with tempfile.TemporaryDirectory() as work:
     # On another rank count the slab's state moves to the new parts: checkpointed at 20 ms on
     # N ranks and resumed to 30 ms on M, it writes the uninterrupted N-rank run's probes within
     # the bounds above (not bitwise: another cut sums in another order); measured 1e-13 ms.
+    # The 4-rank run goes on past its checkpoint (at 20 ms) to 30 ms: the 2-rank run that
+    # resumes from it rewrites the last frame in 2 pieces, and the other 2 are deleted.
     for before, after in ((2, 4), (2, 3), (4, 2)):
         moved = os.path.join(work, f"moved{before}to{after}")
-        code, text = run(before, moved, "-q", "--checkpoint-every", "0.01", until="0.02")
+        code, text = run(before, moved, "-q", "--checkpoint-every", "0.01" if before == 2 else "0.02",
+                         until="0.02" if before == 2 else "0.03")
         check(code == 0, f"{before} ranks with checkpoints: exit {code}: {text}")
         code, text = run(after, moved, "--resume", os.path.join(moved, "checkpoint.gck"))
         check(code == 0 and f"the checkpoint was written on {before} ranks" in text,
@@ -454,6 +457,13 @@ with tempfile.TemporaryDirectory() as work:
         compare_probes(f"{before} ranks' checkpoint resumed on {after}",
                        os.path.join(work, f"ranks{before}"), moved,
                        ("far_corner", "activated", "diagonal"))
+        last = sorted(f for f in files(moved) if f.endswith(".pvtu"))[-1]
+        with open(os.path.join(moved, last)) as f:
+            listed = re.findall(r'Source="([^"]+)"', f.read())
+        pieces = sorted(f for f in files(moved) if f.startswith(last[:-len(".pvtu")] + "_p"))
+        check(len(listed) == after and len(pieces) == after,
+              f"{before} ranks' checkpoint resumed on {after}: the last frame {last} lists "
+              f"{listed} and has the pieces {pieces}")
     # A split FemSolid resumes only on the rank count that wrote it (its state does not move
     # yet), and the ranks' files only as the set written together; the refusals name the files
     # and the way out, and leave the outputs as they were.

@@ -94,6 +94,13 @@ void VtuSeriesWriter::WriteFrame(Series& series, double t) {
     for (const NamedArray& a : fields.point_data) point_shapes.push_back({a.name, a.components});
     for (const NamedArray& a : fields.cell_data) cell_shapes.push_back({a.name, a.components});
     WritePvtu(directory_ / name / (stem + ".pvtu"), pieces, point_shapes, cell_shapes);
+    // A run resumed on fewer ranks rewrites frames an earlier run wrote in more pieces: the
+    // pieces past this count are no longer listed.
+    for (int k = piece.count;; ++k) {
+      std::error_code error;
+      if (!std::filesystem::remove(directory_ / name / fmt::format("{}_p{}.vtu", stem, k), error))
+        break;
+    }
     series.domain.AddFrame(t, name + "/" + stem + ".pvtu");
     return;
   }
