@@ -383,8 +383,8 @@ std::vector<std::filesystem::path> CheckResumeFiles(const std::filesystem::path&
   gipsi::ThrowInputError(
       "command line", "--resume",
       fmt::format("{} does not exist, and {} to {} are the checkpoint of a run on {} MPI ranks: "
-                  "resume it with mpirun -np {} (or on another count of 2 or more ranks if the "
-                  "objects split over them are Monodomains; docs/scale-out.md)",
+                  "resume it with mpirun -np {} (or another count of 2 or more; "
+                  "docs/scale-out.md)",
                   resume.string(), pieces.front().string(), pieces.back().string(), pieces.size(),
                   pieces.size()));
 }

@@ -119,6 +119,8 @@ class StateReader {
     ReadBytes(m.data(), static_cast<std::size_t>(rows * cols) * sizeof(typename M::Scalar));
   }
 
+  /// What the data is named by in messages (e.g. the checkpoint file).
+  [[nodiscard]] const std::string& source() const { return source_; }
   /// True when everything has been read.
   [[nodiscard]] bool at_end() const { return pos_ == bytes_.size(); }
   /// Skips the rest of the open section (the next call is its EndSection).

@@ -384,23 +384,29 @@ StepStatus DistributedMonodomain::DoStep(double t, double dt) {
   }
 }
 
-void DistributedMonodomain::ReadNodeRows(StateReader& in, std::int64_t num_nodes,
-                                         std::vector<double>& rows,
-                                         std::vector<double>& shared) const {
+StateRows DistributedMonodomain::ReadStateRows(StateReader& in, const ItemCounts& counts) const {
   // What SaveObjectState writes: the bound EpState and no cache.
-  EpState read = EpState::Sized(cell(), static_cast<std::size_t>(num_nodes));
+  EpState read = EpState::Sized(cell(), static_cast<std::size_t>(counts.nodes));
   BindStateValue(read)->Read(in, {});
-  rows = read.ToRows();
-  shared.assign(1, static_cast<double>(read.last_iterations));
+  StateRows rows;
+  rows.node_width = EpState::RowWidth(cell());
+  rows.node = read.ToRows();
+  StateWriter shared;
+  shared.WriteInt(read.last_iterations);
+  rows.shared = shared.TakeBytes();
+  return rows;
 }
 
-void DistributedMonodomain::WriteNodeRows(StateWriter& out, std::span<const double> rows,
-                                          std::span<const double> shared) const {
-  GIPSI_CHECK(shared.size() == 1, "a Monodomain part's shared state is 1 value, not {}",
-              shared.size());
+void DistributedMonodomain::WriteStateRows(StateWriter& out, const StateRows& rows) const {
   EpState written = EpState::Sized(cell(), static_cast<std::size_t>(num_nodes()));
-  written.FromRows(rows);
-  written.last_iterations = static_cast<int>(shared[0]);
+  StateReader shared(rows.shared, fmt::format("object '{}': the shared state", name()));
+  if (rows.node_width != EpState::RowWidth(cell()) || rows.tet_width != 0 || rows.face_width != 0)
+    shared.Fail(
+        fmt::format("rows of {}/{}/{} values per node/tet/face, where a Monodomain of "
+                    "this cell model has {}/0/0",
+                    rows.node_width, rows.tet_width, rows.face_width, EpState::RowWidth(cell())));
+  written.FromRows(rows.node);
+  written.last_iterations = static_cast<int>(shared.ReadInt());
   BindStateValue(written)->Write(out);
 }
 

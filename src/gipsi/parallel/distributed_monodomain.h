@@ -28,16 +28,16 @@
 #include <vector>
 
 #include "gipsi/base/export.h"
+#include "gipsi/core/row_state.h"
 #include "gipsi/models/ep/ep_tissue.h"
 #include "gipsi/parallel/mesh_partition.h"
-#include "gipsi/parallel/node_state_part.h"
 
 GIPSI_EXPORT_BEGIN
 namespace gipsi {
 
 /// Not copyable or movable (a SimObject). Needs a ParallelSession for its whole lifetime. Its
-/// checkpoints move to another partition (NodeStatePart).
-class DistributedMonodomain final : public EpTissue, public NodeStatePart {
+/// checkpoints move to another partition (RowState).
+class DistributedMonodomain final : public EpTissue, public RowState {
  public:
   /// Collective: partitions `whole` (identical on every rank) over `comm`. Regions select
   /// nodes of the whole mesh, then each rank keeps its own; fibre rules are evaluated on the
@@ -67,12 +67,9 @@ class DistributedMonodomain final : public EpTissue, public NodeStatePart {
   [[nodiscard]] std::vector<double> Gather(const double* local) const {
     return GatherNodeValues(part_, local, comm_);
   }
-  /// NodeStatePart: EpState's rows (EpState::ToRows); shared: the last solve's iterations.
-  [[nodiscard]] int node_row_width() const override { return EpState::RowWidth(cell()); }
-  void ReadNodeRows(StateReader& in, std::int64_t num_nodes, std::vector<double>& rows,
-                    std::vector<double>& shared) const override;
-  void WriteNodeRows(StateWriter& out, std::span<const double> rows,
-                     std::span<const double> shared) const override;
+  /// RowState: EpState's rows per node (EpState::ToRows); shared: the last solve's iterations.
+  [[nodiscard]] StateRows ReadStateRows(StateReader& in, const ItemCounts& counts) const override;
+  void WriteStateRows(StateWriter& out, const StateRows& rows) const override;
 
  protected:
   StepStatus DoStep(double t, double dt) override;

@@ -83,22 +83,23 @@ std::vector<int> LocalNodesOf(const MeshPart& part, std::span<const int> whole);
 /// Collective; O(part) per rank.
 BoundarySurface PartBoundary(const MeshPart& part, MPI_Comm comm);
 
-/// What MoveNodeRows delivered. Plain struct.
-struct MovedNodeRows {
-  std::vector<double> rows;   ///< a row per local node of the part, in local order
-  std::int64_t missing = 0;   ///< local nodes no row reached, summed over the parts
-  std::int64_t repeated = 0;  ///< rows given again for a node (every rank's count)
-  std::int64_t outside = 0;   ///< rows given for no node of the whole mesh (every rank's count)
-  int first_missing = -1;     ///< the lowest missing node's whole-mesh index (-1: none)
+/// What MoveRows delivered. Plain struct.
+struct MovedRows {
+  std::vector<double> rows;   ///< a row per held item, in the order of `held`
+  std::int64_t missing = 0;   ///< held items no row reached, summed over the ranks
+  std::int64_t repeated = 0;  ///< rows given again for an item (every rank's count)
+  std::int64_t outside = 0;   ///< rows given for no item in [0, count) (every rank's count)
+  int first_missing = -1;     ///< the lowest missing item (-1: none)
 };
-/// Sends rows of `width` values, each given by some rank for a whole-mesh node (`whole[j]` for
-/// row j of `rows`), to every rank whose part holds that node: how per-node state moves from one
-/// partition to another (a checkpoint restored on another rank count). Each row passes through
-/// its node's block rank (BlockBegin), which learns who holds the node; so every rank sends and
-/// keeps O(its rows + its part), and a node given by no rank, or by two, is counted (the
-/// caller decides; the counts are the same on every rank). Collective.
-MovedNodeRows MoveNodeRows(const MeshPart& part, std::span<const int> whole,
-                           std::span<const double> rows, int width, MPI_Comm comm);
+/// Sends rows of `width` values, each given by some rank for an item (`whole[j]` in
+/// [0, `count`) for row j of `rows`: a whole mesh's node, tet or boundary face), to every rank
+/// that holds the item (`held`: this rank's items, e.g. a part's whole_node): how state moves
+/// from one partition to another (a checkpoint restored on another rank count). Each row
+/// passes through its item's block rank (BlockBegin), which learns who holds the item; so
+/// every rank sends and keeps O(its rows + its items), and an item given by no rank, or by two,
+/// is counted (the caller decides; the counts are the same on every rank). Collective.
+MovedRows MoveRows(std::span<const int> held, std::int64_t count, std::span<const int> whole,
+                   std::span<const double> rows, int width, MPI_Comm comm);
 
 /// Every rank's owned values of a node field, gathered on rank 0 in the whole mesh's node order
 /// (`local`: one value per local node of `part`). Collective; ranks other than 0 get an empty

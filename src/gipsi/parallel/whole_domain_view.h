@@ -15,10 +15,11 @@
 /// restore checks them on every rank together and, once read, that every rank's part is at the same
 /// time and step, so a checkpoint restores bitwise on the rank count and partition that wrote it,
 /// and a set of files from different checkpoints (a run stopped while writing them) is refused.
-/// On another rank count a part whose state is per node (NodeStatePart) is restored from every
-/// file's part: each rank reads some of the files (rank q those of ranks q, q + M, ...), and the
-/// owned nodes' rows move to the new parts (MoveNodeRows); the run then goes on within the
-/// solvers' tolerance of the uninterrupted one (another cut sums in another order).
+/// On another rank count a part whose state is rows per item (RowState: per node, tet and
+/// boundary face) is restored from every file's part: each rank reads some of the files (rank
+/// q those of ranks q, q + M, ...), and the rows of the owned nodes, the tets and the faces move
+/// to the new parts (MoveRows); the run then goes on within the solvers' tolerance of the
+/// uninterrupted one (another cut sums in another order; solver caches start afresh).
 ///
 /// Without the whole mesh (the second constructor: a "part-only" view, for an object nothing
 /// but probes and outputs reads, ObjectBuildContext::standalone) the view's domain and boundary
@@ -45,6 +46,7 @@
 #include "gipsi/base/state.h"
 #include "gipsi/core/cavity_law.h"
 #include "gipsi/core/partitioned_object.h"
+#include "gipsi/core/row_state.h"
 #include "gipsi/core/sim_object.h"
 #include "gipsi/parallel/mesh_partition.h"
 
@@ -98,7 +100,7 @@ class WholeDomainView final : public SimObject, public CavityWall, public Partit
   }
   void SaveObjectState(StateWriter& out) const override;
   /// Collective: every rank restores its own rank's file; on another rank count (a part that is
-  /// a NodeStatePart, with SetCheckpointFiles) rank q reads rank q % N's file of N.
+  /// a RowState, with SetCheckpointFiles) rank q reads rank q % N's file of N.
   void RestoreObjectState(StateReader& in) override;
   /// The files of the distributed checkpoint being resumed, rank 0's first (the tool sets them
   /// before Kernel::ReadCheckpoint): a restore on another rank count reads the parts in them.
@@ -164,10 +166,13 @@ class WholeDomainView final : public SimObject, public CavityWall, public Partit
   void Describe();
   // What a checkpoint's DistributedPart section holds before the part's state.
   struct SavedPart {
-    std::int64_t size = 0, rank = 0, whole_nodes = 0, local_nodes = 0;
+    std::int64_t size = 0, rank = 0, whole_nodes = 0, whole_tets = 0, whole_faces = 0;
     std::uint64_t fingerprint = 0;
-    Index boundary_vertices = 0, boundary_faces = 0;
+    Index boundary_vertices = 0;
+    ItemCounts local;        // the part's nodes, tets and boundary faces
     std::vector<int> owned;  // whole-mesh indices of the owned nodes (local [0, owned))
+    std::vector<int> tets;   // of every local tet
+    std::vector<int> faces;  // the whole boundary's face of every part face (BoundaryMap), or none
   };
   static SavedPart ReadSavedPart(StateReader& in);
   // RestoreObjectState from a checkpoint of `saved.size` ranks, another count (`at`: where the

@@ -12,7 +12,8 @@
 
 #include "gipsi/base/error.h"
 #include "gipsi/base/state.h"
-#include "gipsi/parallel/node_state_part.h"
+#include "gipsi/core/row_state.h"
+#include "gipsi/parallel/mesh_partition.h"
 #include "gipsi/parallel/whole_domain_view.h"
 
 namespace gipsi {
@@ -51,13 +52,17 @@ void WholeDomainView::SaveObjectState(StateWriter& out) const {
   out.WriteInt(mesh_part_.size);
   out.WriteInt(mesh_part_.rank);
   out.WriteInt(static_cast<std::int64_t>(partition_fingerprint_));
-  // What another rank count needs to read the part: its size, boundary and owned nodes.
+  // What another rank count needs to read the part: its items and where they are in the whole.
   out.WriteInt(mesh_part_.num_global_nodes);
+  out.WriteInt(mesh_part_.num_global_tets);
+  out.WriteInt(forward_bcs_ ? boundary().num_triangles() : 0);
   out.WriteInt(mesh_part_.num_local());
   out.WriteInt(part_->boundary_conditions().num_vertices());
-  out.WriteInt(part_->boundary_conditions().num_faces());
+  out.WriteInt(part_->boundary().num_triangles());
   out.WriteArray(std::span<const int>(mesh_part_.whole_node.data(),
                                       static_cast<std::size_t>(mesh_part_.num_owned)));
+  out.WriteArray(mesh_part_.whole_tet);
+  out.WriteArray(forward_bcs_ ? bc_face_ : std::vector<int>{});
   part_->SaveState(out);
   out.EndSection();
 }
@@ -68,13 +73,19 @@ WholeDomainView::SavedPart WholeDomainView::ReadSavedPart(StateReader& in) {
   saved.rank = in.ReadInt();
   saved.fingerprint = static_cast<std::uint64_t>(in.ReadInt());
   saved.whole_nodes = in.ReadInt();
-  saved.local_nodes = in.ReadInt();
+  saved.whole_tets = in.ReadInt();
+  saved.whole_faces = in.ReadInt();
+  saved.local.nodes = in.ReadInt();
   saved.boundary_vertices = in.ReadInt();
-  saved.boundary_faces = in.ReadInt();
+  saved.local.faces = in.ReadInt();
   in.ReadArray(saved.owned);
-  if (saved.size < 1 || saved.rank < 0 || saved.rank >= saved.size || saved.local_nodes < 0 ||
-      saved.boundary_vertices < 0 || saved.boundary_faces < 0 ||
-      static_cast<std::int64_t>(saved.owned.size()) > saved.local_nodes)
+  in.ReadArray(saved.tets);
+  in.ReadArray(saved.faces);
+  saved.local.tets = static_cast<std::int64_t>(saved.tets.size());
+  if (saved.size < 1 || saved.rank < 0 || saved.rank >= saved.size || saved.local.nodes < 0 ||
+      saved.boundary_vertices < 0 || saved.local.faces < 0 ||
+      static_cast<std::int64_t>(saved.owned.size()) > saved.local.nodes ||
+      (!saved.faces.empty() && static_cast<std::int64_t>(saved.faces.size()) != saved.local.faces))
     in.Fail("a corrupted part header");
   return saved;
 }
@@ -124,18 +135,19 @@ void WholeDomainView::RestoreObjectState(StateReader& in) {
 void WholeDomainView::RestoreOnAnotherRankCount(StateReader& in, const StateReader::Position& at,
                                                 const SavedPart& saved) {
   const int ranks = mesh_part_.size, rank = mesh_part_.rank;
-  const auto* movable = dynamic_cast<const NodeStatePart*>(part_.get());
+  const auto* movable = dynamic_cast<const RowState*>(part_.get());
   std::vector<std::filesystem::path> files;
   {
     const std::lock_guard lock(files_mutex);
     files = CheckpointFiles();
   }
+  const std::int64_t whole_faces = forward_bcs_ ? boundary().num_triangles() : 0;
   std::string refused;
   if (movable == nullptr)
     refused = fmt::format(
         "the checkpoint was written on {} ranks and this run has {}: a split {} resumes only "
-        "on the rank count that wrote it (a Monodomain's state moves to another; this type's "
-        "does not yet): mpirun -np {}",
+        "on the rank count that wrote it (its state does not move to another yet): mpirun -np "
+        "{}",
         saved.size, ranks, type_name(), saved.size);
   else if (files.empty())
     refused = fmt::format(
@@ -148,19 +160,23 @@ void WholeDomainView::RestoreOnAnotherRankCount(StateReader& in, const StateRead
         "the checkpoint's parts were written on {} ranks, and {} files were found ({} to {}): "
         "the set mixes checkpoints of different rank counts",
         saved.size, files.size(), files.front().string(), files.back().string());
-  else if (saved.whole_nodes != mesh_part_.num_global_nodes)
-    refused = fmt::format("the checkpoint's mesh has {} nodes, and this scene's has {}",
-                          saved.whole_nodes, mesh_part_.num_global_nodes);
+  else if (saved.whole_nodes != mesh_part_.num_global_nodes ||
+           saved.whole_tets != mesh_part_.num_global_tets || saved.whole_faces != whole_faces)
+    refused = fmt::format(
+        "the checkpoint's mesh has {} nodes, {} tets and {} boundary faces, and this scene's "
+        "has {}, {} and {}",
+        saved.whole_nodes, saved.whole_tets, saved.whole_faces, mesh_part_.num_global_nodes,
+        mesh_part_.num_global_tets, whole_faces);
   FailTogether(in, refused, comm_,
                files.empty() ? std::string()
                              : fmt::format("{} (object '{}')", files.front().string(), name()));
 
   // Rank q reads the parts of ranks q, q + M, ... of the N that wrote the checkpoint; its own
-  // file (that of rank q % N) is one of them when q < N.
-  const int width = movable->node_row_width();
-  std::vector<int> whole;
-  std::vector<double> rows, shared;
-  std::array<double, 2> clock{0, 0};  // time, steps
+  // file (that of rank q % N) is one of them when q < N. It keeps the rows of the owned nodes,
+  // of every tet and every boundary face (each on one part), with their whole-mesh indices.
+  StateRows mine;
+  std::vector<int> node_of, tet_of, face_of;
+  std::string common;  // the clock, the widths and the shared bytes: the same in every file
   std::string failed;
   auto read_part = [&](StateReader& from, const SavedPart& part, std::int64_t expected_rank) {
     if (part.size != saved.size || part.rank != expected_rank)
@@ -168,18 +184,35 @@ void WholeDomainView::RestoreOnAnotherRankCount(StateReader& in, const StateRead
           fmt::format("this file holds rank {}'s part of {} where rank {}'s part of {} was "
                       "expected: the set mixes checkpoints",
                       part.rank, part.size, expected_rank, saved.size));
-    std::vector<double> part_rows;
+    StateRows rows;
     const SimObject::SavedHeader header = SimObject::ReadSavedState(
-        from, part.boundary_vertices, part.boundary_faces,
-        [&](StateReader& own) { movable->ReadNodeRows(own, part.local_nodes, part_rows, shared); });
+        from, part.boundary_vertices, part.local.faces,
+        [&](StateReader& own) { rows = movable->ReadStateRows(own, part.local); });
     if (header.name != part_->name() || header.type != part_->type_name())
       from.Fail(fmt::format("the checkpoint has object '{}' ({}) where this scene has '{}' ({})",
                             header.name, header.type, part_->name(), part_->type_name()));
-    whole.insert(whole.end(), part.owned.begin(), part.owned.end());
-    rows.insert(rows.end(), part_rows.begin(),
-                part_rows.begin() + static_cast<std::ptrdiff_t>(part.owned.size() *
-                                                                static_cast<std::size_t>(width)));
-    clock = {header.time, static_cast<double>(header.steps)};
+    if (rows.face_width > 0 && part.faces.empty())
+      from.Fail("the part's boundary faces have state but no place on the whole boundary");
+    auto keep = [](std::vector<double>& to, const std::vector<double>& from_rows, int width,
+                   std::size_t count) {
+      to.insert(
+          to.end(), from_rows.begin(),
+          from_rows.begin() + static_cast<std::ptrdiff_t>(count * static_cast<std::size_t>(width)));
+    };
+    keep(mine.node, rows.node, rows.node_width, part.owned.size());
+    keep(mine.tet, rows.tet, rows.tet_width, rows.tet_width > 0 ? part.tets.size() : 0);
+    keep(mine.face, rows.face, rows.face_width, rows.face_width > 0 ? part.faces.size() : 0);
+    node_of.insert(node_of.end(), part.owned.begin(), part.owned.end());
+    if (rows.tet_width > 0) tet_of.insert(tet_of.end(), part.tets.begin(), part.tets.end());
+    if (rows.face_width > 0) face_of.insert(face_of.end(), part.faces.begin(), part.faces.end());
+    StateWriter c;
+    c.WriteDouble(header.time);
+    c.WriteInt(header.steps);
+    c.WriteInt(rows.node_width);
+    c.WriteInt(rows.tet_width);
+    c.WriteInt(rows.face_width);
+    c.WriteString(rows.shared);
+    common = c.TakeBytes();
   };
   try {
     if (rank < saved.size) {
@@ -192,15 +225,18 @@ void WholeDomainView::RestoreOnAnotherRankCount(StateReader& in, const StateRead
       StateReader other(ReadCheckpointFile(file), file.string());
       other.Seek(at);
       other.BeginSection("DistributedPart", 2);
+      const std::string before = common;
       read_part(other, ReadSavedPart(other), r);
+      if (!before.empty() && before != common)
+        other.Fail("this file is from another checkpoint than the others this rank read");
       other.EndSection();
     }
   } catch (const InputError& e) {
     failed = e.what();
   }
   {  // like FailTogether, with the message the reader already formatted
-    int mine = failed.empty() ? 0 : 1, any = 0;
-    MPI_Allreduce(&mine, &any, 1, MPI_INT, MPI_MAX, comm_);
+    int failing = failed.empty() ? 0 : 1, any = 0;
+    MPI_Allreduce(&failing, &any, 1, MPI_INT, MPI_MAX, comm_);
     if (any != 0)
       throw InputError(failed.empty()
                            ? fmt::format("{}: another rank's checkpoint file was refused (see its "
@@ -209,35 +245,50 @@ void WholeDomainView::RestoreOnAnotherRankCount(StateReader& in, const StateRead
                            : failed);
   }
 
-  // Every file of one checkpoint has the same clock and shared values. Rank 0 read file 0; a
-  // rank that read none takes its values.
-  std::vector<double> common(clock.begin(), clock.end());
-  common.insert(common.end(), shared.begin(), shared.end());
-  auto count = static_cast<int>(common.size());
-  MPI_Bcast(&count, 1, MPI_INT, 0, comm_);
-  std::vector<double> first = common;
-  first.resize(static_cast<std::size_t>(count));
-  MPI_Bcast(first.data(), count, MPI_DOUBLE, 0, comm_);
-  if (rank >= saved.size) common = first;
-  int differs = common != first ? 1 : 0;
+  // Every file of one checkpoint has the same clock, widths and shared state. Rank 0 read
+  // file 0; a rank that read none takes its values.
+  auto length = static_cast<int>(common.size());
+  MPI_Bcast(&length, 1, MPI_INT, 0, comm_);
+  std::string first = rank == 0 ? common : std::string(static_cast<std::size_t>(length), '\0');
+  MPI_Bcast(first.data(), length, MPI_CHAR, 0, comm_);
+  int differs = rank < saved.size && common != first ? 1 : 0;
   MPI_Allreduce(MPI_IN_PLACE, &differs, 1, MPI_INT, MPI_MAX, comm_);
   if (differs != 0)
     in.Fail(
-        fmt::format("the ranks' checkpoint files are from different checkpoints (object '{}' "
-                    "at t = {:.9g} s in rank 0's): resume from a set written together",
-                    name(), first[0]));
+        fmt::format("the ranks' checkpoint files are from different checkpoints (object "
+                    "'{}'): resume from a set written together",
+                    name()));
+  StateReader agreed(first, in.source());
+  const double time = agreed.ReadDouble();
+  const std::int64_t steps = agreed.ReadInt();
+  mine.node_width = static_cast<int>(agreed.ReadInt());
+  mine.tet_width = static_cast<int>(agreed.ReadInt());
+  mine.face_width = static_cast<int>(agreed.ReadInt());
+  mine.shared = agreed.ReadString();
 
-  const MovedNodeRows moved = MoveNodeRows(mesh_part_, whole, rows, width, comm_);
-  if (moved.missing > 0 || moved.repeated > 0 || moved.outside > 0)
-    in.Fail(fmt::format(
-        "the checkpoint's parts do not hold every node of this scene's mesh once ({} nodes "
-        "missing, the first {}; {} given twice; {} not in the mesh): it was written for another "
-        "mesh",
-        moved.missing, moved.first_missing, moved.repeated, moved.outside));
-  const std::vector<double> state_shared(first.begin() + 2, first.end());
-  part_->RestoreStateFrom(first[0], static_cast<std::int64_t>(first[1]), [&](StateWriter& out) {
-    movable->WriteNodeRows(out, moved.rows, state_shared);
-  });
+  // The rows go to the parts that hold their items.
+  std::string lost;
+  auto move = [&](const char* what, std::span<const int> held, std::int64_t count,
+                  const std::vector<int>& of, std::vector<double>& rows, int width) {
+    if (width == 0) return;
+    MovedRows moved = MoveRows(held, count, of, rows, width, comm_);
+    if (lost.empty() && (moved.missing > 0 || moved.repeated > 0 || moved.outside > 0))
+      lost = fmt::format(
+          "the checkpoint's parts do not hold every {} of this scene's mesh once ({} missing, "
+          "the first {}; {} given twice; {} not in the mesh): it was written for another mesh",
+          what, moved.missing, moved.first_missing, moved.repeated, moved.outside);
+    rows = std::move(moved.rows);
+  };
+  move("node", mesh_part_.whole_node, mesh_part_.num_global_nodes, node_of, mine.node,
+       mine.node_width);
+  move("tet", mesh_part_.whole_tet, mesh_part_.num_global_tets, tet_of, mine.tet, mine.tet_width);
+  if (mine.face_width > 0 && !forward_bcs_)
+    lost = "the part's boundary faces have state but no place on the whole boundary";
+  else
+    move("boundary face", bc_face_, whole_faces, face_of, mine.face, mine.face_width);
+  if (!lost.empty()) in.Fail(lost);
+  part_->RestoreStateFrom(time, steps,
+                          [&](StateWriter& out) { movable->WriteStateRows(out, mine); });
 }
 
 }  // namespace gipsi

@@ -35,6 +35,7 @@
 
 #include "gipsi/base/export.h"
 #include "gipsi/core/registry.h"
+#include "gipsi/core/row_state.h"
 #include "gipsi/core/sim_object.h"
 #include "gipsi/geometry/enclosed_volume.h"
 #include "gipsi/geometry/region.h"
@@ -100,7 +101,7 @@ struct FemProfile {
 };
 
 /// Not copyable or movable (a SimObject).
-class FemSolid final : public SimObject, public CavityWall {
+class FemSolid final : public SimObject, public CavityWall, public RowState {
  public:
   /// Throws InputError for a mesh without tets, inverted/degenerate tets, a missing material,
   /// or a non-positive density.
@@ -138,6 +139,9 @@ class FemSolid final : public SimObject, public CavityWall {
   /// Newton solver's warm start and kept factorisation (a bitwise continuation needs them);
   /// a snapshot restore drops the latter (fem_solid_state.cc).
   [[nodiscard]] const FemState& state() const { return state_; }
+  /// RowState (fem_solid_rows.cc): a split solid's part moves to another partition.
+  [[nodiscard]] StateRows ReadStateRows(StateReader& in, const ItemCounts& counts) const override;
+  void WriteStateRows(StateWriter& out, const StateRows& rows) const override;
 
   /// The OdeSystem contract (y = [u; v], 6N; fem_solid_ode.cc). CalcDerivative evaluates the
   /// loads at the fraction (t − t_n)/Δt of the step in progress (1 outside a step), and gives

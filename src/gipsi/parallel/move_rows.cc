@@ -1,6 +1,6 @@
 /// @file
-/// MoveNodeRows: per-node rows from wherever they are to the parts that hold their nodes,
-/// through each node's block rank.
+/// MoveRows: per-item rows from wherever they are to the ranks that hold their items, through
+/// each item's block rank.
 
 #include <algorithm>
 #include <array>
@@ -14,22 +14,28 @@
 
 namespace gipsi {
 
-MovedNodeRows MoveNodeRows(const MeshPart& part, std::span<const int> whole,
-                           std::span<const double> rows, int width, MPI_Comm comm) {
+MovedRows MoveRows(std::span<const int> held, std::int64_t count, std::span<const int> whole,
+                   std::span<const double> rows, int width, MPI_Comm comm) {
   GIPSI_CHECK(width > 0 && rows.size() == whole.size() * static_cast<std::size_t>(width),
-              "MoveNodeRows: {} values for {} rows of {}", rows.size(), whole.size(), width);
-  const std::int64_t nodes = part.num_global_nodes;
-  const int size = part.size, rank = part.rank;
+              "MoveRows: {} values for {} rows of {}", rows.size(), whole.size(), width);
+  const std::int64_t nodes = count;  // items of any kind: "node" below
+  int size = 1, rank = 0;
+  MPI_Comm_size(comm, &size);
+  MPI_Comm_rank(comm, &rank);
+  if (count == 0) {  // no items of this kind anywhere
+    GIPSI_CHECK(held.empty() && whole.empty(), "MoveRows: items of an empty kind");
+    return {};
+  }
   const auto w = static_cast<std::size_t>(width);
   const auto record = w + 1;           // the node's whole index (exact in a double), then the row
   std::int64_t counts[3] = {0, 0, 0};  // missing, repeated, outside
   int first_missing = std::numeric_limits<int>::max();
 
-  // 1. Every part tells each of its nodes' block rank that it holds the node.
+  // 1. Every rank tells each of its items' block rank that it holds the item.
   std::vector<std::vector<int>> asks(static_cast<std::size_t>(size));
-  for (const int n : part.whole_node)
+  for (const int n : held)
     asks[static_cast<std::size_t>(detail::BlockRank(n, nodes, size))].push_back(n);
-  const detail::Received<int> held = detail::Exchange(asks, comm);
+  const detail::Received<int> holders = detail::Exchange(asks, comm);
   asks = {};
 
   // 2. The rows go to their nodes' block ranks.
@@ -61,9 +67,9 @@ MovedNodeRows MoveNodeRows(const MeshPart& part, std::span<const int> whole,
   }
   std::size_t from = 0;
   for (int r = 0; r < size; ++r) {
-    const auto count = static_cast<std::size_t>(held.counts[static_cast<std::size_t>(r)]);
-    for (std::size_t k = from; k < from + count; ++k) {
-      const int n = held.items[k];
+    const auto asked = static_cast<std::size_t>(holders.counts[static_cast<std::size_t>(r)]);
+    for (std::size_t k = from; k < from + asked; ++k) {
+      const int n = holders.items[k];
       const std::int64_t at = row_at[static_cast<std::size_t>(n - begin)];
       if (at < 0) {
         ++counts[0];
@@ -74,26 +80,25 @@ MovedNodeRows MoveNodeRows(const MeshPart& part, std::span<const int> whole,
       const auto* row = arrived.items.data() + at;
       out.insert(out.end(), row, row + record);
     }
-    from += count;
+    from += asked;
   }
   arrived = {};
   const detail::Received<double> mine = detail::Exchange(to, comm);
   to = {};
 
-  // 4. Each part puts its rows in local order.
+  // 4. Each rank puts its rows in the order of its items.
   std::vector<std::pair<int, int>> local_of;  // (whole index, local index)
-  local_of.reserve(part.whole_node.size());
-  for (std::size_t i = 0; i < part.whole_node.size(); ++i)
-    local_of.emplace_back(part.whole_node[i], static_cast<int>(i));
+  local_of.reserve(held.size());
+  for (std::size_t i = 0; i < held.size(); ++i) local_of.emplace_back(held[i], static_cast<int>(i));
   std::sort(local_of.begin(), local_of.end());
-  MovedNodeRows moved;
-  moved.rows.assign(part.whole_node.size() * w, 0.0);
+  MovedRows moved;
+  moved.rows.assign(held.size() * w, 0.0);
   for (std::size_t at = 0; at < mine.items.size(); at += record) {
     const auto n = static_cast<int>(mine.items[at]);
     const auto it = std::lower_bound(local_of.begin(), local_of.end(), std::make_pair(n, -1));
     GIPSI_CHECK(it != local_of.end() && it->first == n,
-                "MoveNodeRows: a row for node {} came "
-                "to a part without it",
+                "MoveRows: a row for item {} came to a "
+                "rank without it",
                 n);
     std::copy_n(mine.items.data() + at + 1, w,
                 moved.rows.data() + static_cast<std::size_t>(it->second) * w);
