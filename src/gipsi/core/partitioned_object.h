@@ -10,10 +10,17 @@
 /// an object its whole domain when anything else in the scene names it
 /// (ObjectBuildContext::standalone).
 ///
+/// Two split objects cut alike (SplitAlike: the same whole domain, the same part on every
+/// process) can be coupled part to part: a connector reads one's local_part() and writes the
+/// other's, each process its own share, and refreshes the nodes its part shares with other
+/// processes from their owners (ShareOwnedNodeValues: O(the part's surface)) instead of gathering
+/// whole fields.
+///
 /// Every process must make the same calls in the same order (they do when every process runs
 /// the same kernel on the same scene).
 
 #include <cstdint>
+#include <optional>
 #include <span>
 #include <vector>
 
@@ -25,6 +32,8 @@
 
 GIPSI_EXPORT_BEGIN
 namespace gipsi {
+
+class SimObject;
 
 /// Interface, implemented beside SimObject; asked for with dynamic_cast.
 class PartitionedObject {
@@ -68,7 +77,43 @@ class PartitionedObject {
   /// Replaces every entry of `values` by its sum, minimum or maximum over the processes.
   /// Collective: O(values.size()) per process.
   virtual void CombineAcross(std::span<double> values, Combine how) const = 0;
+
+  // Coupling part to part (SplitAlike).
+  /// This process's part: the object that steps this process's share of the domain. Its node
+  /// and element fields are per local node and tet; local nodes [0, num_owned_nodes()) are the
+  /// ones this process owns, the others are shared with (and owned by) other processes.
+  [[nodiscard]] virtual SimObject& local_part() = 0;
+  [[nodiscard]] virtual const SimObject& local_part() const = 0;
+  [[nodiscard]] virtual Index num_owned_nodes() const = 0;
+  /// The whole domain's index of each node and each tet of local_part()'s domain, in its order.
+  [[nodiscard]] virtual std::span<const int> whole_nodes_of_part() const = 0;
+  [[nodiscard]] virtual std::span<const int> whole_tets_of_part() const = 0;
+  /// Sets the columns of `values` (components × local_part()'s nodes) at the shared nodes to
+  /// those their owners hold. Collective: each process sends the owned nodes other processes
+  /// share and receives its shared ones (O(the part's surface); neighbours only).
+  virtual void ShareOwnedNodeValues(Eigen::Ref<Eigen::MatrixXd> values) const = 0;
 };
+
+/// True when `a` and `b` are both PartitionedObjects split alike: on every process their parts
+/// hold the same whole-domain nodes, at the same rest positions, and the same whole-domain tets,
+/// in the same order (two objects on one mesh cut by the same partitioner on the same processes).
+/// A node or element index of one part is then the same item of the other's. Collective over the
+/// processes of `a` when both are split (an agreement: the same answer on every process); false
+/// at once, on every process alike, when either is not split.
+[[nodiscard]] bool SplitAlike(const SimObject& a, const SimObject& b);
+
+/// An item whose value is not finite, and the value. Plain struct.
+struct NonFiniteItem {
+  Index item = 0;
+  double value = 0;
+};
+/// The first item (column) of `values` with a non-finite entry, or nullopt. With `split` (a
+/// coupling of parts: `values` per local node or tet of its part, as `location` says), the
+/// smallest whole-domain index of any process's first such item, the same on every process so
+/// that all stop alike, with a NaN value (each process sees only its own). Collective then.
+[[nodiscard]] std::optional<NonFiniteItem> FirstNonFinite(
+    const Eigen::Ref<const Eigen::MatrixXd>& values, FieldLocation location,
+    const PartitionedObject* split);
 
 }  // namespace gipsi
 GIPSI_EXPORT_END

@@ -36,8 +36,9 @@
 /// capability; 13: SolidMaterial::ElementStressAndStiffnessBatch (a new virtual); 14: meshes in
 /// blocks (MeshProvider::GetMeshBlock, ObjectBuildContext::standalone), the PartitionedObject
 /// capability; 15: PartitionedObject's reductions where the nodes are owned (SelectOwnedNodes,
-/// ReadOwnedNodes, CombineAcross).
-#define GIPSI_PLUGIN_INTERFACE 15
+/// ReadOwnedNodes, CombineAcross); 16: coupling split objects part to part (PartitionedObject's
+/// local_part, whole_nodes_of_part, whole_tets_of_part, num_owned_nodes, ShareOwnedNodeValues).
+#define GIPSI_PLUGIN_INTERFACE 16
 /// What a plugin's gipsi_plugin_abi_version() returns and the loader requires: the package's
 /// major and minor version with the plugin interface, MAJOR·10⁶ + MINOR·10³ + INTERFACE. A
 /// plugin thus loads only into the release line it was built against (0.1.x, as the CMake

@@ -4,10 +4,12 @@
 #include "gipsi/parallel/whole_domain_view.h"
 
 #include <fmt/format.h>
+#include <petscvec.h>
 
 #include <algorithm>
 #include <array>
 #include <limits>
+#include <map>
 #include <numeric>
 #include <variant>
 
@@ -15,8 +17,58 @@
 #include "gipsi/base/state.h"
 #include "gipsi/geometry/boundary.h"
 #include "gipsi/geometry/region.h"
+#include "gipsi/parallel/petsc_check.h"
 
 namespace gipsi {
+
+// ShareOwnedNodeValues: shared nodes refreshed from their owners through a ghosted PETSc Vec
+// (the part's owned nodes in the global numbering, its shared ones as ghosts).
+struct WholeDomainView::NodeExchange {
+  std::map<int, Vec> by_components;  // block size → its ghosted Vec
+  NodeExchange() = default;
+  NodeExchange(const NodeExchange&) = delete;
+  NodeExchange& operator=(const NodeExchange&) = delete;
+  ~NodeExchange() {
+    for (auto& entry : by_components) VecDestroy(&entry.second);
+  }
+};
+
+WholeDomainView::~WholeDomainView() = default;
+
+void WholeDomainView::ShareOwnedNodeValues(Eigen::Ref<Eigen::MatrixXd> values) const {
+  const auto n = static_cast<Index>(mesh_part_.whole_node.size());
+  const auto owned = static_cast<Index>(mesh_part_.num_owned);
+  const auto c = static_cast<int>(values.rows());
+  GIPSI_CHECK(values.cols() == n && c >= 1, "'{}': {} by {} values for {} part nodes", name(), c,
+              values.cols(), n);
+  if (!exchange_) exchange_ = std::make_unique<NodeExchange>();
+  Vec& shared = exchange_->by_components[c];
+  if (shared == nullptr) {  // collective: every rank asks for the same component counts
+    std::vector<PetscInt> ghosts;
+    ghosts.reserve(static_cast<std::size_t>(n - owned));
+    for (Index i = owned; i < n; ++i)
+      ghosts.push_back(static_cast<PetscInt>(mesh_part_.global[static_cast<std::size_t>(i)]));
+    GIPSI_PETSC(VecCreateGhostBlock(comm_, c, static_cast<PetscInt>(c * owned), PETSC_DECIDE,
+                                    static_cast<PetscInt>(ghosts.size()), ghosts.data(), &shared));
+  }
+  // The local form holds the owned nodes' blocks, then the shared ones', as `values` does.
+  Vec local = nullptr;
+  PetscScalar* a = nullptr;
+  GIPSI_PETSC(VecGhostGetLocalForm(shared, &local));
+  GIPSI_PETSC(VecGetArray(local, &a));
+  for (Index i = 0; i < owned; ++i)
+    for (int k = 0; k < c; ++k) a[c * i + k] = values(k, i);
+  GIPSI_PETSC(VecRestoreArray(local, &a));
+  GIPSI_PETSC(VecGhostRestoreLocalForm(shared, &local));
+  GIPSI_PETSC(VecGhostUpdateBegin(shared, INSERT_VALUES, SCATTER_FORWARD));
+  GIPSI_PETSC(VecGhostUpdateEnd(shared, INSERT_VALUES, SCATTER_FORWARD));
+  GIPSI_PETSC(VecGhostGetLocalForm(shared, &local));
+  GIPSI_PETSC(VecGetArray(local, &a));
+  for (Index i = owned; i < n; ++i)
+    for (int k = 0; k < c; ++k) values(k, i) = a[c * i + k];
+  GIPSI_PETSC(VecRestoreArray(local, &a));
+  GIPSI_PETSC(VecGhostRestoreLocalForm(shared, &local));
+}
 
 WholeDomainView::Layout WholeDomainView::MakeLayout(const std::vector<int>& whole_of_local,
                                                     std::int64_t owned, MPI_Comm comm) {
@@ -349,6 +401,7 @@ void WholeDomainView::DoReadField(FieldId id, Eigen::Ref<Eigen::MatrixXd> out) c
     part_->ReadField(part_id, out);
     return;
   }
+  ++whole_field_reads_;
   const Layout& layout = LayoutOf(info.location);
   const int c = info.components;
   local_.resize(c, part_->FieldCount(part_id));

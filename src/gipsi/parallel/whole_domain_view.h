@@ -31,7 +31,9 @@
 /// same kernel on the same scene). The whole-field gathers make ReadField the simple path, not
 /// the scalable one: VTU series write the part as one piece per rank instead (output_piece),
 /// and probes read only the items they need (ReadFieldItems), each sent by the rank that owns
-/// it. Connectors still read whole fields (docs/scale-out.md).
+/// it. A connector between two objects split alike (SplitAlike) reads and writes their parts
+/// (local_part) and refreshes shared nodes from their owners (ShareOwnedNodeValues, through a
+/// ghosted PETSc Vec); other connectors read whole fields (docs/scale-out.md).
 
 #include <mpi.h>
 
@@ -75,6 +77,7 @@ class WholeDomainView final : public SimObject, public CavityWall, public Partit
   /// A part-only view (see the file comment): `part` on `mesh_part.mesh` (which must outlive
   /// the view), no whole mesh on any rank. Collective.
   WholeDomainView(std::unique_ptr<SimObject> part, const MeshPart& mesh_part, MPI_Comm comm);
+  ~WholeDomainView() override;
 
   /// PartitionedObject: false for a part-only view. The calls below work in both kinds.
   [[nodiscard]] bool holds_whole_domain() const override { return !part_only_; }
@@ -91,6 +94,19 @@ class WholeDomainView final : public SimObject, public CavityWall, public Partit
   void ReadOwnedNodes(FieldId id, std::span<const int> local,
                       Eigen::Ref<Eigen::MatrixXd> out) const override;
   void CombineAcross(std::span<double> values, Combine how) const override;
+  [[nodiscard]] SimObject& local_part() override { return *part_; }
+  [[nodiscard]] const SimObject& local_part() const override { return *part_; }
+  [[nodiscard]] Index num_owned_nodes() const override { return mesh_part_.num_owned; }
+  [[nodiscard]] std::span<const int> whole_nodes_of_part() const override {
+    return mesh_part_.whole_node;
+  }
+  [[nodiscard]] std::span<const int> whole_tets_of_part() const override {
+    return mesh_part_.whole_tet;
+  }
+  void ShareOwnedNodeValues(Eigen::Ref<Eigen::MatrixXd> values) const override;
+  /// How many node or element fields this view has gathered whole (ReadField: an Allgatherv of
+  /// the whole field to every rank), so tests can check that a coupling does not.
+  [[nodiscard]] std::int64_t whole_field_reads() const { return whole_field_reads_; }
 
   [[nodiscard]] std::string_view type_name() const override { return part_->type_name(); }
   [[nodiscard]] const Points& domain_positions() const override { return domain().nodes; }
@@ -179,6 +195,10 @@ class WholeDomainView final : public SimObject, public CavityWall, public Partit
   // DistributedPart section starts in `in`, to find it in the other ranks' files).
   void RestoreOnAnotherRankCount(StateReader& in, const StateReader::Position& at,
                                  const SavedPart& saved);
+  // ShareOwnedNodeValues' ghosted PETSc Vecs, one per component count.
+  struct NodeExchange;
+  mutable std::unique_ptr<NodeExchange> exchange_;
+  mutable std::int64_t whole_field_reads_ = 0;
   // Buffers of the gathers, kept between reads (no allocation once sized).
   mutable std::vector<double> receive_;
   mutable std::vector<int> counts_, offsets_;

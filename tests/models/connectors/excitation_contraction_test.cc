@@ -1,5 +1,5 @@
-// ExcitationContraction: the exact twitch ODE, the voltage → tension mapping between two
-// different meshes (exact for linear fields), and its wiring errors.
+// ExcitationContraction: the exact twitch ODE, relaxing the muscle's own tension, the voltage →
+// tension mapping between two different meshes (exact for linear fields), and its wiring errors.
 
 #include "gipsi/models/connectors/excitation_contraction.h"
 
@@ -101,6 +101,30 @@ TEST(ExcitationContraction, IntegratesTheTwitchExactly) {
   EXPECT_NEAR(ta.maxCoeff(), peak * std::exp(-25 * 0.02), 1e-9 * peak);
 }
 
+// The tension is the muscle's: a firing relaxes it from the field's current value (here one
+// written since the last firing, as a restored or moved muscle would hold), so T_a after Δt is
+// k u + (T₀ − k u) e^{−ε Δt} from that T₀ at every node.
+TEST(ExcitationContraction, RelaxesTheMusclesOwnTension) {
+  auto loaded = Load(kConnector);
+  Kernel& kernel = *loaded->scene.kernel;
+  SimObject& ep = kernel.FindObject("ep");
+  SimObject& muscle = kernel.FindObject("muscle");
+  ep.WriteField(ep.FindField("V"), Eigen::MatrixXd::Constant(1, ep.domain().num_nodes(), -30.0));
+  Connector& ec = kernel.coordinator().connector(0);
+  ASSERT_TRUE(ec.Fire(0.0).ok());
+  const FieldId tension = muscle.FindField("nodal_active_tension");
+  Eigen::MatrixXd t0(1, muscle.domain().num_nodes());
+  for (Index i = 0; i < t0.cols(); ++i) t0(0, i) = 1e3 * static_cast<double>(i % 7);  // Pa
+  muscle.WriteField(tension, t0);
+  ASSERT_TRUE(ec.Fire(0.02).ok());
+  Eigen::MatrixXd ta(1, t0.cols());
+  muscle.ReadField(tension, ta);
+  const double target = 4e4 * 0.5;  // u = (−30 + 80)/100, above the threshold: the rise rate
+  for (Index i = 0; i < ta.cols(); ++i)
+    EXPECT_NEAR(ta(0, i), target + (t0(0, i) - target) * std::exp(-8 * 0.02), 1e-9 * target)
+        << "node " << i;
+}
+
 TEST(ExcitationContraction, BadWiringGetsAClearError) {
   auto error = [](const std::string& connector) {
     try {
@@ -115,7 +139,7 @@ TEST(ExcitationContraction, BadWiringGetsAClearError) {
               HasSubstr("'from' must be a readable scalar node field"));
   EXPECT_THAT(error(R"({"type": "ExcitationContraction", "from": "ep.V",
                         "to": "muscle.von_mises_stress"})"),
-              HasSubstr("'to' must be a writable scalar node or element field"));
+              HasSubstr("'to' must be a readable and writable scalar node or element field"));
   EXPECT_THAT(error(R"({"type": "ExcitationContraction", "from": "ep.V",
                         "to": "muscle.nodal_active_tension", "gain": "40 kPa/s"})"),
               HasSubstr("connectors.ec.gain"));

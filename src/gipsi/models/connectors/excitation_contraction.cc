@@ -9,6 +9,7 @@
 #include <cmath>
 
 #include "gipsi/base/error.h"
+#include "gipsi/base/log.h"
 #include "gipsi/base/units.h"
 #include "gipsi/models/connectors/item_positions.h"
 
@@ -18,9 +19,9 @@ ExcitationContraction::ExcitationContraction(std::string name, const SimObject& 
                                              SimObject& muscle, FieldId tension,
                                              const ExcitationContractionParams& params)
     : Connector(std::move(name)),
-      ep_(ep),
+      ep_(&ep),
       voltage_(voltage),
-      muscle_(muscle),
+      muscle_(&muscle),
       tension_field_(tension),
       params_(params) {
   const FieldInfo& v = ep.field_info(voltage);
@@ -31,46 +32,58 @@ ExcitationContraction::ExcitationContraction(std::string name, const SimObject& 
                     "'{}.{}' is not",
                     ep.path(), v.name));
   if ((ta.location != FieldLocation::kNode && ta.location != FieldLocation::kElement) ||
-      ta.components != 1 || !ta.writable())
+      ta.components != 1 || !ta.writable() || !ta.readable())
     throw InputError(
-        fmt::format("'to' must be a writable scalar node or element field (an "
-                    "active tension); '{}.{}' is not",
+        fmt::format("'to' must be a readable and writable scalar node or element field (an "
+                    "active tension the muscle keeps); '{}.{}' is not",
                     muscle.path(), ta.name));
   if (!(params.v_peak > params.v_rest)) throw InputError("v_peak must exceed v_rest");
   // v_rest and v_peak are in mV; the tension it writes in Pa.
   UseField("from", ep, v.name, FieldAccess::kRead, "mV", 1);
-  UseField("to", muscle, ta.name, FieldAccess::kWrite, "Pa", 1);
-  const Points src = ItemRestPositions(ep, FieldLocation::kNode);
-  const Points dst = ItemRestPositions(muscle, ta.location);
+  UseField("to", muscle, ta.name, FieldAccess::kReadWrite, "Pa", 1);
+  tension_location_ = ta.location;
+  if (SplitAlike(ep, muscle)) {  // couple the parts, process by process
+    split_ = dynamic_cast<const PartitionedObject*>(&ep);
+    ep_ = &split_->local_part();
+    muscle_ = &dynamic_cast<PartitionedObject&>(muscle).local_part();
+    voltage_ = ep_->FindField(v.name);
+    tension_field_ = muscle_->FindField(ta.name);
+    Log().debug("{}: couples the parts of {} and {}, each process its own (split alike)", path(),
+                ep.path(), muscle.path());
+  }
+  const Points src = ItemRestPositions(*ep_, FieldLocation::kNode);
+  const Points dst = ItemRestPositions(*muscle_, ta.location);
   const bool coincide = src.cols() == dst.cols() && (src - dst).cwiseAbs().maxCoeff() <= 1e-12;
-  if (!coincide) map_ = ep.MapFromNodes(dst);
+  if (!coincide) map_ = ep_->MapFromNodes(dst);
   source_.resize(1, src.cols());
   mapped_.resize(1, dst.cols());
-  state_.tension = VecX::Zero(dst.cols());
+  tension_.resize(1, dst.cols());
   BindState(state_);
 }
 
 StepStatus ExcitationContraction::DoFire(double t) {
-  VecX& tension = state_.tension;
-  const double dt = state_.fired ? t - state_.last_time : 0.0;
-  state_.fired = true;
-  state_.last_time = t;
-  ep_.ReadField(voltage_, source_);
+  ep_->ReadField(voltage_, source_);
+  if (split_ != nullptr) split_->ShareOwnedNodeValues(source_);
   if (map_) {
     map_->Apply(source_, mapped_);
   } else {
     mapped_ = source_;
   }
+  // Every process stops alike when coupling parts (each sees its own).
+  if (const auto bad = FirstNonFinite(mapped_, tension_location_, split_))
+    return StepStatus::Diverged("non-finite voltage at item", bad->item, bad->value);
+  const double dt = state_.fired ? t - state_.last_time : 0.0;
+  muscle_->ReadField(tension_field_, tension_);  // the tension to relax from
   const ExcitationContractionParams& p = params_;
-  for (Index i = 0; i < tension.size(); ++i) {
-    const double v = mapped_(0, i);
-    if (!std::isfinite(v)) return StepStatus::Diverged("non-finite voltage at item", i, v);
-    const double u = std::clamp((v - p.v_rest) / (p.v_peak - p.v_rest), 0.0, 1.0);
+  for (Index i = 0; i < tension_.cols(); ++i) {
+    const double u = std::clamp((mapped_(0, i) - p.v_rest) / (p.v_peak - p.v_rest), 0.0, 1.0);
     const double rate = u >= p.threshold ? p.rise_rate : p.decay_rate;
     const double target = p.gain * u;
-    tension[i] = target + (tension[i] - target) * std::exp(-rate * dt);
+    tension_(0, i) = target + (tension_(0, i) - target) * std::exp(-rate * dt);
   }
-  muscle_.WriteField(tension_field_, tension.transpose());
+  muscle_->WriteField(tension_field_, tension_);
+  state_.fired = true;
+  state_.last_time = t;
   return StepStatus::Ok();
 }
 

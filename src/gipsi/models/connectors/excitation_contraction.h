@@ -12,7 +12,15 @@
 /// so tension builds up during the action potential and relaxes after repolarisation. V is held
 /// at its value at the firing time over the interval since the previous firing, and the linear
 /// ODE is integrated exactly: T_a ← k u + (T_a − k u) e^{−ε Δt} (stable for any interval).
-/// The state T_a lives in the connector (one value per target item, starting at 0).
+/// T_a is the muscle's: each firing reads the tension field back and relaxes it from its current
+/// value (what the connector last Set, unless something else wrote it since), so the tension's
+/// state is checkpointed, restored and moved with the muscle; the connector keeps only its clock.
+///
+/// When the electrophysiology and the muscle are split alike over the processes of a
+/// distributed run (SplitAlike: one mesh, one cut), each process couples its own parts: it reads
+/// its part's V, takes the values of the nodes it shares from their owners
+/// (ShareOwnedNodeValues, O(the part's surface)), and writes its part's tension. No process
+/// gathers a whole field, and every item gets the value the whole-field path would give it.
 ///
 /// Units: V in mV (the EP objects' unit); k in Pa; rates in 1/s; kernel time in s.
 
@@ -23,6 +31,7 @@
 
 #include "gipsi/base/export.h"
 #include "gipsi/core/connector.h"
+#include "gipsi/core/partitioned_object.h"
 #include "gipsi/core/registry.h"
 #include "gipsi/core/sim_object.h"
 #include "gipsi/geometry/mapping.h"
@@ -42,16 +51,14 @@ struct ExcitationContractionParams {
 };
 
 /// What ExcitationContraction carries from one firing to the next (a state value type,
-/// gipsi/base/state_value.h).
+/// gipsi/base/state_value.h). Version 2: the tension is the muscle's (version 1 kept a copy).
 struct ExcitationContractionState {
   static constexpr std::string_view kTag = "ExcitationContractionState";
-  static constexpr std::uint32_t kVersion = 1;
-  VecX tension;          ///< the active tension [Pa] per target item (last value Set)
+  static constexpr std::uint32_t kVersion = 2;
   double last_time = 0;  ///< when it last fired [s]
   bool fired = false;    ///< whether it has fired (the first firing integrates over 0 s)
   template <class Self, class V>
   static void Fields(Self& s, V& v) {
-    v("tension", s.tension, Shape::kFixed);
     v("last_time", s.last_time);
     v("fired", s.fired);
   }
@@ -60,28 +67,33 @@ struct ExcitationContractionState {
 /// Not copyable or movable (a Connector).
 class ExcitationContraction final : public Connector {
  public:
-  /// `voltage` must be a readable scalar node field of `ep`; `tension` a writable scalar node or
-  /// element field of `muscle`. Throws InputError otherwise, or for bad parameters.
+  /// `voltage` must be a readable scalar node field of `ep`; `tension` a readable and writable
+  /// scalar node or element field of `muscle`. Throws InputError otherwise, or for bad
+  /// parameters. Collective over the processes of a distributed run when both objects are split
+  /// (SplitAlike).
   ExcitationContraction(std::string name, const SimObject& ep, FieldId voltage, SimObject& muscle,
                         FieldId tension, const ExcitationContractionParams& params);
 
   [[nodiscard]] std::string_view type_name() const override { return "ExcitationContraction"; }
-  /// The active tension [Pa] per target item (last value Set).
-  [[nodiscard]] const VecX& tension() const { return state_.tension; }
   /// The state (bound with BindState: checkpoints and snapshots copy it).
   [[nodiscard]] const ExcitationContractionState& state() const { return state_; }
+  /// Whether it couples the objects' parts, process by process (split alike).
+  [[nodiscard]] bool couples_parts() const { return split_ != nullptr; }
 
  protected:
   StepStatus DoFire(double t) override;
 
  private:
-  const SimObject& ep_;
+  // The objects read and written: the scene's, or their parts when they are split alike.
+  const SimObject* ep_;
   FieldId voltage_;
-  SimObject& muscle_;
+  SimObject* muscle_;
   FieldId tension_field_;
+  const PartitionedObject* split_ = nullptr;  // the split EP object, when coupling parts
+  FieldLocation tension_location_ = FieldLocation::kNode;
   ExcitationContractionParams params_;
   std::optional<PointMap> map_;  // empty: the items coincide
-  Eigen::MatrixXd source_, mapped_;
+  Eigen::MatrixXd source_, mapped_, tension_;
   ExcitationContractionState state_;
 };
 

@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 
 #include "gipsi/base/error.h"
+#include "gipsi/base/log.h"
 #include "gipsi/base/units.h"
 #include "gipsi/models/connectors/item_positions.h"
 
@@ -15,9 +16,9 @@ FieldCopy::FieldCopy(std::string name, SimObject& from, FieldId from_field, SimO
                      FieldId to_field, Mapping mapping, double scale,
                      const std::string& scale_units)
     : Connector(std::move(name)),
-      from_(from),
+      from_(&from),
       from_field_(from_field),
-      to_(to),
+      to_(&to),
       to_field_(to_field),
       mapping_(mapping),
       scale_(scale) {
@@ -63,23 +64,40 @@ FieldCopy::FieldCopy(std::string name, SimObject& from, FieldId from_field, SimO
   }
   if (mapping_ == Mapping::kDirect && n_src != n_dst)
     fail(fmt::format("'direct' mapping needs equal item counts ({} vs {})", n_src, n_dst));
+  if (mapping_ == Mapping::kBarycentric && src.location != FieldLocation::kNode)
+    fail("'barycentric' mapping needs a node field as source");
+  // Objects split alike: copied part to part when every target item of a part takes its value
+  // from that part's items (item for item, or inside the part's own tets). A nearest item may
+  // be another process's, so "nearest" reads the source whole.
+  if (src.location != FieldLocation::kGlobal && mapping_ != Mapping::kNearest &&
+      (mapping_ == Mapping::kBarycentric || src.location == dst.location) && SplitAlike(from, to)) {
+    split_ = dynamic_cast<const PartitionedObject*>(&from);
+    from_ = &dynamic_cast<PartitionedObject&>(from).local_part();
+    to_ = &dynamic_cast<PartitionedObject&>(to).local_part();
+    from_field_ = from_->FindField(src.name);
+    to_field_ = to_->FindField(dst.name);
+    src_pos = ItemRestPositions(*from_, src.location);
+    dst_pos = ItemRestPositions(*to_, dst.location);
+    Log().debug("{}: copies the parts of {} to those of {}, each process its own (split alike)",
+                this->path(), from.path(), to.path());
+  }
   if (mapping_ == Mapping::kBarycentric) {
-    if (src.location != FieldLocation::kNode)
-      fail("'barycentric' mapping needs a node field as source");
-    map_ = from.MapFromNodes(dst_pos);
+    map_ = from_->MapFromNodes(dst_pos);
   } else if (mapping_ == Mapping::kNearest) {
     map_ = PointMap::Nearest(src_pos, dst_pos);
   }
-  source_.resize(src.components, n_src);
-  target_.resize(dst.components, n_dst);
+  source_.resize(src.components, from_->FieldCount(from_field_));
+  target_.resize(dst.components, to_->FieldCount(to_field_));
 }
 
 StepStatus FieldCopy::DoFire(double /*t*/) {
-  from_.ReadField(from_field_, source_);
+  from_->ReadField(from_field_, source_);
+  if (split_ != nullptr && from_->field_info(from_field_).location == FieldLocation::kNode)
+    split_->ShareOwnedNodeValues(source_);
   // A source field's no-data marker (e.g. -1 for "never activated") is neither blended nor
   // scaled: an item that reads it, or whose interpolation touches it, gets the target field's
   // own marker if it declares one, else the source's marker unchanged.
-  const std::optional<double> marker = from_.field_info(from_field_).no_data;
+  const std::optional<double> marker = from_->field_info(from_field_).no_data;
   if (map_ && marker) {
     map_->ApplyMarked(source_, target_, *marker);
   } else if (map_) {
@@ -87,12 +105,12 @@ StepStatus FieldCopy::DoFire(double /*t*/) {
     // The source's own interpolation where it is of higher order than the blend of the tet's
     // vertices (a MixedSolid's quadratic displacement).
     if (mapping_ == Mapping::kBarycentric)
-      from_.CorrectInterpolated(from_field_, map_->indices(), map_->weights(), target_);
+      from_->CorrectInterpolated(from_field_, map_->indices(), map_->weights(), target_);
   } else {
     target_ = source_;
   }
   if (marker) {
-    const double written = to_.field_info(to_field_).no_data.value_or(*marker);
+    const double written = to_->field_info(to_field_).no_data.value_or(*marker);
     for (Index i = 0; i < target_.size(); ++i) {
       double& v = target_.data()[i];
       v = v == *marker ? written : v * scale_;
@@ -100,11 +118,10 @@ StepStatus FieldCopy::DoFire(double /*t*/) {
   } else if (scale_ != 1.0) {
     target_ *= scale_;
   }
-  for (Index i = 0; i < target_.size(); ++i)
-    if (!std::isfinite(target_.data()[i]))
-      return StepStatus::Diverged("non-finite value transferred at item", i / target_.rows(),
-                                  target_.data()[i]);
-  to_.WriteField(to_field_, target_);
+  // Every process stops alike when copying parts (each sees its own).
+  if (const auto bad = FirstNonFinite(target_, to_->field_info(to_field_).location, split_))
+    return StepStatus::Diverged("non-finite value transferred at item", bad->item, bad->value);
+  to_->WriteField(to_field_, target_);
   return StepStatus::Ok();
 }
 

@@ -15,11 +15,16 @@
 /// A source field with a no-data marker (FieldInfo::no_data, e.g. `activation_time`'s -1) keeps
 /// it apart: a target item whose value would read or blend the marker gets the target field's
 /// marker (the source's if the target declares none), never a blend and never scaled.
+/// Between objects split alike over the processes of a distributed run (SplitAlike), a direct or
+/// barycentric copy runs part to part: each process reads its part of the source, takes the
+/// values of the nodes it shares from their owners, and writes its part of the target; no
+/// process gathers a whole field. A nearest-item copy reads the source whole.
 
 #include <optional>
 
 #include "gipsi/base/export.h"
 #include "gipsi/core/connector.h"
+#include "gipsi/core/partitioned_object.h"
 #include "gipsi/core/registry.h"
 #include "gipsi/geometry/mapping.h"
 
@@ -43,15 +48,19 @@ class FieldCopy final : public Connector {
   [[nodiscard]] Mapping mapping() const { return mapping_; }
   /// The factor applied: the scale times the conversion of its units into the target's.
   [[nodiscard]] double factor() const { return scale_; }
+  /// Whether it copies the objects' parts, process by process (split alike).
+  [[nodiscard]] bool couples_parts() const { return split_ != nullptr; }
 
  protected:
   StepStatus DoFire(double t) override;
 
  private:
-  SimObject& from_;
+  // The objects read and written: the scene's, or their parts when they are split alike.
+  const SimObject* from_;
   FieldId from_field_;
-  SimObject& to_;
+  SimObject* to_;
   FieldId to_field_;
+  const PartitionedObject* split_ = nullptr;  // the split source, when copying parts
   Mapping mapping_;
   double scale_;
   std::optional<PointMap> map_;

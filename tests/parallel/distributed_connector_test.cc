@@ -1,0 +1,255 @@
+// Connectors between split objects (parallel/whole_domain_view.h): objects split alike are
+// coupled part to part, with no whole-field gather, and give every item the value the
+// whole-field path gives it. Runs under `mpiexec -np 2` and `-np 4 --oversubscribe`
+// (tests/CMakeLists.txt); every test is collective.
+
+#include <gtest/gtest.h>
+#include <mpi.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <memory>
+#include <string>
+
+#include "gipsi/core/partitioned_object.h"
+#include "gipsi/geometry/generators.h"
+#include "gipsi/models/connectors/excitation_contraction.h"
+#include "gipsi/models/connectors/field_copy.h"
+#include "gipsi/models/ep/phenomenological.h"
+#include "gipsi/models/fem/fem_solid.h"
+#include "gipsi/models/fem/solid_laws.h"
+#include "gipsi/parallel/distributed_monodomain.h"
+#include "gipsi/parallel/distributed_solid.h"
+#include "gipsi/parallel/parallel_session.h"
+#include "gipsi/parallel/whole_domain_view.h"
+
+namespace gipsi {
+namespace {
+
+MPI_Comm World() { return ParallelSession::world(); }
+
+// A 10 × 4 × 2 mm box of Aliev–Panfilov tissue, stimulated in the corner at x = 0 for 2 ms: after
+// 6 ms V runs from rest (u = 0) through the wave front to the plateau (u near 1).
+std::shared_ptr<const Mesh> Box(double length = 0.010) {
+  return std::make_shared<Mesh>(MakeTetBox(Vec3::Zero(), Vec3(length, 0.004, 0.002), {20, 8, 4}));
+}
+
+EpTissueParams TissueParams() {
+  EpTissueParams p;
+  p.cell = std::make_shared<AlievPanfilov>();
+  p.sigma_longitudinal = p.sigma_transverse = 0.1;
+  p.fibre = Vec3::UnitX();
+  p.linear.preconditioner = "jacobi";
+  p.linear.tolerance = 1e-10;
+  StimulusSpec corner;
+  corner.name = "corner";
+  corner.region = BoxRegion{Vec3::Constant(-1e-6), Vec3(0.002, 0.004, 0.002)};
+  corner.amplitude = 50;
+  corner.pulses.duration = 2.0;
+  p.stimuli.push_back(corner);
+  return p;
+}
+
+std::unique_ptr<WholeDomainView> SplitTissue(std::shared_ptr<const Mesh> whole) {
+  auto part = std::make_unique<DistributedMonodomain>("ep", *whole, TissueParams(), World());
+  const MeshPart& mesh_part = part->part();
+  return std::make_unique<WholeDomainView>(std::move(part), mesh_part, whole, World());
+}
+
+FemParams MuscleParams() {
+  FemParams p;
+  p.material = std::make_shared<CorotationalSolid>(1e5, 0.45);
+  p.fibre = Vec3::UnitX();
+  p.gravity = Vec3::Zero();
+  return p;
+}
+
+// The serial muscle, or the view on this rank's part of it.
+std::unique_ptr<SimObject> Muscle(std::shared_ptr<const Mesh> whole, bool split) {
+  FemParams p = MuscleParams();
+  if (!split) return std::make_unique<FemSolid>("muscle", whole, std::move(p));
+  auto distribution = std::make_shared<DistributedSolid>(whole, World());
+  p.distribution = distribution;
+  const MeshPart& part = distribution->part();
+  return std::make_unique<WholeDomainView>(
+      std::make_unique<FemSolid>("muscle", part.mesh, std::move(p)), part, whole, World(),
+      WholeDomainView::BoundaryMap{distribution->whole_boundary_vertex(),
+                                   distribution->whole_boundary_face()});
+}
+
+Eigen::MatrixXd Read(const SimObject& object, const std::string& field) {
+  const FieldId id = object.FindField(field);
+  Eigen::MatrixXd out(object.field_info(id).components, object.FieldCount(id));
+  object.ReadField(id, out);
+  return out;
+}
+
+const ExcitationContractionParams kTwitch{
+    .v_rest = -80, .v_peak = 20, .threshold = 0.05, .gain = 4e4, .rise_rate = 8, .decay_rate = 25};
+
+// The twitch law at a voltage, from a tension `from` over `dt` (the connector's documented
+// exact step).
+double Twitch(double v, double from, double dt) {
+  const ExcitationContractionParams& p = kTwitch;
+  const double u = std::clamp((v - p.v_rest) / (p.v_peak - p.v_rest), 0.0, 1.0);
+  const double rate = u >= p.threshold ? p.rise_rate : p.decay_rate;
+  return p.gain * u + (from - p.gain * u) * std::exp(-rate * dt);
+}
+
+// Every rank's shared nodes take their owners' values, for one and for three components; the
+// owned ones are left as they were.
+TEST(SplitCoupling, SharedNodesTakeTheirOwnersValues) {
+  const auto tissue = SplitTissue(Box());
+  const std::span<const int> whole = tissue->whole_nodes_of_part();
+  const Index owned = tissue->num_owned_nodes();
+  for (int components : {1, 3}) {
+    Eigen::MatrixXd values(components, static_cast<Index>(whole.size()));
+    for (Index i = 0; i < values.cols(); ++i)
+      for (int k = 0; k < components; ++k)
+        values(k, i) = i < owned ? 10.0 * whole[static_cast<std::size_t>(i)] + k : -1.0;
+    tissue->ShareOwnedNodeValues(values);
+    for (Index i = 0; i < values.cols(); ++i)
+      for (int k = 0; k < components; ++k)
+        ASSERT_EQ(values(k, i), 10.0 * whole[static_cast<std::size_t>(i)] + k)
+            << "local node " << i << " (owned: " << owned << "), component " << k;
+  }
+}
+
+// A non-finite value one rank meets in its part is reported alike on every rank: the smallest
+// whole-mesh index of the ranks' first such nodes (or tets).
+TEST(SplitCoupling, ANonFiniteValueIsAgreedOnEveryRank) {
+  const auto tissue = SplitTissue(Box());
+  const int rank = ParallelSession::rank(World()), size = ParallelSession::size(World());
+  const std::span<const int> nodes = tissue->whole_nodes_of_part();
+  const std::span<const int> tets = tissue->whole_tets_of_part();
+  Eigen::MatrixXd at_nodes = Eigen::MatrixXd::Zero(2, static_cast<Index>(nodes.size()));
+  Eigen::MatrixXd at_tets = Eigen::MatrixXd::Zero(1, static_cast<Index>(tets.size()));
+  EXPECT_FALSE(FirstNonFinite(at_nodes, FieldLocation::kNode, tissue.get()));
+  // The last rank's last node, rank 0's middle node and first tet: the node reported is the
+  // smaller of the two nodes' whole indices, the tet rank 0's.
+  constexpr int kNone = std::numeric_limits<int>::max();
+  int planted[3] = {kNone, kNone, kNone};  // rank 0's node, the last rank's node, rank 0's tet
+  if (rank == size - 1) {
+    at_nodes(1, at_nodes.cols() - 1) = std::numeric_limits<double>::infinity();
+    planted[1] = nodes.back();
+  }
+  if (rank == 0) {
+    at_nodes(0, at_nodes.cols() / 2) = std::numeric_limits<double>::quiet_NaN();
+    planted[0] = nodes[nodes.size() / 2];
+    at_tets(0, 0) = std::numeric_limits<double>::quiet_NaN();
+    planted[2] = tets[0];
+  }
+  MPI_Allreduce(MPI_IN_PLACE, planted, 3, MPI_INT, MPI_MIN, World());
+  const auto node = FirstNonFinite(at_nodes, FieldLocation::kNode, tissue.get());
+  ASSERT_TRUE(node);
+  EXPECT_EQ(node->item, std::min(planted[0], planted[1]));
+  EXPECT_TRUE(std::isnan(node->value));
+  const auto tet = FirstNonFinite(at_tets, FieldLocation::kElement, tissue.get());
+  ASSERT_TRUE(tet);
+  EXPECT_EQ(tet->item, planted[2]);
+}
+
+// The tissue and a muscle on the same mesh are split alike on every rank; on another mesh, or
+// with the muscle whole on every rank, they are not (and every rank says so alike).
+TEST(SplitCoupling, ObjectsOnOneMeshAreSplitAlike) {
+  const auto mesh = Box();
+  const auto tissue = SplitTissue(mesh);
+  EXPECT_TRUE(SplitAlike(*tissue, *Muscle(mesh, true)));
+  EXPECT_FALSE(SplitAlike(*tissue, *Muscle(mesh, false)));
+  EXPECT_FALSE(SplitAlike(*tissue, *Muscle(Box(0.011), true)));
+}
+
+// The excitation–contraction coupling of a split tissue and a split muscle on one mesh couples
+// the parts: no whole field is gathered, and every local item of every part (owned or shared)
+// gets the twitch law's value at the whole mesh's V, on nodes and, through the interpolation on
+// the part, at the tets' centroids. With the muscle whole on every rank the connector reads V
+// whole, and gives the same values.
+TEST(SplitCoupling, ExcitationContractionCouplesThePartsWithoutGathers) {
+  const auto mesh = Box();
+  const auto tissue = SplitTissue(mesh);
+  for (int s = 0; s < 60; ++s) ASSERT_TRUE(tissue->Step(1e-4).ok());  // 6 ms
+  const Eigen::MatrixXd volts = Read(*tissue, "V");
+  ASSERT_LT(volts.minCoeff(), -70.0);  // rest and plateau both present
+  ASSERT_GT(volts.maxCoeff(), 0.0);
+  const FieldId v = tissue->FindField("V");
+  // Each field on muscles of its own (a FemSolid's element tension reads its nodal one's mean
+  // once that is written).
+  for (const char* field : {"nodal_active_tension", "active_tension"}) {
+    SCOPED_TRACE(field);
+    std::unique_ptr<SimObject> split_muscle = Muscle(mesh, true),
+                               whole_muscle = Muscle(mesh, false);
+    ExcitationContraction on_parts("ec", *tissue, v, *split_muscle, split_muscle->FindField(field),
+                                   kTwitch);
+    ExcitationContraction whole_v("ec", *tissue, v, *whole_muscle, whole_muscle->FindField(field),
+                                  kTwitch);
+    EXPECT_TRUE(on_parts.couples_parts());
+    EXPECT_FALSE(whole_v.couples_parts());
+    const std::int64_t reads_before = tissue->whole_field_reads();
+    for (double t : {0.0, 0.004}) ASSERT_TRUE(on_parts.Fire(t).ok());
+    EXPECT_EQ(tissue->whole_field_reads(), reads_before);
+    EXPECT_EQ(dynamic_cast<const WholeDomainView&>(*split_muscle).whole_field_reads(), 0);
+    for (double t : {0.0, 0.004}) ASSERT_TRUE(whole_v.Fire(t).ok());
+    EXPECT_EQ(tissue->whole_field_reads(), reads_before + 2);
+
+    const auto& part = dynamic_cast<PartitionedObject&>(*split_muscle);
+    const Eigen::MatrixXd local = Read(part.local_part(), field);
+    if (std::string(field) == "nodal_active_tension") {
+      // Every local node of the muscle's part, shared ones too, as at the whole mesh's node.
+      const std::span<const int> nodes = part.whole_nodes_of_part();
+      for (Index i = 0; i < local.cols(); ++i) {
+        const int n = nodes[static_cast<std::size_t>(i)];
+        ASSERT_EQ(local(0, i), Twitch(volts(0, n), 0.0, 0.004)) << "local node " << i;
+      }
+    } else {
+      // V at a tet's centroid is the mean of its corners' (barycentric weights of 1/4).
+      const std::span<const int> tets = part.whole_tets_of_part();
+      for (Index i = 0; i < local.cols(); ++i) {
+        const int e = tets[static_cast<std::size_t>(i)];
+        double mean = 0;
+        for (int a = 0; a < 4; ++a) mean += 0.25 * volts(0, mesh->tets(a, e));
+        ASSERT_NEAR(local(0, i), Twitch(mean, 0.0, 0.004), 1e-9) << "tet " << e;
+      }
+    }
+    EXPECT_EQ(Read(*whole_muscle, field), Read(*split_muscle, field));
+  }
+}
+
+// A FieldCopy of V (scaled to a tension: 2 kPa/mV) between the same split objects copies the
+// parts, item for item onto the nodes and barycentrically onto the tets, with no gather; the
+// values are the whole-field copy's at every item. A nearest-item copy reads V whole.
+TEST(SplitCoupling, FieldCopyCopiesThePartsWithoutGathers) {
+  const auto mesh = Box();
+  const auto tissue = SplitTissue(mesh);
+  for (int s = 0; s < 60; ++s) ASSERT_TRUE(tissue->Step(1e-4).ok());  // 6 ms
+  const FieldId v = tissue->FindField("V");
+  using Mapping = FieldCopy::Mapping;
+  for (const char* field : {"nodal_active_tension", "active_tension"}) {
+    SCOPED_TRACE(field);
+    std::unique_ptr<SimObject> split_muscle = Muscle(mesh, true),
+                               whole_muscle = Muscle(mesh, false);
+    FieldCopy on_parts("copy", *tissue, v, *split_muscle, split_muscle->FindField(field),
+                       Mapping::kAuto, 2, "kPa/mV");
+    FieldCopy whole_v("copy", *tissue, v, *whole_muscle, whole_muscle->FindField(field),
+                      Mapping::kAuto, 2, "kPa/mV");
+    EXPECT_TRUE(on_parts.couples_parts());
+    EXPECT_FALSE(whole_v.couples_parts());
+    EXPECT_EQ(on_parts.mapping(),
+              std::string(field) == "active_tension" ? Mapping::kBarycentric : Mapping::kDirect);
+    const std::int64_t reads_before = tissue->whole_field_reads();
+    ASSERT_TRUE(on_parts.Fire(0).ok());
+    EXPECT_EQ(tissue->whole_field_reads(), reads_before);
+    ASSERT_TRUE(whole_v.Fire(0).ok());
+    const Eigen::MatrixXd copied = Read(*split_muscle, field);
+    EXPECT_LE((Read(*whole_muscle, field) - copied).cwiseAbs().maxCoeff(),
+              1e-12 * copied.cwiseAbs().maxCoeff());
+    EXPECT_GT(copied.cwiseAbs().maxCoeff(), 1e5);  // Pa: 2 kPa/mV of tens of mV
+  }
+  auto muscle = Muscle(mesh, true);
+  FieldCopy nearest("copy", *tissue, v, *muscle, muscle->FindField("active_tension"),
+                    Mapping::kNearest, 2, "kPa/mV");
+  EXPECT_FALSE(nearest.couples_parts());
+}
+
+}  // namespace
+}  // namespace gipsi
