@@ -358,9 +358,10 @@ std::filesystem::path RankFile(const std::filesystem::path& file, int rank) {
 
 /// Before a resume: the files of a distributed checkpoint (`<stem>_p0`, `_p1`, ... that exist),
 /// which a distributed run reads whatever its rank count (rank q reads rank q % N's file of N,
-/// and split objects read the others' parts, docs/scale-out.md); a serial run's checkpoint
-/// named for a distributed run, or the reverse, gets a message that says which run wrote it (a
-/// missing file is left to the reader).
+/// and split objects read the others' parts, docs/scale-out.md), or a serial run's one file,
+/// which every rank of a distributed run reads (split objects take their parts of it); a
+/// distributed checkpoint named for a serial run gets a message that says which run wrote it
+/// (a missing file is left to the reader).
 std::vector<std::filesystem::path> CheckResumeFiles(const std::filesystem::path& resume,
                                                     const Ranks& ranks) {
   std::error_code error;
@@ -371,12 +372,7 @@ std::vector<std::filesystem::path> CheckResumeFiles(const std::filesystem::path&
     // Every rank looks at the same files and refuses alike (a rank whose file exists would
     // otherwise wait for the others).
     if (!pieces.empty()) return pieces;
-    if (std::filesystem::is_regular_file(resume, error))
-      gipsi::ThrowInputError(
-          "command line", "--resume",
-          fmt::format("{} is the checkpoint of a run on one process, and this run has {} ranks "
-                      "(which would read {}): resume it without mpirun",
-                      resume.string(), ranks.size, RankFile(resume, ranks.rank).string()));
+    if (std::filesystem::is_regular_file(resume, error)) return {resume};  // a serial run's
     return {RankFile(resume, ranks.rank)};  // missing: the reader says so
   }
   if (std::filesystem::exists(resume, error) || pieces.empty()) return {};
@@ -460,7 +456,12 @@ int Run(const std::string& file, const std::string& out_dir, double until, bool 
       if (ranks.set_checkpoint_files) ranks.set_checkpoint_files(resume_files);
       kernel.ReadCheckpoint(
           resume_files[static_cast<std::size_t>(ranks.rank) % resume_files.size()]);
-      if (resume_files.size() != static_cast<std::size_t>(ranks.size))
+      if (resume_files.size() == 1 && resume_files.front() == checkpoints.resume)
+        gipsi::Log().info(
+            "the checkpoint was written by a run on one process: the split objects' state has "
+            "moved to this run's {} ranks (docs/scale-out.md, Checkpoints)",
+            ranks.size);
+      else if (resume_files.size() != static_cast<std::size_t>(ranks.size))
         gipsi::Log().info(
             "the checkpoint was written on {} ranks: the split objects' state has "
             "moved to this run's {} (docs/scale-out.md, Checkpoints)",

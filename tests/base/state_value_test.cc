@@ -281,6 +281,26 @@ TEST(StateReader, APositionFindsTheSameEntryInAnotherShare) {
   EXPECT_EQ(other.position().index, (std::vector<std::uint64_t>{1, 3, 3}));
 }
 
+// NextIsSection tells a section by its tag without reading it; SkipEntries passes entries of
+// any kind (a whole section counts as one).
+TEST(StateReader, TheNextSectionIsToldWithoutReadingIt) {
+  StateReader in(Share(3, 1.0), "p0.gck");
+  EXPECT_FALSE(in.NextIsSection("Objects"));  // a string first
+  (void)in.ReadString();
+  EXPECT_TRUE(in.NextIsSection("Objects"));
+  EXPECT_FALSE(in.NextIsSection("Object"));
+  EXPECT_FALSE(in.NextIsSection("Objects2"));
+  in.BeginSection("Objects", 3);
+  EXPECT_FALSE(in.NextIsSection("First"));  // an integer first
+  in.SkipEntries(1);
+  EXPECT_TRUE(in.NextIsSection("First"));
+  in.SkipEntries(2);  // the section "First" and the string after it
+  EXPECT_TRUE(in.NextIsSection("Second"));
+  in.SkipEntries(1);
+  EXPECT_FALSE(in.NextIsSection("Second"));  // the end of "Objects"
+  in.EndSection();
+}
+
 TEST(StateReader, SeekIntoAnotherLayoutIsRefusedByName) {
   StateReader mine(Share(3, 1.0), "p0.gck");
   (void)mine.ReadString();

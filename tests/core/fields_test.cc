@@ -2,6 +2,8 @@
 #include <gtest/gtest.h>
 
 #include "gipsi/base/error.h"
+#include "gipsi/base/state.h"
+#include "gipsi/core/boundary_conditions.h"
 #include "gipsi/geometry/generators.h"
 #include "gipsi/models/mass_spring/mass_spring.h"
 
@@ -95,6 +97,29 @@ TEST(BoundaryConditions, CouplingLoadsAddToAppliedLoadsAndClear) {
   bcs.ClearCouplingLoads();
   EXPECT_EQ(bcs.force(0), Vec3(1, 0, 0));
   EXPECT_EQ(bcs.pressure(0), 0);
+}
+
+// SkipApplied reads conditions saved for a store of any size and says whether they apply
+// anything: a free store's do not; a fixed vertex, a force or a pressure does.
+TEST(BoundaryConditions, SkippingSavedConditionsTellsWhetherTheyApplyAnything) {
+  auto skipped = [](const BoundaryConditions& bcs) {
+    StateWriter out;
+    bcs.SaveApplied(out);
+    out.WriteInt(42);  // what follows is read next
+    StateReader in(out.TakeBytes(), "bcs");
+    const bool free = BoundaryConditions::SkipApplied(in);
+    EXPECT_EQ(in.ReadInt(), 42);
+    return free;
+  };
+  EXPECT_TRUE(skipped(BoundaryConditions(5, 3)));
+  EXPECT_TRUE(skipped(BoundaryConditions(0, 0)));
+  BoundaryConditions fixed(5, 3), loaded(5, 3), pressed(5, 3);
+  fixed.Fix(4);
+  loaded.SetForce(2, Vec3(0, 0, 1));
+  pressed.SetPressure(1, 10);
+  EXPECT_FALSE(skipped(fixed));
+  EXPECT_FALSE(skipped(loaded));
+  EXPECT_FALSE(skipped(pressed));
 }
 
 }  // namespace

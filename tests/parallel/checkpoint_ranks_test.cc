@@ -24,6 +24,7 @@
 #include "gipsi/geometry/generators.h"
 #include "gipsi/geometry/mesh_block.h"
 #include "gipsi/geometry/region.h"
+#include "gipsi/models/ep/monodomain.h"
 #include "gipsi/models/ep/ten_tusscher_panfilov_2006.h"
 #include "gipsi/models/fem/fem_solid.h"
 #include "gipsi/models/fem/solid_laws.h"
@@ -249,17 +250,45 @@ TEST(CheckpointRanks, ASlabsStateMovesToFewerRanksAndRunsOn) {
 
 // The soft cantilever of distributed_solid_test.cc (10 x 1 x 1 cm, corotational, backward
 // Euler, Newton and CG to 1e-11, GAMG), clamped at x = 0, split over `comm`.
+FemParams CantileverParams() {
+  FemParams p;
+  p.material = std::make_shared<CorotationalSolid>(1e5, 0.45);
+  p.rayleigh_mass = 2.0;
+  p.scheme = ImplicitSchemeKind::kBackwardEuler;
+  p.newton.tolerance = 1e-11;
+  p.linear_solver.tolerance = 1e-11;
+  return p;
+}
+
+std::shared_ptr<const Mesh> CantileverMesh() {
+  return std::make_shared<Mesh>(MakeTetBox(Vec3::Zero(), Vec3(0.1, 0.01, 0.01), {20, 2, 2}));
+}
+
+// Holds the vertices at x = 0 of `object`'s boundary (the whole mesh's).
+void Clamp(SimObject& object) {
+  const BoundarySurface& b = object.boundary();
+  for (Index v = 0; v < b.num_vertices(); ++v)
+    if (object.domain().nodes(0, b.vertex_to_node[static_cast<std::size_t>(v)]) == 0)
+      object.boundary_conditions().Fix(v);
+}
+
+// Displacements and velocities of every node (a view gathers them on every rank).
+Eigen::MatrixXd Motion(const SimObject& object) {
+  Eigen::MatrixXd out(6, object.domain().num_nodes());
+  for (int k = 0; k < 2; ++k) {
+    const FieldId id = object.FindField(k == 0 ? "displacement" : "velocity");
+    Eigen::MatrixXd values(3, out.cols());
+    object.ReadField(id, values);
+    out.middleRows(3 * k, 3) = values;
+  }
+  return out;
+}
+
 struct SplitCantilever {
-  std::shared_ptr<const Mesh> whole =
-      std::make_shared<Mesh>(MakeTetBox(Vec3::Zero(), Vec3(0.1, 0.01, 0.01), {20, 2, 2}));
+  std::shared_ptr<const Mesh> whole = CantileverMesh();
   std::unique_ptr<WholeDomainView> view;
   explicit SplitCantilever(MPI_Comm comm) {
-    FemParams p;
-    p.material = std::make_shared<CorotationalSolid>(1e5, 0.45);
-    p.rayleigh_mass = 2.0;
-    p.scheme = ImplicitSchemeKind::kBackwardEuler;
-    p.newton.tolerance = 1e-11;
-    p.linear_solver.tolerance = 1e-11;
+    FemParams p = CantileverParams();
     p.linear_solver.preconditioner = "amg";
     auto distribution = std::make_shared<DistributedSolid>(whole, comm);
     p.distribution = distribution;
@@ -268,25 +297,12 @@ struct SplitCantilever {
         std::make_unique<FemSolid>("beam", part.mesh, std::move(p)), part, whole, comm,
         WholeDomainView::BoundaryMap{distribution->whole_boundary_vertex(),
                                      distribution->whole_boundary_face()});
-    const BoundarySurface& b = view->boundary();
-    for (Index v = 0; v < b.num_vertices(); ++v)
-      if (whole->nodes(0, b.vertex_to_node[static_cast<std::size_t>(v)]) == 0)
-        view->boundary_conditions().Fix(v);
+    Clamp(*view);
   }
   void Run(int steps) const {
     for (int s = 0; s < steps; ++s) ASSERT_TRUE(view->Step(5e-3).ok());
   }
-  // Displacements and velocities of every node (the view gathers them on every rank).
-  [[nodiscard]] Eigen::MatrixXd Motion() const {
-    Eigen::MatrixXd out(6, whole->num_nodes());
-    for (int k = 0; k < 2; ++k) {
-      const FieldId id = view->FindField(k == 0 ? "displacement" : "velocity");
-      Eigen::MatrixXd values(3, whole->num_nodes());
-      view->ReadField(id, values);
-      out.middleRows(3 * k, 3) = values;
-    }
-    return out;
-  }
+  [[nodiscard]] Eigen::MatrixXd Motion() const { return gipsi::Motion(*view); }
 };
 
 // Checkpointed after 20 steps of 5 ms on N ranks and restored on M: the motion is the written
@@ -336,6 +352,100 @@ TEST(CheckpointRanks, ACantileversStateMovesAndSwingsOn) {
     MPI_Barrier(World());
     if (Rank(World()) == 0) std::filesystem::remove_all(folder);
   }
+}
+
+// The rows of a serial monodomain's state, column after column (as SplitSlab::Rows).
+std::vector<double> Columns(const Monodomain& tissue) {
+  const auto width = static_cast<std::size_t>(EpState::RowWidth(tissue.cell()));
+  const std::vector<double> rows = tissue.state().ToRows();
+  const std::size_t nodes = rows.size() / width;
+  std::vector<double> columns(rows.size());
+  for (std::size_t i = 0; i < nodes; ++i)
+    for (std::size_t j = 0; j < width; ++j) columns[j * nodes + i] = rows[i * width + j];
+  return columns;
+}
+
+// A serial run's checkpoint (one file, the serial objects' state) restored on every rank of the
+// world: the slab's monodomain (part-only and whole view) and the cantilever's solid take their
+// parts of it, bit for bit, and run on as the serial run does within the bounds of the moves
+// above (the split solves sum in other orders; the solid's first Newton solve starts afresh).
+TEST(CheckpointRanks, ASerialRunsStateMovesToTheRanks) {
+  const std::filesystem::path folder = Folder("serial");
+  const std::vector<std::filesystem::path> files = {folder / "serial.gck"};
+  const long before = 1000, after = 2000;
+  std::vector<double> written, reference;
+  Eigen::MatrixXd beam_written, beam_reference;
+  if (Rank(World()) == 0) {
+    Monodomain slab("slab", std::make_shared<Mesh>(MakeTetBox(Vec3::Zero(), kSize, {40, 14, 6})),
+                    SlabParams());
+    for (long s = 0; s < before; ++s) ASSERT_TRUE(slab.Step(kDt).ok());
+    StateWriter out;
+    slab.SaveState(out);
+    WriteCheckpointFile(files[0], out.bytes());
+    written = Columns(slab);
+    for (long s = 0; s < after; ++s) ASSERT_TRUE(slab.Step(kDt).ok());
+    reference = Columns(slab);
+    FemSolid beam("beam", CantileverMesh(), CantileverParams());
+    Clamp(beam);
+    for (int s = 0; s < 20; ++s) ASSERT_TRUE(beam.Step(5e-3).ok());
+    StateWriter beam_out;
+    beam.SaveState(beam_out);
+    WriteCheckpointFile(folder / "beam.gck", beam_out.bytes());
+    beam_written = Motion(beam);
+    for (int s = 0; s < 20; ++s) ASSERT_TRUE(beam.Step(5e-3).ok());
+    beam_reference = Motion(beam);
+  }
+  MPI_Barrier(World());
+  for (bool part_only : {true, false}) {
+    const SplitSlab slab(World(), part_only);
+    Restore(*slab.view, World(), files);
+    EXPECT_NEAR(slab.view->time(), before * kDt, 1e-15);
+    EXPECT_EQ(slab.tissue->step_count(), before);
+    const std::vector<double> restored = slab.Rows();
+    slab.Run(after);
+    const std::vector<double> continued = slab.Rows();
+    if (Rank(World()) != 0) continue;
+    ASSERT_EQ(restored.size(), written.size());
+    for (std::size_t i = 0; i < written.size(); ++i)
+      ASSERT_EQ(std::bit_cast<std::uint64_t>(restored[i]), std::bit_cast<std::uint64_t>(written[i]))
+          << "part-only " << part_only << ": value " << i;
+    const std::size_t nodes =
+        written.size() / static_cast<std::size_t>(EpState::RowWidth(slab.tissue->cell()));
+    const std::size_t activation =
+        static_cast<std::size_t>(slab.tissue->cell().num_states()) * nodes;
+    const std::size_t v = static_cast<std::size_t>(slab.tissue->cell().v_index()) * nodes;
+    double worst_t = 0, worst_v = 0;
+    for (std::size_t i = 0; i < nodes; ++i) {
+      worst_v = std::max(worst_v, std::abs(continued[v + i] - reference[v + i]));
+      ASSERT_EQ(continued[activation + i] >= 0, reference[activation + i] >= 0) << "node " << i;
+      if (reference[activation + i] >= 0)
+        worst_t =
+            std::max(worst_t, std::abs(continued[activation + i] - reference[activation + i]));
+    }
+    EXPECT_LE(worst_t, 1e-5);
+    EXPECT_LE(worst_v, 1e-2);
+    std::printf("[ serial slab to %d ranks, part-only %d ] largest differences %.3g ms, %.3g mV\n",
+                Size(World()), part_only, worst_t, worst_v);
+  }
+  const SplitCantilever beam(World());
+  Restore(*beam.view, World(), {folder / "beam.gck"});
+  const Eigen::MatrixXd restored = beam.Motion();
+  beam.Run(20);
+  const Eigen::MatrixXd continued = beam.Motion();
+  if (Rank(World()) == 0) {
+    for (Index i = 0; i < beam_written.size(); ++i)
+      ASSERT_EQ(std::bit_cast<std::uint64_t>(restored.data()[i]),
+                std::bit_cast<std::uint64_t>(beam_written.data()[i]))
+          << "beam: value " << i;
+    const double sag = -beam_reference.row(2).minCoeff();
+    EXPECT_GT(sag, 0.01);
+    const double worst = (continued.topRows(3) - beam_reference.topRows(3)).cwiseAbs().maxCoeff();
+    EXPECT_LE(worst, 1e-9 * sag);
+    std::printf("[ serial beam to %d ranks ] sag %.4g m; largest difference %.3g m\n",
+                Size(World()), sag, worst);
+  }
+  MPI_Barrier(World());
+  if (Rank(World()) == 0) std::filesystem::remove_all(folder);
 }
 
 // A set of files that is not one checkpoint of this mesh is refused on every rank, by a message

@@ -36,8 +36,9 @@ Runs the N-version benchmark slab (scenes/slab_ep_0.5mm.json, its first 30 ms) s
     uninterrupted run's files byte for byte (the slab, the cantilever and the heart, their solids
     split); resumed on another rank count they give the uninterrupted run's probes within the
     bounds above (the slab 2 → 4, 2 → 3, 4 → 2, the last frame's extra pieces deleted; the
-    cantilever 2 → 4; the heart 2 → 3); a set of files from two checkpoints is refused with the
-    way out;
+    cantilever 2 → 4; the heart 2 → 3), and a serial run's checkpoint resumed on 2 ranks gives
+    them too (the slab, its series listing the serial frames before the checkpoint; the heart);
+    a set of files from two checkpoints is refused with the way out;
   - the object's "parallel" block chooses the distributed diffusion solver (BoomerAMG: one CG
     iteration per step, fewer in all than Jacobi's one or two);
   - a bad scene exits with the serial code, its error printed once (not once per rank).
@@ -497,6 +498,34 @@ with tempfile.TemporaryDirectory() as work:
           f"the heart's 2-rank checkpoint on 3 ranks: exit {code}: {text}")
     compare_heart("the heart's 2-rank checkpoint resumed on 3", os.path.join(work, "heart_full"),
                   beating, ("pv",))
+    # A serial run's checkpoint resumes on several ranks (the split objects take their parts of
+    # its one file): the slab checkpointed at 20 ms serially and resumed to 30 ms on 2 ranks
+    # writes the serial run's probes within the bounds above, and its series lists the serial
+    # run's whole frames before the checkpoint and the split run's after; the heart checkpointed
+    # at 0.2 s serially and resumed on 2 ranks to 0.4 s gives the uninterrupted 2-rank run's PV
+    # loop within the bound of its serial comparison.
+    grown = os.path.join(work, "from_serial")
+    code, text = run(1, grown, "-q", "--checkpoint-every", "0.02", until="0.02")
+    check(code == 0, f"serial run with a checkpoint: exit {code}: {text}")
+    code, text = run(2, grown, "--resume", os.path.join(grown, "checkpoint.gck"))
+    check(code == 0 and "the checkpoint was written by a run on one process" in text,
+          f"a serial checkpoint resumed on 2 ranks: exit {code}: {text}")
+    compare_probes("a serial checkpoint resumed on 2 ranks", serial, grown,
+                   ("far_corner", "activated", "diagonal"))
+    with open(os.path.join(grown, "tissue.pvd")) as pvd:
+        listed = re.findall(r'timestep="([^"]+)" group="" part="0" file="([^"]+)"', pvd.read())
+    check(listed and all(f.endswith(".vtu") == (float(t) <= 0.02 + 1e-12) for t, f in listed)
+          and all(os.path.exists(os.path.join(grown, f)) for _, f in listed),
+          f"a serial checkpoint resumed on 2 ranks: tissue.pvd lists {listed}")
+    grown_heart = os.path.join(work, "heart_from_serial")
+    code, text = run(1, grown_heart, "-q", "--checkpoint-every", "0.2", scene=heart, until="0.2")
+    check(code == 0, f"the serial heart with a checkpoint: exit {code}: {text}")
+    code, text = run(2, grown_heart, "--resume", os.path.join(grown_heart, "checkpoint.gck"),
+                     scene=heart, until="0.4")
+    check(code == 0 and "the checkpoint was written by a run on one process" in text,
+          f"the serial heart's checkpoint on 2 ranks: exit {code}: {text}")
+    compare_heart("the serial heart's checkpoint resumed on 2", os.path.join(work, "heart_full"),
+                  grown_heart, ("pv",))
     # The ranks' files resume only as the set written together; the refusals name the files
     # and the way out, and leave the outputs as they were.
     checkpoint = os.path.join(resumed, "checkpoint.gck")

@@ -207,6 +207,18 @@ void StateReader::SkipRestOfSection() {
   pos_ = open_.back().end;
 }
 
+bool StateReader::NextIsSection(std::string_view tag) const {
+  const std::size_t limit = open_.empty() ? bytes_.size() : open_.back().end;
+  std::size_t at = pos_;
+  if (at >= limit || bytes_[at] != kSection) return false;
+  ++at;
+  std::uint64_t size = 0;
+  if (limit - at < sizeof(size)) return false;
+  std::memcpy(&size, bytes_.data() + at, sizeof(size));
+  at += sizeof(size);
+  return size == tag.size() && limit - at >= size && bytes_.compare(at, size, tag) == 0;
+}
+
 void StateReader::SkipEntry() {
   char code = 0;
   ReadBytes(&code, 1);

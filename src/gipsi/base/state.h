@@ -125,6 +125,12 @@ class StateReader {
   [[nodiscard]] bool at_end() const { return pos_ == bytes_.size(); }
   /// Skips the rest of the open section (the next call is its EndSection).
   void SkipRestOfSection();
+  /// Whether the next entry is a section tagged `tag` (reads nothing).
+  [[nodiscard]] bool NextIsSection(std::string_view tag) const;
+  /// Skips the next `count` entries of the open section (or of the top level).
+  void SkipEntries(int count) {
+    for (int i = 0; i < count; ++i) SkipEntry();
+  }
 
   /// Where the reader is, as entries rather than bytes: the sections it is in (by their index
   /// among their parent's entries, their tag and version) and how many entries of the innermost

@@ -33,6 +33,31 @@ void BoundaryConditions::RestoreApplied(StateReader& in) {
   ClearCouplingLoads();
 }
 
+namespace {
+
+// BoundaryConditions::Applied's fields, of whatever shape they were written.
+struct AnyShapeApplied {
+  BoundaryConditions::Applied value;
+  template <class Self, class V>
+  static void Fields(Self& s, V& v) {
+    v("kind", s.value.kind, Shape::kAny);
+    v("value", s.value.value, Shape::kAny);
+    v("force", s.value.force, Shape::kAny);
+    v("traction", s.value.traction, Shape::kAny);
+    v("pressure", s.value.pressure, Shape::kAny);
+  }
+};
+
+}  // namespace
+
+bool BoundaryConditions::SkipApplied(StateReader& in) {
+  AnyShapeApplied read;
+  ReadFields(in, read);
+  const Applied& a = read.value;
+  return std::ranges::all_of(a.kind, [](ConstraintKind k) { return k == ConstraintKind::kFree; }) &&
+         a.force.isZero(0) && a.traction.isZero(0) && a.pressure.isZero(0);
+}
+
 void BoundaryConditions::PrescribeDisplacement(Index v, const Vec3& u, AxisMask axes) {
   GIPSI_CHECK(v >= 0 && v < num_vertices(), "boundary vertex {} out of range", v);
   for (int a = 0; a < 3; ++a) {

@@ -126,6 +126,9 @@ class BoundaryConditions {
   /// stamp) and clears the coupling loads.
   void SaveApplied(StateWriter& out) const { WriteFields(out, applied_); }
   void RestoreApplied(StateReader& in);
+  /// Reads what SaveApplied wrote for a store of any size, and drops it; returns whether it
+  /// applied nothing (every vertex free, no force, traction or pressure).
+  static bool SkipApplied(StateReader& in);
 
  private:
   /// Marks the applied part as changed (a new stamp).

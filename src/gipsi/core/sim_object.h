@@ -223,6 +223,10 @@ class SimObject {
   /// does not support checkpoints") for a type that bound none.
   virtual void SaveObjectState(StateWriter& out) const;
   virtual void RestoreObjectState(StateReader& in);
+  /// Checkpoints: reads the applied boundary conditions SaveState wrote into
+  /// boundary_conditions() (the default). An object without a store of its own (a split
+  /// object's part-only view) overrides it to take what another kind of object wrote.
+  virtual void RestoreAppliedConditions(StateReader& in);
 
   /// Whether snapshots copy the type's state as a value (it bound one with BindState) rather
   /// than serialising it through SaveObjectState (`gipsi validate` lists the objects that

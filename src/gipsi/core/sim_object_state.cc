@@ -46,7 +46,7 @@ void SimObject::RestoreState(StateReader& in) {
                         type, name_, type_name()));
   const double time = in.ReadDouble();
   const std::int64_t steps = in.ReadInt();
-  bcs_.RestoreApplied(in);
+  RestoreAppliedConditions(in);
   in.BeginSection(type_name(), 1);
   RestoreObjectState(in);
   in.EndSection();
@@ -54,6 +54,8 @@ void SimObject::RestoreState(StateReader& in) {
   time_ = time;
   step_count_ = steps;
 }
+
+void SimObject::RestoreAppliedConditions(StateReader& in) { bcs_.RestoreApplied(in); }
 
 SimObject::SavedHeader SimObject::ReadSavedState(
     StateReader& in, Index boundary_vertices, Index boundary_faces,

@@ -95,12 +95,14 @@ void VtuSeriesWriter::WriteFrame(Series& series, double t) {
     for (const NamedArray& a : fields.cell_data) cell_shapes.push_back({a.name, a.components});
     WritePvtu(directory_ / name / (stem + ".pvtu"), pieces, point_shapes, cell_shapes);
     // A run resumed on fewer ranks rewrites frames an earlier run wrote in more pieces: the
-    // pieces past this count are no longer listed.
+    // pieces past this count are no longer listed; nor is the frame a serial run wrote whole.
     for (int k = piece.count;; ++k) {
       std::error_code error;
       if (!std::filesystem::remove(directory_ / name / fmt::format("{}_p{}.vtu", stem, k), error))
         break;
     }
+    std::error_code error;
+    std::filesystem::remove(directory_ / name / (stem + ".vtu"), error);
     series.domain.AddFrame(t, name + "/" + stem + ".pvtu");
     return;
   }
@@ -182,7 +184,15 @@ void VtuSeriesWriter::CommitRestore() {
     std::vector<std::pair<double, std::string>> frames, display;
     for (std::int64_t k = 0; k < frame_; ++k) {
       const double t = frame_times_[static_cast<std::size_t>(k)];
-      frames.emplace_back(t, FrameFile(series.object->name(), k, false, pieces));
+      // A frame a run of the other kind wrote (a serial run's whole .vtu before a distributed
+      // resume) keeps its file.
+      std::string file = FrameFile(series.object->name(), k, false, pieces);
+      const std::string other = FrameFile(series.object->name(), k, false, !pieces);
+      std::error_code error;
+      if (!std::filesystem::exists(directory_ / file, error) &&
+          std::filesystem::exists(directory_ / other, error))
+        file = other;
+      frames.emplace_back(t, file);
       display.emplace_back(t, FrameFile(series.object->name(), k, true, false));
     }
     series.domain.SetFrames(frames);

@@ -116,8 +116,13 @@ class WholeDomainView final : public SimObject, public CavityWall, public Partit
   }
   void SaveObjectState(StateWriter& out) const override;
   /// Collective: every rank restores its own rank's file; on another rank count (a part that is
-  /// a RowState, with SetCheckpointFiles) rank q reads rank q % N's file of N.
+  /// a RowState, with SetCheckpointFiles) rank q reads rank q % N's file of N. A checkpoint of a
+  /// run on one process (the serial object's state, every rank reading the one file) restores
+  /// as a part of one rank's checkpoint would: rank 0 reads the rows and they move to the parts.
   void RestoreObjectState(StateReader& in) override;
+  /// A part-only view keeps no store: it takes a serial object's conditions only if they apply
+  /// nothing (nothing names a part-only object, so nothing set any).
+  void RestoreAppliedConditions(StateReader& in) override;
   /// The files of the distributed checkpoint being resumed, rank 0's first (the tool sets them
   /// before Kernel::ReadCheckpoint): a restore on another rank count reads the parts in them.
   /// Empty (the default): a restore accepts only the rank count that wrote the checkpoint.
@@ -193,8 +198,18 @@ class WholeDomainView final : public SimObject, public CavityWall, public Partit
   static SavedPart ReadSavedPart(StateReader& in);
   // RestoreObjectState from a checkpoint of `saved.size` ranks, another count (`at`: where the
   // DistributedPart section starts in `in`, to find it in the other ranks' files).
+  // With `one_process`, `in` holds the serial object's state at `at` (`saved` then describes it
+  // as the one part of a run on one rank: OneProcessPart).
   void RestoreOnAnotherRankCount(StateReader& in, const StateReader::Position& at,
-                                 const SavedPart& saved);
+                                 const SavedPart& saved, bool one_process = false);
+  [[nodiscard]] SavedPart OneProcessPart() const;
+  // RestoreObjectState from the files of a distributed run (a DistributedPart section at `at`).
+  void RestoreFromParts(StateReader& in, const StateReader::Position& at);
+  // Reads the serial object's state at `at` in `in` as rows (`counts` items), and its clock
+  // from its header, which SimObject::RestoreState has read before: again, from `file`.
+  SimObject::SavedHeader ReadOneProcessState(StateReader& in, const StateReader::Position& at,
+                                             const std::filesystem::path& file,
+                                             const ItemCounts& counts, StateRows& rows) const;
   // ShareOwnedNodeValues' ghosted PETSc Vecs, one per component count.
   struct NodeExchange;
   mutable std::unique_ptr<NodeExchange> exchange_;

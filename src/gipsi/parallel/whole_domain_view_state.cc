@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <array>
 #include <mutex>
+#include <numeric>
 #include <string>
 #include <utility>
 
@@ -90,8 +91,82 @@ WholeDomainView::SavedPart WholeDomainView::ReadSavedPart(StateReader& in) {
   return saved;
 }
 
+void WholeDomainView::RestoreAppliedConditions(StateReader& in) {
+  if (!part_only_) {
+    SimObject::RestoreAppliedConditions(in);
+    return;
+  }
+  if (!BoundaryConditions::SkipApplied(in))
+    in.Fail(fmt::format(
+        "the checkpoint holds boundary conditions of object '{}', which this run keeps in parts "
+        "without a boundary-condition store",
+        name()));
+}
+
+WholeDomainView::SavedPart WholeDomainView::OneProcessPart() const {
+  SavedPart saved;
+  saved.size = 1;
+  saved.whole_nodes = saved.local.nodes = mesh_part_.num_global_nodes;
+  saved.whole_tets = saved.local.tets = mesh_part_.num_global_tets;
+  saved.whole_faces = saved.local.faces = forward_bcs_ ? boundary().num_triangles() : 0;
+  saved.owned.resize(static_cast<std::size_t>(saved.whole_nodes));
+  std::iota(saved.owned.begin(), saved.owned.end(), 0);
+  saved.tets.resize(static_cast<std::size_t>(saved.whole_tets));
+  std::iota(saved.tets.begin(), saved.tets.end(), 0);
+  saved.faces.resize(static_cast<std::size_t>(saved.whole_faces));
+  std::iota(saved.faces.begin(), saved.faces.end(), 0);
+  return saved;
+}
+
 void WholeDomainView::RestoreObjectState(StateReader& in) {
   const StateReader::Position at = in.position();
+  // A checkpoint of a run on one process holds the serial object's state here (every rank reads
+  // that one file, so all take the same way).
+  const bool one_process = !in.NextIsSection("DistributedPart");
+  if (one_process) {
+    RestoreOnAnotherRankCount(in, at, OneProcessPart(), true);
+  } else {
+    RestoreFromParts(in, at);
+  }
+  // The files of one checkpoint hold the same time and step count on every rank; a set mixed
+  // from two checkpoints (a run stopped while its ranks wrote them) does not.
+  const std::array<double, 2> local{part_->time(), static_cast<double>(part_->step_count())};
+  std::array<double, 2> low{}, high{};
+  MPI_Allreduce(local.data(), low.data(), 2, MPI_DOUBLE, MPI_MIN, comm_);
+  MPI_Allreduce(local.data(), high.data(), 2, MPI_DOUBLE, MPI_MAX, comm_);
+  if (low != high)
+    in.Fail(fmt::format(
+        "the ranks' checkpoint files are from different checkpoints (object '{}' at t = {:.9g} "
+        "to {:.9g} s, {} to {} steps): resume from a set written together",
+        name(), low[0], high[0], low[1], high[1]));
+}
+
+SimObject::SavedHeader WholeDomainView::ReadOneProcessState(StateReader& in,
+                                                            const StateReader::Position& at,
+                                                            const std::filesystem::path& file,
+                                                            const ItemCounts& counts,
+                                                            StateRows& rows) const {
+  rows = dynamic_cast<const RowState&>(*part_).ReadStateRows(in, counts);
+  in.SkipRestOfSection();  // a serial solver's cache, not moved
+  // `at` is inside the object's SimObject section and its type's: the header is the first
+  // entries of the former.
+  StateReader::Position header_at = at;
+  GIPSI_CHECK(header_at.index.size() >= 3 && header_at.tags.size() >= 2);
+  header_at.index.resize(header_at.index.size() - 2);
+  header_at.index.push_back(0);
+  header_at.tags.pop_back();
+  header_at.versions.pop_back();
+  StateReader again(ReadCheckpointFile(file), file.string());
+  again.Seek(header_at);
+  SimObject::SavedHeader header;
+  header.name = again.ReadString();
+  header.type = again.ReadString();
+  header.time = again.ReadDouble();
+  header.steps = again.ReadInt();
+  return header;
+}
+
+void WholeDomainView::RestoreFromParts(StateReader& in, const StateReader::Position& at) {
   in.BeginSection("DistributedPart", 2);
   const SavedPart saved = ReadSavedPart(in);
   // Every rank decides which way to restore from its own file's header; they agree when the
@@ -119,21 +194,10 @@ void WholeDomainView::RestoreObjectState(StateReader& in) {
     part_->RestoreState(in);
   }
   in.EndSection();
-  // The files of one checkpoint hold the same time and step count on every rank; a set mixed
-  // from two checkpoints (a run stopped while its ranks wrote them) does not.
-  const std::array<double, 2> local{part_->time(), static_cast<double>(part_->step_count())};
-  std::array<double, 2> low{}, high{};
-  MPI_Allreduce(local.data(), low.data(), 2, MPI_DOUBLE, MPI_MIN, comm_);
-  MPI_Allreduce(local.data(), high.data(), 2, MPI_DOUBLE, MPI_MAX, comm_);
-  if (low != high)
-    in.Fail(fmt::format(
-        "the ranks' checkpoint files are from different checkpoints (object '{}' at t = {:.9g} "
-        "to {:.9g} s, {} to {} steps): resume from a set written together",
-        name(), low[0], high[0], low[1], high[1]));
 }
 
 void WholeDomainView::RestoreOnAnotherRankCount(StateReader& in, const StateReader::Position& at,
-                                                const SavedPart& saved) {
+                                                const SavedPart& saved, bool one_process) {
   const int ranks = mesh_part_.size, rank = mesh_part_.rank;
   const auto* movable = dynamic_cast<const RowState*>(part_.get());
   std::vector<std::filesystem::path> files;
@@ -144,11 +208,22 @@ void WholeDomainView::RestoreOnAnotherRankCount(StateReader& in, const StateRead
   const std::int64_t whole_faces = forward_bcs_ ? boundary().num_triangles() : 0;
   std::string refused;
   if (movable == nullptr)
-    refused = fmt::format(
-        "the checkpoint was written on {} ranks and this run has {}: a split {} resumes only "
-        "on the rank count that wrote it (its state does not move to another yet): mpirun -np "
-        "{}",
-        saved.size, ranks, type_name(), saved.size);
+    refused = one_process ? fmt::format(
+                                "the checkpoint was written by a run on one process and this "
+                                "run has {} ranks: a split {} does not take a serial object's "
+                                "state yet; resume it without mpirun",
+                                ranks, type_name())
+                          : fmt::format(
+                                "the checkpoint was written on {} ranks and this run has {}: a "
+                                "split {} resumes only on the rank count that wrote it (its "
+                                "state does not move to another yet): mpirun -np {}",
+                                saved.size, ranks, type_name(), saved.size);
+  else if (one_process && files.size() != 1)
+    refused =
+        "a checkpoint of a run on one process is read from its one file (gipsi run "
+        "--resume finds it)";
+  else if (one_process)
+    refused = {};
   else if (files.empty())
     refused = fmt::format(
         "the checkpoint holds rank {}'s part of a run on {} ranks, and this run has {}; to "
@@ -185,9 +260,12 @@ void WholeDomainView::RestoreOnAnotherRankCount(StateReader& in, const StateRead
                       "expected: the set mixes checkpoints",
                       part.rank, part.size, expected_rank, saved.size));
     StateRows rows;
-    const SimObject::SavedHeader header = SimObject::ReadSavedState(
-        from, part.boundary_vertices, part.local.faces,
-        [&](StateReader& own) { rows = movable->ReadStateRows(own, part.local); });
+    const SimObject::SavedHeader header =
+        one_process ? ReadOneProcessState(from, at, files.front(), part.local, rows)
+                    : SimObject::ReadSavedState(from, part.boundary_vertices, part.local.faces,
+                                                [&](StateReader& own) {
+                                                  rows = movable->ReadStateRows(own, part.local);
+                                                });
     if (header.name != part_->name() || header.type != part_->type_name())
       from.Fail(fmt::format("the checkpoint has object '{}' ({}) where this scene has '{}' ({})",
                             header.name, header.type, part_->name(), part_->type_name()));
