@@ -39,6 +39,7 @@
 #include "gipsi/base/version.h"
 #include "gipsi/core/aggregate.h"
 #include "gipsi/core/registry.h"
+#include "gipsi/core/row_state.h"
 #include "gipsi/haptics/realtime_haptics.h"
 #include "gipsi/io/builtins.h"
 #include "gipsi/io/mesh_io.h"
@@ -358,10 +359,10 @@ std::filesystem::path RankFile(const std::filesystem::path& file, int rank) {
 
 /// Before a resume: the files of a distributed checkpoint (`<stem>_p0`, `_p1`, ... that exist),
 /// which a distributed run reads whatever its rank count (rank q reads rank q % N's file of N,
-/// and split objects read the others' parts, docs/scale-out.md), or a serial run's one file,
-/// which every rank of a distributed run reads (split objects take their parts of it); a
-/// distributed checkpoint named for a serial run gets a message that says which run wrote it
-/// (a missing file is left to the reader).
+/// and split objects read the others' parts, docs/scale-out.md), also for a run on one process
+/// (which reads rank 0's file, its serial objects taking every rank's part of a split one), or
+/// a serial run's one file, which every rank of a distributed run reads (split objects take
+/// their parts of it). A missing file is left to the reader.
 std::vector<std::filesystem::path> CheckResumeFiles(const std::filesystem::path& resume,
                                                     const Ranks& ranks) {
   std::error_code error;
@@ -375,14 +376,8 @@ std::vector<std::filesystem::path> CheckResumeFiles(const std::filesystem::path&
     if (std::filesystem::is_regular_file(resume, error)) return {resume};  // a serial run's
     return {RankFile(resume, ranks.rank)};  // missing: the reader says so
   }
-  if (std::filesystem::exists(resume, error) || pieces.empty()) return {};
-  gipsi::ThrowInputError(
-      "command line", "--resume",
-      fmt::format("{} does not exist, and {} to {} are the checkpoint of a run on {} MPI ranks: "
-                  "resume it with mpirun -np {} (or another count of 2 or more; "
-                  "docs/scale-out.md)",
-                  resume.string(), pieces.front().string(), pieces.back().string(), pieces.size(),
-                  pieces.size()));
+  if (std::filesystem::exists(resume, error)) return {};
+  return pieces;  // a distributed run's: the serial objects take the split ones' parts
 }
 
 /// Options of `gipsi run` about checkpoints.
@@ -466,6 +461,21 @@ int Run(const std::string& file, const std::string& out_dir, double until, bool 
             "the checkpoint was written on {} ranks: the split objects' state has "
             "moved to this run's {} (docs/scale-out.md, Checkpoints)",
             resume_files.size(), ranks.size);
+    } else if (!resume_files.empty()) {
+      // A distributed run's files: rank 0's for what every rank held alike, every rank's for
+      // the objects it split.
+      gipsi::SetCheckpointPieces(resume_files);
+      try {
+        kernel.ReadCheckpoint(resume_files.front());
+      } catch (...) {
+        gipsi::SetCheckpointPieces({});
+        throw;
+      }
+      gipsi::SetCheckpointPieces({});
+      gipsi::Log().info(
+          "the checkpoint was written on {} ranks: the split objects' parts are gathered in "
+          "this run on one process (docs/scale-out.md, Checkpoints)",
+          resume_files.size());
     } else {
       kernel.ReadCheckpoint(checkpoints.resume);
     }

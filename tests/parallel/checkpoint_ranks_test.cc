@@ -21,6 +21,7 @@
 
 #include "gipsi/base/error.h"
 #include "gipsi/base/state.h"
+#include "gipsi/core/row_state.h"
 #include "gipsi/geometry/generators.h"
 #include "gipsi/geometry/mesh_block.h"
 #include "gipsi/geometry/region.h"
@@ -442,6 +443,94 @@ TEST(CheckpointRanks, ASerialRunsStateMovesToTheRanks) {
     const double worst = (continued.topRows(3) - beam_reference.topRows(3)).cwiseAbs().maxCoeff();
     EXPECT_LE(worst, 1e-9 * sag);
     std::printf("[ serial beam to %d ranks ] sag %.4g m; largest difference %.3g m\n",
+                Size(World()), sag, worst);
+  }
+  MPI_Barrier(World());
+  if (Rank(World()) == 0) std::filesystem::remove_all(folder);
+}
+
+// The other way: a distributed run's checkpoint (every rank's file) read by a run on one process
+// (rank 0 here, alone): the serial objects gather the split ones' parts, bit for bit, and run on
+// as the split runs do within the bounds above.
+TEST(CheckpointRanks, ADistributedRunsPartsGatherInTheSerialObject) {
+  const long before = 1000, after = 2000;
+  auto read = [](SimObject& object, const std::vector<std::filesystem::path>& files) {
+    SetCheckpointPieces(files);
+    StateReader in(ReadCheckpointFile(files[0]), files[0].string());
+    object.RestoreState(in);
+    SetCheckpointPieces({});
+  };
+  for (bool part_only : {true, false}) {
+    const std::filesystem::path folder = Folder(fmt::format("gathered{}", part_only));
+    std::vector<std::filesystem::path> files;
+    std::vector<double> written, reference;
+    {
+      const SplitSlab slab(World(), part_only);
+      slab.Run(before);
+      files = Write(*slab.view, World(), folder);
+      written = slab.Rows();
+      slab.Run(after);
+      reference = slab.Rows();
+    }
+    MPI_Barrier(World());
+    if (Rank(World()) == 0) {
+      Monodomain serial("slab",
+                        std::make_shared<Mesh>(MakeTetBox(Vec3::Zero(), kSize, {40, 14, 6})),
+                        SlabParams());
+      read(serial, files);
+      EXPECT_NEAR(serial.time(), before * kDt, 1e-15);
+      EXPECT_EQ(serial.step_count(), before);
+      const std::vector<double> restored = Columns(serial);
+      ASSERT_EQ(restored.size(), written.size());
+      for (std::size_t i = 0; i < written.size(); ++i)
+        ASSERT_EQ(std::bit_cast<std::uint64_t>(restored[i]),
+                  std::bit_cast<std::uint64_t>(written[i]))
+            << "part-only " << part_only << ": value " << i;
+      for (long s = 0; s < after; ++s) ASSERT_TRUE(serial.Step(kDt).ok());
+      const std::vector<double> continued = Columns(serial);
+      const std::size_t nodes =
+          written.size() / static_cast<std::size_t>(EpState::RowWidth(serial.cell()));
+      const std::size_t activation = static_cast<std::size_t>(serial.cell().num_states()) * nodes;
+      double worst_t = 0;
+      for (std::size_t i = 0; i < nodes; ++i) {
+        ASSERT_EQ(continued[activation + i] >= 0, reference[activation + i] >= 0) << "node " << i;
+        if (reference[activation + i] >= 0)
+          worst_t =
+              std::max(worst_t, std::abs(continued[activation + i] - reference[activation + i]));
+      }
+      EXPECT_LE(worst_t, 1e-5);
+      std::printf("[ %d ranks' slab on one process, part-only %d ] largest difference %.3g ms\n",
+                  Size(World()), part_only, worst_t);
+    }
+    MPI_Barrier(World());
+    if (Rank(World()) == 0) std::filesystem::remove_all(folder);
+  }
+  const std::filesystem::path folder = Folder("gathered_beam");
+  std::vector<std::filesystem::path> files;
+  Eigen::MatrixXd written, reference;
+  {
+    const SplitCantilever beam(World());
+    beam.Run(20);
+    files = Write(*beam.view, World(), folder);
+    written = beam.Motion();
+    beam.Run(20);
+    reference = beam.Motion();
+  }
+  MPI_Barrier(World());
+  if (Rank(World()) == 0) {
+    FemSolid beam("beam", CantileverMesh(), CantileverParams());
+    Clamp(beam);
+    read(beam, files);
+    const Eigen::MatrixXd restored = Motion(beam);
+    for (Index i = 0; i < written.size(); ++i)
+      ASSERT_EQ(std::bit_cast<std::uint64_t>(restored.data()[i]),
+                std::bit_cast<std::uint64_t>(written.data()[i]))
+          << "beam: value " << i;
+    for (int s = 0; s < 20; ++s) ASSERT_TRUE(beam.Step(5e-3).ok());
+    const double sag = -reference.row(2).minCoeff();
+    const double worst = (Motion(beam).topRows(3) - reference.topRows(3)).cwiseAbs().maxCoeff();
+    EXPECT_LE(worst, 1e-9 * sag);
+    std::printf("[ %d ranks' beam on one process ] sag %.4g m; largest difference %.3g m\n",
                 Size(World()), sag, worst);
   }
   MPI_Barrier(World());

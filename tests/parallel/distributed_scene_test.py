@@ -37,7 +37,8 @@ Runs the N-version benchmark slab (scenes/slab_ep_0.5mm.json, its first 30 ms) s
     split); resumed on another rank count they give the uninterrupted run's probes within the
     bounds above (the slab 2 → 4, 2 → 3, 4 → 2, the last frame's extra pieces deleted; the
     cantilever 2 → 4; the heart 2 → 3), and a serial run's checkpoint resumed on 2 ranks gives
-    them too (the slab, its series listing the serial frames before the checkpoint; the heart);
+    them too (the slab, its series listing the serial frames before the checkpoint; the heart),
+    as does a 2-rank checkpoint resumed on one process (the slab, the cantilever);
     a set of files from two checkpoints is refused with the way out;
   - the object's "parallel" block chooses the distributed diffusion solver (BoomerAMG: one CG
     iteration per step, fewer in all than Jacobi's one or two);
@@ -218,6 +219,22 @@ def compare_cantilever(label, reference, out, least_rows):
                 worst = max(worst, abs(x - y) / (scale if scale else max(abs(x), 1e-300)))
                 check(abs(x - y) <= bound, f"{label}, {name}.{column}: {y} vs {x}")
         print(f"{label}, {name}: largest relative difference {worst:.3g}")
+
+
+def resumed_across(label, folder, ranks, logged, before):
+    """The slab checkpointed at 20 ms in `folder` by a run of the other kind, resumed on `ranks`
+    to 30 ms: it logs `logged`, writes the serial run's probes within BOUNDS, and its series
+    lists the earlier run's frames (`before`: ".vtu" or ".pvtu") up to the checkpoint and its
+    own after, every one on disk."""
+    code, text = run(ranks, folder, "--resume", os.path.join(folder, "checkpoint.gck"))
+    check(code == 0 and logged in text, f"{label}: exit {code}: {text}")
+    compare_probes(label, os.path.join(work, "serial"), folder,
+                   ("far_corner", "activated", "diagonal"))
+    with open(os.path.join(folder, "tissue.pvd")) as pvd:
+        listed = re.findall(r'timestep="([^"]+)" group="" part="0" file="([^"]+)"', pvd.read())
+    check(listed and all(f.endswith(before) == (float(t) <= 0.02 + 1e-12) for t, f in listed)
+          and all(os.path.exists(os.path.join(folder, f)) for _, f in listed),
+          f"{label}: tissue.pvd lists {listed}")
 
 
 def resumes_bitwise(label, scene, every, stop, end):
@@ -507,16 +524,8 @@ with tempfile.TemporaryDirectory() as work:
     grown = os.path.join(work, "from_serial")
     code, text = run(1, grown, "-q", "--checkpoint-every", "0.02", until="0.02")
     check(code == 0, f"serial run with a checkpoint: exit {code}: {text}")
-    code, text = run(2, grown, "--resume", os.path.join(grown, "checkpoint.gck"))
-    check(code == 0 and "the checkpoint was written by a run on one process" in text,
-          f"a serial checkpoint resumed on 2 ranks: exit {code}: {text}")
-    compare_probes("a serial checkpoint resumed on 2 ranks", serial, grown,
-                   ("far_corner", "activated", "diagonal"))
-    with open(os.path.join(grown, "tissue.pvd")) as pvd:
-        listed = re.findall(r'timestep="([^"]+)" group="" part="0" file="([^"]+)"', pvd.read())
-    check(listed and all(f.endswith(".vtu") == (float(t) <= 0.02 + 1e-12) for t, f in listed)
-          and all(os.path.exists(os.path.join(grown, f)) for _, f in listed),
-          f"a serial checkpoint resumed on 2 ranks: tissue.pvd lists {listed}")
+    resumed_across("a serial checkpoint resumed on 2 ranks", grown, 2,
+                   "the checkpoint was written by a run on one process", ".vtu")
     grown_heart = os.path.join(work, "heart_from_serial")
     code, text = run(1, grown_heart, "-q", "--checkpoint-every", "0.2", scene=heart, until="0.2")
     check(code == 0, f"the serial heart with a checkpoint: exit {code}: {text}")
@@ -526,12 +535,26 @@ with tempfile.TemporaryDirectory() as work:
           f"the serial heart's checkpoint on 2 ranks: exit {code}: {text}")
     compare_heart("the serial heart's checkpoint resumed on 2", os.path.join(work, "heart_full"),
                   grown_heart, ("pv",))
+    # And the other way: a 2-rank checkpoint resumed by a run on one process (its serial objects
+    # gather the parts). The slab checkpointed at 20 ms on 2 ranks and resumed serially to 30 ms
+    # gives the serial run's probes within the bounds, its series listing the 2-rank frames
+    # before the checkpoint and whole ones after; the cantilever's 2-rank checkpoint at 0.25 s
+    # resumed serially to 0.5 s gives the 2-rank run's probes within its serial bounds.
+    shrunk = os.path.join(work, "to_serial")
+    code, text = run(2, shrunk, "-q", "--checkpoint-every", "0.02", until="0.02")
+    check(code == 0, f"2 ranks with a checkpoint: exit {code}: {text}")
+    resumed_across("a 2-rank checkpoint resumed on one process", shrunk, 1,
+                   "the checkpoint was written on 2 ranks: the split objects' parts are gathered",
+                   ".pvtu")
+    code, text = run(1, beam, "--resume", os.path.join(beam, "checkpoint.gck"), scene=cantilever,
+                     until="0.5")
+    check(code == 0 and "the checkpoint was written on 2 ranks" in text,
+          f"the cantilever's 2-rank checkpoint on one process: exit {code}: {text}")
+    compare_cantilever("the cantilever's 2-rank checkpoint resumed on one process",
+                       os.path.join(work, "cantilever_full"), beam, 20)
     # The ranks' files resume only as the set written together; the refusals name the files
     # and the way out, and leave the outputs as they were.
     checkpoint = os.path.join(resumed, "checkpoint.gck")
-    code, text = run(1, resumed, "--resume", checkpoint)
-    check(code == 1 and "are the checkpoint of a run on 2 MPI ranks" in text,
-          f"a 2-rank checkpoint serially: exit {code}: {text}")
     with open(os.path.join(resumed, "checkpoint_p1.gck"), "wb") as f:
         f.write(early[1])  # rank 1's file of the checkpoint at 20 ms, rank 0's at 30 ms
     before = rows(os.path.join(resumed, "probes", "far_corner.csv"))

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 
+#include <fmt/format.h>
+
 #include "gipsi/base/error.h"
 
 namespace gipsi {
@@ -56,6 +58,25 @@ bool BoundaryConditions::SkipApplied(StateReader& in) {
   const Applied& a = read.value;
   return std::ranges::all_of(a.kind, [](ConstraintKind k) { return k == ConstraintKind::kFree; }) &&
          a.force.isZero(0) && a.traction.isZero(0) && a.pressure.isZero(0);
+}
+
+void BoundaryConditions::RestoreAppliedUnlessEmpty(StateReader& in) {
+  AnyShapeApplied read;
+  ReadFields(in, read);
+  Applied& a = read.value;
+  if (a.kind.empty() && a.value.cols() == 0 && a.force.cols() == 0 && a.traction.cols() == 0 &&
+      a.pressure.size() == 0)
+    return;
+  if (a.kind.size() != applied_.kind.size() || a.value.cols() != applied_.value.cols() ||
+      a.force.cols() != applied_.force.cols() || a.traction.cols() != applied_.traction.cols() ||
+      a.pressure.size() != applied_.pressure.size())
+    in.Fail(fmt::format(
+        "boundary conditions of {} vertices and {} faces where this object has {} and {}",
+        a.value.cols(), a.traction.cols(), num_vertices(), applied_.traction.cols()));
+  a.stamp = applied_.stamp;
+  applied_ = std::move(a);
+  Touch();
+  ClearCouplingLoads();
 }
 
 void BoundaryConditions::PrescribeDisplacement(Index v, const Vec3& u, AxisMask axes) {

@@ -129,6 +129,9 @@ class BoundaryConditions {
   /// Reads what SaveApplied wrote for a store of any size, and drops it; returns whether it
   /// applied nothing (every vertex free, no force, traction or pressure).
   static bool SkipApplied(StateReader& in);
+  /// As RestoreApplied, except that what a store without vertices or faces wrote (a split
+  /// object's part-only view) leaves these conditions as they are.
+  void RestoreAppliedUnlessEmpty(StateReader& in);
 
  private:
   /// Marks the applied part as changed (a new stamp).

@@ -37,7 +37,9 @@
 /// blocks (MeshProvider::GetMeshBlock, ObjectBuildContext::standalone), the PartitionedObject
 /// capability; 15: PartitionedObject's reductions where the nodes are owned (SelectOwnedNodes,
 /// ReadOwnedNodes, CombineAcross); 16: coupling split objects part to part (PartitionedObject's
-/// local_part, whole_nodes_of_part, whole_tets_of_part, num_owned_nodes, ShareOwnedNodeValues).
+/// local_part, whole_nodes_of_part, whole_tets_of_part, num_owned_nodes, ShareOwnedNodeValues),
+/// checkpoints between serial and split objects (SimObject::RestoreAppliedConditions, EpTissue a
+/// RowState).
 #define GIPSI_PLUGIN_INTERFACE 16
 /// What a plugin's gipsi_plugin_abi_version() returns and the loader requires: the package's
 /// major and minor version with the plugin interface, MAJOR·10⁶ + MINOR·10³ + INTERFACE. A

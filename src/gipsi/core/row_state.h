@@ -6,10 +6,16 @@
 /// object's part restored on another partition, a checkpoint resumed on another rank count
 /// (gipsi/parallel/whole_domain_view.h, docs/scale-out.md). The rows are read from and written
 /// in the type's own checkpoint format (SaveObjectState's bytes), so nothing else changes.
-/// DistributedMonodomain and FemSolid have it.
+/// EpTissue (the monodomains, serial and split) and FemSolid have it.
+///
+/// A split object's checkpoint holds, before its part's state, where the part's items are in
+/// the whole domain (SavedPart, written by gipsi/parallel/whole_domain_view.h): a run of another
+/// rank count, or on one process, reads the parts' rows and puts them where they belong.
 
 #include <cstdint>
+#include <filesystem>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "gipsi/base/export.h"
@@ -30,6 +36,32 @@ struct StateRows {
   std::vector<double> node, tet, face;
   std::string shared;
 };
+
+/// What a split object's checkpoint holds before its part's state, in its section
+/// kSavedPartTag (version kSavedPartVersion): the rank count and rank that wrote it, a
+/// fingerprint of the partition, the whole domain's counts, and the whole-domain indices of the
+/// part's owned nodes, of its tets and of its boundary faces (empty when it keeps no boundary
+/// conditions). Plain struct.
+struct SavedPart {
+  std::int64_t size = 0, rank = 0, whole_nodes = 0, whole_tets = 0, whole_faces = 0;
+  std::uint64_t fingerprint = 0;
+  std::int64_t boundary_vertices = 0;
+  ItemCounts local;        ///< the part's nodes, tets and boundary faces
+  std::vector<int> owned;  ///< whole-domain indices of the owned nodes (local [0, owned))
+  std::vector<int> tets;   ///< of every local tet
+  std::vector<int> faces;  ///< the whole boundary's face of every part face, or none
+};
+inline constexpr std::string_view kSavedPartTag = "DistributedPart";
+inline constexpr std::uint32_t kSavedPartVersion = 2;
+/// Reads a SavedPart's fields (its section entered). Throws InputError for a corrupted one.
+[[nodiscard]] SavedPart ReadSavedPart(StateReader& in);
+
+/// The files of a distributed checkpoint being resumed (every rank's, rank 0's first), which
+/// the tool sets before Kernel::ReadCheckpoint so that split objects (or, in a run on one
+/// process, the serial objects) read the parts in them; empty when none is being resumed.
+/// Thread-safe.
+void SetCheckpointPieces(std::vector<std::filesystem::path> files);
+[[nodiscard]] std::vector<std::filesystem::path> CheckpointPieces();
 
 /// Interface, implemented beside SimObject; asked for with dynamic_cast. Not copyable.
 class RowState {

@@ -341,6 +341,10 @@ class SimObject {
   virtual void DoWriteField(FieldId id, const Eigen::Ref<const Eigen::MatrixXd>& in) = 0;
 
  private:
+  // RestoreState of a split object's part (a distributed run's checkpoint) into this serial
+  // object: every rank's part, from the files of CheckpointPieces (core/row_state.h).
+  void RestoreFromPieces(StateReader& in);
+
   std::string name_;
   std::string path_;  // name_ under the ObjectPathScope active at construction
   std::unique_ptr<StateBinding> state_binding_;

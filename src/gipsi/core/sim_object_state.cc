@@ -5,9 +5,16 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
+#include <optional>
+#include <span>
+#include <tuple>
+
 #include "gipsi/base/error.h"
 #include "gipsi/base/object_state.h"
 #include "gipsi/base/state.h"
+#include "gipsi/core/partitioned_object.h"
+#include "gipsi/core/row_state.h"
 #include "gipsi/core/sim_object.h"
 
 namespace gipsi {
@@ -48,14 +55,132 @@ void SimObject::RestoreState(StateReader& in) {
   const std::int64_t steps = in.ReadInt();
   RestoreAppliedConditions(in);
   in.BeginSection(type_name(), 1);
-  RestoreObjectState(in);
+  // A distributed run's checkpoint holds a split object's part here; a run on one process
+  // reads every rank's part into the serial object.
+  if (dynamic_cast<const PartitionedObject*>(this) == nullptr && in.NextIsSection(kSavedPartTag))
+    RestoreFromPieces(in);
+  else
+    RestoreObjectState(in);
   in.EndSection();
   in.EndSection();
   time_ = time;
   step_count_ = steps;
 }
 
-void SimObject::RestoreAppliedConditions(StateReader& in) { bcs_.RestoreApplied(in); }
+void SimObject::RestoreAppliedConditions(StateReader& in) {
+  // A distributed run's checkpoint read on one process: a split object's part-only view kept
+  // no conditions (nothing names it, so nothing set any).
+  if (dynamic_cast<const PartitionedObject*>(this) == nullptr && !CheckpointPieces().empty())
+    bcs_.RestoreAppliedUnlessEmpty(in);
+  else
+    bcs_.RestoreApplied(in);
+}
+
+void SimObject::RestoreFromPieces(StateReader& in) {
+  const auto* rows_of = dynamic_cast<const RowState*>(this);
+  const std::vector<std::filesystem::path> pieces = CheckpointPieces();
+  if (rows_of == nullptr)
+    in.Fail(
+        fmt::format("object '{}' was split over the ranks of a distributed run, and a {} "
+                    "does not take a split object's parts: resume it with mpirun",
+                    name_, type_name()));
+  if (pieces.empty())
+    in.Fail(
+        fmt::format("object '{}' was split over the ranks of a distributed run: resume from "
+                    "every rank's file (gipsi run --resume finds them)",
+                    name_));
+  const ItemCounts mine{domain().num_nodes(), domain().num_tets(), boundary().num_triangles()};
+  const StateReader::Position at = in.position();
+  StateRows whole;
+  std::vector<char> node_set, tet_set, face_set;
+  SavedHeader first;
+  // Each part's rows go where its items are in the whole domain.
+  auto place = [&](StateReader& from, const std::vector<double>& rows, int width,
+                   std::span<const int> where, std::vector<double>& to, std::vector<char>& set,
+                   std::int64_t count, const char* what) {
+    if (width == 0) return;
+    for (std::size_t i = 0; i < where.size(); ++i) {
+      const int item = where[i];
+      if (item < 0 || item >= count || set[static_cast<std::size_t>(item)] != 0)
+        from.Fail(
+            fmt::format("the parts do not hold every {} of this object's once ({} {}): "
+                        "the checkpoint is of another mesh",
+                        what, what, item));
+      set[static_cast<std::size_t>(item)] = 1;
+      std::copy_n(rows.begin() + static_cast<std::ptrdiff_t>(i * static_cast<std::size_t>(width)),
+                  width,
+                  to.begin() + static_cast<std::ptrdiff_t>(static_cast<std::size_t>(item) *
+                                                           static_cast<std::size_t>(width)));
+    }
+  };
+  for (std::size_t k = 0; k < pieces.size(); ++k) {
+    std::optional<StateReader> other;
+    if (k > 0) {
+      other.emplace(ReadCheckpointFile(pieces[k]), pieces[k].string());
+      other->Seek(at);
+    }
+    StateReader& from = k == 0 ? in : *other;
+    from.BeginSection(kSavedPartTag, kSavedPartVersion);
+    const SavedPart part = ReadSavedPart(from);
+    if (part.size != static_cast<std::int64_t>(pieces.size()) ||
+        part.rank != static_cast<std::int64_t>(k))
+      from.Fail(
+          fmt::format("this file holds rank {}'s part of {} where rank {}'s part of {} was "
+                      "expected: the set mixes checkpoints",
+                      part.rank, part.size, k, pieces.size()));
+    if (part.whole_nodes != mine.nodes || part.whole_tets != mine.tets)
+      from.Fail(
+          fmt::format("the checkpoint's mesh has {} nodes and {} tets, and this object's "
+                      "has {} and {}",
+                      part.whole_nodes, part.whole_tets, mine.nodes, mine.tets));
+    StateRows rows;
+    const SavedHeader header =
+        ReadSavedState(from, part.boundary_vertices, part.local.faces,
+                       [&](StateReader& own) { rows = rows_of->ReadStateRows(own, part.local); });
+    from.EndSection();
+    if (header.name != name_ || header.type != type_name())
+      from.Fail(fmt::format("the checkpoint has object '{}' ({}) where this scene has '{}' ({})",
+                            header.name, header.type, name_, type_name()));
+    if (k == 0) {
+      first = header;
+      whole.node_width = rows.node_width;
+      whole.tet_width = rows.tet_width;
+      whole.face_width = rows.face_width;
+      whole.shared = rows.shared;
+      whole.node.resize(static_cast<std::size_t>(mine.nodes * rows.node_width));
+      whole.tet.resize(static_cast<std::size_t>(mine.tets * rows.tet_width));
+      whole.face.resize(static_cast<std::size_t>(mine.faces * rows.face_width));
+      node_set.assign(static_cast<std::size_t>(mine.nodes), 0);
+      tet_set.assign(static_cast<std::size_t>(mine.tets), 0);
+      face_set.assign(static_cast<std::size_t>(mine.faces), 0);
+    } else if (header.time != first.time || header.steps != first.steps ||
+               rows.node_width != whole.node_width || rows.tet_width != whole.tet_width ||
+               rows.face_width != whole.face_width || rows.shared != whole.shared) {
+      from.Fail(
+          "this file is from another checkpoint than the others: resume from a set "
+          "written together");
+    }
+    if (rows.face_width > 0 && part.faces.empty())
+      from.Fail("the part's boundary faces have state but no place on the whole boundary");
+    place(from, rows.node, rows.node_width, part.owned, whole.node, node_set, mine.nodes, "node");
+    place(from, rows.tet, rows.tet_width, part.tets, whole.tet, tet_set, mine.tets, "tet");
+    place(from, rows.face, rows.face_width, part.faces, whole.face, face_set, mine.faces,
+          "boundary face");
+  }
+  for (const auto& [set, width, what] : {std::tuple{&node_set, whole.node_width, "node"},
+                                         std::tuple{&tet_set, whole.tet_width, "tet"},
+                                         std::tuple{&face_set, whole.face_width, "boundary face"}})
+    if (width > 0 && std::ranges::find(*set, 0) != set->end())
+      in.Fail(
+          fmt::format("the parts do not hold every {} of this object's: the checkpoint is of "
+                      "another mesh",
+                      what));
+  StateWriter gathered;
+  rows_of->WriteStateRows(gathered, whole);
+  StateReader own(gathered.TakeBytes(),
+                  fmt::format("object '{}' gathered from {} parts", name_, pieces.size()));
+  RestoreObjectState(own);
+}
 
 SimObject::SavedHeader SimObject::ReadSavedState(
     StateReader& in, Index boundary_vertices, Index boundary_faces,

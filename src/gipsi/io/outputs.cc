@@ -108,6 +108,15 @@ void VtuSeriesWriter::WriteFrame(Series& series, double t) {
   }
   const std::string name = object.name();
   const std::string file = fmt::format("{}/{}_{:06d}.vtu", name, name, frame_);
+  if (write_) {  // a distributed run's pieces of this frame are no longer listed
+    const std::string stem = fmt::format("{}_{:06d}", name, frame_);
+    std::error_code error;
+    if (std::filesystem::remove(directory_ / name / (stem + ".pvtu"), error))
+      for (int k = 0;
+           std::filesystem::remove(directory_ / name / fmt::format("{}_p{}.vtu", stem, k), error);
+           ++k) {
+      }
+  }
   SimObject::QuadraticOutput quadratic;
   if (mesh.num_tets() > 0 && object.GetQuadraticOutput(quadratic)) {
     WriteQuadraticFrame(object, quadratic, point_ids, fields, directory_ / file);

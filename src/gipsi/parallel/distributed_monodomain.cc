@@ -384,32 +384,6 @@ StepStatus DistributedMonodomain::DoStep(double t, double dt) {
   }
 }
 
-StateRows DistributedMonodomain::ReadStateRows(StateReader& in, const ItemCounts& counts) const {
-  // What SaveObjectState writes: the bound EpState and no cache.
-  EpState read = EpState::Sized(cell(), static_cast<std::size_t>(counts.nodes));
-  BindStateValue(read)->Read(in, {});
-  StateRows rows;
-  rows.node_width = EpState::RowWidth(cell());
-  rows.node = read.ToRows();
-  StateWriter shared;
-  shared.WriteInt(read.last_iterations);
-  rows.shared = shared.TakeBytes();
-  return rows;
-}
-
-void DistributedMonodomain::WriteStateRows(StateWriter& out, const StateRows& rows) const {
-  EpState written = EpState::Sized(cell(), static_cast<std::size_t>(num_nodes()));
-  StateReader shared(rows.shared, fmt::format("object '{}': the shared state", name()));
-  if (rows.node_width != EpState::RowWidth(cell()) || rows.tet_width != 0 || rows.face_width != 0)
-    shared.Fail(
-        fmt::format("rows of {}/{}/{} values per node/tet/face, where a Monodomain of "
-                    "this cell model has {}/0/0",
-                    rows.node_width, rows.tet_width, rows.face_width, EpState::RowWidth(cell())));
-  written.FromRows(rows.node);
-  written.last_iterations = static_cast<int>(shared.ReadInt());
-  BindStateValue(written)->Write(out);
-}
-
 void DistributedMonodomain::DoReadField(FieldId id, Eigen::Ref<Eigen::MatrixXd> out) const {
   if (id == f_activated_) {
     double counts[2] = {0, static_cast<double>(part_.num_owned)};

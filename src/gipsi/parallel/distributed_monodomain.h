@@ -28,7 +28,6 @@
 #include <vector>
 
 #include "gipsi/base/export.h"
-#include "gipsi/core/row_state.h"
 #include "gipsi/models/ep/ep_tissue.h"
 #include "gipsi/parallel/mesh_partition.h"
 
@@ -36,8 +35,8 @@ GIPSI_EXPORT_BEGIN
 namespace gipsi {
 
 /// Not copyable or movable (a SimObject). Needs a ParallelSession for its whole lifetime. Its
-/// checkpoints move to another partition (RowState).
-class DistributedMonodomain final : public EpTissue, public RowState {
+/// checkpoints move to another partition (EpTissue's RowState).
+class DistributedMonodomain final : public EpTissue {
  public:
   /// Collective: partitions `whole` (identical on every rank) over `comm`. Regions select
   /// nodes of the whole mesh, then each rank keeps its own; fibre rules are evaluated on the
@@ -67,9 +66,6 @@ class DistributedMonodomain final : public EpTissue, public RowState {
   [[nodiscard]] std::vector<double> Gather(const double* local) const {
     return GatherNodeValues(part_, local, comm_);
   }
-  /// RowState: EpState's rows per node (EpState::ToRows); shared: the last solve's iterations.
-  [[nodiscard]] StateRows ReadStateRows(StateReader& in, const ItemCounts& counts) const override;
-  void WriteStateRows(StateWriter& out, const StateRows& rows) const override;
 
  protected:
   StepStatus DoStep(double t, double dt) override;

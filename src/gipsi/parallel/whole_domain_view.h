@@ -185,17 +185,6 @@ class WholeDomainView final : public SimObject, public CavityWall, public Partit
   double region_tolerance_ = 0;  // RegionTolerance of the whole mesh
   // The constructors' shared part: fingerprint, bounding box.
   void Describe();
-  // What a checkpoint's DistributedPart section holds before the part's state.
-  struct SavedPart {
-    std::int64_t size = 0, rank = 0, whole_nodes = 0, whole_tets = 0, whole_faces = 0;
-    std::uint64_t fingerprint = 0;
-    Index boundary_vertices = 0;
-    ItemCounts local;        // the part's nodes, tets and boundary faces
-    std::vector<int> owned;  // whole-mesh indices of the owned nodes (local [0, owned))
-    std::vector<int> tets;   // of every local tet
-    std::vector<int> faces;  // the whole boundary's face of every part face (BoundaryMap), or none
-  };
-  static SavedPart ReadSavedPart(StateReader& in);
   // RestoreObjectState from a checkpoint of `saved.size` ranks, another count (`at`: where the
   // DistributedPart section starts in `in`, to find it in the other ranks' files).
   // With `one_process`, `in` holds the serial object's state at `at` (`saved` then describes it

@@ -6,7 +6,6 @@
 
 #include <algorithm>
 #include <array>
-#include <mutex>
 #include <numeric>
 #include <string>
 #include <utility>
@@ -19,12 +18,6 @@
 
 namespace gipsi {
 namespace {
-
-std::mutex files_mutex;
-std::vector<std::filesystem::path>& CheckpointFiles() {
-  static std::vector<std::filesystem::path> files;
-  return files;
-}
 
 // Fails every rank together: each learns whether any rank failed before going on, so none
 // waits in a collective the others never reach. `mine` is empty where this rank did not fail.
@@ -44,12 +37,11 @@ void FailTogether(StateReader& in, const std::string& mine, MPI_Comm comm,
 }  // namespace
 
 void WholeDomainView::SetCheckpointFiles(std::vector<std::filesystem::path> files) {
-  const std::lock_guard lock(files_mutex);
-  CheckpointFiles() = std::move(files);
+  SetCheckpointPieces(std::move(files));
 }
 
 void WholeDomainView::SaveObjectState(StateWriter& out) const {
-  out.BeginSection("DistributedPart", 2);
+  out.BeginSection(kSavedPartTag, kSavedPartVersion);
   out.WriteInt(mesh_part_.size);
   out.WriteInt(mesh_part_.rank);
   out.WriteInt(static_cast<std::int64_t>(partition_fingerprint_));
@@ -68,29 +60,6 @@ void WholeDomainView::SaveObjectState(StateWriter& out) const {
   out.EndSection();
 }
 
-WholeDomainView::SavedPart WholeDomainView::ReadSavedPart(StateReader& in) {
-  SavedPart saved;
-  saved.size = in.ReadInt();
-  saved.rank = in.ReadInt();
-  saved.fingerprint = static_cast<std::uint64_t>(in.ReadInt());
-  saved.whole_nodes = in.ReadInt();
-  saved.whole_tets = in.ReadInt();
-  saved.whole_faces = in.ReadInt();
-  saved.local.nodes = in.ReadInt();
-  saved.boundary_vertices = in.ReadInt();
-  saved.local.faces = in.ReadInt();
-  in.ReadArray(saved.owned);
-  in.ReadArray(saved.tets);
-  in.ReadArray(saved.faces);
-  saved.local.tets = static_cast<std::int64_t>(saved.tets.size());
-  if (saved.size < 1 || saved.rank < 0 || saved.rank >= saved.size || saved.local.nodes < 0 ||
-      saved.boundary_vertices < 0 || saved.local.faces < 0 ||
-      static_cast<std::int64_t>(saved.owned.size()) > saved.local.nodes ||
-      (!saved.faces.empty() && static_cast<std::int64_t>(saved.faces.size()) != saved.local.faces))
-    in.Fail("a corrupted part header");
-  return saved;
-}
-
 void WholeDomainView::RestoreAppliedConditions(StateReader& in) {
   if (!part_only_) {
     SimObject::RestoreAppliedConditions(in);
@@ -103,7 +72,7 @@ void WholeDomainView::RestoreAppliedConditions(StateReader& in) {
         name()));
 }
 
-WholeDomainView::SavedPart WholeDomainView::OneProcessPart() const {
+SavedPart WholeDomainView::OneProcessPart() const {
   SavedPart saved;
   saved.size = 1;
   saved.whole_nodes = saved.local.nodes = mesh_part_.num_global_nodes;
@@ -122,7 +91,7 @@ void WholeDomainView::RestoreObjectState(StateReader& in) {
   const StateReader::Position at = in.position();
   // A checkpoint of a run on one process holds the serial object's state here (every rank reads
   // that one file, so all take the same way).
-  const bool one_process = !in.NextIsSection("DistributedPart");
+  const bool one_process = !in.NextIsSection(kSavedPartTag);
   if (one_process) {
     RestoreOnAnotherRankCount(in, at, OneProcessPart(), true);
   } else {
@@ -167,7 +136,7 @@ SimObject::SavedHeader WholeDomainView::ReadOneProcessState(StateReader& in,
 }
 
 void WholeDomainView::RestoreFromParts(StateReader& in, const StateReader::Position& at) {
-  in.BeginSection("DistributedPart", 2);
+  in.BeginSection(kSavedPartTag, kSavedPartVersion);
   const SavedPart saved = ReadSavedPart(in);
   // Every rank decides which way to restore from its own file's header; they agree when the
   // files are one checkpoint's (checked below).
@@ -200,11 +169,7 @@ void WholeDomainView::RestoreOnAnotherRankCount(StateReader& in, const StateRead
                                                 const SavedPart& saved, bool one_process) {
   const int ranks = mesh_part_.size, rank = mesh_part_.rank;
   const auto* movable = dynamic_cast<const RowState*>(part_.get());
-  std::vector<std::filesystem::path> files;
-  {
-    const std::lock_guard lock(files_mutex);
-    files = CheckpointFiles();
-  }
+  const std::vector<std::filesystem::path> files = CheckpointPieces();
   const std::int64_t whole_faces = forward_bcs_ ? boundary().num_triangles() : 0;
   std::string refused;
   if (movable == nullptr)
@@ -302,7 +267,7 @@ void WholeDomainView::RestoreOnAnotherRankCount(StateReader& in, const StateRead
       const std::filesystem::path& file = files[static_cast<std::size_t>(r)];
       StateReader other(ReadCheckpointFile(file), file.string());
       other.Seek(at);
-      other.BeginSection("DistributedPart", 2);
+      other.BeginSection(kSavedPartTag, kSavedPartVersion);
       const std::string before = common;
       read_part(other, ReadSavedPart(other), r);
       if (!before.empty() && before != common)

@@ -28,6 +28,7 @@
 #include <vector>
 
 #include "gipsi/base/export.h"
+#include "gipsi/core/row_state.h"
 #include "gipsi/core/sim_object.h"
 #include "gipsi/geometry/region.h"
 #include "gipsi/models/ep/cell_model.h"
@@ -148,8 +149,13 @@ struct EpState {
 };
 
 /// Base of the monodomain objects (see the file comment). Not copyable or movable.
-class EpTissue : public SimObject {
+class EpTissue : public SimObject, public RowState {
  public:
+  /// RowState: EpState's rows per node (EpState::ToRows); shared: the last solve's iterations.
+  /// The serial object and a split one's part write the same state, so either reads the
+  /// other's (a checkpoint moved between runs on one process and on several).
+  [[nodiscard]] StateRows ReadStateRows(StateReader& in, const ItemCounts& counts) const override;
+  void WriteStateRows(StateWriter& out, const StateRows& rows) const override;
   [[nodiscard]] const EpTissueParams& params() const { return params_; }
   [[nodiscard]] const CellModel& cell() const { return *params_.cell; }
   [[nodiscard]] Index num_nodes() const { return static_cast<Index>(state_.cells.num_nodes()); }
