@@ -6,15 +6,18 @@
 #include <gtest/gtest.h>
 #include <mpi.h>
 
+#include <algorithm>
 #include <cmath>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "gipsi/base/error.h"
 #include "gipsi/core/cavity_law.h"
 #include "gipsi/geometry/boundary.h"
 #include "gipsi/geometry/generators.h"
 #include "gipsi/geometry/mesh_block.h"
+#include "gipsi/geometry/region.h"
 #include "gipsi/models/fem/fem_solid.h"
 #include "gipsi/models/fem/solid_laws.h"
 #include "gipsi/numerics/ode.h"
@@ -118,7 +121,8 @@ TEST(DistributedSolid, CantileverSwingsAsTheSerialObject) {
 
 // A cantilever made block by block, which no rank holds whole: its part's boundary, found by
 // exchanges between the ranks, is the whole mesh's boundary restricted to the part (faces,
-// their orientation and order, and every local node on it as a vertex), and a FemSolid on it,
+// their orientation and order, every local node on it as a vertex, and their numbers on the
+// whole boundary), and a FemSolid on it,
 // clamped on its own boundary, swings as the one split from the whole mesh.
 TEST(DistributedSolid, APartMadeInBlocksFindsTheWholeBoundaryAndSwingsAlike) {
   const auto whole = Cantilever();
@@ -136,6 +140,13 @@ TEST(DistributedSolid, APartMadeInBlocksFindsTheWholeBoundaryAndSwingsAlike) {
   EXPECT_EQ(b.triangles, a.triangles);
   EXPECT_EQ(b.face_to_tet, a.face_to_tet);
   EXPECT_GT(b.num_triangles(), 0);
+  // Where its vertices and faces are on the whole boundary, numbered by ranking at the block
+  // ranks: what the whole mesh's boundary says.
+  EXPECT_EQ(from_blocks->whole_boundary_vertex(), from_whole->whole_boundary_vertex());
+  EXPECT_EQ(from_blocks->whole_boundary_face(), from_whole->whole_boundary_face());
+  const BoundarySurface whole_boundary = MakeBoundary(*whole);
+  EXPECT_EQ(from_blocks->whole_boundary_vertices(), whole_boundary.num_vertices());
+  EXPECT_EQ(from_blocks->whole_boundary_faces(), whole_boundary.num_triangles());
 
   FemParams params_a = CantileverParams("amg"), params_b = CantileverParams("amg");
   params_a.distribution = from_whole;
@@ -155,6 +166,65 @@ TEST(DistributedSolid, APartMadeInBlocksFindsTheWholeBoundaryAndSwingsAlike) {
   // The same arithmetic; on 4 ranks two runs of the same split differ by up to 1e-17 m (the
   // order in which shared nodes' sums arrive), so the bound is the split-vs-serial one.
   EXPECT_LE((u_b - u_a).cwiseAbs().maxCoeff(), 1e-9 * sag);
+}
+
+// The view of a FemSolid made in blocks keeps its boundary conditions numbered on the whole
+// boundary without its geometry: a region's whole-boundary vertices and faces, selected on the
+// parts and gathered, are the serial selection's on the whole mesh (face groups, faces whose
+// three vertices a box or a half-space selects, node ids, every face); and each rank's own
+// boundary vertices of a region (what probes reduce) make the whole selection once over the
+// ranks.
+TEST(DistributedSolid, APartOnlyViewSelectsTheWholeBoundarysItems) {
+  const auto whole = Cantilever();
+  const BoundarySurface whole_boundary = MakeBoundary(*whole);
+  auto distribution = std::make_shared<DistributedSolid>(
+      PartitionMeshBlocks(
+          MakeTetBoxBlock(Vec3::Zero(), Vec3(0.1, 0.01, 0.01), {20, 2, 2}, HexSplit::kSix,
+                          ParallelSession::rank(World()), ParallelSession::size(World())),
+          World()),
+      World());
+  FemParams params = CantileverParams("amg");
+  params.distribution = distribution;
+  const MeshPart& part = distribution->part();
+  WholeDomainView view(
+      std::make_unique<FemSolid>("solid", part.mesh, std::move(params)), part, World(),
+      WholeDomainView::BoundaryMap{
+          distribution->whole_boundary_vertex(), distribution->whole_boundary_face(),
+          distribution->whole_boundary_vertices(), distribution->whole_boundary_faces()});
+  ASSERT_FALSE(view.holds_whole_domain());
+  EXPECT_EQ(view.boundary_conditions().num_vertices(), whole_boundary.num_vertices());
+  EXPECT_EQ(view.boundary_conditions().num_faces(), whole_boundary.num_triangles());
+  const std::vector<Region> regions = {AllRegion{},
+                                       GroupRegion{"xmax"},
+                                       GroupRegion{"zmax"},
+                                       BoxRegion{Vec3(0.03, -1, -1), Vec3(0.07, 0.0001, 1)},
+                                       HalfSpaceRegion{Vec3(0.05, 0, 0), Vec3(1, 0, 0)},
+                                       NodeIdsRegion{{0, 20, 21, 40, 62, 100}}};
+  for (std::size_t k = 0; k < regions.size(); ++k) {
+    const Region& region = regions[k];
+    const std::vector<int> vertices = SelectBoundaryVertices(region, *whole, whole_boundary);
+    const std::vector<int> faces = SelectBoundaryFaces(region, *whole, whole_boundary);
+    EXPECT_FALSE(vertices.empty()) << "region " << k;
+    EXPECT_EQ(view.SelectWholeBoundary(region, false), vertices) << "region " << k;
+    EXPECT_EQ(view.SelectWholeBoundary(region, true), faces) << "region " << k;
+    std::vector<int> owned;
+    for (const int v : view.SelectOwnedBoundaryVertices(region)) {
+      EXPECT_LT(view.boundary().vertex_to_node[static_cast<std::size_t>(v)], part.num_owned);
+      owned.push_back(distribution->whole_boundary_vertex()[static_cast<std::size_t>(v)]);
+    }
+    const int count = static_cast<int>(owned.size());
+    std::vector<int> counts(static_cast<std::size_t>(ParallelSession::size(World())));
+    MPI_Allgather(&count, 1, MPI_INT, counts.data(), 1, MPI_INT, World());
+    std::vector<int> offsets(counts.size(), 0);
+    for (std::size_t r = 1; r < counts.size(); ++r) offsets[r] = offsets[r - 1] + counts[r - 1];
+    std::vector<int> all(static_cast<std::size_t>(offsets.back() + counts.back()));
+    MPI_Allgatherv(owned.data(), count, MPI_INT, all.data(), counts.data(), offsets.data(), MPI_INT,
+                   World());
+    std::sort(all.begin(), all.end());
+    EXPECT_EQ(all, vertices) << "region " << k;  // each once: no repeats
+  }
+  // A group no part has is refused on every rank.
+  EXPECT_THROW((void)view.SelectWholeBoundary(GroupRegion{"no_such_group"}, false), InputError);
 }
 
 // The same release with the Newmark scheme (average acceleration), which starts from the

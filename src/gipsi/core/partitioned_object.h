@@ -69,7 +69,9 @@ class PartitionedObject {
   /// regions are decided where the nodes are, with no communication. Collective; throws
   /// InputError on every process as SelectNodes does.
   [[nodiscard]] virtual std::vector<int> SelectOwnedNodes(const Region& region) const = 0;
-  /// ReadFieldItems of a node field at local nodes (from SelectOwnedNodes). Not collective.
+  /// ReadFieldItems of a node field at local nodes (from SelectOwnedNodes), or of a
+  /// boundary-vertex field at local boundary vertices (SelectOwnedBoundaryVertices). Not
+  /// collective.
   virtual void ReadOwnedNodes(FieldId id, std::span<const int> local,
                               Eigen::Ref<Eigen::MatrixXd> out) const = 0;
   /// How CombineAcross combines.
@@ -77,6 +79,20 @@ class PartitionedObject {
   /// Replaces every entry of `values` by its sum, minimum or maximum over the processes.
   /// Collective: O(values.size()) per process.
   virtual void CombineAcross(std::span<double> values, Combine how) const = 0;
+  /// The local indices of the boundary vertices (of domain()'s boundary) whose node this
+  /// process owns among SelectWholeNodes(region): region probes of boundary-vertex fields
+  /// reduce them as SelectOwnedNodes' nodes (ReadOwnedNodes reads them). Collective.
+  [[nodiscard]] virtual std::vector<int> SelectOwnedBoundaryVertices(
+      const Region& region) const = 0;
+
+  // Boundary conditions on an object without its whole domain (holds_whole_domain() false).
+  /// The whole boundary's vertices, or with `faces` its triangles, that `region` selects as
+  /// SelectBoundaryVertices and SelectBoundaryFaces select them on the whole domain, sorted,
+  /// the same on every process: where a condition goes in the object's store of boundary
+  /// conditions, which is numbered on the whole boundary. Collective; throws InputError on
+  /// every process as SelectNodes does, or if the object takes no boundary conditions.
+  [[nodiscard]] virtual std::vector<int> SelectWholeBoundary(const Region& region,
+                                                             bool faces) const = 0;
 
   // Coupling part to part (SplitAlike).
   /// This process's part: the object that steps this process's share of the domain. Its node

@@ -39,8 +39,9 @@
 /// ReadOwnedNodes, CombineAcross); 16: coupling split objects part to part (PartitionedObject's
 /// local_part, whole_nodes_of_part, whole_tets_of_part, num_owned_nodes, ShareOwnedNodeValues),
 /// checkpoints between serial and split objects (SimObject::RestoreAppliedConditions, EpTissue a
-/// RowState).
-#define GIPSI_PLUGIN_INTERFACE 16
+/// RowState); 17: boundary conditions and boundary-field probes on split objects without their
+/// whole domain (PartitionedObject's SelectWholeBoundary, SelectOwnedBoundaryVertices).
+#define GIPSI_PLUGIN_INTERFACE 17
 /// What a plugin's gipsi_plugin_abi_version() returns and the loader requires: the package's
 /// major and minor version with the plugin interface, MAJOR·10⁶ + MINOR·10³ + INTERFACE. A
 /// plugin thus loads only into the release line it was built against (0.1.x, as the CMake

@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include "gipsi/base/error.h"
+#include "gipsi/core/partitioned_object.h"
 #include "gipsi/geometry/region_json.h"
 
 namespace gipsi {
@@ -42,13 +43,21 @@ BoundaryConditionSpec ParseBoundaryCondition(const JsonNode& node, const SimObje
         "'total_force', 'pressure', 'traction'");
   Region region = AllRegion{};
   if (auto r = node.Find("region")) region = ParseRegion(*r);
-  if (object.boundary().num_vertices() == 0)
+  // An object split over the processes without its whole mesh keeps its conditions on the
+  // whole boundary, which only its collective calls know (every process parses alike).
+  const auto* split = dynamic_cast<const PartitionedObject*>(&object);
+  if (split != nullptr && split->holds_whole_domain()) split = nullptr;
+  const Index boundary_vertices = split != nullptr ? object.boundary_conditions().num_vertices()
+                                                   : object.boundary().num_vertices();
+  if (boundary_vertices == 0)
     node.Fail(
         fmt::format("object '{}' has no boundary geometry to put conditions on", object.path()));
 
   bool on_faces = node.Has("pressure") || node.Has("traction");
   try {
-    if (on_faces) {
+    if (split != nullptr) {
+      (on_faces ? spec.faces : spec.vertices) = split->SelectWholeBoundary(region, on_faces);
+    } else if (on_faces) {
       spec.faces = SelectBoundaryFaces(region, object.domain(), object.boundary());
     } else {
       spec.vertices = SelectBoundaryVertices(region, object.domain(), object.boundary());

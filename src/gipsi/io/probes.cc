@@ -282,20 +282,19 @@ Probe ParseProbe(const std::string& name, const JsonNode& node, const Kernel& ke
   } else if (auto r = node.Find("region")) {
     probe.region = true;
     Region region = ParseRegion(*r);
-    if (location == FieldLocation::kBoundaryVertex && split != nullptr)
-      r->Fail(fmt::format(
-          "region probes of boundary fields are not offered on '{}', split over the processes "
-          "without its whole mesh (probe a node field)",
-          object.path()));
-    // A split object's nodes are reduced where they are owned (whole mesh or not).
+    // A split object's nodes are reduced where they are owned (whole mesh or not), and so are
+    // the boundary vertices of one without its whole mesh (a vertex is owned with its node).
     bool anywhere = false;  // some process owns a node of the region
     const auto* owners = location == FieldLocation::kNode
                              ? dynamic_cast<const PartitionedObject*>(&object)
-                             : nullptr;
+                         : location == FieldLocation::kBoundaryVertex ? split
+                                                                      : nullptr;
     try {
       if (owners != nullptr) {
         probe.owners = owners;
-        probe.items = owners->SelectOwnedNodes(region);
+        probe.items = location == FieldLocation::kNode
+                          ? owners->SelectOwnedNodes(region)
+                          : owners->SelectOwnedBoundaryVertices(region);
         std::array<double, 1> selected{static_cast<double>(probe.items.size())};
         owners->CombineAcross(selected, PartitionedObject::Combine::kSum);
         anywhere = selected[0] > 0;

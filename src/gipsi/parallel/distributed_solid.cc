@@ -427,6 +427,8 @@ DistributedSolid::DistributedSolid(std::shared_ptr<const Mesh> whole_mesh, MPI_C
       boundary_.triangles(a, static_cast<Index>(k)) =
           part_vertex[static_cast<std::size_t>(whole_boundary.triangles(a, faces[k]))];
   whole_face_ = std::move(faces);
+  whole_vertices_ = whole_boundary.num_vertices();
+  whole_faces_ = whole_boundary.num_triangles();
   ghosts_->v = MakeGhosted(part_, comm_);
 }
 
@@ -435,6 +437,11 @@ DistributedSolid::DistributedSolid(MeshPart part, MPI_Comm comm)
       part_(std::move(part)),
       boundary_(PartBoundary(part_, comm)),
       ghosts_(std::make_unique<Ghosts>()) {
+  WholeBoundaryNumbers numbers = NumberOnWholeBoundary(part_, boundary_, comm_);
+  whole_vertex_ = std::move(numbers.vertex);
+  whole_face_ = std::move(numbers.face);
+  whole_vertices_ = numbers.whole_vertices;
+  whole_faces_ = numbers.whole_faces;
   ghosts_->v = MakeGhosted(part_, comm_);
 }
 

@@ -20,6 +20,7 @@
 
 #include <mpi.h>
 
+#include <cstdint>
 #include <memory>
 #include <vector>
 
@@ -48,9 +49,13 @@ class DistributedSolid final : public SolidDistribution {
   [[nodiscard]] const MeshPart& part() const { return part_; }
   [[nodiscard]] MPI_Comm comm() const { return comm_; }
   /// For each vertex of boundary(), its vertex in the whole mesh's boundary (MakeBoundary);
-  /// for each face, its face there (whole_face()). Empty without the whole mesh.
+  /// for each face, its face there (whole_face()); with or without the whole mesh
+  /// (NumberOnWholeBoundary).
   [[nodiscard]] const std::vector<int>& whole_boundary_vertex() const { return whole_vertex_; }
   [[nodiscard]] const std::vector<int>& whole_boundary_face() const { return whole_face_; }
+  /// The whole mesh's boundary vertices and faces.
+  [[nodiscard]] std::int64_t whole_boundary_vertices() const { return whole_vertices_; }
+  [[nodiscard]] std::int64_t whole_boundary_faces() const { return whole_faces_; }
 
   [[nodiscard]] Index num_owned_nodes() const override { return part_.num_owned; }
   [[nodiscard]] const BoundarySurface& boundary() const override { return boundary_; }
@@ -70,6 +75,7 @@ class DistributedSolid final : public SolidDistribution {
   MeshPart part_;
   BoundarySurface boundary_, whole_boundary_;
   std::vector<int> whole_vertex_, whole_face_;
+  std::int64_t whole_vertices_ = 0, whole_faces_ = 0;
   struct Ghosts;
   std::unique_ptr<Ghosts> ghosts_;  // SumShared's vector
 };

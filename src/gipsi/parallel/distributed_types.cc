@@ -5,6 +5,9 @@
 
 #include <fmt/format.h>
 
+#include <functional>
+#include <string>
+
 #include "gipsi/base/error.h"
 #include "gipsi/base/log.h"
 #include "gipsi/base/units.h"
@@ -15,6 +18,57 @@
 #include "gipsi/parallel/whole_domain_view.h"
 
 namespace gipsi {
+
+namespace {
+
+// Warns when an explicit integrator's dt exceeds the stability estimate (collective).
+void CheckExplicitDt(const ObjectBuildContext& ctx, const FemSolid& solid) {
+  if (auto dt = ctx.params.Find("dt"); dt && solid.ode_integrator()) {
+    const double value = ReadPositiveQuantity(*dt, "s");
+    const double limit = solid.stable_dt_estimate();  // collective
+    if (value > limit)
+      Log().warn("{}: {}: dt = {:.3g} s exceeds the estimated explicit stability limit {:.3g} s",
+                 dt->file(), dt->path(), value, limit);
+  }
+}
+
+// Adds an object to the summary's list of split objects.
+using NoteSplit = std::function<void(const std::string& name, const char* type)>;
+
+// A standalone FemSolid on a mesh made as one block per rank and cut from the blocks: its
+// boundary and where it lies on the whole mesh's are found by exchanges, and the view keeps the
+// scene's conditions on the whole boundary's numbering without its geometry.
+
+std::unique_ptr<SimObject> FemSolidInBlocks(const ObjectBuildContext& ctx, FemSolidSpec spec,
+                                            MPI_Comm comm, const NoteSplit& note) {
+  int rank = 0, size = 1;
+  MPI_Comm_rank(comm, &rank);
+  MPI_Comm_size(comm, &size);
+  auto block = std::make_unique<MeshBlock>(ctx.DomainMeshBlock(rank, size));
+  if (block->num_tets == 0)
+    throw InputError("the FemSolid object needs a tetrahedral domain mesh (this one has none)");
+  MeshPart cut = PartitionMeshBlocks(*block, comm);
+  block.reset();  // before the object allocates its state
+  auto distribution = std::make_shared<DistributedSolid>(std::move(cut), comm);
+  spec.params.distribution = distribution;
+  const MeshPart& mesh_part = distribution->part();
+  auto solid = spec.ode
+                   ? std::make_unique<FemSolid>(ctx.name, mesh_part.mesh, std::move(spec.params),
+                                                std::move(spec.ode))
+                   : std::make_unique<FemSolid>(ctx.name, mesh_part.mesh, std::move(spec.params));
+  if (spec.fibre_rule.ellipsoidal)  // evaluated on the local tets alone
+    solid->WriteField(solid->FindField("fibre"),
+                      EllipsoidalFibresAtCentroids(*mesh_part.mesh, *spec.fibre_rule.ellipsoidal));
+  CheckExplicitDt(ctx, *solid);
+  note(ctx.name, "FemSolid, in blocks");
+  return std::make_unique<WholeDomainView>(
+      std::move(solid), mesh_part, comm,
+      WholeDomainView::BoundaryMap{
+          distribution->whole_boundary_vertex(), distribution->whole_boundary_face(),
+          distribution->whole_boundary_vertices(), distribution->whole_boundary_faces()});
+}
+
+}  // namespace
 
 void RegisterDistributedTypes(TypeRegistry& registry, MPI_Comm comm,
                               std::shared_ptr<std::vector<std::string>> split) {
@@ -76,6 +130,17 @@ void RegisterDistributedTypes(TypeRegistry& registry, MPI_Comm comm,
             spec.ode->name() != "ExplicitEuler")
           return whole_solid(ctx);
         spec.params.linear_solver = spec.distributed_linear;
+        // Nothing else reads it: its mesh is made in blocks and no rank holds it whole
+        // (cavities, a Laplace fibre rule and an embedded display need the whole mesh).
+        const auto display = ctx.params.Find("display");
+        if (ctx.standalone && spec.params.cavities.empty() && !spec.fibre_rule.transmural &&
+            !(display && display->is_object() && display->Has("mesh"))) {
+          try {
+            return FemSolidInBlocks(ctx, std::move(spec), comm, note);
+          } catch (const InputError& e) {
+            ctx.params.Fail(e.what());
+          }
+        }
         std::shared_ptr<const Mesh> whole = ctx.DomainMesh();
         try {
           auto distribution = std::make_shared<DistributedSolid>(whole, comm);
@@ -97,14 +162,7 @@ void RegisterDistributedTypes(TypeRegistry& registry, MPI_Comm comm,
               local.col(static_cast<Index>(e)) = all.col(mesh_part.whole_tet[e]);
             solid->WriteField(solid->FindField("fibre"), local);
           }
-          if (auto dt = ctx.params.Find("dt"); dt && solid->ode_integrator()) {
-            const double value = ReadPositiveQuantity(*dt, "s");
-            const double limit = solid->stable_dt_estimate();  // collective
-            if (value > limit)
-              Log().warn(
-                  "{}: {}: dt = {:.3g} s exceeds the estimated explicit stability limit {:.3g} s",
-                  dt->file(), dt->path(), value, limit);
-          }
+          CheckExplicitDt(ctx, *solid);
           note(ctx.name, "FemSolid");
           return std::make_unique<WholeDomainView>(
               std::move(solid), mesh_part, whole, comm,

@@ -83,6 +83,20 @@ std::vector<int> LocalNodesOf(const MeshPart& part, std::span<const int> whole);
 /// Collective; O(part) per rank.
 BoundarySurface PartBoundary(const MeshPart& part, MPI_Comm comm);
 
+/// Where a part's boundary (PartBoundary's) lies on the whole mesh's (MakeBoundary's), found
+/// without the whole mesh. Plain struct.
+struct WholeBoundaryNumbers {
+  std::vector<int> vertex;  ///< the whole boundary's vertex of each part boundary vertex
+  std::vector<int> face;    ///< the whole boundary's face of each part face
+  std::int64_t whole_vertices = 0, whole_faces = 0;  ///< the whole boundary's counts
+};
+/// The whole boundary orders its vertices by node and its faces by tet, then by the tet's local
+/// node the face is opposite to (MakeBoundary): each item's number is its rank among every
+/// part's items in that order, counted at the block rank of its node or tet (one exchange
+/// there and back). Collective; O(the part's boundary) per rank.
+WholeBoundaryNumbers NumberOnWholeBoundary(const MeshPart& part, const BoundarySurface& boundary,
+                                           MPI_Comm comm);
+
 /// What MoveRows delivered. Plain struct.
 struct MovedRows {
   std::vector<double> rows;   ///< a row per held item, in the order of `held`

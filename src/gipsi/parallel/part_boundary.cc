@@ -5,8 +5,10 @@
 #include <algorithm>
 #include <array>
 #include <cstdint>
+#include <span>
 #include <vector>
 
+#include "gipsi/base/error.h"
 #include "gipsi/geometry/boundary.h"
 #include "gipsi/parallel/mesh_partition.h"
 #include "gipsi/parallel/mesh_partition_detail.h"
@@ -41,7 +43,85 @@ std::vector<std::vector<char>> MatchedTwice(const detail::Received<FaceRecord>& 
   return reply;
 }
 
+// Each key's position among the distinct keys of every rank, ascending (a key may come from
+// several ranks, or twice from one), and how many distinct keys there are. Keys lie in
+// [0, count); each is ranked at its block rank (BlockRank is increasing in the key, so a block
+// rank's offset is the number of distinct keys of the blocks before it).
+std::vector<int> RankAmongAll(std::span<const std::int64_t> keys, std::int64_t count, MPI_Comm comm,
+                              std::int64_t& distinct_total) {
+  int size = 1;
+  MPI_Comm_size(comm, &size);
+  std::vector<std::vector<std::int64_t>> to(static_cast<std::size_t>(size));
+  std::vector<int> sent_to(keys.size());
+  for (std::size_t i = 0; i < keys.size(); ++i) {
+    const int rank = detail::BlockRank(keys[i], count, size);
+    sent_to[i] = rank;
+    to[static_cast<std::size_t>(rank)].push_back(keys[i]);
+  }
+  const auto got = detail::Exchange(to, comm);
+  std::vector<std::int64_t> distinct = got.items;
+  std::sort(distinct.begin(), distinct.end());
+  distinct.erase(std::unique(distinct.begin(), distinct.end()), distinct.end());
+  const auto mine = static_cast<std::int64_t>(distinct.size());
+  std::int64_t offset = 0;
+  MPI_Exscan(&mine, &offset, 1, MPI_INT64_T, MPI_SUM, comm);
+  int rank = 0;
+  MPI_Comm_rank(comm, &rank);
+  if (rank == 0) offset = 0;  // MPI_Exscan leaves rank 0's result undefined
+  MPI_Allreduce(&mine, &distinct_total, 1, MPI_INT64_T, MPI_SUM, comm);
+  GIPSI_CHECK(distinct_total < std::int64_t{1} << 31, "more than 2^31 - 1 boundary items");
+  std::vector<std::vector<int>> reply(static_cast<std::size_t>(size));
+  std::size_t k = 0;
+  for (int r = 0; r < size; ++r)
+    for (int c = 0; c < got.counts[static_cast<std::size_t>(r)]; ++c, ++k)
+      reply[static_cast<std::size_t>(r)].push_back(static_cast<int>(
+          offset +
+          (std::lower_bound(distinct.begin(), distinct.end(), got.items[k]) - distinct.begin())));
+  const auto answers = detail::Exchange(reply, comm);
+  // The answers come per rank in the order sent.
+  std::vector<std::size_t> next(static_cast<std::size_t>(size), 0);
+  for (int r = 1; r < size; ++r)
+    next[static_cast<std::size_t>(r)] =
+        next[static_cast<std::size_t>(r - 1)] +
+        static_cast<std::size_t>(answers.counts[static_cast<std::size_t>(r - 1)]);
+  std::vector<int> out(keys.size());
+  for (std::size_t i = 0; i < keys.size(); ++i)
+    out[i] = answers.items[next[static_cast<std::size_t>(sent_to[i])]++];
+  return out;
+}
+
 }  // namespace
+
+WholeBoundaryNumbers NumberOnWholeBoundary(const MeshPart& part, const BoundarySurface& boundary,
+                                           MPI_Comm comm) {
+  const Mesh& mesh = *part.mesh;
+  std::vector<std::int64_t> keys;
+  keys.reserve(boundary.vertex_to_node.size());
+  for (const int node : boundary.vertex_to_node)
+    keys.push_back(part.whole_node[static_cast<std::size_t>(node)]);
+  WholeBoundaryNumbers out;
+  out.vertex = RankAmongAll(keys, part.num_global_nodes, comm, out.whole_vertices);
+  // A face's key: its tet's whole index, then the tet's local node it is opposite to.
+  keys.clear();
+  for (Index f = 0; f < boundary.num_triangles(); ++f) {
+    const int tet = boundary.face_to_tet[static_cast<std::size_t>(f)];
+    int opposite = -1;
+    for (int k = 0; k < 4; ++k) {
+      const int node = mesh.tets(k, tet);
+      bool on_face = false;
+      for (int a = 0; a < 3; ++a)
+        on_face =
+            on_face ||
+            boundary.vertex_to_node[static_cast<std::size_t>(boundary.triangles(a, f))] == node;
+      if (!on_face) opposite = k;
+    }
+    GIPSI_CHECK(opposite >= 0, "boundary face {} is not a face of its tet", f);
+    keys.push_back(4 * static_cast<std::int64_t>(part.whole_tet[static_cast<std::size_t>(tet)]) +
+                   opposite);
+  }
+  out.face = RankAmongAll(keys, 4 * part.num_global_tets, comm, out.whole_faces);
+  return out;
+}
 
 BoundarySurface PartBoundary(const MeshPart& part, MPI_Comm comm) {
   const Mesh& mesh = *part.mesh;

@@ -11,6 +11,7 @@
 #include <limits>
 #include <map>
 #include <numeric>
+#include <span>
 #include <variant>
 
 #include "gipsi/base/error.h"
@@ -115,16 +116,27 @@ WholeDomainView::WholeDomainView(std::unique_ptr<SimObject> part, const MeshPart
 }
 
 WholeDomainView::WholeDomainView(std::unique_ptr<SimObject> part, const MeshPart& mesh_part,
-                                 MPI_Comm comm)
+                                 MPI_Comm comm, std::optional<BoundaryMap> boundary)
     : SimObject(std::string(part->name())),
       part_(std::move(part)),
       mesh_part_(mesh_part),
       comm_(comm),
       part_only_(true) {
   SetGeometry(mesh_part_.mesh, part_->boundary());
-  // Nothing sets boundary conditions on a part-only object (the factory's rule): an empty store
-  // keeps its checkpoints free of the part's boundary, so they restore on another partition.
-  boundary_conditions() = BoundaryConditions();
+  // The store of conditions is numbered on the whole boundary, so its checkpoints restore on
+  // another partition; without a BoundaryMap nothing sets conditions (the factory's rule) and
+  // an empty store keeps the checkpoints free of the part's boundary.
+  if (boundary) {
+    GIPSI_CHECK(static_cast<Index>(boundary->vertex.size()) == part_->boundary().num_vertices() &&
+                static_cast<Index>(boundary->face.size()) == part_->boundary().num_triangles());
+    boundary_conditions() = BoundaryConditions(static_cast<Index>(boundary->whole_vertices),
+                                               static_cast<Index>(boundary->whole_faces));
+    bc_vertex_ = std::move(boundary->vertex);
+    bc_face_ = std::move(boundary->face);
+    forward_bcs_ = true;
+  } else {
+    boundary_conditions() = BoundaryConditions();
+  }
   for (std::size_t f = 0; f < part_->fields().size(); ++f) {
     DeclareField(part_->fields()[f]);
     part_field_.emplace_back(static_cast<std::int64_t>(f));
@@ -219,21 +231,94 @@ std::vector<int> WholeDomainView::SelectWholeNodes(const Region& region) const {
                              comm_);
 }
 
-std::vector<int> WholeDomainView::SelectOwnedNodes(const Region& region) const {
-  std::vector<int> local;
-  if (std::holds_alternative<NodeIdsRegion>(region)) {  // whole-mesh indices, range-checked
-    local = LocalNodesOf(mesh_part_,
-                         part_only_ ? SelectWholeNodes(region) : SelectNodes(region, domain()));
-  } else if (std::holds_alternative<GroupRegion>(region)) {  // gathered: see SelectWholeNodes
-    local = LocalNodesOf(
+std::vector<int> WholeDomainView::SelectLocalNodes(const Region& region) const {
+  if (std::holds_alternative<NodeIdsRegion>(region))  // whole-mesh indices, range-checked
+    return LocalNodesOf(mesh_part_,
+                        part_only_ ? SelectWholeNodes(region) : SelectNodes(region, domain()));
+  if (std::holds_alternative<GroupRegion>(region))  // gathered: see SelectWholeNodes
+    return LocalNodesOf(
         mesh_part_,
         GatherSelectedNodes(mesh_part_, SelectNodes(region, *mesh_part_.mesh, region_tolerance_),
                             comm_));
-  } else {  // decided by each node's position, at the whole mesh's tolerance
-    local = SelectNodes(region, *mesh_part_.mesh, region_tolerance_);
-  }
+  // Decided by each node's position, at the whole mesh's tolerance.
+  return SelectNodes(region, *mesh_part_.mesh, region_tolerance_);
+}
+
+std::vector<int> WholeDomainView::SelectOwnedNodes(const Region& region) const {
+  std::vector<int> local = SelectLocalNodes(region);
   std::erase_if(local, [this](int i) { return i >= mesh_part_.num_owned; });
   return local;
+}
+
+namespace {
+
+// The vertices of `boundary` whose node is in `nodes` (ascending), in vertex order.
+std::vector<int> VerticesOfNodes(const BoundarySurface& boundary, std::span<const int> nodes) {
+  std::vector<int> vertices;
+  for (Index v = 0; v < boundary.num_vertices(); ++v)
+    if (std::binary_search(nodes.begin(), nodes.end(),
+                           boundary.vertex_to_node[static_cast<std::size_t>(v)]))
+      vertices.push_back(static_cast<int>(v));
+  return vertices;
+}
+
+}  // namespace
+
+std::vector<int> WholeDomainView::SelectOwnedBoundaryVertices(const Region& region) const {
+  return VerticesOfNodes(part_->boundary(), SelectOwnedNodes(region));
+}
+
+std::vector<int> WholeDomainView::SelectWholeBoundary(const Region& region, bool faces) const {
+  if (!forward_bcs_)
+    throw InputError(
+        fmt::format("object '{}' ({}, split over the processes) takes no boundary conditions",
+                    name(), type_name()));
+  if (!part_only_)
+    return faces ? SelectBoundaryFaces(region, domain(), boundary())
+                 : SelectBoundaryVertices(region, domain(), boundary());
+  const BoundarySurface& part_boundary = part_->boundary();
+  const std::vector<int> vertices = VerticesOfNodes(part_boundary, SelectLocalNodes(region));
+  std::vector<int> mine;
+  if (!faces) {
+    for (const int v : vertices) mine.push_back(bc_vertex_[static_cast<std::size_t>(v)]);
+  } else {
+    // A triangle group's faces are matched to the part's (every face of a local tet has its
+    // triangles here); otherwise a face is selected when its three vertices are, as on the
+    // whole mesh.
+    const auto* group_region = std::get_if<GroupRegion>(&region);
+    const MeshGroup* group =
+        group_region != nullptr ? mesh_part_.mesh->FindGroup(group_region->name) : nullptr;
+    std::vector<int> local;
+    if (group != nullptr && group->dim == 2) {
+      local = SelectBoundaryFaces(region, *mesh_part_.mesh, part_boundary);
+    } else {
+      std::vector<char> selected(static_cast<std::size_t>(part_boundary.num_vertices()), 0);
+      for (const int v : vertices) selected[static_cast<std::size_t>(v)] = 1;
+      for (Index f = 0; f < part_boundary.num_triangles(); ++f)
+        if (selected[static_cast<std::size_t>(part_boundary.triangles(0, f))] != 0 &&
+            selected[static_cast<std::size_t>(part_boundary.triangles(1, f))] != 0 &&
+            selected[static_cast<std::size_t>(part_boundary.triangles(2, f))] != 0)
+          local.push_back(static_cast<int>(f));
+    }
+    for (const int f : local) mine.push_back(bc_face_[static_cast<std::size_t>(f)]);
+  }
+  // Every rank's, on every rank: O(the selection).
+  int size = 1;
+  MPI_Comm_size(comm_, &size);
+  std::vector<int> counts(static_cast<std::size_t>(size)), offsets(static_cast<std::size_t>(size));
+  const int count = static_cast<int>(mine.size());
+  MPI_Allgather(&count, 1, MPI_INT, counts.data(), 1, MPI_INT, comm_);
+  std::exclusive_scan(counts.begin(), counts.end(), offsets.begin(), 0);
+  std::vector<int> all(static_cast<std::size_t>(offsets.back() + counts.back()));
+  MPI_Allgatherv(mine.data(), count, MPI_INT, all.data(), counts.data(), offsets.data(), MPI_INT,
+                 comm_);
+  std::sort(all.begin(), all.end());
+  all.erase(std::unique(all.begin(), all.end()), all.end());
+  return all;
+}
+
+std::int64_t WholeDomainView::whole_boundary_faces() const {
+  return forward_bcs_ ? static_cast<std::int64_t>(boundary_conditions().num_faces()) : 0;
 }
 
 void WholeDomainView::ReadOwnedNodes(FieldId id, std::span<const int> local,

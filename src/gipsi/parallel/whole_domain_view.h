@@ -25,7 +25,9 @@
 /// but probes and outputs reads, ObjectBuildContext::standalone) the view's domain and boundary
 /// are the part's, its fields are the part's local ones, and probes address the whole mesh's
 /// nodes through its PartitionedObject calls (collective; the whole mesh's indices are the
-/// part's `whole_node`). No rank then holds anything of the size of the whole mesh.
+/// part's `whole_node`). No rank then holds anything of the size of the whole mesh, except a
+/// store of boundary conditions numbered on the whole boundary when the part takes conditions
+/// (a FemSolid's: selected with SelectWholeBoundary, forwarded as the other view does).
 ///
 /// Every rank must make the same calls in the same order (they do when every rank runs the
 /// same kernel on the same scene). The whole-field gathers make ReadField the simple path, not
@@ -63,6 +65,9 @@ class WholeDomainView final : public SimObject, public CavityWall, public Partit
   /// vertex of each part boundary vertex, the whole face of each part face. Plain struct.
   struct BoundaryMap {
     std::vector<int> vertex, face;
+    /// The whole boundary's vertex and face counts (a part-only view's store of conditions is
+    /// numbered on the whole boundary; the other view reads them from its whole mesh).
+    std::int64_t whole_vertices = 0, whole_faces = 0;
   };
   /// `part` is this rank's object on `mesh_part.mesh` (`mesh_part` must outlive the view: the
   /// part usually owns it), `whole` the mesh it was cut from. Collective. With `boundary`,
@@ -75,8 +80,13 @@ class WholeDomainView final : public SimObject, public CavityWall, public Partit
                   std::shared_ptr<const Mesh> whole, MPI_Comm comm,
                   std::optional<BoundaryMap> boundary = std::nullopt);
   /// A part-only view (see the file comment): `part` on `mesh_part.mesh` (which must outlive
-  /// the view), no whole mesh on any rank. Collective.
-  WholeDomainView(std::unique_ptr<SimObject> part, const MeshPart& mesh_part, MPI_Comm comm);
+  /// the view), no whole mesh on any rank. Collective. With `boundary` (its whole counts set),
+  /// the view keeps a store of boundary conditions numbered on the whole boundary, as the other
+  /// view does, without the whole boundary's geometry: conditions are selected with
+  /// SelectWholeBoundary and copied to the part before each step, and checkpoints hold them
+  /// alike (so they move between rank counts and serial runs).
+  WholeDomainView(std::unique_ptr<SimObject> part, const MeshPart& mesh_part, MPI_Comm comm,
+                  std::optional<BoundaryMap> boundary = std::nullopt);
   ~WholeDomainView() override;
 
   /// PartitionedObject: false for a part-only view. The calls below work in both kinds.
@@ -94,6 +104,9 @@ class WholeDomainView final : public SimObject, public CavityWall, public Partit
   void ReadOwnedNodes(FieldId id, std::span<const int> local,
                       Eigen::Ref<Eigen::MatrixXd> out) const override;
   void CombineAcross(std::span<double> values, Combine how) const override;
+  [[nodiscard]] std::vector<int> SelectOwnedBoundaryVertices(const Region& region) const override;
+  [[nodiscard]] std::vector<int> SelectWholeBoundary(const Region& region,
+                                                     bool faces) const override;
   [[nodiscard]] SimObject& local_part() override { return *part_; }
   [[nodiscard]] const SimObject& local_part() const override { return *part_; }
   [[nodiscard]] Index num_owned_nodes() const override { return mesh_part_.num_owned; }
@@ -120,8 +133,9 @@ class WholeDomainView final : public SimObject, public CavityWall, public Partit
   /// run on one process (the serial object's state, every rank reading the one file) restores
   /// as a part of one rank's checkpoint would: rank 0 reads the rows and they move to the parts.
   void RestoreObjectState(StateReader& in) override;
-  /// A part-only view keeps no store: it takes a serial object's conditions only if they apply
-  /// nothing (nothing names a part-only object, so nothing set any).
+  /// A part-only view without a BoundaryMap keeps no store: it takes a serial object's
+  /// conditions only if they apply nothing (nothing names a part-only object, so nothing set
+  /// any).
   void RestoreAppliedConditions(StateReader& in) override;
   /// The files of the distributed checkpoint being resumed, rank 0's first (the tool sets them
   /// before Kernel::ReadCheckpoint): a restore on another rank count reads the parts in them.
@@ -168,6 +182,12 @@ class WholeDomainView final : public SimObject, public CavityWall, public Partit
   void MapBoundary(BoundaryMap map);
   // Copies the view's boundary conditions to the part's (BoundaryMap).
   void CopyBoundaryConditions();
+  // The whole boundary's faces where the view forwards conditions (their store's), else 0.
+  [[nodiscard]] std::int64_t whole_boundary_faces() const;
+  // The local nodes (owned and shared) of the whole domain's selection: group regions gathered
+  // (a triangle or tet group names a node only where its triangle or tet is), node ids mapped,
+  // other regions decided where the nodes are. Collective for groups and node ids.
+  [[nodiscard]] std::vector<int> SelectLocalNodes(const Region& region) const;
 
   std::unique_ptr<SimObject> part_;
   const MeshPart& mesh_part_;

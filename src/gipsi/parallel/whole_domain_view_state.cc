@@ -48,7 +48,7 @@ void WholeDomainView::SaveObjectState(StateWriter& out) const {
   // What another rank count needs to read the part: its items and where they are in the whole.
   out.WriteInt(mesh_part_.num_global_nodes);
   out.WriteInt(mesh_part_.num_global_tets);
-  out.WriteInt(forward_bcs_ ? boundary().num_triangles() : 0);
+  out.WriteInt(whole_boundary_faces());
   out.WriteInt(mesh_part_.num_local());
   out.WriteInt(part_->boundary_conditions().num_vertices());
   out.WriteInt(part_->boundary().num_triangles());
@@ -61,7 +61,7 @@ void WholeDomainView::SaveObjectState(StateWriter& out) const {
 }
 
 void WholeDomainView::RestoreAppliedConditions(StateReader& in) {
-  if (!part_only_) {
+  if (!part_only_ || forward_bcs_) {  // a store numbered on the whole boundary
     SimObject::RestoreAppliedConditions(in);
     return;
   }
@@ -77,7 +77,7 @@ SavedPart WholeDomainView::OneProcessPart() const {
   saved.size = 1;
   saved.whole_nodes = saved.local.nodes = mesh_part_.num_global_nodes;
   saved.whole_tets = saved.local.tets = mesh_part_.num_global_tets;
-  saved.whole_faces = saved.local.faces = forward_bcs_ ? boundary().num_triangles() : 0;
+  saved.whole_faces = saved.local.faces = whole_boundary_faces();
   saved.owned.resize(static_cast<std::size_t>(saved.whole_nodes));
   std::iota(saved.owned.begin(), saved.owned.end(), 0);
   saved.tets.resize(static_cast<std::size_t>(saved.whole_tets));
@@ -170,7 +170,7 @@ void WholeDomainView::RestoreOnAnotherRankCount(StateReader& in, const StateRead
   const int ranks = mesh_part_.size, rank = mesh_part_.rank;
   const auto* movable = dynamic_cast<const RowState*>(part_.get());
   const std::vector<std::filesystem::path> files = CheckpointPieces();
-  const std::int64_t whole_faces = forward_bcs_ ? boundary().num_triangles() : 0;
+  const std::int64_t whole_faces = whole_boundary_faces();
   std::string refused;
   if (movable == nullptr)
     refused = one_process ? fmt::format(
@@ -187,15 +187,13 @@ void WholeDomainView::RestoreOnAnotherRankCount(StateReader& in, const StateRead
     refused =
         "a checkpoint of a run on one process is read from its one file (gipsi run "
         "--resume finds it)";
-  else if (one_process)
-    refused = {};
-  else if (files.empty())
+  else if (!one_process && files.empty())
     refused = fmt::format(
         "the checkpoint holds rank {}'s part of a run on {} ranks, and this run has {}; to "
         "resume on another rank count the restore needs every rank's file (gipsi run --resume "
         "finds them), or resume with mpirun -np {}",
         saved.rank, saved.size, ranks, saved.size);
-  else if (static_cast<std::int64_t>(files.size()) != saved.size)
+  else if (!one_process && static_cast<std::int64_t>(files.size()) != saved.size)
     refused = fmt::format(
         "the checkpoint's parts were written on {} ranks, and {} files were found ({} to {}): "
         "the set mixes checkpoints of different rank counts",
