@@ -121,9 +121,15 @@ std::vector<int> GatherSelectedNodes(const MeshPart& part, std::span<const int> 
   std::vector<int> mine;
   mine.reserve(local.size());
   for (const int i : local) mine.push_back(part.whole_node[static_cast<std::size_t>(i)]);
+  return GatherUnion(mine, comm);
+}
+
+std::vector<int> GatherUnion(std::span<const int> mine, MPI_Comm comm) {
+  int size = 1;
+  MPI_Comm_size(comm, &size);
   const int count = static_cast<int>(mine.size());
-  std::vector<int> counts(static_cast<std::size_t>(part.size)),
-      offsets(static_cast<std::size_t>(part.size), 0);
+  std::vector<int> counts(static_cast<std::size_t>(size)),
+      offsets(static_cast<std::size_t>(size), 0);
   MPI_Allgather(&count, 1, MPI_INT, counts.data(), 1, MPI_INT, comm);
   std::partial_sum(counts.begin(), counts.end() - 1, offsets.begin() + 1);
   std::vector<int> all(static_cast<std::size_t>(offsets.back() + counts.back()));

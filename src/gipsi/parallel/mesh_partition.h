@@ -73,6 +73,8 @@ MeshPart PartitionMeshBlocks(const MeshBlock& block, MPI_Comm comm);
 /// the group's triangle or tet is, which may be another rank's. Collective; O(selected).
 std::vector<int> GatherSelectedNodes(const MeshPart& part, std::span<const int> local,
                                      MPI_Comm comm);
+/// Every rank's `mine`, sorted and unique, the same on every rank. Collective; O(the union).
+std::vector<int> GatherUnion(std::span<const int> mine, MPI_Comm comm);
 /// The local indices, ascending, of the whole-mesh nodes `whole` that this part holds.
 std::vector<int> LocalNodesOf(const MeshPart& part, std::span<const int> whole);
 

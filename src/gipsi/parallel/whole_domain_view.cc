@@ -302,19 +302,7 @@ std::vector<int> WholeDomainView::SelectWholeBoundary(const Region& region, bool
     }
     for (const int f : local) mine.push_back(bc_face_[static_cast<std::size_t>(f)]);
   }
-  // Every rank's, on every rank: O(the selection).
-  int size = 1;
-  MPI_Comm_size(comm_, &size);
-  std::vector<int> counts(static_cast<std::size_t>(size)), offsets(static_cast<std::size_t>(size));
-  const int count = static_cast<int>(mine.size());
-  MPI_Allgather(&count, 1, MPI_INT, counts.data(), 1, MPI_INT, comm_);
-  std::exclusive_scan(counts.begin(), counts.end(), offsets.begin(), 0);
-  std::vector<int> all(static_cast<std::size_t>(offsets.back() + counts.back()));
-  MPI_Allgatherv(mine.data(), count, MPI_INT, all.data(), counts.data(), offsets.data(), MPI_INT,
-                 comm_);
-  std::sort(all.begin(), all.end());
-  all.erase(std::unique(all.begin(), all.end()), all.end());
-  return all;
+  return GatherUnion(mine, comm_);  // every rank's, on every rank: O(the selection)
 }
 
 std::int64_t WholeDomainView::whole_boundary_faces() const {
