@@ -265,6 +265,7 @@ std::vector<int> VerticesOfNodes(const BoundarySurface& boundary, std::span<cons
 }  // namespace
 
 std::vector<int> WholeDomainView::SelectOwnedBoundaryVertices(const Region& region) const {
+  GIPSI_CHECK(part_only_, "'{}': a view with the whole mesh reads its whole boundary", name());
   return VerticesOfNodes(part_->boundary(), SelectOwnedNodes(region));
 }
 
