@@ -54,7 +54,7 @@ stage_done package
 
 if [ "${1:-}" = "--full" ]; then
   # The slowest pure-physics tests (convergence studies on refined meshes and long
-  # integrations, 3.5-12 s each in the release build; the resolved ventricle about 70 s); the release stage runs them, and their
+  # integrations, 3.5-12 s each in the release build; the resolved ventricle 70-225 s); the release stage runs them, and their
   # code paths are covered under the sanitizers by the smaller tests of the same solvers.
   asan_skip='^(FemSolid\.CantileverDeflectionConvergesToBeamTheory'
   asan_skip+='|Amg\.IterationsStayBoundedUnderRefinement|FemAmg\.CgIterationsStayBoundedUnderRefinement'
