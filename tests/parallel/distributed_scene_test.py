@@ -224,6 +224,20 @@ def compare_cantilever(label, reference, out, least_rows):
         print(f"{label}, {name}: largest relative difference {worst:.3g}")
 
 
+def run_beam(label, scene, rank_counts, until):
+    """Runs a cantilever scene on each of `rank_counts` (to `until` s); each run must succeed,
+    and a split one name its beam as made in blocks. Returns each run's folder by rank count."""
+    outs = {}
+    for ranks in rank_counts:
+        outs[ranks] = os.path.join(work, f"{label}{ranks}")
+        code, text = run(ranks, outs[ranks], scene=scene, until=until)
+        check(code == 0, f"{label} on {ranks} ranks: exit {code}: {text}")
+        if ranks > 1:
+            check("(split over them: beam (FemSolid, in blocks))" in text,
+                  f"{label} on {ranks} ranks: the beam is not made in blocks:\n{text}")
+    return outs
+
+
 def compare_scaled(label, reference, out, scales, factor, least_rows):
     """Each probe (name, scale) of `scales` in `out` has `reference`'s header and more than
     `least_rows` rows, every value within `factor` times its scale of the reference's."""
@@ -343,17 +357,10 @@ with tempfile.TemporaryDirectory() as work:
     # their difference at ~1e-6 of the motion (a mass-dominated tangent amplifies little).
     # Measured: 4e-10 m on a 7 cm sag.
     cantilever = os.path.join(SOURCE, "scenes", "cantilever.json")
-    solid_runs = {}
-    for ranks in (1, 2, 4):
-        out = os.path.join(work, f"cantilever{ranks}")
-        code, text = run(ranks, out, scene=cantilever, until="1")
-        check(code == 0, f"cantilever on {ranks} ranks: exit {code}: {text}")
-        if ranks > 1:
-            check(f"(split over them: beam (FemSolid, in blocks))" in text,
-                  f"cantilever on {ranks} ranks: the summary does not name the split solid:\n{text}")
-            check(files(out) == expected_files(files(solid_runs[1]), ranks, "beam"),
-                  f"cantilever on {ranks} ranks: files differ from the serial run's")
-        solid_runs[ranks] = out
+    solid_runs = run_beam("cantilever", cantilever, (1, 2, 4), "1")
+    for ranks in (2, 4):
+        check(files(solid_runs[ranks]) == expected_files(files(solid_runs[1]), ranks, "beam"),
+              f"cantilever on {ranks} ranks: files differ from the serial run's")
     for ranks in (2, 4):
         compare_cantilever(f"cantilever on {ranks} ranks", solid_runs[1], solid_runs[ranks], 50)
     # The cantilever integrated explicitly (scenes/cantilever_explicit.json: RK4, lumped mass,
@@ -361,15 +368,7 @@ with tempfile.TemporaryDirectory() as work:
     # sums at shared nodes, so its probes agree to rounding, amplified little over 1,000 steps
     # (bound 1e-9 of the sag and of the weight).
     explicit = os.path.join(SOURCE, "scenes", "cantilever_explicit.json")
-    explicit_runs = {}
-    for ranks in (1, 2):
-        out = os.path.join(work, f"cantilever_explicit{ranks}")
-        code, text = run(ranks, out, scene=explicit, until="0.1")
-        check(code == 0, f"explicit cantilever on {ranks} ranks: exit {code}: {text}")
-        if ranks > 1:
-            check("(split over them: beam (FemSolid, in blocks))" in text,
-                  f"explicit cantilever on 2 ranks: the summary does not name the split solid:\n{text}")
-        explicit_runs[ranks] = out
+    explicit_runs = run_beam("cantilever_explicit", explicit, (1, 2), "0.1")
     compare_scaled("explicit cantilever on 2 ranks", explicit_runs[1], explicit_runs[2],
                    (("tip", 0.07), ("clamp", 0.1)), 1e-9, 5)
     # The cantilever under more kinds of conditions, made in blocks like the others (no rank
@@ -393,15 +392,7 @@ with tempfile.TemporaryDirectory() as work:
     loaded = os.path.join(work, "cantilever_loaded.json")
     with open(loaded, "w") as f:
         json.dump(scene, f)
-    loaded_runs = {}
-    for ranks in (1, 2, 4):
-        out = os.path.join(work, f"cantilever_loaded{ranks}")
-        code, text = run(ranks, out, scene=loaded, until="0.2")
-        check(code == 0, f"loaded cantilever on {ranks} ranks: exit {code}: {text}")
-        if ranks > 1:
-            check("(split over them: beam (FemSolid, in blocks))" in text,
-                  f"loaded cantilever on {ranks} ranks: not made in blocks:\n{text}")
-        loaded_runs[ranks] = out
+    loaded_runs = run_beam("cantilever_loaded", loaded, (1, 2, 4), "0.2")
     for ranks in (2, 4):
         compare_scaled(f"loaded cantilever on {ranks} ranks", loaded_runs[1], loaded_runs[ranks],
                        (("tip", 0.07), ("clamp", 0.1), ("reaction_box", 0.1)), 1e-6, 10)
