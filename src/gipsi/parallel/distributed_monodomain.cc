@@ -15,7 +15,9 @@
 #include "gipsi/base/state_binding.h"
 #include "gipsi/geometry/boundary.h"
 #include "gipsi/models/ep/monodomain.h"
+#include "gipsi/parallel/distributed_fibres.h"
 #include "gipsi/parallel/petsc_check.h"
+#include "gipsi/parallel/petsc_part.h"
 
 namespace gipsi {
 namespace {
@@ -60,34 +62,13 @@ void LocaliseRegions(EpTissueParams& params, const Mesh& whole, const MeshPart& 
 // node ids as whole-mesh indices; a region that selects no node on any rank is refused on
 // every rank.
 void LocaliseRegionsOnPart(EpTissueParams& params, const MeshPart& part, MPI_Comm comm) {
-  const Mesh& mesh = *part.mesh;
-  Vec3 low = Vec3::Constant(std::numeric_limits<double>::infinity()), high = -low;
-  if (mesh.num_nodes() > 0) {
-    low = mesh.nodes.rowwise().minCoeff();
-    high = mesh.nodes.rowwise().maxCoeff();
-  }
-  MPI_Allreduce(MPI_IN_PLACE, low.data(), 3, MPI_DOUBLE, MPI_MIN, comm);
-  MPI_Allreduce(MPI_IN_PLACE, high.data(), 3, MPI_DOUBLE, MPI_MAX, comm);
-  const double tolerance = RegionTolerance(low, high);
+  const double tolerance = WholeRegionTolerance(part, comm);
   auto localise = [&](Region& region, const std::string& what) {
     NodeIdsRegion ids;
-    if (const auto* whole_ids = std::get_if<NodeIdsRegion>(&region)) {
-      std::vector<int> wanted = whole_ids->ids;
-      for (std::size_t i = 0; i < wanted.size(); ++i)
-        if (wanted[i] < 0 || wanted[i] >= part.num_global_nodes)
-          throw InputError(fmt::format("{}: node id {} (ids[{}]) out of range [0, {})", what,
-                                       wanted[i], i, part.num_global_nodes));
-      std::sort(wanted.begin(), wanted.end());
-      for (std::size_t i = 0; i < part.whole_node.size(); ++i)
-        if (std::binary_search(wanted.begin(), wanted.end(), part.whole_node[i]))
-          ids.ids.push_back(static_cast<int>(i));
-    } else if (std::holds_alternative<GroupRegion>(region)) {
-      // A triangle or tet group names a node only on the ranks that hold its triangle or tet:
-      // every rank that holds the node takes it.
-      ids.ids =
-          LocalNodesOf(part, GatherSelectedNodes(part, SelectNodes(region, mesh, tolerance), comm));
-    } else {
-      ids.ids = SelectNodes(region, mesh, tolerance);
+    try {
+      ids.ids = SelectPartNodes(region, part, tolerance, comm);
+    } catch (const InputError& e) {
+      throw InputError(fmt::format("{}: {}", what, e.what()));
     }
     int found = ids.ids.empty() ? 0 : 1;
     MPI_Allreduce(MPI_IN_PLACE, &found, 1, MPI_INT, MPI_MAX, comm);
@@ -166,10 +147,6 @@ DistributedMonodomain::DistributedMonodomain(std::string name, EpTissueParams pa
         fmt::format("unknown preconditioner '{}' for the distributed monodomain; choices: 'none', "
                     "'jacobi', 'amg' (PETSc's GAMG), 'hypre' (BoomerAMG)",
                     linear.preconditioner));
-  if (whole == nullptr && params_.fibre_rule)
-    throw InputError(
-        "a fibre rule needs the whole mesh, which a mesh split as it was read does not give: "
-        "give the fibres a direction");
   if (whole != nullptr)
     LocaliseRegions(params_, *whole, part_);
   else
@@ -177,13 +154,10 @@ DistributedMonodomain::DistributedMonodomain(std::string name, EpTissueParams pa
   SetGeometry(part_.mesh, MakeBoundary(*part_.mesh));
   const Vec3 fibre = params_.fibre.value_or(Vec3::UnitX()).normalized();
   fibres_.resize(3, static_cast<Index>(part_.whole_tet.size()));
-  if (params_.fibre_rule) {
-    const Points all = MakeTransmuralFibres(*whole, *params_.fibre_rule).fibre;
-    for (std::size_t e = 0; e < part_.whole_tet.size(); ++e)
-      fibres_.col(static_cast<Index>(e)) = all.col(part_.whole_tet[e]);
-  } else {
+  if (params_.fibre_rule)  // solved over the ranks, with or without the whole mesh
+    fibres_ = TransmuralFibresOnPart(part_, *params_.fibre_rule, comm_).fibre;
+  else
     fibres_.colwise() = fibre;
-  }
   // As the serial object's, read-only: a written fibre would need the operator assembled anew.
   f_fibre_ = DeclareField({"fibre", FieldLocation::kElement, 3, "1", FieldAccess::kRead,
                            "fibre direction per element"});
@@ -213,25 +187,9 @@ void DistributedMonodomain::Assemble() {
         !std::equal(m.innerIndexPtr(), m.innerIndexPtr() + entries, k.innerIndexPtr()))
       throw std::logic_error("the P1 mass and stiffness matrices differ in pattern");
   }
-  const auto owned = static_cast<PetscInt>(part_.num_owned);
-  const auto global = static_cast<PetscInt>(part_.num_global_nodes);
   // Each local operator goes to PETSc and is then freed, which keeps the set-up peak down.
   auto make_matrix = [&](Mat* out, SparseMatrix& a) {
-    std::vector<PetscInt> rows(entries), cols(entries);
-    for (Index j = 0; j < a.outerSize(); ++j)
-      for (int at = a.outerIndexPtr()[j]; at < a.outerIndexPtr()[j + 1]; ++at) {
-        rows[static_cast<std::size_t>(at)] =
-            static_cast<PetscInt>(part_.global[static_cast<std::size_t>(a.innerIndexPtr()[at])]);
-        cols[static_cast<std::size_t>(at)] =
-            static_cast<PetscInt>(part_.global[static_cast<std::size_t>(j)]);
-      }
-    GIPSI_PETSC(MatDestroy(out));
-    GIPSI_PETSC(MatCreate(comm_, out));
-    GIPSI_PETSC(MatSetSizes(*out, owned, owned, global, global));
-    GIPSI_PETSC(MatSetType(*out, MATAIJ));
-    GIPSI_PETSC(
-        MatSetPreallocationCOO(*out, static_cast<PetscCount>(entries), rows.data(), cols.data()));
-    GIPSI_PETSC(MatSetValuesCOO(*out, a.valuePtr(), INSERT_VALUES));
+    MakePartMatrix(part_, a, comm_, out);
     a = SparseMatrix();
   };
   make_matrix(&p.stiffness, ops.stiffness);
@@ -242,11 +200,7 @@ void DistributedMonodomain::Assemble() {
   GIPSI_PETSC(MatDuplicate(p.stiffness, MAT_DO_NOT_COPY_VALUES, &p.system));
 
   GIPSI_PETSC(VecDestroy(&p.v));
-  std::vector<PetscInt> ghosts;
-  for (std::size_t i = static_cast<std::size_t>(part_.num_owned); i < part_.global.size(); ++i)
-    ghosts.push_back(static_cast<PetscInt>(part_.global[i]));
-  GIPSI_PETSC(VecCreateGhost(comm_, owned, global, static_cast<PetscInt>(ghosts.size()),
-                             ghosts.data(), &p.v));
+  p.v = MakeGhostedNodeVec(part_, comm_);
   GIPSI_PETSC(VecDestroy(&p.rhs));
   GIPSI_PETSC(VecDestroy(&p.work));
   GIPSI_PETSC(VecDestroy(&p.lumped));

@@ -39,17 +39,18 @@ namespace gipsi {
 class DistributedMonodomain final : public EpTissue {
  public:
   /// Collective: partitions `whole` (identical on every rank) over `comm`. Regions select
-  /// nodes of the whole mesh, then each rank keeps its own; fibre rules are evaluated on the
-  /// whole mesh. The diffusion solver is `params.distributed_linear` where set (the scene's
-  /// "parallel" block), else `params.linear`. Throws InputError as Monodomain does (a region
-  /// that selects no node of the whole mesh, on every rank), PetscError if PETSc fails.
+  /// nodes of the whole mesh, then each rank keeps its own; a fibre rule is solved over the
+  /// ranks (TransmuralFibresOnPart), in both constructors. The diffusion solver is
+  /// `params.distributed_linear` where set (the scene's "parallel" block), else `params.linear`.
+  /// Throws InputError as Monodomain does (a region that selects no node of the whole mesh, on
+  /// every rank), PetscError if PETSc fails.
   DistributedMonodomain(std::string name, const Mesh& whole, EpTissueParams params, MPI_Comm comm);
   /// Collective: on a mesh already cut (`part`, this rank's, e.g. from PartitionMeshBlocks, so
   /// that no rank held the mesh whole). Each rank selects the region nodes among its own, the
   /// geometric regions at the whole mesh's tolerance, node ids as whole-mesh indices, and a
   /// group's nodes as every rank found them (a rank may hold a node of a face group without
   /// the face's triangle). Throws
-  /// InputError as above, and for a fibre rule (it needs the whole mesh).
+  /// InputError as above.
   DistributedMonodomain(std::string name, MeshPart part, EpTissueParams params, MPI_Comm comm);
   ~DistributedMonodomain() override;
 

@@ -13,6 +13,7 @@
 #include "gipsi/base/units.h"
 #include "gipsi/models/ep/ep_tissue_json.h"
 #include "gipsi/models/fem/fem_solid.h"
+#include "gipsi/parallel/distributed_fibres.h"
 #include "gipsi/parallel/distributed_monodomain.h"
 #include "gipsi/parallel/distributed_solid.h"
 #include "gipsi/parallel/whole_domain_view.h"
@@ -30,6 +31,18 @@ void CheckExplicitDt(const ObjectBuildContext& ctx, const FemSolid& solid) {
       Log().warn("{}: {}: dt = {:.3g} s exceeds the estimated explicit stability limit {:.3g} s",
                  dt->file(), dt->path(), value, limit);
   }
+}
+
+// Writes a scene's fibre rule into a split solid's "fibre" field (its part's tets): an
+// ellipsoidal rule evaluated on the local tets alone, a transmural one solved over the ranks.
+void WriteFibreRule(FemSolid& solid, const MeshPart& part, const SolidFibreRule& rule,
+                    MPI_Comm comm) {
+  if (rule.ellipsoidal)
+    solid.WriteField(solid.FindField("fibre"),
+                     EllipsoidalFibresAtCentroids(*part.mesh, *rule.ellipsoidal));
+  if (rule.transmural)
+    solid.WriteField(solid.FindField("fibre"),
+                     TransmuralFibresOnPart(part, *rule.transmural, comm).fibre);
 }
 
 // Adds an object to the summary's list of split objects.
@@ -56,9 +69,7 @@ std::unique_ptr<SimObject> FemSolidInBlocks(const ObjectBuildContext& ctx, FemSo
                    ? std::make_unique<FemSolid>(ctx.name, mesh_part.mesh, std::move(spec.params),
                                                 std::move(spec.ode))
                    : std::make_unique<FemSolid>(ctx.name, mesh_part.mesh, std::move(spec.params));
-  if (spec.fibre_rule.ellipsoidal)  // evaluated on the local tets alone
-    solid->WriteField(solid->FindField("fibre"),
-                      EllipsoidalFibresAtCentroids(*mesh_part.mesh, *spec.fibre_rule.ellipsoidal));
+  WriteFibreRule(*solid, mesh_part, spec.fibre_rule, comm);
   CheckExplicitDt(ctx, *solid);
   note(ctx.name, "FemSolid, in blocks");
   return std::make_unique<WholeDomainView>(
@@ -81,9 +92,9 @@ void RegisterDistributedTypes(TypeRegistry& registry, MPI_Comm comm,
         CheckEpTissueKeys(ctx, {"parallel"});
         EpTissueParams params = ParseEpTissueParams(ctx);
         // Nothing but probes and outputs reads it: its mesh is made in blocks and no rank holds
-        // it whole (a Laplace fibre rule and an embedded display need the whole mesh).
+        // it whole (boundary conditions and an embedded display need the whole mesh).
         const auto display = ctx.params.Find("display");
-        if (ctx.standalone && !params.fibre_rule && !ctx.params.Has("boundary_conditions") &&
+        if (ctx.standalone && !ctx.params.Has("boundary_conditions") &&
             !(display && display->is_object() && display->Has("mesh"))) {
           int rank = 0, size = 1;
           MPI_Comm_rank(comm, &rank);
@@ -131,9 +142,9 @@ void RegisterDistributedTypes(TypeRegistry& registry, MPI_Comm comm,
           return whole_solid(ctx);
         spec.params.linear_solver = spec.distributed_linear;
         // Nothing else reads it: its mesh is made in blocks and no rank holds it whole
-        // (cavities, a Laplace fibre rule and an embedded display need the whole mesh).
+        // (cavities and an embedded display need the whole mesh).
         const auto display = ctx.params.Find("display");
-        if (ctx.standalone && spec.params.cavities.empty() && !spec.fibre_rule.transmural &&
+        if (ctx.standalone && spec.params.cavities.empty() &&
             !(display && display->is_object() && display->Has("mesh"))) {
           try {
             return FemSolidInBlocks(ctx, std::move(spec), comm, note);
@@ -151,17 +162,7 @@ void RegisterDistributedTypes(TypeRegistry& registry, MPI_Comm comm,
                   ? std::make_unique<FemSolid>(ctx.name, mesh_part.mesh, std::move(spec.params),
                                                std::move(spec.ode))
                   : std::make_unique<FemSolid>(ctx.name, mesh_part.mesh, std::move(spec.params));
-          if (spec.fibre_rule.ellipsoidal)  // evaluated on the local tets alone
-            solid->WriteField(
-                solid->FindField("fibre"),
-                EllipsoidalFibresAtCentroids(*mesh_part.mesh, *spec.fibre_rule.ellipsoidal));
-          if (spec.fibre_rule.transmural) {  // evaluated on the whole mesh, kept for the local tets
-            const Points all = MakeTransmuralFibres(*whole, *spec.fibre_rule.transmural).fibre;
-            Points local(3, static_cast<Index>(mesh_part.whole_tet.size()));
-            for (std::size_t e = 0; e < mesh_part.whole_tet.size(); ++e)
-              local.col(static_cast<Index>(e)) = all.col(mesh_part.whole_tet[e]);
-            solid->WriteField(solid->FindField("fibre"), local);
-          }
+          WriteFibreRule(*solid, mesh_part, spec.fibre_rule, comm);
           CheckExplicitDt(ctx, *solid);
           note(ctx.name, "FemSolid");
           return std::make_unique<WholeDomainView>(

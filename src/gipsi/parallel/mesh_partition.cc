@@ -14,6 +14,7 @@
 #include <cstring>
 #include <limits>
 #include <numeric>
+#include <variant>
 
 #include "gipsi/base/error.h"
 #include "gipsi/parallel/mesh_partition_detail.h"
@@ -152,7 +153,36 @@ std::vector<int> LocalNodesOf(const MeshPart& part, std::span<const int> whole) 
     if (it != by_whole.end() && it->first == w) out.push_back(it->second);
   }
   std::sort(out.begin(), out.end());
+  out.erase(std::unique(out.begin(), out.end()), out.end());
   return out;
+}
+
+double WholeRegionTolerance(const MeshPart& part, MPI_Comm comm) {
+  const Points& x = part.mesh->nodes;
+  Vec3 low = Vec3::Constant(std::numeric_limits<double>::infinity()), high = -low;
+  if (x.cols() > 0) {
+    low = x.rowwise().minCoeff();
+    high = x.rowwise().maxCoeff();
+  }
+  MPI_Allreduce(MPI_IN_PLACE, low.data(), 3, MPI_DOUBLE, MPI_MIN, comm);
+  MPI_Allreduce(MPI_IN_PLACE, high.data(), 3, MPI_DOUBLE, MPI_MAX, comm);
+  return RegionTolerance(low, high);
+}
+
+std::vector<int> SelectPartNodes(const Region& region, const MeshPart& part, double tolerance,
+                                 MPI_Comm comm) {
+  if (const auto* ids = std::get_if<NodeIdsRegion>(&region)) {
+    for (std::size_t i = 0; i < ids->ids.size(); ++i)
+      if (ids->ids[i] < 0 || ids->ids[i] >= part.num_global_nodes)
+        throw InputError(fmt::format("node id {} (ids[{}]) out of range [0, {})", ids->ids[i], i,
+                                     part.num_global_nodes));
+    return LocalNodesOf(part, ids->ids);
+  }
+  std::vector<int> local = SelectNodes(region, *part.mesh, tolerance);
+  // A triangle or tet group names a node only on the ranks that hold its triangle or tet.
+  if (std::holds_alternative<GroupRegion>(region))
+    local = LocalNodesOf(part, GatherSelectedNodes(part, local, comm));
+  return local;
 }
 
 }  // namespace gipsi

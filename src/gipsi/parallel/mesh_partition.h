@@ -27,6 +27,7 @@
 #include "gipsi/geometry/boundary.h"
 #include "gipsi/geometry/mesh.h"
 #include "gipsi/geometry/mesh_block.h"
+#include "gipsi/geometry/region.h"
 
 GIPSI_EXPORT_BEGIN
 namespace gipsi {
@@ -77,6 +78,17 @@ std::vector<int> GatherSelectedNodes(const MeshPart& part, std::span<const int> 
 std::vector<int> GatherUnion(std::span<const int> mine, MPI_Comm comm);
 /// The local indices, ascending, of the whole-mesh nodes `whole` that this part holds.
 std::vector<int> LocalNodesOf(const MeshPart& part, std::span<const int> whole);
+
+/// The whole mesh's RegionTolerance (geometry/region.h) from the parts' bounding boxes: the
+/// tolerance at which a part selects by position what the whole mesh would. Collective.
+double WholeRegionTolerance(const MeshPart& part, MPI_Comm comm);
+/// The local nodes (ascending) of `part` that `region` selects on the whole mesh, found without
+/// it: a position is decided where the node is, at `tolerance` (WholeRegionTolerance); node ids
+/// are whole-mesh indices (one out of range throws InputError); a group's nodes are gathered
+/// from every rank (GatherSelectedNodes). Collective (every rank must call it with the same
+/// region); O(the part), and O(the selection) for a group.
+std::vector<int> SelectPartNodes(const Region& region, const MeshPart& part, double tolerance,
+                                 MPI_Comm comm);
 
 /// The whole mesh's boundary on this rank's part, found without the whole mesh: the whole
 /// boundary's faces of local tets (outward, in the order of their tets), and every local node on

@@ -232,16 +232,9 @@ std::vector<int> WholeDomainView::SelectWholeNodes(const Region& region) const {
 }
 
 std::vector<int> WholeDomainView::SelectLocalNodes(const Region& region) const {
-  if (std::holds_alternative<NodeIdsRegion>(region))  // whole-mesh indices, range-checked
-    return LocalNodesOf(mesh_part_,
-                        part_only_ ? SelectWholeNodes(region) : SelectNodes(region, domain()));
-  if (std::holds_alternative<GroupRegion>(region))  // gathered: see SelectWholeNodes
-    return LocalNodesOf(
-        mesh_part_,
-        GatherSelectedNodes(mesh_part_, SelectNodes(region, *mesh_part_.mesh, region_tolerance_),
-                            comm_));
-  // Decided by each node's position, at the whole mesh's tolerance.
-  return SelectNodes(region, *mesh_part_.mesh, region_tolerance_);
+  if (!part_only_ && std::holds_alternative<NodeIdsRegion>(region))
+    return LocalNodesOf(mesh_part_, SelectNodes(region, domain()));  // range-checked there
+  return SelectPartNodes(region, mesh_part_, region_tolerance_, comm_);
 }
 
 std::vector<int> WholeDomainView::SelectOwnedNodes(const Region& region) const {

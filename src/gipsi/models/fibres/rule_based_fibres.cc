@@ -7,6 +7,7 @@
 
 #include <cmath>
 #include <numbers>
+#include <utility>
 #include <vector>
 
 #include "gipsi/base/error.h"
@@ -78,8 +79,15 @@ FibreField MakeTransmuralFibres(const Mesh& mesh, const TransmuralFibreRule& rul
   }
   const P1ScalarOperators ops = AssembleP1Scalar(
       mesh.nodes, mesh.tets, 1.0, [](Index) -> Mat3 { return Mat3::Identity(); }, false);
+  return TransmuralFibresFrom(mesh, rule, SolveLaplace(ops.stiffness, value, is_fixed));
+}
+
+FibreField TransmuralFibresFrom(const Mesh& mesh, const TransmuralFibreRule& rule,
+                                VecX transmural) {
+  GIPSI_CHECK(transmural.size() == mesh.num_nodes(), "{} transmural values for {} nodes",
+              transmural.size(), mesh.num_nodes());
   FibreField out;
-  out.transmural = SolveLaplace(ops.stiffness, value, is_fixed);
+  out.transmural = std::move(transmural);
   const Index ne = mesh.num_tets();
   out.fibre.resize(3, ne);
   out.sheet.resize(3, ne);

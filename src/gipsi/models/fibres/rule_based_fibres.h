@@ -40,6 +40,11 @@ struct FibreField {
 /// or epi selects no node or they share a node, or if the Laplace solve fails.
 FibreField MakeTransmuralFibres(const Mesh& mesh, const TransmuralFibreRule& rule);
 
+/// Steps 2 and 3 above for the tets of `mesh`, given e at its nodes (`transmural`, one value per
+/// node, moved into the result): how MakeTransmuralFibres ends, and how a solver that found e
+/// otherwise (over the ranks, for one rank's part of a split mesh) gets the same fibres from it.
+FibreField TransmuralFibresFrom(const Mesh& mesh, const TransmuralFibreRule& rule, VecX transmural);
+
 /// The rule's fibre at transmural coordinate `e` in a tet whose unit transmural direction is
 /// `t` (FibreField::sheet): f = cos α c + sin α l, α = α_endo + (α_epi − α_endo) e (step 3
 /// above). MakeTransmuralFibres evaluates it at each tet's centroid; a solver may evaluate it
