@@ -3,6 +3,7 @@
 // under `mpiexec -np 2` and `-np 4 --oversubscribe` (tests/CMakeLists.txt); every test is
 // collective.
 
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 #include <mpi.h>
 
@@ -396,6 +397,78 @@ TEST(DistributedSolid, CoupledCavityFillsAsTheSerialObject) {
   const Eigen::MatrixXd u = Read(*solids[0], "displacement");
   EXPECT_LE((u - Read(*solids[1], "displacement")).cwiseAbs().maxCoeff(),
             1e-8 * u.cwiseAbs().maxCoeff());
+}
+
+// The ventricle made in blocks, which no rank holds whole, with the same cavity: its faces,
+// selected on the parts and gathered, are the whole mesh's selection (a face group, and the
+// faces whose vertices a box selects), in the whole boundary's order and vertex order; the
+// part's FemSolid encloses the volume of the solid split from the whole mesh (the same parts,
+// cavity surface and sums: measured equal bits) and, coupled to the filling blood, fills as it
+// does: pressure, volume and displacements within the split-vs-serial bound of 1e-8 above. A
+// cavity whose region selects no face is refused on every rank with the serial message.
+TEST(DistributedSolid, ACavityMadeInBlocksIsTheWholeMeshsCavity) {
+  const auto whole = Ventricle();
+  const BoundarySurface whole_boundary = MakeBoundary(*whole);
+  auto from_whole = std::make_shared<DistributedSolid>(whole, World());
+  auto from_blocks = std::make_shared<DistributedSolid>(
+      PartitionMeshBlocks(
+          BlockOfMesh(*whole, ParallelSession::rank(World()), ParallelSession::size(World())),
+          World()),
+      World());
+  ASSERT_FALSE(from_blocks->has_whole_mesh());
+  ASSERT_EQ(from_blocks->part().whole_tet, from_whole->part().whole_tet);
+  for (const Region& region :
+       {Region{GroupRegion{"endo"}}, Region{BoxRegion{Vec3(-1, -1, -1), Vec3(1, 0.002, 0)}}}) {
+    const std::vector<int> expected = SelectBoundaryFaces(region, *whole, whole_boundary);
+    ASSERT_FALSE(expected.empty());
+    const WholeFaceSelection got = from_blocks->SelectWholeFaces(region);
+    EXPECT_EQ(got.faces, expected);
+    ASSERT_EQ(got.surface.num_triangles(), static_cast<Index>(expected.size()));
+    for (std::size_t k = 0; k < expected.size(); ++k)
+      for (int a = 0; a < 3; ++a)
+        ASSERT_EQ(got.surface.vertex_to_node[static_cast<std::size_t>(
+                      got.surface.triangles(a, static_cast<Index>(k)))],
+                  whole_boundary.vertex_to_node[static_cast<std::size_t>(
+                      whole_boundary.triangles(a, expected[k]))]);
+  }
+  FemParams p = VentricleParams();
+  p.newton.tolerance = 1e-10;
+  p.linear_solver.type = "cholmod";
+  p.cavities = {{"lv", GroupRegion{"endo"}}};
+  FemParams pa = p, pb = p;
+  pa.distribution = from_whole;
+  pb.distribution = from_blocks;
+  FemSolid a("a", from_whole->part().mesh, std::move(pa));
+  FemSolid b("b", from_blocks->part().mesh, std::move(pb));
+  const double v0 = Read(a, "lv_volume")(0, 0);
+  EXPECT_EQ(Read(b, "lv_volume")(0, 0), v0);
+  FillingLaw blood_a(v0, 2e-6 / 0.1, 1e-11), blood_b(v0, 2e-6 / 0.1, 1e-11);
+  a.AttachCavityLaw("lv", &blood_a);
+  b.AttachCavityLaw("lv", &blood_b);
+  HoldBase(a);
+  HoldBase(b);
+  for (int step = 0; step < 10; ++step) {
+    for (FemSolid* solid : {&a, &b}) {
+      solid->SetTime(0.01 * step);
+      ASSERT_TRUE(solid->Step(0.01).ok()) << solid->failure_detail();
+    }
+  }
+  const double pressure = Read(a, "lv_pressure")(0, 0);
+  EXPECT_GT(pressure, 100.0);
+  EXPECT_NEAR(Read(b, "lv_pressure")(0, 0), pressure, 1e-8 * pressure);
+  const double volume = Read(a, "lv_volume")(0, 0);
+  EXPECT_NEAR(Read(b, "lv_volume")(0, 0), volume, 1e-8 * volume);
+  const Eigen::MatrixXd u = Read(a, "displacement");
+  double scale = u.cwiseAbs().maxCoeff();
+  MPI_Allreduce(MPI_IN_PLACE, &scale, 1, MPI_DOUBLE, MPI_MAX, World());
+  EXPECT_LE((u - Read(b, "displacement")).cwiseAbs().maxCoeff(), 1e-8 * scale);
+
+  FemParams none = VentricleParams();
+  none.cavities = {{"lv", BoxRegion{Vec3::Constant(1), Vec3::Constant(2)}}};
+  none.distribution = from_blocks;
+  EXPECT_THAT([&] { FemSolid("c", from_blocks->part().mesh, std::move(none)); },
+              ::testing::ThrowsMessage<InputError>(
+                  ::testing::HasSubstr("cavity 'lv' selects no boundary face")));
 }
 
 // A load that inverts elements: the step fails on every rank alike (the admissibility verdict

@@ -40,8 +40,10 @@
 /// local_part, whole_nodes_of_part, whole_tets_of_part, num_owned_nodes, ShareOwnedNodeValues),
 /// checkpoints between serial and split objects (SimObject::RestoreAppliedConditions, EpTissue a
 /// RowState); 17: boundary conditions and boundary-field probes on split objects without their
-/// whole domain (PartitionedObject's SelectWholeBoundary, SelectOwnedBoundaryVertices).
-#define GIPSI_PLUGIN_INTERFACE 17
+/// whole domain (PartitionedObject's SelectWholeBoundary, SelectOwnedBoundaryVertices); 18:
+/// cavities of a split solid without its whole mesh (SolidDistribution's has_whole_mesh,
+/// SelectWholeFaces).
+#define GIPSI_PLUGIN_INTERFACE 18
 /// What a plugin's gipsi_plugin_abi_version() returns and the loader requires: the package's
 /// major and minor version with the plugin interface, MAJOR·10⁶ + MINOR·10³ + INTERFACE. A
 /// plugin thus loads only into the release line it was built against (0.1.x, as the CMake

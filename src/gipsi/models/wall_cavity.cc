@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
@@ -32,35 +33,41 @@ std::vector<WallCavity> MakeWallCavities(std::string_view object, std::span<cons
                                          const std::function<FieldId(FieldInfo)>& declare,
                                          std::string_view pressure_description) {
   std::vector<WallCavity> cavities;
-  for (const CavitySpec& spec : specs) {
-    std::vector<int> faces = SelectBoundaryFaces(spec.region, mesh, boundary);
-    if (faces.empty())
-      throw InputError(
-          fmt::format("object '{}': cavity '{}' selects no boundary face", object, spec.name));
-    CavitySurface surface = MakeCavitySurface(boundary, faces);
-    const auto nc = static_cast<Index>(surface.nodes.size());
-    EnclosedVolume volume = [&] {
-      try {
-        return EnclosedVolume(surface.triangles, nc);
-      } catch (const InputError& e) {
-        throw InputError(fmt::format("object '{}': cavity '{}': {}", object, spec.name, e.what()));
-      }
-    }();
-    const FieldId f_volume =
-        declare({spec.name + "_volume", FieldLocation::kGlobal, 1, "m^3", FieldAccess::kRead,
-                 "volume enclosed by the cavity's faces (rim capped)"});
-    const FieldId f_pressure =
-        declare({spec.name + "_pressure", FieldLocation::kGlobal, 1, "Pa", FieldAccess::kReadWrite,
-                 std::string(pressure_description)});
-    cavities.push_back(WallCavity{.faces = std::move(faces),
-                                  .nodes = std::move(surface.nodes),
-                                  .volume = std::move(volume),
-                                  .positions = Points::Zero(3, nc),
-                                  .local_gradient = Points::Zero(3, nc),
-                                  .f_volume = f_volume,
-                                  .f_pressure = f_pressure});
-  }
+  for (const CavitySpec& spec : specs)
+    cavities.push_back(MakeWallCavity(object, spec, boundary,
+                                      SelectBoundaryFaces(spec.region, mesh, boundary), declare,
+                                      pressure_description));
   return cavities;
+}
+
+WallCavity MakeWallCavity(std::string_view object, const CavitySpec& spec,
+                          const BoundarySurface& boundary, std::vector<int> faces,
+                          const std::function<FieldId(FieldInfo)>& declare,
+                          std::string_view pressure_description) {
+  if (faces.empty())
+    throw InputError(
+        fmt::format("object '{}': cavity '{}' selects no boundary face", object, spec.name));
+  CavitySurface surface = MakeCavitySurface(boundary, faces);
+  const auto nc = static_cast<Index>(surface.nodes.size());
+  EnclosedVolume volume = [&] {
+    try {
+      return EnclosedVolume(surface.triangles, nc);
+    } catch (const InputError& e) {
+      throw InputError(fmt::format("object '{}': cavity '{}': {}", object, spec.name, e.what()));
+    }
+  }();
+  const FieldId f_volume =
+      declare({spec.name + "_volume", FieldLocation::kGlobal, 1, "m^3", FieldAccess::kRead,
+               "volume enclosed by the cavity's faces (rim capped)"});
+  const FieldId f_pressure = declare({spec.name + "_pressure", FieldLocation::kGlobal, 1, "Pa",
+                                      FieldAccess::kReadWrite, std::string(pressure_description)});
+  return WallCavity{.faces = std::move(faces),
+                    .nodes = std::move(surface.nodes),
+                    .volume = std::move(volume),
+                    .positions = Points::Zero(3, nc),
+                    .local_gradient = Points::Zero(3, nc),
+                    .f_volume = f_volume,
+                    .f_pressure = f_pressure};
 }
 
 double CavityLawStiffness(CavityLaw& law, double t, double dt, double p, double vb) {

@@ -58,6 +58,13 @@ std::vector<WallCavity> MakeWallCavities(std::string_view object, std::span<cons
                                          const std::function<FieldId(FieldInfo)>& declare,
                                          std::string_view pressure_description);
 
+/// One cavity of MakeWallCavities, on faces already selected (`faces` of `boundary`, in the
+/// order the cavity keeps them). The same checks and fields.
+WallCavity MakeWallCavity(std::string_view object, const CavitySpec& spec,
+                          const BoundarySurface& boundary, std::vector<int> faces,
+                          const std::function<FieldId(FieldInfo)>& declare,
+                          std::string_view pressure_description);
+
 /// −dp/dV_b of `law` at pressure p [Pa/m³] over the step [t, t + dt], given V_b(p) = vb: a
 /// one-sided difference of 1e-6 of the pressure (at least 1 mPa); 0 if the law fails there or
 /// is not decreasing (then p is not determined by the volume). The weight of a cavity's

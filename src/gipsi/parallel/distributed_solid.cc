@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numeric>
 #include <span>
 #include <string>
 #include <string_view>
@@ -446,6 +447,44 @@ DistributedSolid::DistributedSolid(MeshPart part, MPI_Comm comm)
 }
 
 DistributedSolid::~DistributedSolid() = default;
+
+WholeFaceSelection DistributedSolid::SelectWholeFaces(const Region& region) const {
+  const std::vector<int> local =
+      SelectPartBoundaryFaces(region, part_, boundary_, WholeRegionTolerance(part_, comm_), comm_);
+  // Each selected face is one rank's (a face of its tet): its number on the whole boundary
+  // and its three whole-mesh nodes, in the whole boundary's vertex order.
+  std::vector<int> mine;
+  mine.reserve(4 * local.size());
+  for (const int f : local) {
+    mine.push_back(whole_face_[static_cast<std::size_t>(f)]);
+    for (int a = 0; a < 3; ++a)
+      mine.push_back(part_.whole_node[static_cast<std::size_t>(
+          boundary_.vertex_to_node[static_cast<std::size_t>(boundary_.triangles(a, f))])]);
+  }
+  const std::vector<int> all = GatherAll(mine, comm_);
+  const std::size_t count = all.size() / 4;
+  std::vector<std::size_t> order(count);
+  std::iota(order.begin(), order.end(), 0);
+  std::sort(order.begin(), order.end(),
+            [&all](std::size_t a, std::size_t b) { return all[4 * a] < all[4 * b]; });
+  WholeFaceSelection out;
+  std::vector<int>& nodes = out.surface.vertex_to_node;
+  for (std::size_t k = 0; k < count; ++k)
+    nodes.insert(nodes.end(), all.begin() + static_cast<std::ptrdiff_t>(4 * k + 1),
+                 all.begin() + static_cast<std::ptrdiff_t>(4 * k + 4));
+  std::sort(nodes.begin(), nodes.end());
+  nodes.erase(std::unique(nodes.begin(), nodes.end()), nodes.end());
+  out.surface.triangles.resize(3, static_cast<Index>(count));
+  for (std::size_t k = 0; k < count; ++k) {
+    const std::size_t at = 4 * order[k];
+    out.faces.push_back(all[at]);
+    for (int a = 0; a < 3; ++a)
+      out.surface.triangles(a, static_cast<Index>(k)) = static_cast<int>(
+          std::lower_bound(nodes.begin(), nodes.end(), all[at + 1 + static_cast<std::size_t>(a)]) -
+          nodes.begin());
+  }
+  return out;
+}
 
 const Mesh& DistributedSolid::whole_mesh() const {
   GIPSI_CHECK(whole_ != nullptr, "a FemSolid split from mesh blocks has no whole mesh");

@@ -35,12 +35,13 @@ namespace gipsi {
 class DistributedSolid final : public SolidDistribution {
  public:
   /// Collective: partitions `whole` (identical on every rank) over `comm`; keeps `whole` (the
-  /// cavities of the solid are computed on it). Throws InputError (fewer tets than ranks),
+  /// cavities of the solid are selected on it). Throws InputError (fewer tets than ranks),
   /// PetscError if PETSc fails.
   DistributedSolid(std::shared_ptr<const Mesh> whole, MPI_Comm comm);
   /// Collective: on a mesh already cut (`part`, this rank's, e.g. from PartitionMeshBlocks),
   /// which no rank holds whole: the part's boundary is found by exchanges (PartBoundary), and
-  /// there is no whole mesh, so the solid may have no cavities (whole_mesh() aborts).
+  /// a cavity's faces are selected on the parts and gathered (SelectWholeFaces); there is no
+  /// whole mesh (whole_mesh() aborts).
   DistributedSolid(MeshPart part, MPI_Comm comm);
   ~DistributedSolid() override;
   DistributedSolid(const DistributedSolid&) = delete;
@@ -64,6 +65,8 @@ class DistributedSolid final : public SolidDistribution {
   [[nodiscard]] std::unique_ptr<LinearSolver> MakeLinearSolver(const LinearSolverOptions& options,
                                                                const VecX& rest) const override;
   [[nodiscard]] std::int64_t WholeTetId(Index local) const override;
+  [[nodiscard]] bool has_whole_mesh() const override { return whole_ != nullptr; }
+  [[nodiscard]] WholeFaceSelection SelectWholeFaces(const Region& region) const override;
   [[nodiscard]] const Mesh& whole_mesh() const override;
   [[nodiscard]] const BoundarySurface& whole_boundary() const override;
   [[nodiscard]] std::span<const int> whole_face() const override { return whole_face_; }

@@ -49,8 +49,9 @@ void WriteFibreRule(FemSolid& solid, const MeshPart& part, const SolidFibreRule&
 using NoteSplit = std::function<void(const std::string& name, const char* type)>;
 
 // A standalone FemSolid on a mesh made as one block per rank and cut from the blocks: its
-// boundary and where it lies on the whole mesh's are found by exchanges, and the view keeps the
-// scene's conditions on the whole boundary's numbering without its geometry.
+// boundary and where it lies on the whole mesh's are found by exchanges, its cavities' faces
+// are selected on the parts and gathered, and the view keeps the scene's conditions on the
+// whole boundary's numbering without its geometry.
 
 std::unique_ptr<SimObject> FemSolidInBlocks(const ObjectBuildContext& ctx, FemSolidSpec spec,
                                             MPI_Comm comm, const NoteSplit& note) {
@@ -142,10 +143,9 @@ void RegisterDistributedTypes(TypeRegistry& registry, MPI_Comm comm,
           return whole_solid(ctx);
         spec.params.linear_solver = spec.distributed_linear;
         // Nothing else reads it: its mesh is made in blocks and no rank holds it whole
-        // (cavities and an embedded display need the whole mesh).
+        // (an embedded display needs the whole mesh).
         const auto display = ctx.params.Find("display");
-        if (ctx.standalone && spec.params.cavities.empty() &&
-            !(display && display->is_object() && display->Has("mesh"))) {
+        if (ctx.standalone && !(display && display->is_object() && display->Has("mesh"))) {
           try {
             return FemSolidInBlocks(ctx, std::move(spec), comm, note);
           } catch (const InputError& e) {

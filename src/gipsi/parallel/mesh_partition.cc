@@ -125,7 +125,7 @@ std::vector<int> GatherSelectedNodes(const MeshPart& part, std::span<const int> 
   return GatherUnion(mine, comm);
 }
 
-std::vector<int> GatherUnion(std::span<const int> mine, MPI_Comm comm) {
+std::vector<int> GatherAll(std::span<const int> mine, MPI_Comm comm) {
   int size = 1;
   MPI_Comm_size(comm, &size);
   const int count = static_cast<int>(mine.size());
@@ -136,6 +136,11 @@ std::vector<int> GatherUnion(std::span<const int> mine, MPI_Comm comm) {
   std::vector<int> all(static_cast<std::size_t>(offsets.back() + counts.back()));
   MPI_Allgatherv(mine.data(), count, MPI_INT, all.data(), counts.data(), offsets.data(), MPI_INT,
                  comm);
+  return all;
+}
+
+std::vector<int> GatherUnion(std::span<const int> mine, MPI_Comm comm) {
+  std::vector<int> all = GatherAll(mine, comm);
   std::sort(all.begin(), all.end());
   all.erase(std::unique(all.begin(), all.end()), all.end());
   return all;

@@ -74,6 +74,8 @@ MeshPart PartitionMeshBlocks(const MeshBlock& block, MPI_Comm comm);
 /// the group's triangle or tet is, which may be another rank's. Collective; O(selected).
 std::vector<int> GatherSelectedNodes(const MeshPart& part, std::span<const int> local,
                                      MPI_Comm comm);
+/// Every rank's `mine`, in rank order, the same on every rank. Collective; O(all of them).
+std::vector<int> GatherAll(std::span<const int> mine, MPI_Comm comm);
 /// Every rank's `mine`, sorted and unique, the same on every rank. Collective; O(the union).
 std::vector<int> GatherUnion(std::span<const int> mine, MPI_Comm comm);
 /// The local indices, ascending, of the whole-mesh nodes `whole` that this part holds.
@@ -96,6 +98,17 @@ std::vector<int> SelectPartNodes(const Region& region, const MeshPart& part, dou
 /// touch. The same surface as the whole mesh's boundary (MakeBoundary) restricted to the part.
 /// Collective; O(part) per rank.
 BoundarySurface PartBoundary(const MeshPart& part, MPI_Comm comm);
+
+/// The vertices of `boundary` (ascending) whose node is in `nodes` (ascending).
+std::vector<int> BoundaryVerticesOfNodes(const BoundarySurface& boundary,
+                                         std::span<const int> nodes);
+/// The faces of a part's boundary (`boundary`, PartBoundary's or the whole boundary's faces of
+/// the part) that `region` selects as SelectBoundaryFaces does on the whole mesh: a triangle
+/// group's faces matched to the part's triangles, any other region's faces whose three vertices
+/// it selects (SelectPartNodes at `tolerance`). Collective; O(the part's boundary).
+std::vector<int> SelectPartBoundaryFaces(const Region& region, const MeshPart& part,
+                                         const BoundarySurface& boundary, double tolerance,
+                                         MPI_Comm comm);
 
 /// Where a part's boundary (PartBoundary's) lies on the whole mesh's (MakeBoundary's), found
 /// without the whole mesh. Plain struct.

@@ -6,6 +6,7 @@
 #include <array>
 #include <cstdint>
 #include <span>
+#include <variant>
 #include <vector>
 
 #include "gipsi/base/error.h"
@@ -211,6 +212,40 @@ BoundarySurface PartBoundary(const MeshPart& part, MPI_Comm comm) {
     out.face_to_tet.push_back(local.face_to_tet[static_cast<std::size_t>(kept[j])]);
   }
   return out;
+}
+
+std::vector<int> BoundaryVerticesOfNodes(const BoundarySurface& boundary,
+                                         std::span<const int> nodes) {
+  std::vector<int> vertices;
+  for (Index v = 0; v < boundary.num_vertices(); ++v)
+    if (std::binary_search(nodes.begin(), nodes.end(),
+                           boundary.vertex_to_node[static_cast<std::size_t>(v)]))
+      vertices.push_back(static_cast<int>(v));
+  return vertices;
+}
+
+std::vector<int> SelectPartBoundaryFaces(const Region& region, const MeshPart& part,
+                                         const BoundarySurface& boundary, double tolerance,
+                                         MPI_Comm comm) {
+  // Collective for every region: the nodes first, on every rank.
+  const std::vector<int> vertices =
+      BoundaryVerticesOfNodes(boundary, SelectPartNodes(region, part, tolerance, comm));
+  // A triangle group's faces are matched to the part's (every face of a local tet has its
+  // triangles here); otherwise a face is selected when its three vertices are, as on the
+  // whole mesh.
+  const auto* group_region = std::get_if<GroupRegion>(&region);
+  const MeshGroup* group =
+      group_region != nullptr ? part.mesh->FindGroup(group_region->name) : nullptr;
+  if (group != nullptr && group->dim == 2) return SelectBoundaryFaces(region, *part.mesh, boundary);
+  std::vector<char> selected(static_cast<std::size_t>(boundary.num_vertices()), 0);
+  for (const int v : vertices) selected[static_cast<std::size_t>(v)] = 1;
+  std::vector<int> faces;
+  for (Index f = 0; f < boundary.num_triangles(); ++f)
+    if (selected[static_cast<std::size_t>(boundary.triangles(0, f))] != 0 &&
+        selected[static_cast<std::size_t>(boundary.triangles(1, f))] != 0 &&
+        selected[static_cast<std::size_t>(boundary.triangles(2, f))] != 0)
+      faces.push_back(static_cast<int>(f));
+  return faces;
 }
 
 }  // namespace gipsi

@@ -243,23 +243,9 @@ std::vector<int> WholeDomainView::SelectOwnedNodes(const Region& region) const {
   return local;
 }
 
-namespace {
-
-// The vertices of `boundary` whose node is in `nodes` (ascending), in vertex order.
-std::vector<int> VerticesOfNodes(const BoundarySurface& boundary, std::span<const int> nodes) {
-  std::vector<int> vertices;
-  for (Index v = 0; v < boundary.num_vertices(); ++v)
-    if (std::binary_search(nodes.begin(), nodes.end(),
-                           boundary.vertex_to_node[static_cast<std::size_t>(v)]))
-      vertices.push_back(static_cast<int>(v));
-  return vertices;
-}
-
-}  // namespace
-
 std::vector<int> WholeDomainView::SelectOwnedBoundaryVertices(const Region& region) const {
   GIPSI_CHECK(part_only_, "'{}': a view with the whole mesh reads its whole boundary", name());
-  return VerticesOfNodes(part_->boundary(), SelectOwnedNodes(region));
+  return BoundaryVerticesOfNodes(part_->boundary(), SelectOwnedNodes(region));
 }
 
 std::vector<int> WholeDomainView::SelectWholeBoundary(const Region& region, bool faces) const {
@@ -271,30 +257,14 @@ std::vector<int> WholeDomainView::SelectWholeBoundary(const Region& region, bool
     return faces ? SelectBoundaryFaces(region, domain(), boundary())
                  : SelectBoundaryVertices(region, domain(), boundary());
   const BoundarySurface& part_boundary = part_->boundary();
-  const std::vector<int> vertices = VerticesOfNodes(part_boundary, SelectLocalNodes(region));
   std::vector<int> mine;
   if (!faces) {
-    for (const int v : vertices) mine.push_back(bc_vertex_[static_cast<std::size_t>(v)]);
+    for (const int v : BoundaryVerticesOfNodes(part_boundary, SelectLocalNodes(region)))
+      mine.push_back(bc_vertex_[static_cast<std::size_t>(v)]);
   } else {
-    // A triangle group's faces are matched to the part's (every face of a local tet has its
-    // triangles here); otherwise a face is selected when its three vertices are, as on the
-    // whole mesh.
-    const auto* group_region = std::get_if<GroupRegion>(&region);
-    const MeshGroup* group =
-        group_region != nullptr ? mesh_part_.mesh->FindGroup(group_region->name) : nullptr;
-    std::vector<int> local;
-    if (group != nullptr && group->dim == 2) {
-      local = SelectBoundaryFaces(region, *mesh_part_.mesh, part_boundary);
-    } else {
-      std::vector<char> selected(static_cast<std::size_t>(part_boundary.num_vertices()), 0);
-      for (const int v : vertices) selected[static_cast<std::size_t>(v)] = 1;
-      for (Index f = 0; f < part_boundary.num_triangles(); ++f)
-        if (selected[static_cast<std::size_t>(part_boundary.triangles(0, f))] != 0 &&
-            selected[static_cast<std::size_t>(part_boundary.triangles(1, f))] != 0 &&
-            selected[static_cast<std::size_t>(part_boundary.triangles(2, f))] != 0)
-          local.push_back(static_cast<int>(f));
-    }
-    for (const int f : local) mine.push_back(bc_face_[static_cast<std::size_t>(f)]);
+    for (const int f :
+         SelectPartBoundaryFaces(region, mesh_part_, part_boundary, region_tolerance_, comm_))
+      mine.push_back(bc_face_[static_cast<std::size_t>(f)]);
   }
   return GatherUnion(mine, comm_);  // every rank's, on every rank: O(the selection)
 }

@@ -19,11 +19,20 @@
 #include "gipsi/base/export.h"
 #include "gipsi/base/math.h"
 #include "gipsi/geometry/boundary.h"
+#include "gipsi/geometry/region.h"
 #include "gipsi/numerics/newton.h"
 #include "gipsi/numerics/sparse/linear_solver.h"
 
 GIPSI_EXPORT_BEGIN
 namespace gipsi {
+
+/// The whole boundary's faces that a region selects, found on the parts. Plain struct.
+struct WholeFaceSelection {
+  std::vector<int> faces;  ///< their faces on the whole boundary (MakeBoundary's), ascending
+  /// Those faces alone, in that order and with the whole boundary's vertex order; its
+  /// vertices are the faces' whole-mesh nodes, ascending (vertex_to_node); no face_to_tet.
+  BoundarySurface surface;
+};
 
 /// Abstract; implementations are collective where noted (every process calls them in the same
 /// order).
@@ -47,7 +56,16 @@ class SolidDistribution : public VectorReduction {
   /// algebraic multigrid coarsens. Throws InputError for options it cannot honour.
   [[nodiscard]] virtual std::unique_ptr<LinearSolver> MakeLinearSolver(
       const LinearSolverOptions& options, const VecX& rest) const = 0;
-  /// The whole mesh the part was cut from, and its boundary (MakeBoundary).
+  /// Whether whole_mesh() and whole_boundary() are there: not for a part cut from blocks,
+  /// which no process held whole.
+  [[nodiscard]] virtual bool has_whole_mesh() const = 0;
+  /// The whole boundary's faces that `region` selects as SelectBoundaryFaces would on the whole
+  /// mesh (a face group's triangles, or the faces whose three vertices the region selects),
+  /// each process selecting among its part's faces; the same on every process. Collective;
+  /// O(the selection) per process. Throws InputError as SelectBoundaryFaces does.
+  [[nodiscard]] virtual WholeFaceSelection SelectWholeFaces(const Region& region) const = 0;
+  /// The whole mesh the part was cut from, and its boundary (MakeBoundary); only when
+  /// has_whole_mesh().
   [[nodiscard]] virtual const Mesh& whole_mesh() const = 0;
   [[nodiscard]] virtual const BoundarySurface& whole_boundary() const = 0;
   /// The whole boundary's face of each face of boundary().
