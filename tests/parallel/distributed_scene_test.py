@@ -229,17 +229,18 @@ def compare_cantilever(label, reference, out, least_rows):
         print(f"{label}, {name}: largest relative difference {worst:.3g}")
 
 
-def run_beam(label, scene, rank_counts, until):
-    """Runs a cantilever scene on each of `rank_counts` (to `until` s); each run must succeed,
-    and a split one name its beam as made in blocks. Returns each run's folder by rank count."""
+def run_in_blocks(label, scene, rank_counts, until, split="beam (FemSolid, in blocks)"):
+    """Runs `scene` on each of `rank_counts` (to `until` s); each run must succeed, and a split
+    one name `split` among its split objects (by default the cantilever's beam, made in
+    blocks). Returns each run's folder by rank count."""
     outs = {}
     for ranks in rank_counts:
         outs[ranks] = os.path.join(work, f"{label}{ranks}")
         code, text = run(ranks, outs[ranks], scene=scene, until=until)
         check(code == 0, f"{label} on {ranks} ranks: exit {code}: {text}")
         if ranks > 1:
-            check("(split over them: beam (FemSolid, in blocks))" in text,
-                  f"{label} on {ranks} ranks: the beam is not made in blocks:\n{text}")
+            check(f"(split over them: {split})" in text,
+                  f"{label} on {ranks} ranks: not split as '{split}':\n{text}")
     return outs
 
 
@@ -362,16 +363,11 @@ with tempfile.TemporaryDirectory() as work:
     # nothing needs its whole mesh and it is made in blocks; its probes give the serial run's
     # within the bounds above.
     ventricle = os.path.join(SOURCE, "scenes", "lv_activation.json")
-    ventricle_runs = {}
-    for ranks in (1, 2, 4):
-        ventricle_runs[ranks] = os.path.join(work, f"lv_activation{ranks}")
-        code, text = run(ranks, ventricle_runs[ranks], scene=ventricle, until="0.05")
-        check(code == 0, f"lv_activation on {ranks} ranks: exit {code}: {text}")
-        if ranks > 1:
-            check("(split over them: ep (Monodomain, in blocks))" in text,
-                  f"lv_activation on {ranks} ranks: the ventricle is not made in blocks:\n{text}")
-            compare_probes(f"lv_activation on {ranks} ranks", ventricle_runs[1],
-                           ventricle_runs[ranks], ("activated", "base"))
+    ventricle_runs = run_in_blocks("lv_activation", ventricle, (1, 2, 4), "0.05",
+                                   "ep (Monodomain, in blocks)")
+    for ranks in (2, 4):
+        compare_probes(f"lv_activation on {ranks} ranks", ventricle_runs[1], ventricle_runs[ranks],
+                       ("activated", "base"))
     # The benchmark ventricle (scenes/lv_inflation.json) with a cavity on its endocardium,
     # inflated to 2 kPa in two increments: the cavity's faces are selected on the parts and
     # gathered, so the wall is made in blocks too; its enclosed volume and the apex give the
@@ -388,23 +384,18 @@ with tempfile.TemporaryDirectory() as work:
     cavity_scene = os.path.join(work, "lv_cavity.json")
     with open(cavity_scene, "w") as f:
         json.dump(scene, f)
-    cavity_runs = {}
-    for ranks in (1, 2, 4):
-        cavity_runs[ranks] = os.path.join(work, f"lv_cavity{ranks}")
-        code, text = run(ranks, cavity_runs[ranks], scene=cavity_scene, until="1")
-        check(code == 0, f"the ventricle's cavity on {ranks} ranks: exit {code}: {text}")
-        if ranks > 1:
-            check("(split over them: lv (FemSolid, in blocks))" in text,
-                  f"the ventricle's cavity on {ranks} ranks: not made in blocks:\n{text}")
-            compare_scaled(f"the ventricle's cavity on {ranks} ranks", cavity_runs[1],
-                           cavity_runs[ranks], (("cavity", 2.5e-6), ("apex", 1e-4)), 1e-6, 1)
+    cavity_runs = run_in_blocks("lv_cavity", cavity_scene, (1, 2, 4), "1",
+                                "lv (FemSolid, in blocks)")
+    for ranks in (2, 4):
+        compare_scaled(f"the ventricle's cavity on {ranks} ranks", cavity_runs[1],
+                       cavity_runs[ranks], (("cavity", 2.5e-6), ("apex", 1e-4)), 1e-6, 1)
     # The soft cantilever (scenes/cantilever.json, 1 s: the sag and two swings), its FemSolid
     # split over 2 and 4 ranks (GAMG), against the serial run (block Gauss-Seidel CG): both
     # solve each step's Newton equations to 1e-8 of the load scale with CG to 1e-6, which bounds
     # their difference at ~1e-6 of the motion (a mass-dominated tangent amplifies little).
     # Measured: 4e-10 m on a 7 cm sag.
     cantilever = os.path.join(SOURCE, "scenes", "cantilever.json")
-    solid_runs = run_beam("cantilever", cantilever, (1, 2, 4), "1")
+    solid_runs = run_in_blocks("cantilever", cantilever, (1, 2, 4), "1")
     for ranks in (2, 4):
         check(files(solid_runs[ranks]) == expected_files(files(solid_runs[1]), ranks, "beam"),
               f"cantilever on {ranks} ranks: files differ from the serial run's")
@@ -415,7 +406,7 @@ with tempfile.TemporaryDirectory() as work:
     # sums at shared nodes, so its probes agree to rounding, amplified little over 1,000 steps
     # (bound 1e-9 of the sag and of the weight).
     explicit = os.path.join(SOURCE, "scenes", "cantilever_explicit.json")
-    explicit_runs = run_beam("cantilever_explicit", explicit, (1, 2), "0.1")
+    explicit_runs = run_in_blocks("cantilever_explicit", explicit, (1, 2), "0.1")
     compare_scaled("explicit cantilever on 2 ranks", explicit_runs[1], explicit_runs[2],
                    (("tip", 0.07), ("clamp", 0.1)), 1e-9, 5)
     # The cantilever under more kinds of conditions, made in blocks like the others (no rank
@@ -439,7 +430,7 @@ with tempfile.TemporaryDirectory() as work:
     loaded = os.path.join(work, "cantilever_loaded.json")
     with open(loaded, "w") as f:
         json.dump(scene, f)
-    loaded_runs = run_beam("cantilever_loaded", loaded, (1, 2, 4), "0.2")
+    loaded_runs = run_in_blocks("cantilever_loaded", loaded, (1, 2, 4), "0.2")
     for ranks in (2, 4):
         compare_scaled(f"loaded cantilever on {ranks} ranks", loaded_runs[1], loaded_runs[ranks],
                        (("tip", 0.07), ("clamp", 0.1), ("reaction_box", 0.1)), 1e-6, 10)

@@ -45,6 +45,21 @@ void WriteFibreRule(FemSolid& solid, const MeshPart& part, const SolidFibreRule&
                      TransmuralFibresOnPart(part, *rule.transmural, comm).fibre);
 }
 
+// The FemSolid on `distribution`'s part, with the scene's integrator (taken from `spec`) and
+// fibre rule, its explicit dt checked (collective).
+std::unique_ptr<FemSolid> MakePartSolid(const ObjectBuildContext& ctx, FemSolidSpec& spec,
+                                        std::shared_ptr<DistributedSolid> distribution,
+                                        MPI_Comm comm) {
+  const MeshPart& part = distribution->part();
+  spec.params.distribution = std::move(distribution);
+  auto solid = spec.ode ? std::make_unique<FemSolid>(ctx.name, part.mesh, std::move(spec.params),
+                                                     std::move(spec.ode))
+                        : std::make_unique<FemSolid>(ctx.name, part.mesh, std::move(spec.params));
+  WriteFibreRule(*solid, part, spec.fibre_rule, comm);
+  CheckExplicitDt(ctx, *solid);
+  return solid;
+}
+
 // Adds an object to the summary's list of split objects.
 using NoteSplit = std::function<void(const std::string& name, const char* type)>;
 
@@ -64,14 +79,8 @@ std::unique_ptr<SimObject> FemSolidInBlocks(const ObjectBuildContext& ctx, FemSo
   MeshPart cut = PartitionMeshBlocks(*block, comm);
   block.reset();  // before the object allocates its state
   auto distribution = std::make_shared<DistributedSolid>(std::move(cut), comm);
-  spec.params.distribution = distribution;
   const MeshPart& mesh_part = distribution->part();
-  auto solid = spec.ode
-                   ? std::make_unique<FemSolid>(ctx.name, mesh_part.mesh, std::move(spec.params),
-                                                std::move(spec.ode))
-                   : std::make_unique<FemSolid>(ctx.name, mesh_part.mesh, std::move(spec.params));
-  WriteFibreRule(*solid, mesh_part, spec.fibre_rule, comm);
-  CheckExplicitDt(ctx, *solid);
+  std::unique_ptr<FemSolid> solid = MakePartSolid(ctx, spec, distribution, comm);
   note(ctx.name, "FemSolid, in blocks");
   return std::make_unique<WholeDomainView>(
       std::move(solid), mesh_part, comm,
@@ -155,15 +164,8 @@ void RegisterDistributedTypes(TypeRegistry& registry, MPI_Comm comm,
         std::shared_ptr<const Mesh> whole = ctx.DomainMesh();
         try {
           auto distribution = std::make_shared<DistributedSolid>(whole, comm);
-          spec.params.distribution = distribution;
           const MeshPart& mesh_part = distribution->part();
-          auto solid =
-              spec.ode
-                  ? std::make_unique<FemSolid>(ctx.name, mesh_part.mesh, std::move(spec.params),
-                                               std::move(spec.ode))
-                  : std::make_unique<FemSolid>(ctx.name, mesh_part.mesh, std::move(spec.params));
-          WriteFibreRule(*solid, mesh_part, spec.fibre_rule, comm);
-          CheckExplicitDt(ctx, *solid);
+          std::unique_ptr<FemSolid> solid = MakePartSolid(ctx, spec, distribution, comm);
           note(ctx.name, "FemSolid");
           return std::make_unique<WholeDomainView>(
               std::move(solid), mesh_part, whole, comm,

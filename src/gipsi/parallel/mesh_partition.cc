@@ -14,6 +14,7 @@
 #include <cstring>
 #include <limits>
 #include <numeric>
+#include <utility>
 #include <variant>
 
 #include "gipsi/base/error.h"
@@ -162,7 +163,7 @@ std::vector<int> LocalNodesOf(const MeshPart& part, std::span<const int> whole) 
   return out;
 }
 
-double WholeRegionTolerance(const MeshPart& part, MPI_Comm comm) {
+std::pair<Vec3, Vec3> WholeBoundingBox(const MeshPart& part, MPI_Comm comm) {
   const Points& x = part.mesh->nodes;
   Vec3 low = Vec3::Constant(std::numeric_limits<double>::infinity()), high = -low;
   if (x.cols() > 0) {
@@ -171,6 +172,11 @@ double WholeRegionTolerance(const MeshPart& part, MPI_Comm comm) {
   }
   MPI_Allreduce(MPI_IN_PLACE, low.data(), 3, MPI_DOUBLE, MPI_MIN, comm);
   MPI_Allreduce(MPI_IN_PLACE, high.data(), 3, MPI_DOUBLE, MPI_MAX, comm);
+  return {low, high};
+}
+
+double WholeRegionTolerance(const MeshPart& part, MPI_Comm comm) {
+  const auto [low, high] = WholeBoundingBox(part, comm);
   return RegionTolerance(low, high);
 }
 

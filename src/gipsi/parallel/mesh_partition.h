@@ -21,6 +21,7 @@
 #include <cstdint>
 #include <memory>
 #include <span>
+#include <utility>
 #include <vector>
 
 #include "gipsi/base/export.h"
@@ -81,6 +82,8 @@ std::vector<int> GatherUnion(std::span<const int> mine, MPI_Comm comm);
 /// The local indices, ascending, of the whole-mesh nodes `whole` that this part holds.
 std::vector<int> LocalNodesOf(const MeshPart& part, std::span<const int> whole);
 
+/// The whole mesh's bounding box (its lowest and highest corners) from the parts'. Collective.
+std::pair<Vec3, Vec3> WholeBoundingBox(const MeshPart& part, MPI_Comm comm);
 /// The whole mesh's RegionTolerance (geometry/region.h) from the parts' bounding boxes: the
 /// tolerance at which a part selects by position what the whole mesh would. Collective.
 double WholeRegionTolerance(const MeshPart& part, MPI_Comm comm);

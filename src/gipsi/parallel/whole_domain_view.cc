@@ -8,7 +8,6 @@
 
 #include <algorithm>
 #include <array>
-#include <limits>
 #include <map>
 #include <numeric>
 #include <span>
@@ -149,14 +148,7 @@ WholeDomainView::WholeDomainView(std::unique_ptr<SimObject> part, const MeshPart
 }
 
 void WholeDomainView::Describe() {
-  const Points& x = mesh_part_.mesh->nodes;
-  Vec3 low = Vec3::Constant(std::numeric_limits<double>::infinity()), high = -low;
-  if (x.cols() > 0) {
-    low = x.rowwise().minCoeff();
-    high = x.rowwise().maxCoeff();
-  }
-  MPI_Allreduce(MPI_IN_PLACE, low.data(), 3, MPI_DOUBLE, MPI_MIN, comm_);
-  MPI_Allreduce(MPI_IN_PLACE, high.data(), 3, MPI_DOUBLE, MPI_MAX, comm_);
+  const auto [low, high] = WholeBoundingBox(mesh_part_, comm_);
   whole_diagonal_ = (high - low).norm();
   region_tolerance_ = RegionTolerance(low, high);
   // FNV-1a over the local nodes' and tets' whole-mesh indices and the owned count: the same

@@ -15,7 +15,12 @@
 // search cuts the steps, and Newton needed 6–13 iterations with several factorisations at each
 // isovolumetric phase of the heart. As a bordered unknown p absorbs that error linearly.
 
+#include <algorithm>
 #include <cmath>
+#include <numeric>
+#include <string_view>
+#include <utility>
+#include <vector>
 
 #include <fmt/format.h>
 
@@ -24,6 +29,80 @@
 #include "gipsi/models/fem/fem_solid.h"
 
 namespace gipsi {
+
+void FemSolid::MakeCavities(const Mesh& domain, const BoundarySurface& bnd) {
+  const Index n = domain.num_nodes();
+  // A split solid's cavities are the whole mesh's: selected on it when it is there, else on
+  // the parts and gathered (the selection's surface then numbers its vertices by whole-mesh
+  // node, so the cavity is the same either way).
+  auto declare = [this](FieldInfo info) { return DeclareField(std::move(info)); };
+  constexpr std::string_view kPressureDescription =
+      "pressure in the cavity, acting on its faces (follower load)";
+  if (dist_ && !dist_->has_whole_mesh()) {
+    for (const CavitySpec& spec : params_.cavities) {
+      WholeFaceSelection selected = dist_->SelectWholeFaces(spec.region);  // collective
+      std::vector<int> all(selected.faces.size());
+      std::iota(all.begin(), all.end(), 0);
+      WallCavity wall = MakeWallCavity(this->name(), spec, selected.surface, std::move(all),
+                                       declare, kPressureDescription);
+      wall.faces = std::move(selected.faces);
+      cavities_.emplace_back(std::move(wall)).gradient = VecX::Zero(3 * n);
+    }
+  } else if (!params_.cavities.empty()) {
+    for (WallCavity& wall :
+         MakeWallCavities(this->name(), params_.cavities, dist_ ? dist_->whole_mesh() : domain,
+                          dist_ ? dist_->whole_boundary() : bnd, declare, kPressureDescription))
+      cavities_.emplace_back(std::move(wall)).gradient = VecX::Zero(3 * n);
+  }
+  if (dist_ && !cavities_.empty()) {
+    // The whole cavity's surface on every process; its faces on this one, in part numbering.
+    const std::span<const int> whole_node = dist_->whole_node();
+    std::vector<std::pair<int, int>> local_of;  // (whole-mesh node, local node), sorted
+    local_of.reserve(whole_node.size());
+    for (std::size_t i = 0; i < whole_node.size(); ++i)
+      local_of.emplace_back(whole_node[i], static_cast<int>(i));
+    std::sort(local_of.begin(), local_of.end());
+    const std::span<const int> whole_face = dist_->whole_face();
+    std::vector<int> my_whole_faces(whole_face.begin(), whole_face.end());
+    std::sort(my_whole_faces.begin(), my_whole_faces.end());
+    for (Cavity& cavity : cavities_) {
+      // Surface triangle k is whole face cavity.faces[k] (MakeCavitySurface keeps the order).
+      std::vector<int> whole_faces = cavity.faces, faces;
+      for (std::size_t k = 0; k < whole_faces.size(); ++k)
+        if (std::binary_search(my_whole_faces.begin(), my_whole_faces.end(), whole_faces[k]))
+          cavity.my_triangles.push_back(static_cast<int>(k));
+      std::sort(whole_faces.begin(), whole_faces.end());
+      for (std::size_t f = 0; f < whole_face.size(); ++f)
+        if (std::binary_search(whole_faces.begin(), whole_faces.end(), whole_face[f]))
+          faces.push_back(static_cast<int>(f));
+      cavity.faces = std::move(faces);
+      for (const int node : cavity.nodes) {
+        const auto it =
+            std::lower_bound(local_of.begin(), local_of.end(), std::make_pair(node, -1));
+        cavity.local_node.push_back(it != local_of.end() && it->first == node ? it->second : -1);
+      }
+      // A rim half-edge a → b runs along one surface triangle in that direction.
+      const Triangles& triangles = cavity.volume.triangles();
+      std::vector<std::pair<int, int>> my_edges;
+      for (int k : cavity.my_triangles)
+        for (int i = 0; i < 3; ++i)
+          my_edges.emplace_back(triangles(i, k), triangles((i + 1) % 3, k));
+      std::sort(my_edges.begin(), my_edges.end());
+      for (const auto& loop : cavity.volume.loops()) {
+        auto& mine = cavity.my_loops.emplace_back();
+        for (const auto& edge : loop)
+          if (std::binary_search(my_edges.begin(), my_edges.end(), edge)) mine.push_back(edge);
+      }
+    }
+  }
+}
+
+double FemSolid::CavityVolume(std::size_t i) const {
+  GIPSI_CHECK(i < cavities_.size());
+  if (!dist_) return cavities_[i].Volume(positions_);
+  return SplitCavityVolume(cavities_[i], u().data(), nullptr);
+}
+
 std::vector<std::string> FemSolid::cavity_names() const { return CavityNames(params_.cavities); }
 
 void FemSolid::AttachCavityLaw(std::string_view cavity, CavityLaw* law) {

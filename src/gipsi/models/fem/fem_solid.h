@@ -317,6 +317,10 @@ class FemSolid final : public SimObject, public CavityWall, public RowState {
     std::vector<int> my_triangles;
     std::vector<std::vector<std::pair<int, int>>> my_loops;
   };
+  /// Builds cavities_ from params_.cavities on `domain` and its boundary `bnd` (a split
+  /// solid's on the whole mesh, or selected on the parts without it: SelectWholeFaces), and
+  /// for a split solid each cavity's faces, nodes and rim half-edges on this part.
+  void MakeCavities(const Mesh& domain, const BoundarySurface& bnd);
   /// Cavity c's vertex positions at displacements u (3 per local node) into its `positions`.
   /// Serial only.
   void CavityPositions(const Cavity& cavity, const double* u) const;
