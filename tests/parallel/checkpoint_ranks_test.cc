@@ -34,11 +34,16 @@
 #include "gipsi/parallel/mesh_partition.h"
 #include "gipsi/parallel/parallel_session.h"
 #include "gipsi/parallel/whole_domain_view.h"
+#include "parallel/cantilever.h"
 
 namespace gipsi {
 namespace {
 
 MPI_Comm World() { return ParallelSession::world(); }
+
+using test::CantileverMesh;
+using test::CantileverParams;
+using test::Clamp;
 int Rank(MPI_Comm comm) { return ParallelSession::rank(comm); }
 int Size(MPI_Comm comm) { return ParallelSession::size(comm); }
 
@@ -247,30 +252,6 @@ TEST(CheckpointRanks, ASlabsStateMovesToFewerRanksAndRunsOn) {
   const int world = Size(World());
   MovesAndRunsOn({world, world - 1, true}, "part-only, more to fewer");
   if (world > 2) MovesAndRunsOn({world - 1, world / 2, false}, "whole view, 3 to 2");
-}
-
-// The soft cantilever of distributed_solid_test.cc (10 x 1 x 1 cm, corotational, backward
-// Euler, Newton and CG to 1e-11, GAMG), clamped at x = 0, split over `comm`.
-FemParams CantileverParams() {
-  FemParams p;
-  p.material = std::make_shared<CorotationalSolid>(1e5, 0.45);
-  p.rayleigh_mass = 2.0;
-  p.scheme = ImplicitSchemeKind::kBackwardEuler;
-  p.newton.tolerance = 1e-11;
-  p.linear_solver.tolerance = 1e-11;
-  return p;
-}
-
-std::shared_ptr<const Mesh> CantileverMesh() {
-  return std::make_shared<Mesh>(MakeTetBox(Vec3::Zero(), Vec3(0.1, 0.01, 0.01), {20, 2, 2}));
-}
-
-// Holds the vertices at x = 0 of `object`'s boundary (the whole mesh's).
-void Clamp(SimObject& object) {
-  const BoundarySurface& b = object.boundary();
-  for (Index v = 0; v < b.num_vertices(); ++v)
-    if (object.domain().nodes(0, b.vertex_to_node[static_cast<std::size_t>(v)]) == 0)
-      object.boundary_conditions().Fix(v);
 }
 
 // Displacements and velocities of every node (a view gathers them on every rank).

@@ -26,11 +26,16 @@
 #include "gipsi/parallel/mesh_partition.h"
 #include "gipsi/parallel/parallel_session.h"
 #include "gipsi/parallel/whole_domain_view.h"
+#include "parallel/cantilever.h"
 
 namespace gipsi {
 namespace {
 
 MPI_Comm World() { return ParallelSession::world(); }
+
+using test::CantileverMesh;
+using test::CantileverParams;
+using test::Clamp;
 
 // The serial object, or the view on this rank's part, on the same whole mesh; stepped by
 // `integrator` through the ODE contract when one is given.
@@ -59,33 +64,6 @@ Eigen::MatrixXd Read(const SimObject& object, const std::string& field) {
   return out;
 }
 
-// The conditions go on the object's boundary (the whole mesh's, for the view as for the serial
-// object: the view hands them to its part): the vertices at x = 0 held.
-void Clamp(SimObject& object) {
-  const BoundarySurface& b = object.boundary();
-  for (Index v = 0; v < b.num_vertices(); ++v)
-    if (object.domain().nodes(0, b.vertex_to_node[static_cast<std::size_t>(v)]) == 0)
-      object.boundary_conditions().Fix(v);
-}
-
-// A soft cantilever (scenes/cantilever.json: 10 × 1 × 1 cm, corotational, E 100 kPa, ν 0.45,
-// consistent mass, Rayleigh α 2 /s, backward Euler) released under gravity: it sags 7 cm.
-FemParams CantileverParams(const std::string& preconditioner) {
-  FemParams p;
-  p.material = std::make_shared<CorotationalSolid>(1e5, 0.45);
-  p.rayleigh_mass = 2.0;
-  p.scheme = ImplicitSchemeKind::kBackwardEuler;
-  // Tight tolerances, so that both runs are near the exact solution of each step's equations.
-  p.newton.tolerance = 1e-11;
-  p.linear_solver.tolerance = 1e-11;
-  p.linear_solver.preconditioner = preconditioner;
-  return p;
-}
-
-std::shared_ptr<const Mesh> Cantilever() {
-  return std::make_shared<Mesh>(MakeTetBox(Vec3::Zero(), Vec3(0.1, 0.01, 0.01), {20, 2, 2}));
-}
-
 // 40 steps of 5 ms: through the first swing, with steps where the first Newton correction
 // raises the residual (accepted by the monotonicity test). Both runs solve every step's
 // equations to a relative residual of 1e-11 (Newton and CG), so their positions differ by the
@@ -93,7 +71,7 @@ std::shared_ptr<const Mesh> Cantilever() {
 // it with a factor 10 to spare. The split run uses GAMG with the rigid-body modes (the default
 // of split runs), the serial one block Gauss-Seidel: their solutions agree only as solutions.
 TEST(DistributedSolid, CantileverSwingsAsTheSerialObject) {
-  const auto whole = Cantilever();
+  const auto whole = CantileverMesh();
   auto serial = MakeSolid(whole, CantileverParams("sgs"), false);
   auto split = MakeSolid(whole, CantileverParams("amg"), true);
   Clamp(*serial);
@@ -126,7 +104,7 @@ TEST(DistributedSolid, CantileverSwingsAsTheSerialObject) {
 // whole boundary), and a FemSolid on it,
 // clamped on its own boundary, swings as the one split from the whole mesh.
 TEST(DistributedSolid, APartMadeInBlocksFindsTheWholeBoundaryAndSwingsAlike) {
-  const auto whole = Cantilever();
+  const auto whole = CantileverMesh();
   auto from_whole = std::make_shared<DistributedSolid>(whole, World());
   auto from_blocks = std::make_shared<DistributedSolid>(
       PartitionMeshBlocks(
@@ -176,7 +154,7 @@ TEST(DistributedSolid, APartMadeInBlocksFindsTheWholeBoundaryAndSwingsAlike) {
 // boundary vertices of a region (what probes reduce) make the whole selection once over the
 // ranks.
 TEST(DistributedSolid, APartOnlyViewSelectsTheWholeBoundarysItems) {
-  const auto whole = Cantilever();
+  const auto whole = CantileverMesh();
   const BoundarySurface whole_boundary = MakeBoundary(*whole);
   auto distribution = std::make_shared<DistributedSolid>(
       PartitionMeshBlocks(
@@ -233,7 +211,7 @@ TEST(DistributedSolid, APartOnlyViewSelectsTheWholeBoundarysItems) {
 // masses (lumped), or solves with the ranks' partial mass matrices summed (consistent). Same
 // bound as above; a wrong a₀ (a partial sum at the shared nodes) would show in the first step.
 TEST(DistributedSolid, CantileverSwingsAsTheSerialObjectWithNewmark) {
-  const auto whole = Cantilever();
+  const auto whole = CantileverMesh();
   for (bool lumped : {false, true}) {
     FemParams serial_params = CantileverParams("sgs"), split_params = CantileverParams("amg");
     for (FemParams* p : {&serial_params, &split_params}) {
@@ -266,7 +244,7 @@ TEST(DistributedSolid, CantileverSwingsAsTheSerialObjectWithNewmark) {
 // the clamp's reaction agree within 1e-9 of their scale. An implicit ODE integrator (its
 // matrix-free Newton is serial) is refused.
 TEST(DistributedSolid, CantileverSwingsAsTheSerialObjectWithRk4) {
-  const auto whole = Cantilever();
+  const auto whole = CantileverMesh();
   FemParams params = CantileverParams("sgs");
   params.lumped_mass = true;
   auto serial = MakeSolid(whole, params, false, std::make_unique<RungeKutta4>());
@@ -479,7 +457,7 @@ TEST(DistributedSolid, AFailedStepFailsEveryRankAlike) {
   p.gravity = Vec3(0, 0, -1e5);
   p.max_bisections = 0;
   p.newton.max_iterations = 5;
-  auto split = MakeSolid(Cantilever(), p, true);
+  auto split = MakeSolid(CantileverMesh(), p, true);
   Clamp(*split);
   const StepStatus status = split->Step(1.0);
   EXPECT_EQ(status.code, StepStatus::Code::kFailed);
