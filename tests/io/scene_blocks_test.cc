@@ -1,6 +1,7 @@
-// The scene loader's meshes for distributed runs: which objects are standalone (nothing else
-// in the scene names them), which meshes it leaves to be made when their object asks, and the
-// blocks it makes without the whole mesh (io/scene.h, core/registry.h).
+// The scene loader's meshes for distributed runs: which objects may be made in blocks (nothing
+// else in the scene names them but connectors coupling their parts), which meshes it leaves to
+// be made when their object asks, and the blocks it makes without the whole mesh (io/scene.h,
+// core/registry.h).
 
 #include <map>
 #include <memory>
@@ -23,22 +24,35 @@ using ::testing::HasSubstr;
 
 // What the "Recorder" objects saw when they were built.
 struct Seen {
-  bool standalone = false;
+  bool in_blocks = false;
   std::shared_ptr<const MeshBlock> block;  // when the object asked for block 1 of 3
 };
 
 // A registry whose "Recorder" objects take their domain whole, or as block 1 of 3 ("blocks":
-// true), and record what the loader told them. "note" may name anything.
+// true), and record what the loader told them. "note" may name anything. In a distributed run
+// (`in_blocks`) a Recorder may be made in blocks unless it says "whole": true. Its "Reader"
+// and "Glance" connectors are FieldCopies under other names: the loader takes a Reader to need
+// its objects whole, and a Glance to read only global fields (as a CavityCoupling does).
 std::unique_ptr<TypeRegistry> RecordingRegistry(std::map<std::string, Seen>& seen, bool in_blocks) {
   auto registry = std::make_unique<TypeRegistry>();
   RegisterBuiltins(*registry);
   registry->meshes_in_blocks = in_blocks;
+  if (in_blocks)
+    registry->splits_in_blocks["Recorder"] = [](const JsonNode& params) {
+      return !params.Bool("whole", false);
+    };
+  const ConnectorFactory* copy = registry->connectors.Find("FieldCopy");
+  registry->connectors.Register("Reader", *copy, "a FieldCopy the loader does not know");
+  registry->connectors.Register("Glance", *copy, "a FieldCopy of global fields");
+  registry->connector_part_use["Glance"] = [](const JsonNode&) {
+    return TypeRegistry::PartUse::kGlobal;
+  };
   registry->objects.Register(
       "Recorder",
       [&seen](const ObjectBuildContext& ctx) -> std::unique_ptr<SimObject> {
-        ctx.CheckKeys({"blocks", "note"});
+        ctx.CheckKeys({"blocks", "note", "whole"});
         Seen& s = seen[ctx.name];
-        s.standalone = ctx.standalone;
+        s.in_blocks = ctx.in_blocks;
         if (ctx.params.Bool("blocks", false))
           s.block = std::make_shared<MeshBlock>(ctx.DomainMeshBlock(1, 3));
         else
@@ -65,17 +79,17 @@ const char* kScene = R"({
   "schedule": {"end": 0.01, "dt": 0.001, "order": ["c", "b", "a"]}
 })";
 
-// An object named by another object is not standalone; one only probes and the schedule's
-// order name is. A distributed run's loader makes a standalone object's own mesh in blocks: the
+// An object named by another object is not made in blocks; one only probes and the schedule's
+// order name is. A distributed run's loader makes such an object's own mesh in blocks: the
 // box's block (scaled and translated) is BlockOfMesh's of the whole box, and the whole box is
 // never built; the meshes that other objects share, and those nobody uses, are built whole.
-TEST(SceneMeshes, AStandaloneObjectsMeshIsMadeInBlocksWithoutTheWholeMesh) {
+TEST(SceneMeshes, AnObjectOnlyProbesReadIsMadeInBlocksWithoutTheWholeMesh) {
   std::map<std::string, Seen> seen;
   auto registry = RecordingRegistry(seen, true);
   Scene scene = LoadSceneFromString(kScene, "scene.json", ".", *registry);
-  EXPECT_TRUE(seen["a"].standalone);
-  EXPECT_FALSE(seen["b"].standalone);  // "c" names it
-  EXPECT_TRUE(seen["c"].standalone);
+  EXPECT_TRUE(seen["a"].in_blocks);
+  EXPECT_FALSE(seen["b"].in_blocks);  // "c" names it
+  EXPECT_TRUE(seen["c"].in_blocks);
   EXPECT_EQ(scene.meshes.count("slab"), 0U);
   EXPECT_EQ(scene.meshes.count("shared"), 1U);
   EXPECT_EQ(scene.meshes.count("unused"), 1U);
@@ -95,19 +109,78 @@ TEST(SceneMeshes, AStandaloneObjectsMeshIsMadeInBlocksWithoutTheWholeMesh) {
   EXPECT_EQ(block.tets, expected.tets);
 }
 
-// A serial run builds every mesh whole, as before; the objects still learn they are standalone,
-// and a block is then cut from the whole mesh.
+// A serial run builds every mesh whole and makes nothing in blocks; a block asked for is then cut
+// from the whole mesh.
 TEST(SceneMeshes, ASerialRunBuildsEveryMeshWhole) {
   std::map<std::string, Seen> seen;
   auto registry = RecordingRegistry(seen, false);
   Scene scene = LoadSceneFromString(kScene, "scene.json", ".", *registry);
-  EXPECT_TRUE(seen["a"].standalone);
-  EXPECT_FALSE(seen["b"].standalone);
+  EXPECT_FALSE(seen["a"].in_blocks);
+  EXPECT_FALSE(seen["b"].in_blocks);
   EXPECT_EQ(scene.meshes.size(), 3U);
   ASSERT_TRUE(seen["a"].block);
   const MeshBlock expected = BlockOfMesh(*scene.meshes.at("slab"), 1, 3);
   EXPECT_EQ(seen["a"].block->nodes, expected.nodes);
   EXPECT_EQ(seen["a"].block->tets, expected.tets);
+}
+
+// Objects joined only by connectors that couple parts (FieldCopy, not "nearest") are made in
+// blocks together when all of them can be and share one domain mesh, whose blocks they then
+// ask for (it is never built whole). Another mesh, a "nearest" copy, an unknown connector, an
+// event, or an end that must be whole keeps every object such a connector joins whole, and
+// through them the objects joined to those. A connector of global fields (Glance) joins an
+// object made in blocks to a whole one.
+TEST(SceneMeshes, ObjectsCoupledPartToPartAreMadeInBlocksTogether) {
+  std::map<std::string, Seen> seen;
+  auto registry = RecordingRegistry(seen, true);
+  const char* scene_text = R"({
+    "meshes": {
+      "heart": {"generate": "box", "min": [0, 0, 0], "max": [1, 1, 1], "cells": [2, 2, 2]},
+      "slab": {"generate": "box", "min": [0, 0, 0], "max": [1, 1, 1], "cells": [2, 1, 1]},
+      "other": {"generate": "box", "min": [0, 0, 0], "max": [1, 1, 1], "cells": [1, 1, 1]},
+      "lone": {"generate": "box", "min": [0, 0, 0], "max": [1, 1, 1], "cells": [1, 1, 3]}
+    },
+    "objects": {
+      "ep": {"type": "Recorder", "domain": "heart", "dt": 0.001, "blocks": true},
+      "muscle": {"type": "Recorder", "domain": "heart", "dt": 0.001, "blocks": true},
+      "x": {"type": "Recorder", "domain": "slab", "dt": 0.001},
+      "y": {"type": "Recorder", "domain": "other", "dt": 0.001},
+      "p": {"type": "Recorder", "domain": "slab", "dt": 0.001},
+      "q": {"type": "Recorder", "domain": "slab", "dt": 0.001},
+      "r": {"type": "Recorder", "domain": "slab", "dt": 0.001},
+      "s": {"type": "Recorder", "domain": "slab", "dt": 0.001},
+      "t": {"type": "Recorder", "domain": "slab", "dt": 0.001, "whole": true},
+      "u": {"type": "Recorder", "domain": "slab", "dt": 0.001},
+      "v": {"type": "Recorder", "domain": "slab", "dt": 0.001},
+      "w": {"type": "Recorder", "domain": "slab", "dt": 0.001},
+      "g": {"type": "Recorder", "domain": "lone", "dt": 0.001, "blocks": true},
+      "h": {"type": "Recorder", "domain": "slab", "dt": 0.001, "whole": true}
+    },
+    "connectors": {
+      "ec": {"type": "FieldCopy", "from": "ep.value", "to": "muscle.value"},
+      "across": {"type": "FieldCopy", "from": "x.value", "to": "y.value"},
+      "pq": {"type": "FieldCopy", "from": "p.value", "to": "q.value"},
+      "qr": {"type": "Reader", "from": "q.value", "to": "r.value"},
+      "st": {"type": "FieldCopy", "from": "s.value", "to": "t.value"},
+      "uv": {"type": "FieldCopy", "from": "u.value", "to": "v.value", "mapping": "nearest"},
+      "gh": {"type": "Glance", "from": "g.value", "to": "h.value"}
+    },
+    "schedule": {"end": 0.002, "dt": 0.001,
+                 "events": [{"at": 0.001, "object": "w", "set_field": {"field": "value",
+                                                                        "value": [0, 0, 0]}}]}
+  })";
+  Scene scene = LoadSceneFromString(scene_text, "scene.json", ".", *registry);
+  EXPECT_TRUE(seen["ep"].in_blocks);
+  EXPECT_TRUE(seen["muscle"].in_blocks);
+  EXPECT_TRUE(seen["g"].in_blocks);
+  for (const char* name : {"x", "y", "p", "q", "r", "s", "t", "u", "v", "w", "h"})
+    EXPECT_FALSE(seen[name].in_blocks) << name;
+  ASSERT_TRUE(seen["ep"].block);
+  ASSERT_TRUE(seen["muscle"].block);
+  EXPECT_EQ(seen["ep"].block->tets, seen["muscle"].block->tets);
+  EXPECT_EQ(seen["ep"].block->num_tets, 48);
+  EXPECT_EQ(scene.meshes.count("heart"), 0U);  // only blocks of it were made
+  EXPECT_EQ(scene.meshes.count("slab"), 1U);
 }
 
 // A mistake in a mesh made in blocks is named by its JSON path, as when it is built whole, and

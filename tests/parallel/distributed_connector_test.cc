@@ -12,8 +12,11 @@
 #include <memory>
 #include <string>
 
+#include "gipsi/core/coordinator.h"
 #include "gipsi/core/partitioned_object.h"
+#include "gipsi/core/port.h"
 #include "gipsi/geometry/generators.h"
+#include "gipsi/geometry/mesh_block.h"
 #include "gipsi/models/connectors/excitation_contraction.h"
 #include "gipsi/models/connectors/field_copy.h"
 #include "gipsi/models/ep/phenomenological.h"
@@ -21,6 +24,7 @@
 #include "gipsi/models/fem/solid_laws.h"
 #include "gipsi/parallel/distributed_monodomain.h"
 #include "gipsi/parallel/distributed_solid.h"
+#include "gipsi/parallel/mesh_partition.h"
 #include "gipsi/parallel/parallel_session.h"
 #include "gipsi/parallel/whole_domain_view.h"
 
@@ -78,6 +82,34 @@ std::unique_ptr<SimObject> Muscle(std::shared_ptr<const Mesh> whole, bool split)
                                    distribution->whole_boundary_face()});
 }
 
+// This rank's part of Box(), made from blocks (no rank holds the whole box).
+MeshPart BoxInBlocks() {
+  return PartitionMeshBlocks(
+      MakeTetBoxBlock(Vec3::Zero(), Vec3(0.010, 0.004, 0.002), {20, 8, 4}, HexSplit::kSix,
+                      ParallelSession::rank(World()), ParallelSession::size(World())),
+      World());
+}
+
+// The tissue and the muscle made in blocks, behind views without the whole box (as a scene run
+// makes the heart's).
+std::unique_ptr<WholeDomainView> TissueInBlocks() {
+  auto part = std::make_unique<DistributedMonodomain>("ep", BoxInBlocks(), TissueParams(), World());
+  const MeshPart& mesh_part = part->part();
+  return std::make_unique<WholeDomainView>(std::move(part), mesh_part, World());
+}
+
+std::unique_ptr<WholeDomainView> MuscleInBlocks() {
+  FemParams p = MuscleParams();
+  auto distribution = std::make_shared<DistributedSolid>(BoxInBlocks(), World());
+  p.distribution = distribution;
+  const MeshPart& part = distribution->part();
+  return std::make_unique<WholeDomainView>(
+      std::make_unique<FemSolid>("muscle", part.mesh, std::move(p)), part, World(),
+      WholeDomainView::BoundaryMap{
+          distribution->whole_boundary_vertex(), distribution->whole_boundary_face(),
+          distribution->whole_boundary_vertices(), distribution->whole_boundary_faces()});
+}
+
 Eigen::MatrixXd Read(const SimObject& object, const std::string& field) {
   const FieldId id = object.FindField(field);
   Eigen::MatrixXd out(object.field_info(id).components, object.FieldCount(id));
@@ -95,6 +127,20 @@ double Twitch(double v, double from, double dt) {
   const double u = std::clamp((v - p.v_rest) / (p.v_peak - p.v_rest), 0.0, 1.0);
   const double rate = u >= p.threshold ? p.rise_rate : p.decay_rate;
   return p.gain * u + (from - p.gain * u) * std::exp(-rate * dt);
+}
+
+// Every tet of the muscle's part holds the twitch law's tension after 4 ms from rest at V of its
+// centroid: the mean of its corners' whole-mesh `volts` (barycentric weights of 1/4).
+void ExpectTwitchAtCentroids(const PartitionedObject& muscle, const Mesh& whole,
+                             const Eigen::MatrixXd& volts) {
+  const Eigen::MatrixXd local = Read(muscle.local_part(), "active_tension");
+  const std::span<const int> tets = muscle.whole_tets_of_part();
+  for (Index i = 0; i < local.cols(); ++i) {
+    const int e = tets[static_cast<std::size_t>(i)];
+    double mean = 0;
+    for (int a = 0; a < 4; ++a) mean += 0.25 * volts(0, whole.tets(a, e));
+    ASSERT_NEAR(local(0, i), Twitch(mean, 0.0, 0.004), 1e-9) << "tet " << e;
+  }
 }
 
 // Every rank's shared nodes take their owners' values, for one and for three components; the
@@ -202,14 +248,7 @@ TEST(SplitCoupling, ExcitationContractionCouplesThePartsWithoutGathers) {
         ASSERT_EQ(local(0, i), Twitch(volts(0, n), 0.0, 0.004)) << "local node " << i;
       }
     } else {
-      // V at a tet's centroid is the mean of its corners' (barycentric weights of 1/4).
-      const std::span<const int> tets = part.whole_tets_of_part();
-      for (Index i = 0; i < local.cols(); ++i) {
-        const int e = tets[static_cast<std::size_t>(i)];
-        double mean = 0;
-        for (int a = 0; a < 4; ++a) mean += 0.25 * volts(0, mesh->tets(a, e));
-        ASSERT_NEAR(local(0, i), Twitch(mean, 0.0, 0.004), 1e-9) << "tet " << e;
-      }
+      ExpectTwitchAtCentroids(part, *mesh, volts);
     }
     EXPECT_EQ(Read(*whole_muscle, field), Read(*split_muscle, field));
   }
@@ -249,6 +288,78 @@ TEST(SplitCoupling, FieldCopyCopiesThePartsWithoutGathers) {
   FieldCopy nearest("copy", *tissue, v, *muscle, muscle->FindField("active_tension"),
                     Mapping::kNearest, 2, "kPa/mV");
   EXPECT_FALSE(nearest.couples_parts());
+}
+
+// Objects made in blocks from one mesh (no rank holds it) are split alike, and the
+// excitation–contraction coupling couples their parts: every muscle tet gets the twitch law at
+// the mean of its corners' V, which the tissue split from the whole box gives too. A coordinator
+// takes the pair. A connector that cannot couple parts is refused on such an object when the
+// coordinator prepares, naming the connector, the field and why: one end whole on every rank,
+// a nearest-item copy. (A connector of its global fields and capabilities, the heart's cavity
+// coupling, is taken: Mpi.SceneRunMatchesTheSerialRun runs the heart in blocks.)
+TEST(SplitCoupling, ObjectsMadeInBlocksCoupleTheirPartsAndOtherConnectorsAreRefused) {
+  const auto mesh = Box();
+  std::unique_ptr<SimObject> tissue = TissueInBlocks();
+  std::unique_ptr<SimObject> muscle = MuscleInBlocks();
+  const auto whole_tissue = SplitTissue(mesh);
+  ASSERT_FALSE(dynamic_cast<PartitionedObject&>(*tissue).holds_whole_domain());
+  ASSERT_FALSE(dynamic_cast<PartitionedObject&>(*muscle).holds_whole_domain());
+  EXPECT_TRUE(SplitAlike(*tissue, *muscle));
+  EXPECT_TRUE(SplitAlike(*tissue, *whole_tissue));  // Scotch cuts the blocks as the whole box
+  for (int s = 0; s < 60; ++s) {
+    ASSERT_TRUE(tissue->Step(1e-4).ok());  // 6 ms
+    ASSERT_TRUE(whole_tissue->Step(1e-4).ok());
+  }
+  const Eigen::MatrixXd volts = Read(*whole_tissue, "V");
+  Coordinator coupled;
+  SimObject* ep = tissue.get();
+  SimObject* wall = muscle.get();
+  coupled.AddObject(std::move(tissue), 1e-4);
+  coupled.AddObject(std::move(muscle), 1e-4);
+  coupled.AddConnector(
+      std::make_unique<ExcitationContraction>("ec", *ep, ep->FindField("V"), *wall,
+                                              wall->FindField("active_tension"), kTwitch),
+      1);
+  EXPECT_TRUE(coupled.connector(0).couples_parts());
+  EXPECT_NO_THROW(coupled.Prepare(1e-4));
+  ASSERT_TRUE(coupled.connector(0).Fire(0.0).ok());
+  ASSERT_TRUE(coupled.connector(0).Fire(0.004).ok());
+  ExpectTwitchAtCentroids(dynamic_cast<PartitionedObject&>(*wall), *mesh, volts);
+
+  {  // EC to a muscle whole on every rank: it would read the tissue's part as the whole field
+    auto source = TissueInBlocks();
+    auto whole_muscle = Muscle(mesh, false);
+    auto ec = std::make_unique<ExcitationContraction>(
+        "ec", *source, source->FindField("V"), *whole_muscle,
+        whole_muscle->FindField("active_tension"), kTwitch);
+    EXPECT_FALSE(ec->couples_parts());
+    Coordinator c;
+    c.AddObject(std::move(source), 1e-4);
+    c.AddObject(std::move(whole_muscle), 1e-4);
+    c.AddConnector(std::move(ec), 1);
+    try {
+      c.Prepare(1e-4);
+      ADD_FAILURE() << "accepted";
+    } catch (const WiringError& e) {
+      EXPECT_NE(std::string(e.what()).find("connector 'ec' (ExcitationContraction) reads field 'V' "
+                                           "of 'ep' (Monodomain) at its 'from' key, but that "
+                                           "object is made in blocks"),
+                std::string::npos)
+          << e.what();
+    }
+  }
+  {  // a nearest-item copy between objects split alike
+    auto source = TissueInBlocks();
+    auto target = MuscleInBlocks();
+    auto copy = std::make_unique<FieldCopy>("copy", *source, source->FindField("V"), *target,
+                                            target->FindField("active_tension"),
+                                            FieldCopy::Mapping::kNearest, 2, "kPa/mV");
+    Coordinator c;
+    c.AddObject(std::move(source), 1e-4);
+    c.AddObject(std::move(target), 1e-4);
+    c.AddConnector(std::move(copy), 1);
+    EXPECT_THROW(c.Prepare(1e-4), WiringError);
+  }
 }
 
 }  // namespace

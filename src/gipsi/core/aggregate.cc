@@ -2,12 +2,16 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
+#include <set>
+#include <string>
 
 #include "gipsi/base/units.h"
 
 #include <fmt/format.h>
 
 #include "gipsi/base/error.h"
+#include "gipsi/core/in_blocks.h"
 
 namespace gipsi {
 
@@ -78,8 +82,13 @@ Coordinator BuildAggregateParts(const ObjectBuildContext& ctx, const JsonNode& p
   Coordinator parts;
   JsonNode part_nodes = p.At("parts");
   if (part_nodes.size() == 0) part_nodes.Expected("at least one part");
+  // Made in blocks (its parts too, by the scene's rule among them) only when nothing outside
+  // reads its parts.
+  const std::set<std::string> in_blocks =
+      ctx.in_blocks ? InBlocksObjects(part_nodes, p.Find("connectors"), std::nullopt, ctx.registry)
+                    : std::set<std::string>{};
   for (const auto& [name, node] : part_nodes.Members()) {
-    BuiltObject built = ctx.build_object(name, node);
+    BuiltObject built = ctx.build_object(name, node, in_blocks.count(name) > 0);
     try {
       parts.AddObject(std::move(built.object), built.dt);
     } catch (const InputError& e) {

@@ -77,6 +77,8 @@ class AggregateObject : public SimObject {
 
 /// Builds the parts, connectors and order of an aggregate from `p` ({"dt", "parts",
 /// "connectors", "order"}) and prepares them with its dt; throws InputError naming the path.
+/// In an aggregate made in blocks (ctx.in_blocks), the parts InBlocksObjects allows among them
+/// are made in blocks too (gipsi/core/in_blocks.h).
 Coordinator BuildAggregateParts(const ObjectBuildContext& ctx, const JsonNode& p);
 
 /// Registers "Aggregate": {"type": "Aggregate", "dt": macro step, "parts": {name: object...},

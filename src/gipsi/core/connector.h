@@ -51,6 +51,11 @@ class Connector {
   /// What the last failed Fire adds to its status (e.g. an exception's message from a connector
   /// written in Python), quoted in the run's diagnostic; empty by default.
   [[nodiscard]] virtual std::string failure_detail() const { return {}; }
+  /// Whether it couples the objects' parts process by process (objects split alike in a
+  /// distributed run; gipsi/core/partitioned_object.h). Only such a connector may use a node or
+  /// element field of an object made in blocks, of which each process holds only its part;
+  /// Coordinator::Prepare refuses any other. False by default.
+  [[nodiscard]] virtual bool couples_parts() const { return false; }
   /// What it uses of the objects it couples, and its constraints on the order, as declared by
   /// its constructor (checked by Coordinator::Prepare, listed by `gipsi validate`).
   [[nodiscard]] std::span<const PortUse> ports() const { return ports_; }

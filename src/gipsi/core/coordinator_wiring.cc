@@ -12,6 +12,7 @@
 #include "gipsi/base/units.h"
 #include "gipsi/core/aggregate.h"
 #include "gipsi/core/coordinator.h"
+#include "gipsi/core/partitioned_object.h"
 
 namespace gipsi {
 namespace {
@@ -68,6 +69,32 @@ void CheckFieldPort(const Connector& c, const PortUse& port) {
         info.units, port.units, info.units, factor, port.units));
 }
 
+// An end on an object made in blocks (each process holds only its part): its node and element
+// fields and its boundary are the part's, so only a connector coupling parts may use them. Its
+// global fields and capabilities are the whole object's.
+void CheckPartOnlyPort(const Connector& c, const PortUse& port) {
+  const auto* split = dynamic_cast<const PartitionedObject*>(port.object);
+  if (split == nullptr || split->holds_whole_domain() || c.couples_parts()) return;
+  if (port.kind == PortUse::Kind::kCapability) return;
+  std::string end;
+  if (port.kind == PortUse::Kind::kField) {
+    const std::optional<FieldId> id = port.object->TryFindField(port.name);
+    if (!id || port.object->field_info(*id).location == FieldLocation::kGlobal) return;
+    end = fmt::format("{} field '{}' of {}", PortAccessName(port.access), port.name,
+                      Describe(*port.object));
+  } else {
+    end = fmt::format("sets the boundary conditions of {}", Describe(*port.object));
+  }
+  throw WiringError(
+      fmt::format("connector '{}' ({}) {} at its '{}' key, but that object is made in blocks in "
+                  "this distributed run (each process holds only its part) and the connector "
+                  "does not couple it part to part (ExcitationContraction does, and FieldCopy "
+                  "with a direct or barycentric mapping, between objects made in blocks from "
+                  "one domain mesh)",
+                  c.path(), c.type_name(), end, port.key),
+      c.name(), "");
+}
+
 }  // namespace
 
 int Coordinator::TopLevelIndex(const SimObject* object) const {
@@ -102,6 +129,7 @@ void Coordinator::CheckWiring() const {
                                       who, port.object->path(), port.key),
                           c.name(), "");
       if (port.kind == PortUse::Kind::kField) CheckFieldPort(c, port);
+      CheckPartOnlyPort(c, port);
     }
 
     for (const OrderRule& rule : c.order_rules()) {

@@ -5,10 +5,11 @@
 /// is then this process's part (local node numbering), and what needs the whole domain goes
 /// through the collective calls below, on the whole domain's node indices, which every process
 /// knows without holding the whole mesh. Probes use them (io/probes.h; region probes reduce
-/// through them on whole objects too, so no process gathers a region); other consumers of the
-/// object's fields (connectors, events) are not offered such an object: the scene loader gives
-/// an object its whole domain when anything else in the scene names it
-/// (ObjectBuildContext::standalone).
+/// through them on whole objects too, so no process gathers a region), and so do connectors that
+/// couple parts (below; Connector::couples_parts). Other consumers of the object's fields (other
+/// connectors, events) are not offered such an object: the scene loader gives an object its
+/// whole domain when anything else in the scene names it (ObjectBuildContext::in_blocks), and
+/// Coordinator::Prepare refuses any other connector's use of its node or element fields.
 ///
 /// Two split objects cut alike (SplitAlike: the same whole domain, the same part on every
 /// process) can be coupled part to part: a connector reads one's local_part() and writes the

@@ -93,10 +93,10 @@ std::unique_ptr<SimObject> TypeRegistry::CreateObject(const std::string& name,
                                                       const JsonNode& params,
                                                       const MeshProvider& meshes,
                                                       const BuildObjectFn& build_object,
-                                                      bool standalone) const {
+                                                      bool in_blocks) const {
   JsonNode type = params.At("type");
   const ObjectFactory& factory = objects.Get(type.AsString(), type);
-  ObjectBuildContext context{name, params, *this, meshes, build_object, standalone};
+  ObjectBuildContext context{name, params, *this, meshes, build_object, in_blocks};
   auto object = factory(context);
   GIPSI_CHECK(object != nullptr, "factory for '{}' returned null", type.AsString());
   return object;

@@ -34,16 +34,19 @@
 /// types for connectors (Connector::BindState, BindNoState) and aggregates
 /// (AggregateObject::BindAggregateState, replacing SaveAggregateState), the HapticEndpoint
 /// capability; 13: SolidMaterial::ElementStressAndStiffnessBatch (a new virtual); 14: meshes in
-/// blocks (MeshProvider::GetMeshBlock, ObjectBuildContext::standalone), the PartitionedObject
-/// capability; 15: PartitionedObject's reductions where the nodes are owned (SelectOwnedNodes,
-/// ReadOwnedNodes, CombineAcross); 16: coupling split objects part to part (PartitionedObject's
-/// local_part, whole_nodes_of_part, whole_tets_of_part, num_owned_nodes, ShareOwnedNodeValues),
-/// checkpoints between serial and split objects (SimObject::RestoreAppliedConditions, EpTissue a
-/// RowState); 17: boundary conditions and boundary-field probes on split objects without their
-/// whole domain (PartitionedObject's SelectWholeBoundary, SelectOwnedBoundaryVertices); 18:
-/// cavities of a split solid without its whole mesh (SolidDistribution's has_whole_mesh,
-/// SelectWholeFaces).
-#define GIPSI_PLUGIN_INTERFACE 18
+/// blocks (MeshProvider::GetMeshBlock, ObjectBuildContext::standalone), the
+/// PartitionedObject capability; 15: PartitionedObject's reductions where the nodes are owned
+/// (SelectOwnedNodes, ReadOwnedNodes, CombineAcross); 16: coupling split objects part to part
+/// (PartitionedObject's local_part, whole_nodes_of_part, whole_tets_of_part, num_owned_nodes,
+/// ShareOwnedNodeValues), checkpoints between serial and split objects
+/// (SimObject::RestoreAppliedConditions, EpTissue a RowState); 17: boundary conditions and
+/// boundary-field probes on split objects without their whole domain (PartitionedObject's
+/// SelectWholeBoundary, SelectOwnedBoundaryVertices); 18: cavities of a split solid without its
+/// whole mesh (SolidDistribution's has_whole_mesh, SelectWholeFaces); 19: objects coupled part to
+/// part made in blocks (ObjectBuildContext::in_blocks replaces standalone;
+/// TypeRegistry::splits_in_blocks and connector_part_use; Connector::couples_parts, checked against
+/// part-only ends).
+#define GIPSI_PLUGIN_INTERFACE 19
 /// What a plugin's gipsi_plugin_abi_version() returns and the loader requires: the package's
 /// major and minor version with the plugin interface, MAJOR·10⁶ + MINOR·10³ + INTERFACE. A
 /// plugin thus loads only into the release line it was built against (0.1.x, as the CMake
@@ -79,8 +82,10 @@ struct BuiltObject {
   std::unique_ptr<SimObject> object;
   double dt = 0;
 };
-/// Builds a complete object (factory, time step, boundary conditions, display) from its JSON.
-using BuildObjectFn = std::function<BuiltObject(const std::string& name, const JsonNode& params)>;
+/// Builds a complete object (factory, time step, boundary conditions, display) from its JSON;
+/// `in_blocks` as ObjectBuildContext::in_blocks (InBlocksObjects, gipsi/core/in_blocks.h).
+using BuildObjectFn =
+    std::function<BuiltObject(const std::string& name, const JsonNode& params, bool in_blocks)>;
 
 /// Everything an object factory may use. The JSON keys every object accepts (type, dt, domain,
 /// display, boundary_conditions, integrator) are handled by the scene loader; factories read
@@ -97,11 +102,15 @@ struct ObjectBuildContext {
   static const std::vector<std::string>& CommonKeys();
   /// Throws InputError for a key that is neither common nor in `own`.
   void CheckKeys(std::initializer_list<std::string_view> own) const;
-  /// Nothing else in the scene names this object (no connector, event or other object): only
-  /// probes and outputs read it, so a distributed run may split it without its whole domain
-  /// (gipsi/core/partitioned_object.h). Set by the scene loader for top-level objects; false for
-  /// the parts of aggregates.
-  bool standalone = false;
+  /// A distributed run may make this object in blocks, without its whole domain on any process
+  /// (gipsi/core/partitioned_object.h): its type can be (TypeRegistry::splits_in_blocks), no
+  /// event or other object names it, and every connector naming it either couples parts with
+  /// objects also made in blocks from the same domain mesh or uses only its global fields and
+  /// capabilities (TypeRegistry::connector_part_use). Besides those, only probes, outputs and
+  /// the schedule's order read it. Set by the scene loader for top-level objects, and by an
+  /// aggregate made in blocks for its parts, by the same rule (InBlocksObjects,
+  /// gipsi/core/in_blocks.h); false in serial runs.
+  bool in_blocks = false;
 
   /// The domain mesh named by params.domain (required).
   [[nodiscard]] std::shared_ptr<const Mesh> DomainMesh() const;
@@ -205,10 +214,28 @@ class TypeRegistry {
   FactoryTable<MaterialFactory> materials{"material law"};
 
   /// Set by a distributed run (gipsi/parallel/): the scene loader then builds the domain mesh
-  /// of a standalone object (ObjectBuildContext::standalone) that nothing else uses only when
+  /// of objects made in blocks (ObjectBuildContext::in_blocks) that nothing else uses only when
   /// its factory asks for it, whole or in blocks (MeshProvider::GetMeshBlock), and keeps no
   /// whole mesh it made only to cut blocks from. False: every mesh is built whole first.
   bool meshes_in_blocks = false;
+  /// Object types a distributed run can make in blocks, and when from the object's JSON (e.g. a
+  /// Monodomain without boundary conditions): set by the run's own types (gipsi/parallel/).
+  /// Empty in serial runs, where nothing is made in blocks.
+  std::map<std::string, std::function<bool(const JsonNode& params)>, std::less<>> splits_in_blocks;
+  /// How a connector uses objects made in blocks (of which each process holds only its part).
+  enum class PartUse {
+    kWhole,       ///< it needs its objects whole (every type not in connector_part_use)
+    kPartToPart,  ///< it couples the parts of objects split alike, made in blocks from one
+                  ///< domain mesh (Connector::couples_parts), or of objects all whole
+    kGlobal,      ///< it uses only its objects' global fields and capabilities: any of them may
+                  ///< be made in blocks
+  };
+  /// Connector types that can join objects made in blocks, and how, from the connector's JSON
+  /// (e.g. a FieldCopy couples parts unless its mapping is "nearest"): registered with the
+  /// connector. The scene loader makes objects in blocks only where every connector naming them
+  /// allows it (ObjectBuildContext::in_blocks).
+  std::map<std::string, std::function<PartUse(const JsonNode& params)>, std::less<>>
+      connector_part_use;
 
   /// The table of another kind of product, which the layer that defines the product declares
   /// (the kernel names no model concept): e.g. `CellModels(registry)` in
@@ -230,12 +257,12 @@ class TypeRegistry {
       std::string_view kind) const;
 
   /// Builds the object described by `params` (its "type" picks the factory);
-  /// `standalone` as ObjectBuildContext::standalone.
+  /// `in_blocks` as ObjectBuildContext::in_blocks.
   [[nodiscard]] std::unique_ptr<SimObject> CreateObject(const std::string& name,
                                                         const JsonNode& params,
                                                         const MeshProvider& meshes,
                                                         const BuildObjectFn& build_object,
-                                                        bool standalone = false) const;
+                                                        bool in_blocks = false) const;
   /// Builds the connector described by `params` within `scope`.
   [[nodiscard]] std::unique_ptr<Connector> CreateConnector(const std::string& name,
                                                            const JsonNode& params,

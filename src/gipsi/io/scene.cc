@@ -15,6 +15,7 @@
 #include "gipsi/base/file_io.h"
 #include "gipsi/base/log.h"
 #include "gipsi/base/units.h"
+#include "gipsi/core/in_blocks.h"
 #include "gipsi/geometry/generators.h"
 #include "gipsi/io/gmsh_block_reader.h"
 #include "gipsi/io/mesh_io.h"
@@ -56,10 +57,11 @@ std::array<int, 3> Cells3(const JsonNode& node) {
   return out;
 }
 
-/// The scene's meshes. Each is built whole when the "meshes" section is read, except, when the
-/// registry asks for meshes in blocks (a distributed run), the domain of a standalone object
-/// that nothing else uses: that one is built when its object asks for it, whole (GetMesh) or as
-/// one process's block (GetMeshBlock), and a block is made without keeping the whole mesh.
+/// The scene's meshes. Each is built whole when the "meshes" section is read, except when the
+/// registry asks for meshes in blocks (a distributed run): then each is built when an object
+/// first asks for it, whole (GetMesh) or as one process's block (GetMeshBlock, for an object made
+/// in blocks), and a block is made without keeping the whole mesh; a mesh no object asks for is
+/// built whole at the end (BuildTheRest), so a mistake in it is still reported.
 class SceneMeshes final : public MeshProvider {
  public:
   using StageFn = std::function<void(const std::string& name, const JsonNode& node)>;
@@ -204,14 +206,16 @@ class ObjectBuilder {
   ObjectBuilder(const TypeRegistry& registry, const SceneMeshes& meshes, Scene& scene,
                 double default_dt)
       : registry_(registry), meshes_(meshes), scene_(scene), default_dt_(default_dt) {
-    fn_ = [this](const std::string& name, const JsonNode& node) { return Build(name, node); };
+    fn_ = [this](const std::string& name, const JsonNode& node, bool in_blocks) {
+      return Build(name, node, in_blocks);
+    };
   }
 
-  /// `standalone` as ObjectBuildContext::standalone (false for the parts of aggregates).
-  BuiltObject Build(const std::string& name, const JsonNode& node, bool standalone = false) {
+  /// `in_blocks` as ObjectBuildContext::in_blocks.
+  BuiltObject Build(const std::string& name, const JsonNode& node, bool in_blocks) {
     if (name.empty() || name.find_first_of("./ ") != std::string::npos)
       node.Fail(fmt::format("object name '{}' must be non-empty without '.', '/' or spaces", name));
-    auto object = registry_.CreateObject(name, node, meshes_, fn_, standalone);
+    auto object = registry_.CreateObject(name, node, meshes_, fn_, in_blocks);
     double dt = default_dt_;
     if (auto d = node.Find("dt")) dt = ReadPositiveQuantity(*d, "s");
     if (!(dt > 0)) node.Fail("missing required key 'dt' (and schedule.dt is not set)");
@@ -453,66 +457,6 @@ int GeneratedOrder(const JsonNode& node) {
   return static_cast<int>(value);
 }
 
-// Whether `node` holds, at any depth, a string that names the object `name` ("name", a dotted
-// path from it: "name.field", "name.part.field", or one of its conditions: "name/clamp").
-bool Names(const JsonNode& node, const std::string& name) {
-  if (node.is_string()) {
-    const std::string& s = node.raw().get_ref<const std::string&>();
-    return s == name || (s.size() > name.size() && s.compare(0, name.size(), name) == 0 &&
-                         (s[name.size()] == '.' || s[name.size()] == '/'));
-  }
-  if (node.is_object()) {
-    for (const auto& [key, value] : node.Members())
-      if (Names(value, name)) return true;
-  } else if (node.is_array()) {
-    for (const auto& item : node.Items())
-      if (Names(item, name)) return true;
-  }
-  return false;
-}
-
-// The top-level objects that no connector, event or other object names
-// (ObjectBuildContext::standalone): only probes, outputs and the schedule's order may name them.
-std::set<std::string> StandaloneObjects(const JsonNode& root) {
-  std::set<std::string> out;
-  const JsonNode objects = root.At("objects");
-  std::vector<JsonNode> others;
-  if (auto connectors = root.Find("connectors")) others.push_back(*connectors);
-  if (auto schedule = root.Find("schedule"); schedule && schedule->is_object())
-    if (auto events = schedule->Find("events")) others.push_back(*events);
-  for (const auto& member : objects.Members()) {
-    const std::string& name = member.first;
-    bool named = std::any_of(others.begin(), others.end(),
-                             [&name](const JsonNode& other) { return Names(other, name); });
-    for (const auto& [other, other_node] : objects.Members())
-      if (other != name && Names(other_node, name)) named = true;
-    if (!named) out.insert(name);
-  }
-  return out;
-}
-
-// The meshes that standalone objects alone use, as their "domain" only: a distributed run
-// builds them when their object asks for them (whole, or in blocks). A mesh any other key of any
-// object names (a display mesh, another object's domain) is built whole first.
-std::set<std::string> DeferrableMeshes(const JsonNode& objects,
-                                       const std::set<std::string>& standalone) {
-  std::set<std::string> out;
-  for (const auto& [name, node] : objects.Members()) {
-    if (!standalone.count(name) || !node.is_object() || !node.Has("domain") ||
-        !node.At("domain").is_string())
-      continue;
-    const std::string mesh = node.At("domain").AsString();
-    bool used_otherwise = false;
-    for (const auto& [other, other_node] : objects.Members()) {
-      if (!other_node.is_object()) continue;
-      for (const auto& [key, value] : other_node.Members())
-        if (!(other == name && key == "domain") && Names(value, mesh)) used_otherwise = true;
-    }
-    if (!used_otherwise) out.insert(mesh);
-  }
-  return out;
-}
-
 }  // namespace
 
 Mesh BuildMesh(const JsonNode& node, const std::filesystem::path& base_dir) {
@@ -646,16 +590,11 @@ Scene LoadSceneFromString(std::string_view text, const std::string& name,
                             ? " (generate " + node.At("generate").AsString() + ")"
                             : ""));
       });
-  // Top-level objects nothing else names; in a distributed run, the meshes only they use.
-  std::set<std::string> standalone;
-  std::set<std::string> deferrable;
-  if (auto objects = root.Find("objects"); objects && objects->is_object()) {
-    standalone = StandaloneObjects(root);
-    if (registry.meshes_in_blocks) deferrable = DeferrableMeshes(*objects, standalone);
-  }
+  // In a distributed run, every mesh is built when an object first asks for it: whole, or only
+  // the process's block (never then the whole mesh) for an object made in blocks.
   if (auto meshes = root.Find("meshes")) {
     for (const auto& [mesh_name, node] : meshes->Members()) {
-      if (deferrable.count(mesh_name))
+      if (registry.meshes_in_blocks)
         mesh_provider.Defer(mesh_name, node);
       else
         mesh_provider.Build(mesh_name, node);
@@ -670,12 +609,16 @@ Scene LoadSceneFromString(std::string_view text, const std::string& name,
   ObjectBuilder builder(registry, mesh_provider, scene, macro_dt);
   JsonNode objects = root.At("objects");
   if (objects.size() == 0) objects.Expected("at least one object");
+  std::optional<JsonNode> events;
+  if (schedule.is_object()) events = schedule.Find("events");
+  const std::set<std::string> in_blocks =
+      InBlocksObjects(objects, root.Find("connectors"), events, registry);
   for (const auto& [object_name, node] : objects.Members()) {
     stage(fmt::format("object '{}'{}", object_name,
                       node.is_object() && node.Has("type") && node.At("type").is_string()
                           ? " (" + node.At("type").AsString() + ")"
                           : ""));
-    BuiltObject built = builder.Build(object_name, node, standalone.count(object_name) > 0);
+    BuiltObject built = builder.Build(object_name, node, in_blocks.count(object_name) > 0);
     try {
       scene.kernel->coordinator().AddObject(std::move(built.object), built.dt);
     } catch (const InputError& e) {

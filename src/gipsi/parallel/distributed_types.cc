@@ -13,6 +13,7 @@
 #include "gipsi/base/units.h"
 #include "gipsi/models/ep/ep_tissue_json.h"
 #include "gipsi/models/fem/fem_solid.h"
+#include "gipsi/numerics/implicit_scheme.h"
 #include "gipsi/parallel/distributed_fibres.h"
 #include "gipsi/parallel/distributed_monodomain.h"
 #include "gipsi/parallel/distributed_solid.h"
@@ -60,13 +61,34 @@ std::unique_ptr<FemSolid> MakePartSolid(const ObjectBuildContext& ctx, FemSolidS
   return solid;
 }
 
+// Whether an object's JSON embeds a display mesh (which needs the whole domain mesh).
+bool HasDisplayMesh(const JsonNode& params) {
+  const auto display = params.Find("display");
+  return display && display->is_object() && display->Has("mesh");
+}
+
+// The integrators a split FemSolid steps with: FemSolid's own implicit schemes and the
+// fixed-step explicit ones of the ODE contract. Any other (the contract's implicit integrator,
+// whose matrix-free Newton is serial; a plugin's, which might adapt its steps from a norm of the
+// state that would differ between ranks) runs whole on every rank, as every object did before.
+bool SplitsWithIntegrator(const JsonNode& params) {
+  const auto integrator = params.Find("integrator");
+  if (!integrator) return true;
+  if (!integrator->is_string()) return false;  // refused by the serial factory
+  const std::string name = integrator->AsString();
+  for (ImplicitSchemeKind kind : {ImplicitSchemeKind::kStatic, ImplicitSchemeKind::kBackwardEuler,
+                                  ImplicitSchemeKind::kBdf2, ImplicitSchemeKind::kNewmark})
+    if (name == ToString(kind)) return true;
+  return name == "RK4" || name == "SymplecticEuler" || name == "ExplicitEuler";
+}
+
 // Adds an object to the summary's list of split objects.
 using NoteSplit = std::function<void(const std::string& name, const char* type)>;
 
-// A standalone FemSolid on a mesh made as one block per rank and cut from the blocks: its
-// boundary and where it lies on the whole mesh's are found by exchanges, its cavities' faces
-// are selected on the parts and gathered, and the view keeps the scene's conditions on the
-// whole boundary's numbering without its geometry.
+// A FemSolid made in blocks (ObjectBuildContext::in_blocks): on a mesh made as one block per rank
+// and cut from the blocks: its boundary and where it lies on the whole mesh's are found by
+// exchanges, its cavities' faces are selected on the parts and gathered, and the view keeps the
+// scene's conditions on the whole boundary's numbering without its geometry.
 
 std::unique_ptr<SimObject> FemSolidInBlocks(const ObjectBuildContext& ctx, FemSolidSpec spec,
                                             MPI_Comm comm, const NoteSplit& note) {
@@ -97,15 +119,26 @@ void RegisterDistributedTypes(TypeRegistry& registry, MPI_Comm comm,
     if (split) split->push_back(fmt::format("{} ({})", name, type));
   };
   registry.meshes_in_blocks = true;
+  // Made in blocks when the scene lets them be (ObjectBuildContext::in_blocks): a Monodomain
+  // unless boundary conditions or an embedded display need its whole mesh, a FemSolid unless an
+  // embedded display does or its integrator runs whole.
+  registry.splits_in_blocks["Monodomain"] = [](const JsonNode& params) {
+    return !params.Has("boundary_conditions") && !HasDisplayMesh(params);
+  };
+  registry.splits_in_blocks["FemSolid"] = [](const JsonNode& params) {
+    return !HasDisplayMesh(params) && SplitsWithIntegrator(params);
+  };
+  // Aggregates whose own code reads only their parts' global fields (the heart's monitor reads
+  // its blood's): made in blocks, they make their parts so by the same rule among the parts.
+  for (const char* aggregate : {"Aggregate", "Heart"})
+    registry.splits_in_blocks[aggregate] = [](const JsonNode&) { return true; };
   registry.objects.Replace(
       "Monodomain", [comm, note](const ObjectBuildContext& ctx) -> std::unique_ptr<SimObject> {
         CheckEpTissueKeys(ctx, {"parallel"});
         EpTissueParams params = ParseEpTissueParams(ctx);
-        // Nothing but probes and outputs reads it: its mesh is made in blocks and no rank holds
-        // it whole (boundary conditions and an embedded display need the whole mesh).
-        const auto display = ctx.params.Find("display");
-        if (ctx.standalone && !ctx.params.Has("boundary_conditions") &&
-            !(display && display->is_object() && display->Has("mesh"))) {
+        // Nothing but probes, outputs and connectors coupling its parts reads it: its mesh is
+        // made in blocks and no rank holds it whole.
+        if (ctx.in_blocks) {
           int rank = 0, size = 1;
           MPI_Comm_rank(comm, &rank);
           MPI_Comm_size(comm, &size);
@@ -136,25 +169,19 @@ void RegisterDistributedTypes(TypeRegistry& registry, MPI_Comm comm,
           ctx.params.Fail(e.what());
         }
       });
-  // A FemSolid with an ODE integrator other than the built-in fixed-step explicit ones (the
-  // implicit one's matrix-free Newton is serial; a plugin's might adapt its steps from a norm
-  // of the state, which would differ between ranks) runs whole on every rank, as every object
-  // did before.
+  // A FemSolid whose integrator runs whole (SplitsWithIntegrator) is the serial one.
   const ObjectFactory* found = registry.objects.Find("FemSolid");
   GIPSI_CHECK(found != nullptr);
   registry.objects.Replace(
       "FemSolid",
       [comm, note,
        whole_solid = *found](const ObjectBuildContext& ctx) -> std::unique_ptr<SimObject> {
+        if (!SplitsWithIntegrator(ctx.params)) return whole_solid(ctx);
         FemSolidSpec spec = ParseFemSolidSpec(ctx);
-        if (spec.ode && spec.ode->name() != "RK4" && spec.ode->name() != "SymplecticEuler" &&
-            spec.ode->name() != "ExplicitEuler")
-          return whole_solid(ctx);
         spec.params.linear_solver = spec.distributed_linear;
-        // Nothing else reads it: its mesh is made in blocks and no rank holds it whole
-        // (an embedded display needs the whole mesh).
-        const auto display = ctx.params.Find("display");
-        if (ctx.standalone && !(display && display->is_object() && display->Has("mesh"))) {
+        // Nothing but probes, outputs and connectors coupling its parts reads it: its mesh is
+        // made in blocks and no rank holds it whole.
+        if (ctx.in_blocks) {
           try {
             return FemSolidInBlocks(ctx, std::move(spec), comm, note);
           } catch (const InputError& e) {

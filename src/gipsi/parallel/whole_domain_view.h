@@ -22,7 +22,8 @@
 /// uninterrupted one (another cut sums in another order; solver caches start afresh).
 ///
 /// Without the whole mesh (the second constructor: a "part-only" view, for an object nothing
-/// but probes and outputs reads, ObjectBuildContext::standalone) the view's domain and boundary
+/// but probes, outputs and connectors coupling its parts reads, ObjectBuildContext::in_blocks)
+/// the view's domain and boundary
 /// are the part's, its fields are the part's local ones, and probes address the whole mesh's
 /// nodes through its PartitionedObject calls (collective; the whole mesh's indices are the
 /// part's `whole_node`). No rank then holds anything of the size of the whole mesh, except a

@@ -96,6 +96,11 @@ void RegisterCavityCoupling(TypeRegistry& registry) {
       },
       "boundary coupling: cavity volume <-> lumped blood pressure (monolithic, "
       "isovolumetric-safe)");
+  // The wall's cavity (a capability) and its global volume and pressure: a wall made in blocks
+  // answers them as a whole one does.
+  registry.connector_part_use["CavityCoupling"] = [](const JsonNode&) {
+    return TypeRegistry::PartUse::kGlobal;
+  };
 }
 
 }  // namespace gipsi

@@ -115,6 +115,11 @@ void RegisterExcitationContraction(TypeRegistry& registry) {
         }
       },
       "volume coupling: transmembrane voltage -> active tension (first-order twitch model)");
+  // Between objects split alike it couples their parts, at the muscle's nodes or, through the
+  // part's own interpolation, at its tets.
+  registry.connector_part_use["ExcitationContraction"] = [](const JsonNode&) {
+    return TypeRegistry::PartUse::kPartToPart;
+  };
 }
 
 }  // namespace gipsi

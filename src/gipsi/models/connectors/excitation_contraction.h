@@ -78,7 +78,7 @@ class ExcitationContraction final : public Connector {
   /// The state (bound with BindState: checkpoints and snapshots copy it).
   [[nodiscard]] const ExcitationContractionState& state() const { return state_; }
   /// Whether it couples the objects' parts, process by process (split alike).
-  [[nodiscard]] bool couples_parts() const { return split_ != nullptr; }
+  [[nodiscard]] bool couples_parts() const override { return split_ != nullptr; }
 
  protected:
   StepStatus DoFire(double t) override;

@@ -154,6 +154,14 @@ void RegisterFieldCopy(TypeRegistry& registry) {
         }
       },
       "volume coupling: Get a field of one object, map it, Set it on another");
+  // Between objects split alike it copies their parts, unless a nearest item (which may be
+  // another process's) is asked for.
+  registry.connector_part_use["FieldCopy"] = [](const JsonNode& params) {
+    const auto mapping = params.Find("mapping");
+    return mapping && mapping->is_string() && mapping->AsString() == "nearest"
+               ? TypeRegistry::PartUse::kWhole
+               : TypeRegistry::PartUse::kPartToPart;
+  };
 }
 
 }  // namespace gipsi

@@ -49,7 +49,7 @@ class FieldCopy final : public Connector {
   /// The factor applied: the scale times the conversion of its units into the target's.
   [[nodiscard]] double factor() const { return scale_; }
   /// Whether it copies the objects' parts, process by process (split alike).
-  [[nodiscard]] bool couples_parts() const { return split_ != nullptr; }
+  [[nodiscard]] bool couples_parts() const override { return split_ != nullptr; }
 
  protected:
   StepStatus DoFire(double t) override;
