@@ -58,25 +58,10 @@ Options Parse(int argc, char** argv) {
   return o;
 }
 
-double Median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  return v[v.size() / 2];
-}
-
 // Median over batches of the slowest rank's time per call of `call` [s].
 template <class Call>
 double TimePerCall(const Options& o, MPI_Comm comm, Call call) {
-  for (int r = 0; r < o.reps; ++r) call();  // warm-up
-  std::vector<double> batches;
-  for (int b = 0; b < o.batches; ++b) {
-    MPI_Barrier(comm);
-    const double start = MPI_Wtime();
-    for (int r = 0; r < o.reps; ++r) call();
-    double t = (MPI_Wtime() - start) / o.reps;
-    MPI_Allreduce(MPI_IN_PLACE, &t, 1, MPI_DOUBLE, MPI_MAX, comm);
-    batches.push_back(t);
-  }
-  return Median(batches);
+  return gipsi::bench::SlowestRankPerCall(comm, o.batches, o.reps, call);
 }
 
 int Main(int argc, char** argv) {

@@ -1,8 +1,8 @@
 #pragma once
 // What the MPI benches share: the N-version slab (20 × 7 × 3 mm) and its size in hexahedra
-// (--cells NX NY NZ), the peak resident memory and a median, a parse that
-// exits 2 with CLI11's message on a bad command line (0 after --help), and a main that reports
-// an error on every rank and ends them all.
+// (--cells NX NY NZ), the peak resident memory, a median and a timing over the ranks, a parse
+// that exits 2 with CLI11's message on a bad command line (0 after --help), and a main that
+// reports an error on every rank and ends them all.
 
 #include <CLI/CLI.hpp>
 
@@ -35,6 +35,23 @@ inline double PeakResidentBytes() {
 inline double Median(std::vector<double> v) {
   std::sort(v.begin(), v.end());
   return v.empty() ? 0 : v[v.size() / 2];
+}
+
+// Median over `batches` batches of the slowest rank's time per call of `call` [s], each batch
+// `reps` calls after `reps` calls of warm-up. Collective.
+template <class Call>
+double SlowestRankPerCall(MPI_Comm comm, int batches, int reps, Call call) {
+  for (int r = 0; r < reps; ++r) call();  // warm-up
+  std::vector<double> times;
+  for (int b = 0; b < batches; ++b) {
+    MPI_Barrier(comm);
+    const double start = MPI_Wtime();
+    for (int r = 0; r < reps; ++r) call();
+    double t = (MPI_Wtime() - start) / reps;
+    MPI_Allreduce(MPI_IN_PLACE, &t, 1, MPI_DOUBLE, MPI_MAX, comm);
+    times.push_back(t);
+  }
+  return Median(times);
 }
 
 // Adds --cells NX NY NZ (hexahedra along the 20 × 7 × 3 mm slab, 6 tets each) into `cells`.

@@ -5,6 +5,8 @@
 
 #include <map>
 #include <memory>
+#include <optional>
+#include <set>
 #include <string>
 
 #include <gmock/gmock.h>
@@ -12,6 +14,8 @@
 
 #include "core/test_objects.h"
 #include "gipsi/base/error.h"
+#include "gipsi/base/json_node.h"
+#include "gipsi/core/in_blocks.h"
 #include "gipsi/geometry/generators.h"
 #include "gipsi/geometry/mesh_block.h"
 #include "gipsi/io/builtins.h"
@@ -181,6 +185,48 @@ TEST(SceneMeshes, ObjectsCoupledPartToPartAreMadeInBlocksTogether) {
   EXPECT_EQ(seen["ep"].block->num_tets, 48);
   EXPECT_EQ(scene.meshes.count("heart"), 0U);  // only blocks of it were made
   EXPECT_EQ(scene.meshes.count("slab"), 1U);
+}
+
+// A barycentric FieldCopy couples parts split any way, so the objects it joins are made in
+// blocks whatever their meshes, and whether or not its other end is: one on another mesh, one
+// kept whole. A direct copy, or "auto" (which may turn out direct), still needs one mesh, and
+// "nearest" objects whole.
+TEST(SceneMeshes, ABarycentricCopyLetsObjectsOnOtherMeshesBeMadeInBlocks) {
+  std::map<std::string, Seen> seen;
+  auto registry = RecordingRegistry(seen, true);
+  const auto& use = registry->connector_part_use.at("FieldCopy");
+  auto use_of = [&use](const char* text) {
+    const JsonDocument doc = JsonDocument::Parse(text, "connector.json");
+    return use(doc.root());
+  };
+  using PartUse = TypeRegistry::PartUse;
+  EXPECT_EQ(use_of(R"({"type": "FieldCopy", "mapping": "barycentric"})"), PartUse::kAnyParts);
+  EXPECT_EQ(use_of(R"({"type": "FieldCopy", "mapping": "direct"})"), PartUse::kPartToPart);
+  EXPECT_EQ(use_of(R"({"type": "FieldCopy", "mapping": "auto"})"), PartUse::kPartToPart);
+  EXPECT_EQ(use_of(R"({"type": "FieldCopy"})"), PartUse::kPartToPart);
+  EXPECT_EQ(use_of(R"({"type": "FieldCopy", "mapping": "nearest"})"), PartUse::kWhole);
+
+  const JsonDocument doc = JsonDocument::Parse(R"({
+    "objects": {
+      "ep": {"type": "Recorder", "domain": "fine"},
+      "muscle": {"type": "Recorder", "domain": "coarse"},
+      "probe": {"type": "Recorder", "domain": "coarse"},
+      "held": {"type": "Recorder", "domain": "fine", "whole": true},
+      "a": {"type": "Recorder", "domain": "fine"},
+      "b": {"type": "Recorder", "domain": "coarse"}
+    },
+    "connectors": {
+      "ec": {"type": "FieldCopy", "from": "ep.V", "to": "muscle.tension",
+             "mapping": "barycentric"},
+      "back": {"type": "FieldCopy", "from": "held.V", "to": "probe.V", "mapping": "barycentric"},
+      "ab": {"type": "FieldCopy", "from": "a.V", "to": "b.V"}
+    }
+  })",
+                                               "scene.json");
+  const JsonNode root = doc.root();
+  const std::set<std::string> in_blocks =
+      InBlocksObjects(root.At("objects"), root.Find("connectors"), std::nullopt, *registry);
+  EXPECT_EQ(in_blocks, (std::set<std::string>{"ep", "muscle", "probe"}));
 }
 
 // A mistake in a mesh made in blocks is named by its JSON path, as when it is built whole, and

@@ -7,11 +7,16 @@
 #include <mpi.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <memory>
+#include <optional>
+#include <span>
 #include <string>
+#include <vector>
 
+#include "gipsi/base/error.h"
 #include "gipsi/core/coordinator.h"
 #include "gipsi/core/partitioned_object.h"
 #include "gipsi/core/port.h"
@@ -19,6 +24,7 @@
 #include "gipsi/geometry/mesh_block.h"
 #include "gipsi/models/connectors/excitation_contraction.h"
 #include "gipsi/models/connectors/field_copy.h"
+#include "gipsi/models/connectors/item_positions.h"
 #include "gipsi/models/ep/phenomenological.h"
 #include "gipsi/models/fem/fem_solid.h"
 #include "gipsi/models/fem/solid_laws.h"
@@ -82,13 +88,19 @@ std::unique_ptr<SimObject> Muscle(std::shared_ptr<const Mesh> whole, bool split)
                                    distribution->whole_boundary_face()});
 }
 
-// This rank's part of Box(), made from blocks (no rank holds the whole box).
-MeshPart BoxInBlocks() {
+// This rank's part of Box() (or of another box), made from blocks (no rank holds the whole box).
+MeshPart BoxInBlocks(const Vec3& lo = Vec3::Zero(), const Vec3& hi = Vec3(0.010, 0.004, 0.002),
+                     const std::array<int, 3>& cells = {20, 8, 4}) {
   return PartitionMeshBlocks(
-      MakeTetBoxBlock(Vec3::Zero(), Vec3(0.010, 0.004, 0.002), {20, 8, 4}, HexSplit::kSix,
-                      ParallelSession::rank(World()), ParallelSession::size(World())),
+      MakeTetBoxBlock(lo, hi, cells, HexSplit::kSix, ParallelSession::rank(World()),
+                      ParallelSession::size(World())),
       World());
 }
+
+// A coarser box on another grid, reaching 1.5 mm past the tissue's end in x and 0.5 mm below it
+// in y: its items there lie outside the tissue.
+const Vec3 kOtherLo(0.001, -0.0005, 0), kOtherHi(0.0115, 0.0045, 0.002);
+constexpr std::array<int, 3> kOtherCells = {7, 3, 2};
 
 // The tissue and the muscle made in blocks, behind views without the whole box (as a scene run
 // makes the heart's).
@@ -98,9 +110,9 @@ std::unique_ptr<WholeDomainView> TissueInBlocks() {
   return std::make_unique<WholeDomainView>(std::move(part), mesh_part, World());
 }
 
-std::unique_ptr<WholeDomainView> MuscleInBlocks() {
+std::unique_ptr<WholeDomainView> MuscleInBlocks(MeshPart cut = BoxInBlocks()) {
   FemParams p = MuscleParams();
-  auto distribution = std::make_shared<DistributedSolid>(BoxInBlocks(), World());
+  auto distribution = std::make_shared<DistributedSolid>(std::move(cut), World());
   p.distribution = distribution;
   const MeshPart& part = distribution->part();
   return std::make_unique<WholeDomainView>(
@@ -256,7 +268,8 @@ TEST(SplitCoupling, ExcitationContractionCouplesThePartsWithoutGathers) {
 
 // A FieldCopy of V (scaled to a tension: 2 kPa/mV) between the same split objects copies the
 // parts, item for item onto the nodes and barycentrically onto the tets, with no gather; the
-// values are the whole-field copy's at every item. A nearest-item copy reads V whole.
+// values are those of the copy onto a whole muscle at every item. A nearest-item copy reads V
+// whole.
 TEST(SplitCoupling, FieldCopyCopiesThePartsWithoutGathers) {
   const auto mesh = Box();
   const auto tissue = SplitTissue(mesh);
@@ -272,7 +285,9 @@ TEST(SplitCoupling, FieldCopyCopiesThePartsWithoutGathers) {
     FieldCopy whole_v("copy", *tissue, v, *whole_muscle, whole_muscle->FindField(field),
                       Mapping::kAuto, 2, "kPa/mV");
     EXPECT_TRUE(on_parts.couples_parts());
-    EXPECT_FALSE(whole_v.couples_parts());
+    // Onto the whole muscle's nodes item for item, reading V whole; onto its tets through the
+    // parts that hold their centroids.
+    EXPECT_EQ(whole_v.couples_parts(), std::string(field) == "active_tension");
     EXPECT_EQ(on_parts.mapping(),
               std::string(field) == "active_tension" ? Mapping::kBarycentric : Mapping::kDirect);
     const std::int64_t reads_before = tissue->whole_field_reads();
@@ -359,6 +374,151 @@ TEST(SplitCoupling, ObjectsMadeInBlocksCoupleTheirPartsAndOtherConnectorsAreRefu
     c.AddObject(std::move(target), 1e-4);
     c.AddConnector(std::move(copy), 1);
     EXPECT_THROW(c.Prepare(1e-4), WiringError);
+  }
+}
+
+// The parts answer for the points each rank asks at: every rank a different set (one none),
+// inside the box, on its nodes (shared faces of parts), and outside it (one far off, nearest a
+// corner): each value is the whole box's interpolation, within rounding (a point on a face
+// between parts may take the other tet), and the farthest distance is the whole box's.
+TEST(SplitCoupling, PartsInterpolateAtThePointsEachRankAsks) {
+  const auto mesh = Box();
+  const auto whole_tissue = SplitTissue(mesh);
+  const auto tissue = TissueInBlocks();
+  for (int s = 0; s < 60; ++s) {
+    ASSERT_TRUE(tissue->Step(1e-4).ok());  // 6 ms
+    ASSERT_TRUE(whole_tissue->Step(1e-4).ok());
+  }
+  const Eigen::MatrixXd volts = Read(*whole_tissue, "V");
+  const int rank = ParallelSession::rank(World()), size = ParallelSession::size(World());
+  // Rank r's points: 40 r + 7 nodes of the box from node 13 r on, three inside points, and for
+  // rank 0 two outside; rank 1 asks for none.
+  auto points_of = [&](int r) {
+    if (r == 1) return Points(3, 0);
+    std::vector<Vec3> at;
+    for (int k = 0; k < 40 * r + 7; ++k)
+      at.push_back(mesh->nodes.col((13 * r + 17 * k) % mesh->num_nodes()));
+    for (int k = 0; k < 3; ++k) at.push_back(Vec3(0.0011 + 0.0029 * k + 1e-4 * r, 0.0013, 0.0007));
+    if (r == 0) {
+      at.push_back(Vec3(0.0105, 0.002, 0.001));  // 0.5 mm past the end
+      at.push_back(Vec3(0.03, -0.01, 0.02));     // far off, nearest the corner (10, 0, 2) mm
+    }
+    Points out(3, static_cast<Index>(at.size()));
+    for (std::size_t j = 0; j < at.size(); ++j) out.col(static_cast<Index>(j)) = at[j];
+    return out;
+  };
+  const Points mine = points_of(rank);
+  const auto interpolation = tissue->InterpolateAtPoints(mine);
+  ASSERT_EQ(interpolation->num_points(), mine.cols());
+  Eigen::MatrixXd values(1, mine.cols());
+  const std::int64_t reads_before = tissue->whole_field_reads();
+  interpolation->Interpolate(tissue->FindField("V"), values, std::nullopt);
+  EXPECT_EQ(tissue->whole_field_reads(), reads_before);
+  const PointMap serial = PointMap::BarycentricInTets(mesh->nodes, mesh->tets, mine);
+  Eigen::MatrixXd expected(1, mine.cols());
+  serial.Apply(volts, expected);
+  const double peak = volts.cwiseAbs().maxCoeff();
+  for (Index j = 0; j < mine.cols(); ++j)
+    ASSERT_NEAR(values(0, j), expected(0, j), 1e-12 * peak) << "point " << j << " of rank " << rank;
+  double farthest = 0;
+  for (int r = 0; r < size; ++r) {
+    const Points theirs = points_of(r);
+    farthest = std::max(
+        farthest, PointMap::BarycentricInTets(mesh->nodes, mesh->tets, theirs).max_distance());
+  }
+  EXPECT_NEAR(interpolation->max_distance(), farthest, 1e-15);
+  EXPECT_GT(farthest, 0.02);  // the far point: sqrt(20² + 10² + 18²) mm from the corner
+
+  // A marker in the field is kept, not blended: V of -80 mV (rest) marked as no data.
+  interpolation->Interpolate(tissue->FindField("V"), values, -80.0);
+  Eigen::MatrixXd marked(1, mine.cols());
+  serial.ApplyMarked(volts, marked, -80.0);
+  for (Index j = 0; j < mine.cols(); ++j)
+    ASSERT_NEAR(values(0, j), marked(0, j), 1e-12 * peak) << "point " << j << " of rank " << rank;
+
+  // A point that is not finite is refused on every rank.
+  Points bad = mine;
+  if (rank == 0) bad(1, 0) = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_THROW((void)tissue->InterpolateAtPoints(bad), InputError);
+}
+
+// A barycentric FieldCopy of V (2 kPa/mV) from the tissue made in blocks onto a muscle on
+// another, coarser mesh that sticks out of it, made in blocks too (so cut differently) or whole
+// on every rank: each rank's items get the whole box's interpolation of V at them (the nearest
+// point of the box outside it), with no gather; a coordinator takes it. A "direct" copy between
+// them is refused.
+TEST(SplitCoupling, ABarycentricCopyJoinsObjectsSplitDifferently) {
+  const auto mesh = Box();
+  const auto other = std::make_shared<Mesh>(MakeTetBox(kOtherLo, kOtherHi, kOtherCells));
+  const auto whole_tissue = SplitTissue(mesh);
+  std::unique_ptr<WholeDomainView> tissue = TissueInBlocks();
+  for (int s = 0; s < 60; ++s) {
+    ASSERT_TRUE(tissue->Step(1e-4).ok());  // 6 ms
+    ASSERT_TRUE(whole_tissue->Step(1e-4).ok());
+  }
+  const Eigen::MatrixXd volts = Read(*whole_tissue, "V");
+  const FieldId v = tissue->FindField("V");
+  using Mapping = FieldCopy::Mapping;
+  const Points centroids = ItemRestPositions(*Muscle(other, false), FieldLocation::kElement);
+  for (const char* field : {"nodal_active_tension", "active_tension"}) {
+    SCOPED_TRACE(field);
+    const bool at_nodes = std::string(field) == "nodal_active_tension";
+    // The whole box's interpolation at every item of the other mesh, scaled to Pa.
+    Eigen::MatrixXd expected(1, at_nodes ? other->num_nodes() : other->num_tets());
+    PointMap::BarycentricInTets(mesh->nodes, mesh->tets, at_nodes ? other->nodes : centroids)
+        .Apply(volts, expected);
+    expected *= 2000.0;
+    const double peak = expected.cwiseAbs().maxCoeff();
+    ASSERT_GT(peak, 1e5);
+
+    std::unique_ptr<WholeDomainView> split_muscle =
+        MuscleInBlocks(BoxInBlocks(kOtherLo, kOtherHi, kOtherCells));
+    std::unique_ptr<SimObject> whole_muscle = Muscle(other, false);
+    EXPECT_FALSE(SplitAlike(*tissue, *split_muscle));
+    FieldCopy onto_parts("copy", *tissue, v, *split_muscle, split_muscle->FindField(field),
+                         Mapping::kAuto, 2, "kPa/mV");
+    FieldCopy onto_whole("copy", *tissue, v, *whole_muscle, whole_muscle->FindField(field),
+                         Mapping::kBarycentric, 2, "kPa/mV");
+    EXPECT_EQ(onto_parts.mapping(), Mapping::kBarycentric);
+    EXPECT_TRUE(onto_parts.couples_parts());
+    EXPECT_TRUE(onto_whole.couples_parts());
+    const std::int64_t reads_before = tissue->whole_field_reads();
+    ASSERT_TRUE(onto_parts.Fire(0).ok());
+    ASSERT_TRUE(onto_whole.Fire(0).ok());
+    EXPECT_EQ(tissue->whole_field_reads(), reads_before);
+
+    const Eigen::MatrixXd local = Read(split_muscle->local_part(), field);
+    const std::span<const int> items =
+        at_nodes ? split_muscle->whole_nodes_of_part() : split_muscle->whole_tets_of_part();
+    ASSERT_EQ(static_cast<std::size_t>(local.cols()), items.size());
+    for (Index i = 0; i < local.cols(); ++i)
+      ASSERT_NEAR(local(0, i), expected(0, items[static_cast<std::size_t>(i)]), 1e-12 * peak)
+          << "whole item " << items[static_cast<std::size_t>(i)];
+    const Eigen::MatrixXd everywhere = Read(*whole_muscle, field);
+    ASSERT_EQ(everywhere.cols(), expected.cols());
+    EXPECT_LE((everywhere - expected).cwiseAbs().maxCoeff(), 1e-12 * peak);
+  }
+
+  // A coordinator takes the copy between the two objects made in blocks.
+  Coordinator coupled;
+  std::unique_ptr<WholeDomainView> muscle =
+      MuscleInBlocks(BoxInBlocks(kOtherLo, kOtherHi, kOtherCells));
+  SimObject* source = tissue.get();
+  SimObject* target = muscle.get();
+  coupled.AddObject(std::move(tissue), 1e-4);
+  coupled.AddObject(std::move(muscle), 1e-4);
+  coupled.AddConnector(
+      std::make_unique<FieldCopy>("copy", *source, v, *target, target->FindField("active_tension"),
+                                  Mapping::kBarycentric, 2, "kPa/mV"),
+      1);
+  EXPECT_NO_THROW(coupled.Prepare(1e-4));
+  // Item for item between them is not a thing: refused on every rank alike.
+  try {
+    FieldCopy direct("copy", *source, v, *target, target->FindField("nodal_active_tension"),
+                     Mapping::kDirect, 2, "kPa/mV");
+    ADD_FAILURE() << "accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("split differently"), std::string::npos) << e.what();
   }
 }
 

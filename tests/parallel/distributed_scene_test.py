@@ -22,6 +22,9 @@ Runs the N-version benchmark slab (scenes/slab_ep_0.5mm.json, its first 30 ms) s
     bounds on 2 and 4 ranks; so does the benchmark ventricle (scenes/lv_inflation.json) with a
     cavity on its endocardium, made in blocks (its enclosed volume and apex within 1e-6 of
     their scale);
+  - the slab's tissue coupled by a barycentric FieldCopy to a muscle on another, coarser mesh
+    that sticks out of it, both made in blocks (cut differently), gives the serial muscle's
+    probes within the bound on V carried over (6e-3 of their scale) on 2 and 4 ranks;
   - the soft cantilever (scenes/cantilever.json), its FemSolid split over 2 and 4 ranks and
     made in blocks (no rank holds its mesh), gives the serial tip motion, clamp reaction and
     kinetic energy within 1e-6 of their scale (Newton to 1e-8, CG to 1e-6); measured 1e-8; so
@@ -373,6 +376,46 @@ with tempfile.TemporaryDirectory() as work:
     for ranks in (2, 4):
         compare_probes(f"lv_activation on {ranks} ranks", ventricle_runs[1], ventricle_runs[ranks],
                        ("activated", "base"))
+    # Two meshes: the slab's tissue copies V barycentrically (1 Pa/mV) onto the active tension
+    # of a muscle on a coarser box that sticks out of the slab by 1.5 mm in x and 0.5 mm in y
+    # (its items there take the nearest point of the slab), clamped at its x-min face and solved
+    # statically every 1 ms. Both are made in blocks, each cut from its own mesh: the copy asks
+    # the tissue's parts for V at the muscle's nodes, each rank at its own. The muscle's
+    # probes give the serial run's within what the tissue's bound on V allows (0.5 mV of 85:
+    # 6e-3 of their scale, the response being linear in the tension at this strain).
+    with open(SCENE) as f:
+        scene = json.load(f)
+    scene["meshes"]["coarse"] = {"generate": "box", "min": [0.001, -0.0005, 0],
+                                 "max": [0.0215, 0.0075, 0.003], "cells": [8, 3, 2]}
+    scene["objects"]["muscle"] = {
+        "type": "FemSolid", "domain": "coarse", "dt": 0.001, "integrator": "Static",
+        "material": {"law": "Corotational", "youngs_modulus": 1e5, "poisson_ratio": 0.45},
+        "gravity": [0, 0, 0], "fibres": {"direction": [1, 0, 0]},
+        "boundary_conditions": [{"name": "clamp", "region": {"group": "xmin"}, "fix": True}]}
+    scene["connectors"] = {"excite": {"type": "FieldCopy", "from": "tissue.V",
+                                      "to": "muscle.nodal_active_tension",
+                                      "mapping": "barycentric", "scale": "1 Pa/mV"}}
+    scene["schedule"]["dt"] = 0.001
+    scene["probes"] = {
+        "tension": {"object": "muscle", "region": {"group": "xmax"},
+                    "fields": ["nodal_active_tension"], "reduce": "mean", "every": 0.001},
+        "tip": {"object": "muscle", "region": {"group": "xmax"}, "fields": ["displacement"],
+                "reduce": "mean", "every": 0.001},
+        "far_corner": scene["probes"]["far_corner"]}
+    scene["outputs"] = {"directory": "out/two_meshes"}
+    two_meshes = os.path.join(work, "two_meshes.json")
+    with open(two_meshes, "w") as f:
+        json.dump(scene, f)
+    two_runs = run_in_blocks("two_meshes", two_meshes, (1, 2, 4), "0.03",
+                             "tissue (Monodomain, in blocks), muscle (FemSolid, in blocks)")
+    tip = rows(os.path.join(two_runs[1], "probes", "tip.csv"))
+    tip_scale = max(abs(float(x)) for row in tip[1:] for x in row[1:])
+    check(tip_scale > 1e-7, f"two meshes: the muscle does not move ({tip_scale} m)")
+    for ranks in (2, 4):
+        compare_scaled(f"two meshes on {ranks} ranks", two_runs[1], two_runs[ranks],
+                       (("tension", 85.0), ("tip", tip_scale)), 6e-3, 25)
+        compare_probes(f"two meshes on {ranks} ranks", two_runs[1], two_runs[ranks],
+                       ("far_corner",))
     # The benchmark ventricle (scenes/lv_inflation.json) with a cavity on its endocardium,
     # inflated to 2 kPa in two increments: the cavity's faces are selected on the parts and
     # gathered, so the wall is made in blocks too; its enclosed volume and the apex give the

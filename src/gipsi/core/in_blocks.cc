@@ -70,7 +70,7 @@ std::set<std::string> InBlocksObjects(const JsonNode& objects,
   for (bool removed = true; removed;) {
     removed = false;
     for (const auto& [use, ends] : links) {
-      if (use == PartUse::kGlobal) continue;
+      if (use == PartUse::kGlobal || use == PartUse::kAnyParts) continue;
       const auto first = domain.find(ends.empty() ? std::string() : ends.front());
       const bool alike = use == PartUse::kPartToPart && first != domain.end() &&
                          first->second.has_value() &&

@@ -25,10 +25,10 @@ class TypeRegistry;
 /// by no other object and nothing in `events`, and by the members of `connectors` only as
 /// TypeRegistry::connector_part_use allows: one that couples parts joins objects all made in
 /// blocks from one domain mesh (their "domain"), or none; one that uses only global fields and
-/// capabilities joins any; any other needs its objects whole. Probes, outputs and the schedule's
-/// order may name them. Empty when the registry makes nothing in blocks (a serial run). Objects
-/// that fail are removed until none does: one object's removal fails the others a part-to-part
-/// connector joins it with.
+/// capabilities, or couples parts split any way, joins any; any other needs its objects whole.
+/// Probes, outputs and the schedule's order may name them. Empty when the registry makes nothing in
+/// blocks (a serial run). Objects that fail are removed until none does: one object's removal fails
+/// the others a part-to-part connector joins it with.
 [[nodiscard]] std::set<std::string> InBlocksObjects(const JsonNode& objects,
                                                     const std::optional<JsonNode>& connectors,
                                                     const std::optional<JsonNode>& events,

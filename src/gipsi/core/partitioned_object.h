@@ -11,6 +11,10 @@
 /// whole domain when anything else in the scene names it (ObjectBuildContext::in_blocks), and
 /// Coordinator::Prepare refuses any other connector's use of its node or element fields.
 ///
+/// Two split objects cut differently (on two meshes, a fine one for the bioelectricity and a
+/// coarse one for the mechanics) are coupled through InterpolateAtPoints: each process asks the
+/// source's parts for the values at its own target items, and the parts that hold them answer.
+///
 /// Two split objects cut alike (SplitAlike: the same whole domain, the same part on every
 /// process) can be coupled part to part: a connector reads one's local_part() and writes the
 /// other's, each process its own share, and refreshes the nodes its part shares with other
@@ -21,6 +25,7 @@
 /// the same kernel on the same scene).
 
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <span>
 #include <vector>
@@ -35,6 +40,33 @@ GIPSI_EXPORT_BEGIN
 namespace gipsi {
 
 class SimObject;
+
+/// Values of a split object's node field at points that each process chooses for itself (its
+/// own part's items, or anything else): made by PartitionedObject::InterpolateAtPoints, for a
+/// connector between objects split differently (another mesh, another cut). Each point is
+/// interpolated by the process whose part holds it and sent to the process that asked, so no
+/// process gathers the field. Not copyable.
+class PartsInterpolation {
+ public:
+  PartsInterpolation() = default;
+  PartsInterpolation(const PartsInterpolation&) = delete;
+  PartsInterpolation& operator=(const PartsInterpolation&) = delete;
+  virtual ~PartsInterpolation() = default;
+  /// This process's points.
+  [[nodiscard]] virtual Index num_points() const = 0;
+  /// The farthest any process's point lies from the whole domain (0 inside; a point outside
+  /// takes the nearest point of the domain, as MapFromNodes does), the same on every process.
+  [[nodiscard]] virtual double max_distance() const = 0;
+  /// The object's node field `id` at this process's points, into `out` (components ×
+  /// num_points()): barycentric in the whole domain's tet that holds the point (on several
+  /// parts, the lowest process's; outside, the nearest part's), from the nodes' owners' values,
+  /// with the object's own higher-order correction (SimObject::CorrectInterpolated). With
+  /// `no_data` (the field's marker), a point whose tet has a node holding the marker gets the
+  /// marker, as PointMap::ApplyMarked. Collective: each process sends the values others asked
+  /// of its part and the values its part's shared nodes take from their owners.
+  virtual void Interpolate(FieldId id, Eigen::Ref<Eigen::MatrixXd> out,
+                           std::optional<double> no_data) const = 0;
+};
 
 /// Interface, implemented beside SimObject; asked for with dynamic_cast.
 class PartitionedObject {
@@ -111,6 +143,16 @@ class PartitionedObject {
   /// those their owners hold. Collective: each process sends the owned nodes other processes
   /// share and receives its shared ones (O(the part's surface); neighbours only).
   virtual void ShareOwnedNodeValues(Eigen::Ref<Eigen::MatrixXd> values) const = 0;
+
+  // Coupling objects split differently (another mesh, another cut).
+  /// Interpolation of this object's node fields at `points`, which each process gives for
+  /// itself (any number, none included; a split target's own items): see PartsInterpolation.
+  /// Each point is located on the parts whose bounding boxes hold it (and, when it lies outside
+  /// every part, on the parts that might be nearer); a process then holds O(its points + the
+  /// points it interpolates for others). Collective; throws InputError on every process if a
+  /// point is not finite.
+  [[nodiscard]] virtual std::unique_ptr<PartsInterpolation> InterpolateAtPoints(
+      const Points& points) const = 0;
 };
 
 /// True when `a` and `b` are both PartitionedObjects split alike: on every process their parts

@@ -45,8 +45,9 @@
 /// whole mesh (SolidDistribution's has_whole_mesh, SelectWholeFaces); 19: objects coupled part to
 /// part made in blocks (ObjectBuildContext::in_blocks replaces standalone;
 /// TypeRegistry::splits_in_blocks and connector_part_use; Connector::couples_parts, checked against
-/// part-only ends).
-#define GIPSI_PLUGIN_INTERFACE 19
+/// part-only ends); 20: coupling objects split differently (PartitionedObject's
+/// InterpolateAtPoints, PartsInterpolation; TypeRegistry::PartUse::kAnyParts).
+#define GIPSI_PLUGIN_INTERFACE 20
 /// What a plugin's gipsi_plugin_abi_version() returns and the loader requires: the package's
 /// major and minor version with the plugin interface, MAJOR·10⁶ + MINOR·10³ + INTERFACE. A
 /// plugin thus loads only into the release line it was built against (0.1.x, as the CMake
@@ -229,9 +230,12 @@ class TypeRegistry {
                   ///< domain mesh (Connector::couples_parts), or of objects all whole
     kGlobal,      ///< it uses only its objects' global fields and capabilities: any of them may
                   ///< be made in blocks
+    kAnyParts,    ///< it couples the parts of objects split any way (other meshes, other cuts)
+                  ///< or whole (a barycentric FieldCopy): any of them may be made in blocks
   };
   /// Connector types that can join objects made in blocks, and how, from the connector's JSON
-  /// (e.g. a FieldCopy couples parts unless its mapping is "nearest"): registered with the
+  /// (e.g. a FieldCopy couples any parts with a "barycentric" mapping, parts split alike with
+  /// another, and none with "nearest"): registered with the
   /// connector. The scene loader makes objects in blocks only where every connector naming them
   /// allows it (ObjectBuildContext::in_blocks).
   std::map<std::string, std::function<PartUse(const JsonNode& params)>, std::less<>>

@@ -17,6 +17,7 @@
 #include "gipsi/base/state.h"
 #include "gipsi/geometry/boundary.h"
 #include "gipsi/geometry/region.h"
+#include "gipsi/parallel/parts_interpolation.h"
 #include "gipsi/parallel/petsc_check.h"
 
 namespace gipsi {
@@ -35,12 +36,21 @@ struct WholeDomainView::NodeExchange {
 
 WholeDomainView::~WholeDomainView() = default;
 
+std::unique_ptr<PartsInterpolation> WholeDomainView::InterpolateAtPoints(
+    const Points& points) const {
+  return MakePartsInterpolation(
+      *part_, mesh_part_, points, comm_,
+      [this](FieldId id) { return part_field_[static_cast<std::size_t>(id.value())]; },
+      [this](Eigen::Ref<Eigen::MatrixXd> values) { ShareOwnedNodeValues(values); });
+}
+
 void WholeDomainView::ShareOwnedNodeValues(Eigen::Ref<Eigen::MatrixXd> values) const {
   const auto n = static_cast<Index>(mesh_part_.whole_node.size());
   const auto owned = static_cast<Index>(mesh_part_.num_owned);
   const auto c = static_cast<int>(values.rows());
   GIPSI_CHECK(values.cols() == n && c >= 1, "'{}': {} by {} values for {} part nodes", name(), c,
               values.cols(), n);
+  if (mesh_part_.size == 1) return;  // one rank owns every node: nothing is shared
   if (!exchange_) exchange_ = std::make_unique<NodeExchange>();
   Vec& shared = exchange_->by_components[c];
   if (shared == nullptr) {  // collective: every rank asks for the same component counts

@@ -118,6 +118,10 @@ class WholeDomainView final : public SimObject, public CavityWall, public Partit
     return mesh_part_.whole_tet;
   }
   void ShareOwnedNodeValues(Eigen::Ref<Eigen::MatrixXd> values) const override;
+  /// The part's node fields at each rank's points (parallel/parts_interpolation.h), for either
+  /// kind of view: only the parts are read.
+  [[nodiscard]] std::unique_ptr<PartsInterpolation> InterpolateAtPoints(
+      const Points& points) const override;
   /// How many node or element fields this view has gathered whole (ReadField: an Allgatherv of
   /// the whole field to every rank), so tests can check that a coupling does not.
   [[nodiscard]] std::int64_t whole_field_reads() const { return whole_field_reads_; }

@@ -55,59 +55,97 @@ FieldCopy::FieldCopy(std::string name, SimObject& from, FieldId from_field, SimO
   }
   Points src_pos = ItemRestPositions(from, src.location);
   Points dst_pos = ItemRestPositions(to, dst.location);
+  // Objects split over the processes of a distributed run: whether they are split alike
+  // (collective when both are split), and whether either holds only its part, whose items are
+  // then this process's alone.
+  auto* from_split = dynamic_cast<const PartitionedObject*>(&from);
+  auto* to_split = dynamic_cast<PartitionedObject*>(&to);
+  const bool part_only = (from_split != nullptr && !from_split->holds_whole_domain()) ||
+                         (to_split != nullptr && !to_split->holds_whole_domain());
+  const bool alike = src.location != FieldLocation::kGlobal && SplitAlike(from, to);
   if (mapping_ == Mapping::kAuto) {
-    bool coincide = n_src == n_dst && (src.location == FieldLocation::kGlobal ||
-                                       (src_pos - dst_pos).cwiseAbs().maxCoeff() <= 1e-12);
+    // Items of differently split parts never pair one for one (and counting them on one
+    // process would decide differently on another).
+    const bool coincide = src.location == FieldLocation::kGlobal
+                              ? n_src == n_dst
+                              : (alike || !part_only) && n_src == n_dst &&
+                                    (src_pos - dst_pos).cwiseAbs().maxCoeff() <= 1e-12;
     mapping_ = coincide                               ? Mapping::kDirect
                : src.location == FieldLocation::kNode ? Mapping::kBarycentric
                                                       : Mapping::kNearest;
   }
+  if (mapping_ == Mapping::kDirect && part_only && !alike && src.location != FieldLocation::kGlobal)
+    fail(
+        "'direct' mapping between objects split differently over the processes (another mesh "
+        "or another cut); use 'barycentric'");
   if (mapping_ == Mapping::kDirect && n_src != n_dst)
     fail(fmt::format("'direct' mapping needs equal item counts ({} vs {})", n_src, n_dst));
   if (mapping_ == Mapping::kBarycentric && src.location != FieldLocation::kNode)
     fail("'barycentric' mapping needs a node field as source");
+  const bool onto_items =
+      dst.location == FieldLocation::kNode || dst.location == FieldLocation::kElement;
   // Objects split alike: copied part to part when every target item of a part takes its value
   // from that part's items (item for item, or inside the part's own tets). A nearest item may
   // be another process's, so "nearest" reads the source whole.
-  if (src.location != FieldLocation::kGlobal && mapping_ != Mapping::kNearest &&
-      (mapping_ == Mapping::kBarycentric || src.location == dst.location) && SplitAlike(from, to)) {
-    split_ = dynamic_cast<const PartitionedObject*>(&from);
-    from_ = &dynamic_cast<PartitionedObject&>(from).local_part();
-    to_ = &dynamic_cast<PartitionedObject&>(to).local_part();
+  if (alike && mapping_ != Mapping::kNearest &&
+      (mapping_ == Mapping::kBarycentric || src.location == dst.location)) {
+    split_ = from_split;
+    agree_on_ = from_split;
+    from_ = &from_split->local_part();
+    to_ = &to_split->local_part();
     from_field_ = from_->FindField(src.name);
     to_field_ = to_->FindField(dst.name);
     src_pos = ItemRestPositions(*from_, src.location);
     dst_pos = ItemRestPositions(*to_, dst.location);
     Log().debug("{}: copies the parts of {} to those of {}, each process its own (split alike)",
                 this->path(), from.path(), to.path());
+  } else if (mapping_ == Mapping::kBarycentric && onto_items &&
+             (from_split != nullptr || to_split != nullptr)) {
+    // Split differently, or one end whole on every process: a split target's part takes the
+    // values at its own items; a split source's values come from the parts that hold the
+    // points (PartitionedObject::InterpolateAtPoints), a whole source's from its own tets.
+    if (to_split != nullptr) {
+      agree_on_ = to_split;
+      to_ = &to_split->local_part();
+      to_field_ = to_->FindField(dst.name);
+      dst_pos = ItemRestPositions(*to_, dst.location);
+    }
+    if (from_split != nullptr) interpolation_ = from_split->InterpolateAtPoints(dst_pos);
+    Log().debug("{}: interpolates {} at the items of {}, each process its own", this->path(),
+                from.path(), to.path());
   }
-  if (mapping_ == Mapping::kBarycentric) {
+  if (mapping_ == Mapping::kBarycentric && !interpolation_) {
     map_ = from_->MapFromNodes(dst_pos);
   } else if (mapping_ == Mapping::kNearest) {
     map_ = PointMap::Nearest(src_pos, dst_pos);
   }
-  source_.resize(src.components, from_->FieldCount(from_field_));
+  if (!interpolation_) source_.resize(src.components, from_->FieldCount(from_field_));
   target_.resize(dst.components, to_->FieldCount(to_field_));
 }
 
 StepStatus FieldCopy::DoFire(double /*t*/) {
-  from_->ReadField(from_field_, source_);
-  if (split_ != nullptr && from_->field_info(from_field_).location == FieldLocation::kNode)
-    split_->ShareOwnedNodeValues(source_);
   // A source field's no-data marker (e.g. -1 for "never activated") is neither blended nor
   // scaled: an item that reads it, or whose interpolation touches it, gets the target field's
   // own marker if it declares one, else the source's marker unchanged.
   const std::optional<double> marker = from_->field_info(from_field_).no_data;
-  if (map_ && marker) {
-    map_->ApplyMarked(source_, target_, *marker);
-  } else if (map_) {
-    map_->Apply(source_, target_);
-    // The source's own interpolation where it is of higher order than the blend of the tet's
-    // vertices (a MixedSolid's quadratic displacement).
-    if (mapping_ == Mapping::kBarycentric)
-      from_->CorrectInterpolated(from_field_, map_->indices(), map_->weights(), target_);
+  if (interpolation_) {
+    // Interpolated by the parts that hold the points, the marker kept and the correction made.
+    interpolation_->Interpolate(from_field_, target_, marker);
   } else {
-    target_ = source_;
+    from_->ReadField(from_field_, source_);
+    if (split_ != nullptr && from_->field_info(from_field_).location == FieldLocation::kNode)
+      split_->ShareOwnedNodeValues(source_);
+    if (map_ && marker) {
+      map_->ApplyMarked(source_, target_, *marker);
+    } else if (map_) {
+      map_->Apply(source_, target_);
+      // The source's own interpolation where it is of higher order than the blend of the tet's
+      // vertices (a MixedSolid's quadratic displacement).
+      if (mapping_ == Mapping::kBarycentric)
+        from_->CorrectInterpolated(from_field_, map_->indices(), map_->weights(), target_);
+    } else {
+      target_ = source_;
+    }
   }
   if (marker) {
     const double written = to_->field_info(to_field_).no_data.value_or(*marker);
@@ -119,7 +157,7 @@ StepStatus FieldCopy::DoFire(double /*t*/) {
     target_ *= scale_;
   }
   // Every process stops alike when copying parts (each sees its own).
-  if (const auto bad = FirstNonFinite(target_, to_->field_info(to_field_).location, split_))
+  if (const auto bad = FirstNonFinite(target_, to_->field_info(to_field_).location, agree_on_))
     return StepStatus::Diverged("non-finite value transferred at item", bad->item, bad->value);
   to_->WriteField(to_field_, target_);
   return StepStatus::Ok();
@@ -154,13 +192,15 @@ void RegisterFieldCopy(TypeRegistry& registry) {
         }
       },
       "volume coupling: Get a field of one object, map it, Set it on another");
-  // Between objects split alike it copies their parts, unless a nearest item (which may be
-  // another process's) is asked for.
+  // A barycentric copy couples parts split any way (each process asks for the values at its
+  // own target items); a direct one, or "auto" (which may turn out direct), those of objects
+  // split alike; a nearest item may be any process's, so "nearest" needs its objects whole.
   registry.connector_part_use["FieldCopy"] = [](const JsonNode& params) {
     const auto mapping = params.Find("mapping");
-    return mapping && mapping->is_string() && mapping->AsString() == "nearest"
-               ? TypeRegistry::PartUse::kWhole
-               : TypeRegistry::PartUse::kPartToPart;
+    const std::string name = mapping && mapping->is_string() ? mapping->AsString() : "auto";
+    return name == "nearest"       ? TypeRegistry::PartUse::kWhole
+           : name == "barycentric" ? TypeRegistry::PartUse::kAnyParts
+                                   : TypeRegistry::PartUse::kPartToPart;
   };
 }
 

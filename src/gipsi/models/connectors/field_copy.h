@@ -18,8 +18,13 @@
 /// Between objects split alike over the processes of a distributed run (SplitAlike), a direct or
 /// barycentric copy runs part to part: each process reads its part of the source, takes the
 /// values of the nodes it shares from their owners, and writes its part of the target; no
-/// process gathers a whole field. A nearest-item copy reads the source whole.
+/// process gathers a whole field. A barycentric copy from a split object to one split
+/// differently (another mesh, another cut) or whole asks the source's parts for the values at
+/// the target's items, each process at its own (PartitionedObject::InterpolateAtPoints), and
+/// one from a whole object onto a split one maps onto the target's part; no process gathers a
+/// whole field either. A nearest-item copy reads the source whole.
 
+#include <memory>
 #include <optional>
 
 #include "gipsi/base/export.h"
@@ -48,8 +53,11 @@ class FieldCopy final : public Connector {
   [[nodiscard]] Mapping mapping() const { return mapping_; }
   /// The factor applied: the scale times the conversion of its units into the target's.
   [[nodiscard]] double factor() const { return scale_; }
-  /// Whether it copies the objects' parts, process by process (split alike).
-  [[nodiscard]] bool couples_parts() const override { return split_ != nullptr; }
+  /// Whether it copies the objects' parts, process by process: split alike, or a barycentric
+  /// copy from or onto a split object.
+  [[nodiscard]] bool couples_parts() const override {
+    return agree_on_ != nullptr || interpolation_ != nullptr;
+  }
 
  protected:
   StepStatus DoFire(double t) override;
@@ -60,7 +68,11 @@ class FieldCopy final : public Connector {
   FieldId from_field_;
   SimObject* to_;
   FieldId to_field_;
-  const PartitionedObject* split_ = nullptr;  // the split source, when copying parts
+  const PartitionedObject* split_ = nullptr;  // the split source, when copying parts alike
+  // The split object whose part the target's values are for (they agree on a failure).
+  const PartitionedObject* agree_on_ = nullptr;
+  // A split source interpolated at the target's items by the parts that hold them.
+  std::unique_ptr<PartsInterpolation> interpolation_;
   Mapping mapping_;
   double scale_;
   std::optional<PointMap> map_;

@@ -1,0 +1,45 @@
+#pragma once
+/// @file
+/// PartitionedObject::InterpolateAtPoints for one rank's part (WholeDomainView's): values of a
+/// split object's node field at points that each rank chooses for itself, each computed by the
+/// rank whose part holds the point and sent to the rank that asked.
+///
+/// Set-up (collective, once): the parts' bounding boxes are gathered (6 numbers per rank); each
+/// rank sends each of its points to the ranks whose box holds it, they locate it on their parts
+/// (PointMap::BarycentricInTets) and answer how far it lies from them (0 inside, up to
+/// rounding), and the point is taken from the nearest part, the lowest rank on a tie, as
+/// LocateWhole does. A point that no part holds is asked again of every rank whose box is
+/// nearer than the nearest part found, so a point outside the whole domain still goes to the
+/// part nearest to it. The chosen rank keeps the point's weights. Each rank then holds O(its
+/// points + the points it answers for others), and 6 numbers per rank for the boxes.
+///
+/// Interpolate (collective, every firing): each rank reads its part's field, takes its shared
+/// nodes' values from their owners, interpolates the points others asked of it and sends the
+/// values back (MPI_Alltoallv with counts fixed at set-up; no allocation once the buffers have
+/// grown to the field's width).
+
+#include <mpi.h>
+
+#include <functional>
+#include <memory>
+
+#include "gipsi/base/export.h"
+#include "gipsi/core/partitioned_object.h"
+#include "gipsi/core/sim_object.h"
+#include "gipsi/parallel/mesh_partition.h"
+
+GIPSI_EXPORT_BEGIN
+namespace gipsi {
+
+/// `part` is this rank's object on `mesh_part.mesh` (both must outlive the result); `points`
+/// this rank's points; `part_field` turns the field ids Interpolate is given into the part's;
+/// `share` sets a part node field's shared nodes to their owners' values
+/// (PartitionedObject::ShareOwnedNodeValues). Collective; throws InputError on every rank if
+/// any rank's point is not finite.
+[[nodiscard]] std::unique_ptr<PartsInterpolation> MakePartsInterpolation(
+    const SimObject& part, const MeshPart& mesh_part, const Points& points, MPI_Comm comm,
+    std::function<FieldId(FieldId)> part_field,
+    std::function<void(Eigen::Ref<Eigen::MatrixXd>)> share);
+
+}  // namespace gipsi
+GIPSI_EXPORT_END
