@@ -187,10 +187,10 @@ TEST(SceneMeshes, ObjectsCoupledPartToPartAreMadeInBlocksTogether) {
   EXPECT_EQ(scene.meshes.count("slab"), 1U);
 }
 
-// A barycentric FieldCopy couples parts split any way, so the objects it joins are made in
-// blocks whatever their meshes, and whether or not its other end is: one on another mesh, one
-// kept whole. A direct copy, or "auto" (which may turn out direct), still needs one mesh, and
-// "nearest" objects whole.
+// A barycentric FieldCopy (and an excitation–contraction) couples parts split any way, so the
+// objects it joins are made in blocks whatever their meshes, and whether or not its other end
+// is: one on another mesh, one kept whole. A direct copy, or "auto" (which may turn out direct),
+// still needs one mesh, and "nearest" objects whole.
 TEST(SceneMeshes, ABarycentricCopyLetsObjectsOnOtherMeshesBeMadeInBlocks) {
   std::map<std::string, Seen> seen;
   auto registry = RecordingRegistry(seen, true);
@@ -205,6 +205,9 @@ TEST(SceneMeshes, ABarycentricCopyLetsObjectsOnOtherMeshesBeMadeInBlocks) {
   EXPECT_EQ(use_of(R"({"type": "FieldCopy", "mapping": "auto"})"), PartUse::kPartToPart);
   EXPECT_EQ(use_of(R"({"type": "FieldCopy"})"), PartUse::kPartToPart);
   EXPECT_EQ(use_of(R"({"type": "FieldCopy", "mapping": "nearest"})"), PartUse::kWhole);
+  const JsonDocument ec = JsonDocument::Parse(R"({"type": "ExcitationContraction"})", "ec.json");
+  EXPECT_EQ(registry->connector_part_use.at("ExcitationContraction")(ec.root()),
+            PartUse::kAnyParts);
 
   const JsonDocument doc = JsonDocument::Parse(R"({
     "objects": {

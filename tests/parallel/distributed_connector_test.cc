@@ -222,7 +222,8 @@ TEST(SplitCoupling, ObjectsOnOneMeshAreSplitAlike) {
 // the parts: no whole field is gathered, and every local item of every part (owned or shared)
 // gets the twitch law's value at the whole mesh's V, on nodes and, through the interpolation on
 // the part, at the tets' centroids. With the muscle whole on every rank the connector reads V
-// whole, and gives the same values.
+// whole for its nodes, and asks the tissue's parts for V at its tets' centroids, and gives the
+// same values.
 TEST(SplitCoupling, ExcitationContractionCouplesThePartsWithoutGathers) {
   const auto mesh = Box();
   const auto tissue = SplitTissue(mesh);
@@ -242,13 +243,16 @@ TEST(SplitCoupling, ExcitationContractionCouplesThePartsWithoutGathers) {
     ExcitationContraction whole_v("ec", *tissue, v, *whole_muscle, whole_muscle->FindField(field),
                                   kTwitch);
     EXPECT_TRUE(on_parts.couples_parts());
-    EXPECT_FALSE(whole_v.couples_parts());
+    // Onto the whole muscle's nodes item for item, reading V whole; onto its tets through the
+    // parts that hold their centroids.
+    const bool at_tets = std::string(field) == "active_tension";
+    EXPECT_EQ(whole_v.couples_parts(), at_tets);
     const std::int64_t reads_before = tissue->whole_field_reads();
     for (double t : {0.0, 0.004}) ASSERT_TRUE(on_parts.Fire(t).ok());
     EXPECT_EQ(tissue->whole_field_reads(), reads_before);
     EXPECT_EQ(dynamic_cast<const WholeDomainView&>(*split_muscle).whole_field_reads(), 0);
     for (double t : {0.0, 0.004}) ASSERT_TRUE(whole_v.Fire(t).ok());
-    EXPECT_EQ(tissue->whole_field_reads(), reads_before + 2);
+    EXPECT_EQ(tissue->whole_field_reads(), reads_before + (at_tets ? 0 : 2));
 
     const auto& part = dynamic_cast<PartitionedObject&>(*split_muscle);
     const Eigen::MatrixXd local = Read(part.local_part(), field);
@@ -308,10 +312,11 @@ TEST(SplitCoupling, FieldCopyCopiesThePartsWithoutGathers) {
 // Objects made in blocks from one mesh (no rank holds it) are split alike, and the
 // excitation–contraction coupling couples their parts: every muscle tet gets the twitch law at
 // the mean of its corners' V, which the tissue split from the whole box gives too. A coordinator
-// takes the pair. A connector that cannot couple parts is refused on such an object when the
-// coordinator prepares, naming the connector, the field and why: one end whole on every rank,
-// a nearest-item copy. (A connector of its global fields and capabilities, the heart's cavity
-// coupling, is taken: Mpi.SceneRunMatchesTheSerialRun runs the heart in blocks.)
+// takes the pair, and the coupling to a muscle whole on every rank (the tissue's parts answer
+// for its tets). A connector that cannot couple parts is refused on such an object when the
+// coordinator prepares, naming the connector, the field and why: a nearest-item copy. (A
+// connector of its global fields and capabilities, the heart's cavity coupling, is taken:
+// Mpi.SceneRunMatchesTheSerialRun runs the heart in blocks.)
 TEST(SplitCoupling, ObjectsMadeInBlocksCoupleTheirPartsAndOtherConnectorsAreRefused) {
   const auto mesh = Box();
   std::unique_ptr<SimObject> tissue = TissueInBlocks();
@@ -341,26 +346,27 @@ TEST(SplitCoupling, ObjectsMadeInBlocksCoupleTheirPartsAndOtherConnectorsAreRefu
   ASSERT_TRUE(coupled.connector(0).Fire(0.004).ok());
   ExpectTwitchAtCentroids(dynamic_cast<PartitionedObject&>(*wall), *mesh, volts);
 
-  {  // EC to a muscle whole on every rank: it would read the tissue's part as the whole field
+  {  // EC to a muscle whole on every rank: the tissue's parts answer for its tets' centroids
     auto source = TissueInBlocks();
+    for (int s = 0; s < 60; ++s) ASSERT_TRUE(source->Step(1e-4).ok());
     auto whole_muscle = Muscle(mesh, false);
+    SimObject& whole_wall = *whole_muscle;
     auto ec = std::make_unique<ExcitationContraction>(
         "ec", *source, source->FindField("V"), *whole_muscle,
         whole_muscle->FindField("active_tension"), kTwitch);
-    EXPECT_FALSE(ec->couples_parts());
+    EXPECT_TRUE(ec->couples_parts());
     Coordinator c;
     c.AddObject(std::move(source), 1e-4);
     c.AddObject(std::move(whole_muscle), 1e-4);
     c.AddConnector(std::move(ec), 1);
-    try {
-      c.Prepare(1e-4);
-      ADD_FAILURE() << "accepted";
-    } catch (const WiringError& e) {
-      EXPECT_NE(std::string(e.what()).find("connector 'ec' (ExcitationContraction) reads field 'V' "
-                                           "of 'ep' (Monodomain) at its 'from' key, but that "
-                                           "object is made in blocks"),
-                std::string::npos)
-          << e.what();
+    EXPECT_NO_THROW(c.Prepare(1e-4));
+    ASSERT_TRUE(c.connector(0).Fire(0.0).ok());
+    ASSERT_TRUE(c.connector(0).Fire(0.004).ok());
+    const Eigen::MatrixXd tension = Read(whole_wall, "active_tension");
+    for (Index e = 0; e < mesh->num_tets(); ++e) {
+      double mean = 0;
+      for (int a = 0; a < 4; ++a) mean += 0.25 * volts(0, mesh->tets(a, e));
+      ASSERT_NEAR(tension(0, e), Twitch(mean, 0.0, 0.004), 1e-9) << "tet " << e;
     }
   }
   {  // a nearest-item copy between objects split alike
@@ -369,11 +375,21 @@ TEST(SplitCoupling, ObjectsMadeInBlocksCoupleTheirPartsAndOtherConnectorsAreRefu
     auto copy = std::make_unique<FieldCopy>("copy", *source, source->FindField("V"), *target,
                                             target->FindField("active_tension"),
                                             FieldCopy::Mapping::kNearest, 2, "kPa/mV");
+    EXPECT_FALSE(copy->couples_parts());
     Coordinator c;
     c.AddObject(std::move(source), 1e-4);
     c.AddObject(std::move(target), 1e-4);
     c.AddConnector(std::move(copy), 1);
-    EXPECT_THROW(c.Prepare(1e-4), WiringError);
+    try {
+      c.Prepare(1e-4);
+      ADD_FAILURE() << "accepted";
+    } catch (const WiringError& e) {
+      EXPECT_NE(std::string(e.what()).find("connector 'copy' (FieldCopy) reads field 'V' of 'ep' "
+                                           "(Monodomain) at its 'from' key, but that object is "
+                                           "made in blocks"),
+                std::string::npos)
+          << e.what();
+    }
   }
 }
 
@@ -447,33 +463,48 @@ TEST(SplitCoupling, PartsInterpolateAtThePointsEachRankAsks) {
 // on every rank: each rank's items get the whole box's interpolation of V at them (the nearest
 // point of the box outside it), with no gather; a coordinator takes it. A "direct" copy between
 // them is refused.
-TEST(SplitCoupling, ABarycentricCopyJoinsObjectsSplitDifferently) {
-  const auto mesh = Box();
-  const auto other = std::make_shared<Mesh>(MakeTetBox(kOtherLo, kOtherHi, kOtherCells));
-  const auto whole_tissue = SplitTissue(mesh);
+// The tissue made in blocks after 6 ms, and V of the whole box (from the tissue split from it)
+// interpolated at the items of a muscle on the other box: its nodes or its tets' centroids.
+struct TwoMeshes {
+  std::shared_ptr<const Mesh> mesh = Box();
+  std::shared_ptr<const Mesh> other =
+      std::make_shared<Mesh>(MakeTetBox(kOtherLo, kOtherHi, kOtherCells));
   std::unique_ptr<WholeDomainView> tissue = TissueInBlocks();
-  for (int s = 0; s < 60; ++s) {
-    ASSERT_TRUE(tissue->Step(1e-4).ok());  // 6 ms
-    ASSERT_TRUE(whole_tissue->Step(1e-4).ok());
+  Eigen::MatrixXd volts;
+
+  TwoMeshes() {
+    const auto whole_tissue = SplitTissue(mesh);
+    for (int s = 0; s < 60; ++s) {
+      EXPECT_TRUE(tissue->Step(1e-4).ok());  // 6 ms
+      EXPECT_TRUE(whole_tissue->Step(1e-4).ok());
+    }
+    volts = Read(*whole_tissue, "V");
   }
-  const Eigen::MatrixXd volts = Read(*whole_tissue, "V");
+  [[nodiscard]] Eigen::MatrixXd VAtOtherItems(bool at_nodes) const {
+    const Points at =
+        at_nodes ? other->nodes : ItemRestPositions(*Muscle(other, false), FieldLocation::kElement);
+    Eigen::MatrixXd out(1, at.cols());
+    PointMap::BarycentricInTets(mesh->nodes, mesh->tets, at).Apply(volts, out);
+    return out;
+  }
+};
+
+TEST(SplitCoupling, ABarycentricCopyJoinsObjectsSplitDifferently) {
+  TwoMeshes two;
+  std::unique_ptr<WholeDomainView>& tissue = two.tissue;
   const FieldId v = tissue->FindField("V");
   using Mapping = FieldCopy::Mapping;
-  const Points centroids = ItemRestPositions(*Muscle(other, false), FieldLocation::kElement);
   for (const char* field : {"nodal_active_tension", "active_tension"}) {
     SCOPED_TRACE(field);
     const bool at_nodes = std::string(field) == "nodal_active_tension";
     // The whole box's interpolation at every item of the other mesh, scaled to Pa.
-    Eigen::MatrixXd expected(1, at_nodes ? other->num_nodes() : other->num_tets());
-    PointMap::BarycentricInTets(mesh->nodes, mesh->tets, at_nodes ? other->nodes : centroids)
-        .Apply(volts, expected);
-    expected *= 2000.0;
+    const Eigen::MatrixXd expected = 2000.0 * two.VAtOtherItems(at_nodes);
     const double peak = expected.cwiseAbs().maxCoeff();
     ASSERT_GT(peak, 1e5);
 
     std::unique_ptr<WholeDomainView> split_muscle =
         MuscleInBlocks(BoxInBlocks(kOtherLo, kOtherHi, kOtherCells));
-    std::unique_ptr<SimObject> whole_muscle = Muscle(other, false);
+    std::unique_ptr<SimObject> whole_muscle = Muscle(two.other, false);
     EXPECT_FALSE(SplitAlike(*tissue, *split_muscle));
     FieldCopy onto_parts("copy", *tissue, v, *split_muscle, split_muscle->FindField(field),
                          Mapping::kAuto, 2, "kPa/mV");
@@ -519,6 +550,40 @@ TEST(SplitCoupling, ABarycentricCopyJoinsObjectsSplitDifferently) {
     ADD_FAILURE() << "accepted";
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("split differently"), std::string::npos) << e.what();
+  }
+}
+
+// The excitation–contraction coupling between the tissue made in blocks and a muscle on another,
+// coarser mesh that sticks out of it, made in blocks too (so cut differently): every muscle node
+// and tet of every part gets the twitch law at the whole box's interpolation of V there, with
+// no gather.
+TEST(SplitCoupling, ExcitationContractionJoinsObjectsOnTwoMeshes) {
+  TwoMeshes two;
+  std::unique_ptr<WholeDomainView>& tissue = two.tissue;
+  for (const char* field : {"nodal_active_tension", "active_tension"}) {
+    SCOPED_TRACE(field);
+    const bool at_nodes = std::string(field) == "nodal_active_tension";
+    const Eigen::MatrixXd v_there = two.VAtOtherItems(at_nodes);
+    std::unique_ptr<WholeDomainView> muscle =
+        MuscleInBlocks(BoxInBlocks(kOtherLo, kOtherHi, kOtherCells));
+    ExcitationContraction ec("ec", *tissue, tissue->FindField("V"), *muscle,
+                             muscle->FindField(field), kTwitch);
+    EXPECT_TRUE(ec.couples_parts());
+    const std::int64_t reads_before = tissue->whole_field_reads();
+    for (double t : {0.0, 0.004}) ASSERT_TRUE(ec.Fire(t).ok());
+    EXPECT_EQ(tissue->whole_field_reads(), reads_before);
+    const Eigen::MatrixXd local = Read(muscle->local_part(), field);
+    const std::span<const int> items =
+        at_nodes ? muscle->whole_nodes_of_part() : muscle->whole_tets_of_part();
+    ASSERT_EQ(static_cast<std::size_t>(local.cols()), items.size());
+    double peak = 0;
+    for (Index i = 0; i < local.cols(); ++i) {
+      const int item = items[static_cast<std::size_t>(i)];
+      ASSERT_NEAR(local(0, i), Twitch(v_there(0, item), 0.0, 0.004), 1e-9) << "whole item " << item;
+      peak = std::max(peak, local(0, i));
+    }
+    MPI_Allreduce(MPI_IN_PLACE, &peak, 1, MPI_DOUBLE, MPI_MAX, World());
+    EXPECT_GT(peak, 1e3);  // Pa: some of the muscle lies in the excited tissue
   }
 }
 

@@ -42,35 +42,69 @@ ExcitationContraction::ExcitationContraction(std::string name, const SimObject& 
   UseField("from", ep, v.name, FieldAccess::kRead, "mV", 1);
   UseField("to", muscle, ta.name, FieldAccess::kReadWrite, "Pa", 1);
   tension_location_ = ta.location;
-  if (SplitAlike(ep, muscle)) {  // couple the parts, process by process
-    split_ = dynamic_cast<const PartitionedObject*>(&ep);
+  // Objects split over the processes of a distributed run: split alike (collective when both
+  // are split), or either holding only its part (whose items are this process's alone).
+  const auto* ep_split = dynamic_cast<const PartitionedObject*>(&ep);
+  auto* muscle_split = dynamic_cast<PartitionedObject*>(&muscle);
+  const bool part_only = (ep_split != nullptr && !ep_split->holds_whole_domain()) ||
+                         (muscle_split != nullptr && !muscle_split->holds_whole_domain());
+  const bool alike = SplitAlike(ep, muscle);
+  if (alike) {  // couple the parts, process by process
+    split_ = ep_split;
+    agree_on_ = ep_split;
     ep_ = &split_->local_part();
-    muscle_ = &dynamic_cast<PartitionedObject&>(muscle).local_part();
+    muscle_ = &muscle_split->local_part();
     voltage_ = ep_->FindField(v.name);
     tension_field_ = muscle_->FindField(ta.name);
     Log().debug("{}: couples the parts of {} and {}, each process its own (split alike)", path(),
                 ep.path(), muscle.path());
   }
   const Points src = ItemRestPositions(*ep_, FieldLocation::kNode);
-  const Points dst = ItemRestPositions(*muscle_, ta.location);
-  const bool coincide = src.cols() == dst.cols() && (src - dst).cwiseAbs().maxCoeff() <= 1e-12;
-  if (!coincide) map_ = ep_->MapFromNodes(dst);
-  source_.resize(1, src.cols());
+  Points dst = ItemRestPositions(*muscle_, ta.location);
+  // Items of differently split parts never coincide (and comparing them on one process would
+  // decide differently on another).
+  const bool coincide = (alike || !part_only) && src.cols() == dst.cols() &&
+                        (src - dst).cwiseAbs().maxCoeff() <= 1e-12;
+  if (!alike && !coincide && (ep_split != nullptr || muscle_split != nullptr)) {
+    // Split differently (another mesh, another cut) or one end whole on every process: a split
+    // muscle's part takes V at its own items; a split EP object's parts answer for them
+    // (PartitionedObject::InterpolateAtPoints), a whole one interpolates in its own tets.
+    if (muscle_split != nullptr) {
+      agree_on_ = muscle_split;
+      muscle_ = &muscle_split->local_part();
+      tension_field_ = muscle_->FindField(ta.name);
+      dst = ItemRestPositions(*muscle_, ta.location);
+    }
+    if (ep_split != nullptr) {
+      interpolation_ = ep_split->InterpolateAtPoints(dst);
+    } else {
+      map_ = ep_->MapFromNodes(dst);
+    }
+    Log().debug("{}: interpolates V of {} at the items of {}, each process its own", path(),
+                ep.path(), muscle.path());
+  } else if (!coincide) {
+    map_ = ep_->MapFromNodes(dst);
+  }
+  source_.resize(1, interpolation_ ? 0 : src.cols());
   mapped_.resize(1, dst.cols());
   tension_.resize(1, dst.cols());
   BindState(state_);
 }
 
 StepStatus ExcitationContraction::DoFire(double t) {
-  ep_->ReadField(voltage_, source_);
-  if (split_ != nullptr) split_->ShareOwnedNodeValues(source_);
-  if (map_) {
-    map_->Apply(source_, mapped_);
+  if (interpolation_) {
+    interpolation_->Interpolate(voltage_, mapped_, std::nullopt);
   } else {
-    mapped_ = source_;
+    ep_->ReadField(voltage_, source_);
+    if (split_ != nullptr) split_->ShareOwnedNodeValues(source_);
+    if (map_) {
+      map_->Apply(source_, mapped_);
+    } else {
+      mapped_ = source_;
+    }
   }
   // Every process stops alike when coupling parts (each sees its own).
-  if (const auto bad = FirstNonFinite(mapped_, tension_location_, split_))
+  if (const auto bad = FirstNonFinite(mapped_, tension_location_, agree_on_))
     return StepStatus::Diverged("non-finite voltage at item", bad->item, bad->value);
   const double dt = state_.fired ? t - state_.last_time : 0.0;
   muscle_->ReadField(tension_field_, tension_);  // the tension to relax from
@@ -116,9 +150,10 @@ void RegisterExcitationContraction(TypeRegistry& registry) {
       },
       "volume coupling: transmembrane voltage -> active tension (first-order twitch model)");
   // Between objects split alike it couples their parts, at the muscle's nodes or, through the
-  // part's own interpolation, at its tets.
+  // part's own interpolation, at its tets; between objects split any other way (another mesh),
+  // or with one end whole, the EP object's parts answer for the muscle's items.
   registry.connector_part_use["ExcitationContraction"] = [](const JsonNode&) {
-    return TypeRegistry::PartUse::kPartToPart;
+    return TypeRegistry::PartUse::kAnyParts;
   };
 }
 

@@ -21,10 +21,15 @@
 /// its part's V, takes the values of the nodes it shares from their owners
 /// (ShareOwnedNodeValues, O(the part's surface)), and writes its part's tension. No process
 /// gathers a whole field, and every item gets the value the whole-field path would give it.
+/// Split any other way (the muscle on another mesh, or one of them whole on every process), the
+/// muscle's items are this process's own (its part's, or all of a whole muscle), and a split
+/// EP object's parts answer for them (PartitionedObject::InterpolateAtPoints): no process
+/// gathers V either.
 ///
 /// Units: V in mV (the EP objects' unit); k in Pa; rates in 1/s; kernel time in s.
 
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -69,16 +74,18 @@ class ExcitationContraction final : public Connector {
  public:
   /// `voltage` must be a readable scalar node field of `ep`; `tension` a readable and writable
   /// scalar node or element field of `muscle`. Throws InputError otherwise, or for bad
-  /// parameters. Collective over the processes of a distributed run when both objects are split
-  /// (SplitAlike).
+  /// parameters. Collective over the processes of a distributed run when either object is
+  /// split.
   ExcitationContraction(std::string name, const SimObject& ep, FieldId voltage, SimObject& muscle,
                         FieldId tension, const ExcitationContractionParams& params);
 
   [[nodiscard]] std::string_view type_name() const override { return "ExcitationContraction"; }
   /// The state (bound with BindState: checkpoints and snapshots copy it).
   [[nodiscard]] const ExcitationContractionState& state() const { return state_; }
-  /// Whether it couples the objects' parts, process by process (split alike).
-  [[nodiscard]] bool couples_parts() const override { return split_ != nullptr; }
+  /// Whether it couples the objects' parts, process by process (split alike, or any way).
+  [[nodiscard]] bool couples_parts() const override {
+    return agree_on_ != nullptr || interpolation_ != nullptr;
+  }
 
  protected:
   StepStatus DoFire(double t) override;
@@ -89,7 +96,11 @@ class ExcitationContraction final : public Connector {
   FieldId voltage_;
   SimObject* muscle_;
   FieldId tension_field_;
-  const PartitionedObject* split_ = nullptr;  // the split EP object, when coupling parts
+  const PartitionedObject* split_ = nullptr;  // the split EP object, when coupling parts alike
+  // The split object whose part the muscle's items are (they agree on a failure).
+  const PartitionedObject* agree_on_ = nullptr;
+  // A split EP object's V interpolated at the muscle's items by the parts that hold them.
+  std::unique_ptr<PartsInterpolation> interpolation_;
   FieldLocation tension_location_ = FieldLocation::kNode;
   ExcitationContractionParams params_;
   std::optional<PointMap> map_;  // empty: the items coincide
