@@ -35,35 +35,21 @@
 #include "gipsi/parallel/parallel_session.h"
 #include "gipsi/parallel/whole_domain_view.h"
 #include "parallel/cantilever.h"
+#include "parallel/checkpoint_files.h"
 
 namespace gipsi {
 namespace {
 
-MPI_Comm World() { return ParallelSession::world(); }
-
 using test::CantileverMesh;
 using test::CantileverParams;
 using test::Clamp;
-int Rank(MPI_Comm comm) { return ParallelSession::rank(comm); }
-int Size(MPI_Comm comm) { return ParallelSession::size(comm); }
-
-// The first `ranks` ranks of the world (MPI_COMM_NULL on the others). Freed with the object.
-class FirstRanks {
- public:
-  explicit FirstRanks(int ranks) {
-    MPI_Comm_split(World(), Rank(World()) < ranks ? 0 : MPI_UNDEFINED, Rank(World()), &comm_);
-  }
-  ~FirstRanks() {
-    if (comm_ != MPI_COMM_NULL) MPI_Comm_free(&comm_);
-  }
-  FirstRanks(const FirstRanks&) = delete;
-  FirstRanks& operator=(const FirstRanks&) = delete;
-  [[nodiscard]] MPI_Comm comm() const { return comm_; }
-  [[nodiscard]] bool member() const { return comm_ != MPI_COMM_NULL; }
-
- private:
-  MPI_Comm comm_ = MPI_COMM_NULL;
-};
+using test::FirstRanks;
+using test::Folder;
+using test::Rank;
+using test::Restore;
+using test::Size;
+using test::World;
+using test::Write;
 
 // The N-version benchmark slab (scenes/slab_ep_0.5mm.json: 0.5 mm; coarser meshes block the front),
 // its solver at 1e-11 (see distributed_monodomain_test.cc), stimulated at the corner.
@@ -128,43 +114,6 @@ struct SplitSlab {
     return all;  // column after column
   }
 };
-
-// A folder of checkpoint files every rank of the world names alike.
-std::filesystem::path Folder(const std::string& name) {
-  int id = Rank(World()) == 0 ? static_cast<int>(::getpid()) : 0;
-  MPI_Bcast(&id, 1, MPI_INT, 0, World());
-  const auto folder =
-      std::filesystem::temp_directory_path() / fmt::format("gipsi_ranks_{}_{}", name, id);
-  if (Rank(World()) == 0) std::filesystem::create_directories(folder);
-  MPI_Barrier(World());
-  return folder;
-}
-
-// Every rank of `comm` writes the view's checkpoint to folder/p<rank>; returns every name.
-std::vector<std::filesystem::path> Write(const WholeDomainView& view, MPI_Comm comm,
-                                         const std::filesystem::path& folder) {
-  StateWriter out;
-  view.SaveState(out);
-  std::vector<std::filesystem::path> files;
-  for (int r = 0; r < Size(comm); ++r) files.push_back(folder / fmt::format("p{}", r));
-  WriteCheckpointFile(files[static_cast<std::size_t>(Rank(comm))], out.bytes());
-  return files;
-}
-
-// Restores `view` on its ranks from `files` (rank q reads file q % N, as the tool does).
-void Restore(WholeDomainView& view, MPI_Comm comm,
-             const std::vector<std::filesystem::path>& files) {
-  WholeDomainView::SetCheckpointFiles(files);
-  const auto& mine = files[static_cast<std::size_t>(Rank(comm)) % files.size()];
-  StateReader in(ReadCheckpointFile(mine), mine.string());
-  try {
-    view.RestoreState(in);
-  } catch (...) {
-    WholeDomainView::SetCheckpointFiles({});
-    throw;
-  }
-  WholeDomainView::SetCheckpointFiles({});
-}
 
 struct Move {
   int from, to;

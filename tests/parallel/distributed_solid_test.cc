@@ -147,12 +147,12 @@ TEST(DistributedSolid, APartMadeInBlocksFindsTheWholeBoundaryAndSwingsAlike) {
   EXPECT_LE((u_b - u_a).cwiseAbs().maxCoeff(), 1e-9 * sag);
 }
 
-// The view of a FemSolid made in blocks keeps its boundary conditions numbered on the whole
-// boundary without its geometry: a region's whole-boundary vertices and faces, selected on the
-// parts and gathered, are the serial selection's on the whole mesh (face groups, faces whose
-// three vertices a box or a half-space selects, node ids, every face); and each rank's own
-// boundary vertices of a region (what probes reduce) make the whole selection once over the
-// ranks.
+// The view of a FemSolid made in blocks keeps its part's boundary conditions only: a region
+// selects on each part exactly the part's vertices and faces that the serial selection on the
+// whole mesh has (face groups, faces whose three vertices a box or a half-space selects, node
+// ids, every face), a vertex on a cut on every part that holds it, and counts the whole
+// selection's items once; and each rank's own boundary vertices of a region (what probes
+// reduce) make the whole selection once over the ranks.
 TEST(DistributedSolid, APartOnlyViewSelectsTheWholeBoundarysItems) {
   const auto whole = CantileverMesh();
   const BoundarySurface whole_boundary = MakeBoundary(*whole);
@@ -171,8 +171,10 @@ TEST(DistributedSolid, APartOnlyViewSelectsTheWholeBoundarysItems) {
           distribution->whole_boundary_vertex(), distribution->whole_boundary_face(),
           distribution->whole_boundary_vertices(), distribution->whole_boundary_faces()});
   ASSERT_FALSE(view.holds_whole_domain());
-  EXPECT_EQ(view.boundary_conditions().num_vertices(), whole_boundary.num_vertices());
-  EXPECT_EQ(view.boundary_conditions().num_faces(), whole_boundary.num_triangles());
+  EXPECT_EQ(view.boundary_conditions().num_vertices(), view.boundary().num_vertices());
+  EXPECT_EQ(view.boundary_conditions().num_faces(), view.boundary().num_triangles());
+  const std::vector<int>& whole_vertex = distribution->whole_boundary_vertex();
+  const std::vector<int>& whole_face = distribution->whole_boundary_face();
   const std::vector<Region> regions = {AllRegion{},
                                        GroupRegion{"xmax"},
                                        GroupRegion{"zmax"},
@@ -184,8 +186,18 @@ TEST(DistributedSolid, APartOnlyViewSelectsTheWholeBoundarysItems) {
     const std::vector<int> vertices = SelectBoundaryVertices(region, *whole, whole_boundary);
     const std::vector<int> faces = SelectBoundaryFaces(region, *whole, whole_boundary);
     EXPECT_FALSE(vertices.empty()) << "region " << k;
-    EXPECT_EQ(view.SelectWholeBoundary(region, false), vertices) << "region " << k;
-    EXPECT_EQ(view.SelectWholeBoundary(region, true), faces) << "region " << k;
+    for (const bool on_faces : {false, true}) {
+      const std::vector<int>& serial = on_faces ? faces : vertices;
+      const std::vector<int>& whole_of = on_faces ? whole_face : whole_vertex;
+      const PartitionedObject::ConditionItems selected =
+          view.SelectConditionItems(region, on_faces);
+      EXPECT_EQ(selected.whole_count, static_cast<std::int64_t>(serial.size())) << "region " << k;
+      std::vector<int> expected;  // the part's items the serial selection has
+      for (std::size_t i = 0; i < whole_of.size(); ++i)
+        if (std::binary_search(serial.begin(), serial.end(), whole_of[i]))
+          expected.push_back(static_cast<int>(i));
+      EXPECT_EQ(selected.items, expected) << "region " << k << (on_faces ? " faces" : " vertices");
+    }
     std::vector<int> owned;
     for (const int v : view.SelectOwnedBoundaryVertices(region)) {
       EXPECT_LT(view.boundary().vertex_to_node[static_cast<std::size_t>(v)], part.num_owned);
@@ -203,7 +215,7 @@ TEST(DistributedSolid, APartOnlyViewSelectsTheWholeBoundarysItems) {
     EXPECT_EQ(all, vertices) << "region " << k;  // each once: no repeats
   }
   // A group no part has is refused on every rank.
-  EXPECT_THROW((void)view.SelectWholeBoundary(GroupRegion{"no_such_group"}, false), InputError);
+  EXPECT_THROW((void)view.SelectConditionItems(GroupRegion{"no_such_group"}, false), InputError);
 }
 
 // The same release with the Newmark scheme (average acceleration), which starts from the

@@ -35,6 +35,15 @@ void BoundaryConditions::RestoreApplied(StateReader& in) {
   ClearCouplingLoads();
 }
 
+void BoundaryConditions::RestoreApplied(Applied applied) {
+  GIPSI_CHECK(applied.kind.size() == applied_.kind.size() &&
+                  applied.pressure.size() == applied_.pressure.size(),
+              "boundary conditions of another store");
+  applied_ = std::move(applied);
+  Touch();
+  ClearCouplingLoads();
+}
+
 namespace {
 
 // BoundaryConditions::Applied's fields, of whatever shape they were written.
@@ -52,31 +61,51 @@ struct AnyShapeApplied {
 
 }  // namespace
 
-bool BoundaryConditions::SkipApplied(StateReader& in) {
+BoundaryConditions::Applied BoundaryConditions::ReadAnySize(StateReader& in) {
   AnyShapeApplied read;
   ReadFields(in, read);
   const Applied& a = read.value;
+  const auto vertices = static_cast<std::size_t>(a.value.cols());
+  if (a.kind.size() != 3 * vertices || a.value.rows() != 3 || a.force.rows() != 3 ||
+      static_cast<std::size_t>(a.force.cols()) != vertices || a.traction.rows() != 3 ||
+      a.traction.cols() != a.pressure.size())
+    in.Fail("boundary conditions of inconsistent sizes: a corrupted checkpoint");
+  for (const ConstraintKind k : a.kind)
+    if (k != ConstraintKind::kFree && k != ConstraintKind::kDisplacement &&
+        k != ConstraintKind::kVelocity)
+      in.Fail("a boundary condition of unknown kind: a corrupted checkpoint");
+  return std::move(read.value);
+}
+
+bool BoundaryConditions::AppliesNothing(const Applied& a) {
   return std::ranges::all_of(a.kind, [](ConstraintKind k) { return k == ConstraintKind::kFree; }) &&
          a.force.isZero(0) && a.traction.isZero(0) && a.pressure.isZero(0);
 }
 
-void BoundaryConditions::RestoreAppliedUnlessEmpty(StateReader& in) {
-  AnyShapeApplied read;
-  ReadFields(in, read);
-  Applied& a = read.value;
-  if (a.kind.empty() && a.value.cols() == 0 && a.force.cols() == 0 && a.traction.cols() == 0 &&
-      a.pressure.size() == 0)
-    return;
-  if (a.kind.size() != applied_.kind.size() || a.value.cols() != applied_.value.cols() ||
-      a.force.cols() != applied_.force.cols() || a.traction.cols() != applied_.traction.cols() ||
-      a.pressure.size() != applied_.pressure.size())
-    in.Fail(fmt::format(
-        "boundary conditions of {} vertices and {} faces where this object has {} and {}",
-        a.value.cols(), a.traction.cols(), num_vertices(), applied_.traction.cols()));
-  a.stamp = applied_.stamp;
-  applied_ = std::move(a);
-  Touch();
-  ClearCouplingLoads();
+void BoundaryConditions::Applied::VertexRow(Index v, double* row) const {
+  for (int a = 0; a < 3; ++a) {
+    row[a] = static_cast<double>(kind[static_cast<std::size_t>(3 * v + a)]);
+    row[3 + a] = value(a, v);
+    row[6 + a] = force(a, v);
+  }
+}
+
+void BoundaryConditions::Applied::SetVertexRow(Index v, const double* row) {
+  for (int a = 0; a < 3; ++a) {
+    kind[static_cast<std::size_t>(3 * v + a)] = static_cast<ConstraintKind>(row[a]);
+    value(a, v) = row[3 + a];
+    force(a, v) = row[6 + a];
+  }
+}
+
+void BoundaryConditions::Applied::FaceRow(Index f, double* row) const {
+  for (int a = 0; a < 3; ++a) row[a] = traction(a, f);
+  row[3] = pressure[f];
+}
+
+void BoundaryConditions::Applied::SetFaceRow(Index f, const double* row) {
+  for (int a = 0; a < 3; ++a) traction(a, f) = row[a];
+  pressure[f] = row[3];
 }
 
 void BoundaryConditions::PrescribeDisplacement(Index v, const Vec3& u, AxisMask axes) {

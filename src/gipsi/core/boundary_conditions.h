@@ -46,6 +46,16 @@ class BoundaryConditions {
     VecX pressure;                     // per face [Pa]
     std::uint64_t stamp = 0;
 
+    /// Vertex `v`'s and face `f`'s conditions as rows of numbers (the constraint kinds as
+    /// their values), so that they move between stores numbered differently (another rank's
+    /// part, the whole boundary): kVertexRow values per vertex, kFaceRow per face. Setting a
+    /// row does not draw a new stamp: the caller does.
+    static constexpr int kVertexRow = 9, kFaceRow = 4;
+    void VertexRow(Index v, double* row) const;
+    void SetVertexRow(Index v, const double* row);
+    void FaceRow(Index f, double* row) const;
+    void SetFaceRow(Index f, const double* row);
+
     template <class Self, class V>
     static void Fields(Self& s, V& v) {
       v("kind", s.kind, Shape::kFixed);
@@ -126,12 +136,16 @@ class BoundaryConditions {
   /// stamp) and clears the coupling loads.
   void SaveApplied(StateWriter& out) const { WriteFields(out, applied_); }
   void RestoreApplied(StateReader& in);
+  /// As RestoreApplied, from conditions already read (ReadAnySize, moved between stores): their
+  /// sizes must be this store's (checked).
+  void RestoreApplied(Applied applied);
+  /// Reads what SaveApplied wrote for a store of any size (the stamp left 0).
+  [[nodiscard]] static Applied ReadAnySize(StateReader& in);
+  /// Whether `applied` applies nothing (every vertex free, no force, traction or pressure).
+  [[nodiscard]] static bool AppliesNothing(const Applied& applied);
   /// Reads what SaveApplied wrote for a store of any size, and drops it; returns whether it
-  /// applied nothing (every vertex free, no force, traction or pressure).
-  static bool SkipApplied(StateReader& in);
-  /// As RestoreApplied, except that what a store without vertices or faces wrote (a split
-  /// object's part-only view) leaves these conditions as they are.
-  void RestoreAppliedUnlessEmpty(StateReader& in);
+  /// applied nothing.
+  static bool SkipApplied(StateReader& in) { return AppliesNothing(ReadAnySize(in)); }
 
  private:
   /// Marks the applied part as changed (a new stamp).

@@ -121,13 +121,21 @@ class PartitionedObject {
       const Region& region) const = 0;
 
   // Boundary conditions on an object without its whole domain (holds_whole_domain() false).
-  /// The whole boundary's vertices, or with `faces` its triangles, that `region` selects as
-  /// SelectBoundaryVertices and SelectBoundaryFaces select them on the whole domain, sorted,
-  /// the same on every process: where a condition goes in the object's store of boundary
-  /// conditions, which is numbered on the whole boundary. Collective; throws InputError on
-  /// every process as SelectNodes does, or if the object takes no boundary conditions.
-  [[nodiscard]] virtual std::vector<int> SelectWholeBoundary(const Region& region,
-                                                             bool faces) const = 0;
+  /// Where a condition on `region` goes in the object's store of boundary conditions, which
+  /// holds its part's boundary only (boundary_conditions(): the vertices and triangles of
+  /// domain()'s boundary, in their order). Plain struct.
+  struct ConditionItems {
+    std::vector<int> items;        ///< this process's selected vertices (or triangles), sorted
+    std::int64_t whole_count = 0;  ///< how many the whole boundary's selection has
+  };
+  /// The part's boundary vertices, or with `faces` its triangles, that `region` selects as
+  /// SelectBoundaryVertices and SelectBoundaryFaces select them on the whole domain, and the
+  /// size of the whole selection (a vertex counted once over the processes, though every part
+  /// holding it selects it: the part counts a nodal force on its node's owner only). No process
+  /// holds more than its part's. Collective; throws InputError on every process as SelectNodes
+  /// does, or if the object takes no boundary conditions.
+  [[nodiscard]] virtual ConditionItems SelectConditionItems(const Region& region,
+                                                            bool faces) const = 0;
 
   // Coupling part to part (SplitAlike).
   /// This process's part: the object that steps this process's share of the domain. Its node

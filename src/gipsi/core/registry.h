@@ -46,8 +46,10 @@
 /// part made in blocks (ObjectBuildContext::in_blocks replaces standalone;
 /// TypeRegistry::splits_in_blocks and connector_part_use; Connector::couples_parts, checked against
 /// part-only ends); 20: coupling objects split differently (PartitionedObject's
-/// InterpolateAtPoints, PartsInterpolation; TypeRegistry::PartUse::kAnyParts).
-#define GIPSI_PLUGIN_INTERFACE 20
+/// InterpolateAtPoints, PartsInterpolation; TypeRegistry::PartUse::kAnyParts); 21: a split
+/// object without its whole domain stores its part's boundary conditions only
+/// (PartitionedObject::SelectConditionItems replaces SelectWholeBoundary).
+#define GIPSI_PLUGIN_INTERFACE 21
 /// What a plugin's gipsi_plugin_abi_version() returns and the loader requires: the package's
 /// major and minor version with the plugin interface, MAJOR·10⁶ + MINOR·10³ + INTERFACE. A
 /// plugin thus loads only into the release line it was built against (0.1.x, as the CMake

@@ -20,6 +20,7 @@
 
 #include "gipsi/base/export.h"
 #include "gipsi/base/state.h"
+#include "gipsi/core/boundary_conditions.h"
 
 GIPSI_EXPORT_BEGIN
 namespace gipsi {
@@ -37,24 +38,41 @@ struct StateRows {
   std::string shared;
 };
 
+/// What the applied boundary conditions in a split object's SimObject section are: none (it
+/// keeps no store), the whole boundary's (a view with the whole mesh), or its part's (a
+/// part-only view: its part's boundary vertices and faces, in the part's order).
+enum class SavedConditions : std::int64_t { kNone = 0, kWhole = 1, kPart = 2 };
+
 /// What a split object's checkpoint holds before its part's state, in its section
 /// kSavedPartTag (version kSavedPartVersion): the rank count and rank that wrote it, a
-/// fingerprint of the partition, the whole domain's counts, and the whole-domain indices of the
-/// part's owned nodes, of its tets and of its boundary faces (empty when it keeps no boundary
-/// conditions). Plain struct.
+/// fingerprint of the partition, the whole domain's counts, the kind of conditions its
+/// SimObject section holds, and the whole-domain indices of the part's owned nodes, of its tets,
+/// of its boundary faces and of its owned boundary vertices (the last two empty when it keeps no
+/// boundary conditions). Plain struct.
 struct SavedPart {
   std::int64_t size = 0, rank = 0, whole_nodes = 0, whole_tets = 0, whole_faces = 0;
+  std::int64_t whole_vertices = 0;  ///< the whole boundary's vertices
   std::uint64_t fingerprint = 0;
+  SavedConditions conditions = SavedConditions::kNone;
   std::int64_t boundary_vertices = 0;
-  ItemCounts local;        ///< the part's nodes, tets and boundary faces
-  std::vector<int> owned;  ///< whole-domain indices of the owned nodes (local [0, owned))
-  std::vector<int> tets;   ///< of every local tet
-  std::vector<int> faces;  ///< the whole boundary's face of every part face, or none
+  ItemCounts local;           ///< the part's nodes, tets and boundary faces
+  std::vector<int> owned;     ///< whole-domain indices of the owned nodes (local [0, owned))
+  std::vector<int> tets;      ///< of every local tet
+  std::vector<int> faces;     ///< the whole boundary's face of every part face, or none
+  std::vector<int> vertices;  ///< the whole boundary's vertex of each owned part boundary
+                              ///< vertex (the part's first ones), or none
 };
 inline constexpr std::string_view kSavedPartTag = "DistributedPart";
-inline constexpr std::uint32_t kSavedPartVersion = 2;
+inline constexpr std::uint32_t kSavedPartVersion = 3;
 /// Reads a SavedPart's fields (its section entered). Throws InputError for a corrupted one.
 [[nodiscard]] SavedPart ReadSavedPart(StateReader& in);
+/// From the start of a checkpoint file's data (`fresh`, nothing read yet): reads the applied
+/// boundary conditions in the SimObject section of the split object whose DistributedPart
+/// section is at `part_at` (found in another rank's file of the same checkpoint), and leaves
+/// `fresh` at `part_at`, as Seek(part_at) would. Throws InputError if the file's layout
+/// differs there.
+[[nodiscard]] BoundaryConditions::Applied SeekPartReadingConditions(
+    StateReader& fresh, const StateReader::Position& part_at);
 
 /// The files of a distributed checkpoint being resumed (every rank's, rank 0's first), which
 /// the tool sets before Kernel::ReadCheckpoint so that split objects (or, in a run on one

@@ -224,8 +224,8 @@ class SimObject {
   virtual void SaveObjectState(StateWriter& out) const;
   virtual void RestoreObjectState(StateReader& in);
   /// Checkpoints: reads the applied boundary conditions SaveState wrote into
-  /// boundary_conditions() (the default). An object without a store of its own (a split
-  /// object's part-only view) overrides it to take what another kind of object wrote.
+  /// boundary_conditions() (the default). A split object's part-only view overrides it to
+  /// place them once it knows whose they are (a part's, the whole boundary's).
   virtual void RestoreAppliedConditions(StateReader& in);
 
   /// Whether snapshots copy the type's state as a value (it bound one with BindState) rather
@@ -342,8 +342,13 @@ class SimObject {
 
  private:
   // RestoreState of a split object's part (a distributed run's checkpoint) into this serial
-  // object: every rank's part, from the files of CheckpointPieces (core/row_state.h).
-  void RestoreFromPieces(StateReader& in);
+  // object: every rank's part, from the files of CheckpointPieces (core/row_state.h), with
+  // `conditions` the applied boundary conditions of the first file's SimObject section (a
+  // part's, the whole boundary's, or none).
+  void RestoreFromPieces(StateReader& in, BoundaryConditions::Applied conditions);
+  // Restores `read` (conditions of any size, from a distributed run's checkpoint) into
+  // boundary_conditions(): nothing if `read` is empty (a part-only view without a store).
+  void RestoreReadConditions(StateReader& in, BoundaryConditions::Applied read);
 
   std::string name_;
   std::string path_;  // name_ under the ObjectPathScope active at construction

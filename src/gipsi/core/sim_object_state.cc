@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <array>
 #include <optional>
 #include <span>
 #include <tuple>
@@ -53,30 +54,42 @@ void SimObject::RestoreState(StateReader& in) {
                         type, name_, type_name()));
   const double time = in.ReadDouble();
   const std::int64_t steps = in.ReadInt();
-  RestoreAppliedConditions(in);
+  // A distributed run's checkpoint read on one process: its conditions are placed once the
+  // type's section says whose they are.
+  const bool serial = dynamic_cast<const PartitionedObject*>(this) == nullptr;
+  std::optional<BoundaryConditions::Applied> read;
+  if (serial && !CheckpointPieces().empty())
+    read = BoundaryConditions::ReadAnySize(in);
+  else
+    RestoreAppliedConditions(in);
   in.BeginSection(type_name(), 1);
   // A distributed run's checkpoint holds a split object's part here; a run on one process
   // reads every rank's part into the serial object.
-  if (dynamic_cast<const PartitionedObject*>(this) == nullptr && in.NextIsSection(kSavedPartTag))
-    RestoreFromPieces(in);
-  else
+  if (serial && in.NextIsSection(kSavedPartTag)) {
+    RestoreFromPieces(in, read ? std::move(*read) : BoundaryConditions::Applied{});
+  } else {
+    if (read) RestoreReadConditions(in, std::move(*read));
     RestoreObjectState(in);
+  }
   in.EndSection();
   in.EndSection();
   time_ = time;
   step_count_ = steps;
 }
 
-void SimObject::RestoreAppliedConditions(StateReader& in) {
-  // A distributed run's checkpoint read on one process: a split object's part-only view kept
-  // no conditions (nothing names it, so nothing set any).
-  if (dynamic_cast<const PartitionedObject*>(this) == nullptr && !CheckpointPieces().empty())
-    bcs_.RestoreAppliedUnlessEmpty(in);
-  else
-    bcs_.RestoreApplied(in);
+void SimObject::RestoreAppliedConditions(StateReader& in) { bcs_.RestoreApplied(in); }
+
+void SimObject::RestoreReadConditions(StateReader& in, BoundaryConditions::Applied read) {
+  const Index vertices = read.value.cols(), faces = read.pressure.size();
+  if (vertices == 0 && faces == 0) return;  // a part-only view without a store set none
+  if (vertices != bcs_.num_vertices() || faces != bcs_.num_faces())
+    in.Fail(fmt::format(
+        "boundary conditions of {} vertices and {} faces where object '{}' has {} and {}", vertices,
+        faces, name_, bcs_.num_vertices(), bcs_.num_faces()));
+  bcs_.RestoreApplied(std::move(read));
 }
 
-void SimObject::RestoreFromPieces(StateReader& in) {
+void SimObject::RestoreFromPieces(StateReader& in, BoundaryConditions::Applied conditions) {
   const auto* rows_of = dynamic_cast<const RowState*>(this);
   const std::vector<std::filesystem::path> pieces = CheckpointPieces();
   if (rows_of == nullptr)
@@ -94,6 +107,11 @@ void SimObject::RestoreFromPieces(StateReader& in) {
   StateRows whole;
   std::vector<char> node_set, tet_set, face_set;
   SavedHeader first;
+  // The parts' stores of conditions (SavedConditions::kPart) gathered on the whole boundary:
+  // each owned boundary vertex and each face from the part that holds it.
+  BoundaryConditions::Applied gathered = bcs_.applied();
+  std::vector<char> vertex_held, face_held;
+  SavedConditions kept = SavedConditions::kNone;
   // Each part's rows go where its items are in the whole domain.
   auto place = [&](StateReader& from, const std::vector<double>& rows, int width,
                    std::span<const int> where, std::vector<double>& to, std::vector<char>& set,
@@ -115,9 +133,12 @@ void SimObject::RestoreFromPieces(StateReader& in) {
   };
   for (std::size_t k = 0; k < pieces.size(); ++k) {
     std::optional<StateReader> other;
+    BoundaryConditions::Applied part_conditions;
     if (k > 0) {
       other.emplace(ReadCheckpointFile(pieces[k]), pieces[k].string());
-      other->Seek(at);
+      part_conditions = SeekPartReadingConditions(*other, at);
+    } else {
+      part_conditions = std::move(conditions);
     }
     StateReader& from = k == 0 ? in : *other;
     from.BeginSection(kSavedPartTag, kSavedPartVersion);
@@ -128,6 +149,41 @@ void SimObject::RestoreFromPieces(StateReader& in) {
           fmt::format("this file holds rank {}'s part of {} where rank {}'s part of {} was "
                       "expected: the set mixes checkpoints",
                       part.rank, part.size, k, pieces.size()));
+    if (k == 0) kept = part.conditions;
+    if (part.conditions != kept)
+      from.Fail("this file keeps the object's boundary conditions otherwise than the first");
+    if (kept == SavedConditions::kWhole && k == 0) {
+      RestoreReadConditions(from, std::move(part_conditions));
+    } else if (kept == SavedConditions::kPart) {
+      if (part.whole_vertices != bcs_.num_vertices() || part.whole_faces != bcs_.num_faces() ||
+          part_conditions.value.cols() != part.boundary_vertices ||
+          part_conditions.pressure.size() != part.local.faces ||
+          static_cast<std::int64_t>(part.faces.size()) != part.local.faces)
+        from.Fail(fmt::format(
+            "the part's boundary conditions are on {} of {} boundary vertices and {} of {} faces, "
+            "and object '{}' has {} and {}: the checkpoint is of another mesh",
+            part_conditions.value.cols(), part.whole_vertices, part_conditions.pressure.size(),
+            part.whole_faces, name_, bcs_.num_vertices(), bcs_.num_faces()));
+      vertex_held.resize(static_cast<std::size_t>(bcs_.num_vertices()));
+      face_held.resize(static_cast<std::size_t>(bcs_.num_faces()));
+      std::array<double, BoundaryConditions::Applied::kVertexRow> row{};
+      for (std::size_t v = 0; v < part.vertices.size(); ++v) {
+        const int w = part.vertices[v];
+        if (w < 0 || w >= bcs_.num_vertices() || vertex_held[static_cast<std::size_t>(w)] != 0)
+          from.Fail(fmt::format("the parts do not hold boundary vertex {} once", w));
+        vertex_held[static_cast<std::size_t>(w)] = 1;
+        part_conditions.VertexRow(static_cast<Index>(v), row.data());
+        gathered.SetVertexRow(w, row.data());
+      }
+      for (std::size_t f = 0; f < part.faces.size(); ++f) {
+        const int w = part.faces[f];
+        if (w < 0 || w >= bcs_.num_faces() || face_held[static_cast<std::size_t>(w)] != 0)
+          from.Fail(fmt::format("the parts do not hold boundary face {} once", w));
+        face_held[static_cast<std::size_t>(w)] = 1;
+        part_conditions.FaceRow(static_cast<Index>(f), row.data());
+        gathered.SetFaceRow(w, row.data());
+      }
+    }
     if (part.whole_nodes != mine.nodes || part.whole_tets != mine.tets)
       from.Fail(
           fmt::format("the checkpoint's mesh has {} nodes and {} tets, and this object's "
@@ -175,9 +231,17 @@ void SimObject::RestoreFromPieces(StateReader& in) {
           fmt::format("the parts do not hold every {} of this object's: the checkpoint is of "
                       "another mesh",
                       what));
-  StateWriter gathered;
-  rows_of->WriteStateRows(gathered, whole);
-  StateReader own(gathered.TakeBytes(),
+  if (kept == SavedConditions::kPart) {
+    if (std::ranges::find(vertex_held, 0) != vertex_held.end() ||
+        std::ranges::find(face_held, 0) != face_held.end())
+      in.Fail(
+          "the parts do not hold every boundary vertex and face of this object's: the "
+          "checkpoint is of another mesh");
+    bcs_.RestoreApplied(std::move(gathered));
+  }
+  StateWriter bytes;
+  rows_of->WriteStateRows(bytes, whole);
+  StateReader own(bytes.TakeBytes(),
                   fmt::format("object '{}' gathered from {} parts", name_, pieces.size()));
   RestoreObjectState(own);
 }

@@ -43,29 +43,33 @@ BoundaryConditionSpec ParseBoundaryCondition(const JsonNode& node, const SimObje
         "'total_force', 'pressure', 'traction'");
   Region region = AllRegion{};
   if (auto r = node.Find("region")) region = ParseRegion(*r);
-  // An object split over the processes without its whole mesh keeps its conditions on the
-  // whole boundary, which only its collective calls know (every process parses alike).
+  // An object split over the processes without its whole mesh keeps its part's conditions; how
+  // many items the whole selection has only its collective calls know (every process parses
+  // alike).
   const auto* split = dynamic_cast<const PartitionedObject*>(&object);
   if (split != nullptr && split->holds_whole_domain()) split = nullptr;
-  const Index boundary_vertices = split != nullptr ? object.boundary_conditions().num_vertices()
-                                                   : object.boundary().num_vertices();
-  if (boundary_vertices == 0)
+  if (split == nullptr && object.boundary().num_vertices() == 0)
     node.Fail(
         fmt::format("object '{}' has no boundary geometry to put conditions on", object.path()));
 
   bool on_faces = node.Has("pressure") || node.Has("traction");
+  std::int64_t whole_count = 0;
   try {
     if (split != nullptr) {
-      (on_faces ? spec.faces : spec.vertices) = split->SelectWholeBoundary(region, on_faces);
-    } else if (on_faces) {
-      spec.faces = SelectBoundaryFaces(region, object.domain(), object.boundary());
+      PartitionedObject::ConditionItems selected = split->SelectConditionItems(region, on_faces);
+      (on_faces ? spec.faces : spec.vertices) = std::move(selected.items);
+      whole_count = selected.whole_count;
     } else {
-      spec.vertices = SelectBoundaryVertices(region, object.domain(), object.boundary());
+      if (on_faces)
+        spec.faces = SelectBoundaryFaces(region, object.domain(), object.boundary());
+      else
+        spec.vertices = SelectBoundaryVertices(region, object.domain(), object.boundary());
+      whole_count = static_cast<std::int64_t>(spec.faces.size() + spec.vertices.size());
     }
   } catch (const InputError& e) {
     node.At("region").Fail(e.what());
   }
-  if (spec.faces.empty() && spec.vertices.empty())
+  if (whole_count == 0)
     node.Fail(fmt::format("the region selects no boundary {} of object '{}'",
                           on_faces ? "triangle" : "vertex", object.path()));
   if (node.Has("axes") && !node.Has("displacement") && !node.Has("velocity"))
@@ -87,7 +91,7 @@ BoundaryConditionSpec ParseBoundaryCondition(const JsonNode& node, const SimObje
     spec.vector = f->AsVec3();
   } else if (auto total = node.Find("total_force")) {
     spec.kind = Kind::kForce;
-    spec.vector = total->AsVec3() / static_cast<double>(spec.vertices.size());
+    spec.vector = total->AsVec3() / static_cast<double>(whole_count);
   } else if (auto p = node.Find("pressure")) {
     spec.kind = Kind::kPressure;
     spec.scalar = p->AsNumber();

@@ -31,8 +31,9 @@ struct BoundaryConditionSpec {
   AxisMask axes = kAllAxes;
   Vec3 vector = Vec3::Zero();  ///< displacement, velocity, force (per vertex) or traction
   double scalar = 0;           ///< pressure
-  std::vector<int> vertices;   ///< boundary vertices (kinematic conditions and forces)
-  std::vector<int> faces;      ///< boundary triangles (pressure, traction)
+  /// Items of the object's store of conditions (a split object's: its part's boundary's).
+  std::vector<int> vertices;  ///< boundary vertices (kinematic conditions and forces)
+  std::vector<int> faces;     ///< boundary triangles (pressure, traction)
 
   /// Writes the condition into `bcs`.
   void Apply(BoundaryConditions& bcs) const;

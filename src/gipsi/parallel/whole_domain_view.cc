@@ -108,6 +108,8 @@ WholeDomainView::WholeDomainView(std::unique_ptr<SimObject> part, const MeshPart
       mesh_part_(mesh_part),
       comm_(comm) {
   SetGeometry(whole, MakeBoundary(*whole));
+  whole_vertices_ = SimObject::boundary().num_vertices();
+  whole_faces_ = SimObject::boundary().num_triangles();
   for (std::size_t f = 0; f < part_->fields().size(); ++f) {
     const FieldInfo& info = part_->fields()[f];
     if (info.location == FieldLocation::kBoundaryVertex ||
@@ -132,17 +134,24 @@ WholeDomainView::WholeDomainView(std::unique_ptr<SimObject> part, const MeshPart
       comm_(comm),
       part_only_(true) {
   SetGeometry(mesh_part_.mesh, part_->boundary());
-  // The store of conditions is numbered on the whole boundary, so its checkpoints restore on
-  // another partition; without a BoundaryMap nothing sets conditions (the factory's rule) and
-  // an empty store keeps the checkpoints free of the part's boundary.
+  // The store of conditions is the part's boundary's (SetGeometry sized it); its checkpoints
+  // name the whole boundary's items, so they restore on another partition. Without a
+  // BoundaryMap nothing sets conditions (the factory's rule) and an empty store keeps the
+  // checkpoints free of the part's boundary.
   if (boundary) {
     GIPSI_CHECK(static_cast<Index>(boundary->vertex.size()) == part_->boundary().num_vertices() &&
                 static_cast<Index>(boundary->face.size()) == part_->boundary().num_triangles());
-    boundary_conditions() = BoundaryConditions(static_cast<Index>(boundary->whole_vertices),
-                                               static_cast<Index>(boundary->whole_faces));
     bc_vertex_ = std::move(boundary->vertex);
     bc_face_ = std::move(boundary->face);
+    whole_vertices_ = boundary->whole_vertices;
+    whole_faces_ = boundary->whole_faces;
     forward_bcs_ = true;
+    const std::vector<int>& v2n = part_->boundary().vertex_to_node;
+    owned_vertices_ = static_cast<std::size_t>(std::count_if(
+        v2n.begin(), v2n.end(), [this](int node) { return node < mesh_part_.num_owned; }));
+    GIPSI_CHECK(std::all_of(v2n.begin(), v2n.begin() + static_cast<std::ptrdiff_t>(owned_vertices_),
+                            [this](int node) { return node < mesh_part_.num_owned; }),
+                "'{}': the owned boundary vertices are not the part's first", name());
   } else {
     boundary_conditions() = BoundaryConditions();
   }
@@ -250,29 +259,34 @@ std::vector<int> WholeDomainView::SelectOwnedBoundaryVertices(const Region& regi
   return BoundaryVerticesOfNodes(part_->boundary(), SelectOwnedNodes(region));
 }
 
-std::vector<int> WholeDomainView::SelectWholeBoundary(const Region& region, bool faces) const {
+PartitionedObject::ConditionItems WholeDomainView::SelectConditionItems(const Region& region,
+                                                                        bool faces) const {
   if (!forward_bcs_)
     throw InputError(
         fmt::format("object '{}' ({}, split over the processes) takes no boundary conditions",
                     name(), type_name()));
-  if (!part_only_)
-    return faces ? SelectBoundaryFaces(region, domain(), boundary())
-                 : SelectBoundaryVertices(region, domain(), boundary());
-  const BoundarySurface& part_boundary = part_->boundary();
-  std::vector<int> mine;
-  if (!faces) {
-    for (const int v : BoundaryVerticesOfNodes(part_boundary, SelectLocalNodes(region)))
-      mine.push_back(bc_vertex_[static_cast<std::size_t>(v)]);
-  } else {
-    for (const int f :
-         SelectPartBoundaryFaces(region, mesh_part_, part_boundary, region_tolerance_, comm_))
-      mine.push_back(bc_face_[static_cast<std::size_t>(f)]);
+  ConditionItems out;
+  if (!part_only_) {
+    out.items = faces ? SelectBoundaryFaces(region, domain(), boundary())
+                      : SelectBoundaryVertices(region, domain(), boundary());
+    out.whole_count = static_cast<std::int64_t>(out.items.size());
+    return out;
   }
-  return GatherUnion(mine, comm_);  // every rank's, on every rank: O(the selection)
-}
-
-std::int64_t WholeDomainView::whole_boundary_faces() const {
-  return forward_bcs_ ? static_cast<std::int64_t>(boundary_conditions().num_faces()) : 0;
+  // Every part holding a selected vertex selects it; its owner counts it. A face is one part's.
+  const BoundarySurface& part_boundary = part_->boundary();
+  out.items =
+      faces ? SelectPartBoundaryFaces(region, mesh_part_, part_boundary, region_tolerance_, comm_)
+            : BoundaryVerticesOfNodes(part_boundary, SelectLocalNodes(region));
+  std::sort(out.items.begin(), out.items.end());
+  auto counted =
+      static_cast<std::int64_t>(faces ? out.items.size()
+                                      : static_cast<std::size_t>(std::count_if(
+                                            out.items.begin(), out.items.end(), [this](int v) {
+                                              return static_cast<std::size_t>(v) < owned_vertices_;
+                                            })));
+  MPI_Allreduce(MPI_IN_PLACE, &counted, 1, MPI_INT64_T, MPI_SUM, comm_);
+  out.whole_count = counted;
+  return out;
 }
 
 void WholeDomainView::ReadOwnedNodes(FieldId id, std::span<const int> local,
@@ -351,9 +365,9 @@ void WholeDomainView::MapBoundary(BoundaryMap map) {
   // A boundary vertex is owned with its node; the owned nodes come first, and so do their
   // boundary vertices. Every face belongs to one tet, so to one rank.
   const std::vector<int>& v2n = part_->boundary().vertex_to_node;
-  const auto owned_vertices = static_cast<std::int64_t>(std::count_if(
+  owned_vertices_ = static_cast<std::size_t>(std::count_if(
       v2n.begin(), v2n.end(), [this](int node) { return node < mesh_part_.num_owned; }));
-  boundary_vertices_ = MakeLayout(bc_vertex_, owned_vertices, comm_);
+  boundary_vertices_ = MakeLayout(bc_vertex_, static_cast<std::int64_t>(owned_vertices_), comm_);
   boundary_faces_ = MakeLayout(bc_face_, static_cast<std::int64_t>(bc_face_.size()), comm_);
   for (std::size_t f = 0; f < part_->fields().size(); ++f) {
     const FieldInfo& info = part_->fields()[f];
@@ -394,21 +408,29 @@ const std::vector<int>& WholeDomainView::WholeOfLocal(FieldLocation location) co
 void WholeDomainView::CopyBoundaryConditions() {
   const BoundaryConditions& from = boundary_conditions();
   BoundaryConditions& to = part_->boundary_conditions();
+  // The view's item of each part vertex and face: the same one for a part-only view (its store
+  // is the part's boundary's), the whole boundary's for the other.
+  auto vertex = [this](std::size_t v) {
+    return static_cast<Index>(part_only_ ? v : static_cast<std::size_t>(bc_vertex_[v]));
+  };
+  auto face = [this](std::size_t f) {
+    return static_cast<Index>(part_only_ ? f : static_cast<std::size_t>(bc_face_[f]));
+  };
   // The applied part when it changed. Its copy takes the view's stamp: the part's conditions
   // are a function of the view's, so equal stamps still mean equal contents.
-  if (to.applied().stamp != from.applied().stamp) {
+  if (part_only_) {
+    to.SetApplied(from.applied());
+  } else if (to.applied().stamp != from.applied().stamp) {
     BoundaryConditions::Applied applied = to.applied();
     const BoundaryConditions::Applied& whole = from.applied();
+    std::array<double, BoundaryConditions::Applied::kVertexRow> row{};
     for (std::size_t v = 0; v < bc_vertex_.size(); ++v) {
-      const auto w = static_cast<std::size_t>(bc_vertex_[v]);
-      for (std::size_t a = 0; a < 3; ++a) applied.kind[3 * v + a] = whole.kind[3 * w + a];
-      applied.value.col(static_cast<Index>(v)) = whole.value.col(static_cast<Index>(w));
-      applied.force.col(static_cast<Index>(v)) = whole.force.col(static_cast<Index>(w));
+      whole.VertexRow(vertex(v), row.data());
+      applied.SetVertexRow(static_cast<Index>(v), row.data());
     }
     for (std::size_t f = 0; f < bc_face_.size(); ++f) {
-      const auto w = static_cast<Index>(bc_face_[f]);
-      applied.traction.col(static_cast<Index>(f)) = whole.traction.col(w);
-      applied.pressure[static_cast<Index>(f)] = whole.pressure[w];
+      whole.FaceRow(face(f), row.data());
+      applied.SetFaceRow(static_cast<Index>(f), row.data());
     }
     applied.stamp = whole.stamp;
     to.SetApplied(applied);
@@ -416,12 +438,12 @@ void WholeDomainView::CopyBoundaryConditions() {
   // The coupling loads (connectors'), every step.
   to.ClearCouplingLoads();
   for (std::size_t v = 0; v < bc_vertex_.size(); ++v) {
-    const Index w = bc_vertex_[v];
+    const Index w = vertex(v);
     const Vec3 coupling = from.force(w) - Vec3(from.applied().force.col(w));
     if (coupling.squaredNorm() > 0) to.AddCouplingForce(static_cast<Index>(v), coupling);
   }
   for (std::size_t f = 0; f < bc_face_.size(); ++f) {
-    const Index w = bc_face_[f];
+    const Index w = face(f);
     const double coupling = from.pressure(w) - from.applied().pressure[w];
     if (coupling != 0) to.AddCouplingPressure(static_cast<Index>(f), coupling);
   }

@@ -26,9 +26,10 @@
 /// the view's domain and boundary
 /// are the part's, its fields are the part's local ones, and probes address the whole mesh's
 /// nodes through its PartitionedObject calls (collective; the whole mesh's indices are the
-/// part's `whole_node`). No rank then holds anything of the size of the whole mesh, except a
-/// store of boundary conditions numbered on the whole boundary when the part takes conditions
-/// (a FemSolid's: selected with SelectWholeBoundary, forwarded as the other view does).
+/// part's `whole_node`). No rank then holds anything of the size of the whole mesh: when the
+/// part takes conditions (a FemSolid's), the view's store holds its part's boundary's only
+/// (selected with SelectConditionItems, forwarded as the other view does; checkpoints move them
+/// by rows with the state).
 ///
 /// Every rank must make the same calls in the same order (they do when every rank runs the
 /// same kernel on the same scene). The whole-field gathers make ReadField the simple path, not
@@ -66,8 +67,8 @@ class WholeDomainView final : public SimObject, public CavityWall, public Partit
   /// vertex of each part boundary vertex, the whole face of each part face. Plain struct.
   struct BoundaryMap {
     std::vector<int> vertex, face;
-    /// The whole boundary's vertex and face counts (a part-only view's store of conditions is
-    /// numbered on the whole boundary; the other view reads them from its whole mesh).
+    /// The whole boundary's vertex and face counts (a part-only view's checkpoints hold them;
+    /// the other view reads them from its whole mesh).
     std::int64_t whole_vertices = 0, whole_faces = 0;
   };
   /// `part` is this rank's object on `mesh_part.mesh` (`mesh_part` must outlive the view: the
@@ -82,10 +83,10 @@ class WholeDomainView final : public SimObject, public CavityWall, public Partit
                   std::optional<BoundaryMap> boundary = std::nullopt);
   /// A part-only view (see the file comment): `part` on `mesh_part.mesh` (which must outlive
   /// the view), no whole mesh on any rank. Collective. With `boundary` (its whole counts set),
-  /// the view keeps a store of boundary conditions numbered on the whole boundary, as the other
-  /// view does, without the whole boundary's geometry: conditions are selected with
-  /// SelectWholeBoundary and copied to the part before each step, and checkpoints hold them
-  /// alike (so they move between rank counts and serial runs).
+  /// the view keeps a store of boundary conditions on its part's boundary (the part's order):
+  /// conditions are selected with SelectConditionItems and copied to the part before each
+  /// step, and checkpoints hold them with the whole boundary's numbers of the part's items (so
+  /// they move between rank counts and serial runs, as the state does).
   WholeDomainView(std::unique_ptr<SimObject> part, const MeshPart& mesh_part, MPI_Comm comm,
                   std::optional<BoundaryMap> boundary = std::nullopt);
   ~WholeDomainView() override;
@@ -106,8 +107,8 @@ class WholeDomainView final : public SimObject, public CavityWall, public Partit
                       Eigen::Ref<Eigen::MatrixXd> out) const override;
   void CombineAcross(std::span<double> values, Combine how) const override;
   [[nodiscard]] std::vector<int> SelectOwnedBoundaryVertices(const Region& region) const override;
-  [[nodiscard]] std::vector<int> SelectWholeBoundary(const Region& region,
-                                                     bool faces) const override;
+  [[nodiscard]] ConditionItems SelectConditionItems(const Region& region,
+                                                    bool faces) const override;
   [[nodiscard]] SimObject& local_part() override { return *part_; }
   [[nodiscard]] const SimObject& local_part() const override { return *part_; }
   [[nodiscard]] Index num_owned_nodes() const override { return mesh_part_.num_owned; }
@@ -138,9 +139,11 @@ class WholeDomainView final : public SimObject, public CavityWall, public Partit
   /// run on one process (the serial object's state, every rank reading the one file) restores
   /// as a part of one rank's checkpoint would: rank 0 reads the rows and they move to the parts.
   void RestoreObjectState(StateReader& in) override;
-  /// A part-only view without a BoundaryMap keeps no store: it takes a serial object's
-  /// conditions only if they apply nothing (nothing names a part-only object, so nothing set
-  /// any).
+  /// A part-only view reads the conditions of any size and places them in RestoreObjectState,
+  /// once the part's section says whose they are (its part's, another rank's part's, the whole
+  /// boundary's): a store of its part's takes its own, moved rows (another rank count) or its
+  /// rows of the whole boundary's; a view without a store (no BoundaryMap) takes them only if
+  /// they apply nothing (nothing names a part-only object, so nothing set any).
   void RestoreAppliedConditions(StateReader& in) override;
   /// The files of the distributed checkpoint being resumed, rank 0's first (the tool sets them
   /// before Kernel::ReadCheckpoint): a restore on another rank count reads the parts in them.
@@ -187,8 +190,21 @@ class WholeDomainView final : public SimObject, public CavityWall, public Partit
   void MapBoundary(BoundaryMap map);
   // Copies the view's boundary conditions to the part's (BoundaryMap).
   void CopyBoundaryConditions();
-  // The whole boundary's faces where the view forwards conditions (their store's), else 0.
-  [[nodiscard]] std::int64_t whole_boundary_faces() const;
+  // The whole boundary's faces where the view forwards conditions, else 0.
+  [[nodiscard]] std::int64_t whole_boundary_faces() const {
+    return forward_bcs_ ? whole_faces_ : 0;
+  }
+  // What the view's SimObject section holds as its applied conditions.
+  [[nodiscard]] SavedConditions saved_conditions() const;
+  // A part-only view's restore of the conditions RestoreAppliedConditions read, on the rank
+  // count and partition that wrote them or from the whole boundary's (a view with the whole
+  // mesh, a serial object: `kept` kWhole); "" or why they do not fit. Not collective.
+  [[nodiscard]] std::string PlaceReadConditions(SavedConditions kept);
+  // On another rank count: the parts' conditions (`vertex_of`, `face_of`: the whole boundary's
+  // items of the rows) moved to the parts that hold their items (MoveRows). Collective.
+  void MoveConditions(StateReader& in, const std::vector<int>& vertex_of,
+                      std::vector<double>& vertex_rows, const std::vector<int>& face_of,
+                      std::vector<double>& face_rows);
   // The local nodes (owned and shared) of the whole domain's selection: group regions gathered
   // (a triangle or tet group names a node only where its triangle or tet is), node ids mapped,
   // other regions decided where the nodes are. Collective for groups and node ids.
@@ -198,6 +214,10 @@ class WholeDomainView final : public SimObject, public CavityWall, public Partit
   const MeshPart& mesh_part_;
   std::vector<int> bc_vertex_, bc_face_;  // BoundaryMap
   bool forward_bcs_ = false;
+  std::int64_t whole_vertices_ = 0, whole_faces_ = 0;  // the whole boundary's (BoundaryMap)
+  std::size_t owned_vertices_ = 0;  // the part's boundary vertices [0, owned) are this rank's
+  // A part-only view's conditions as RestoreAppliedConditions read them, until placed.
+  BoundaryConditions::Applied read_conditions_;
   MPI_Comm comm_;
   std::vector<FieldId> part_field_;  // the part's field behind each of the view's
   [[nodiscard]] const Layout& LayoutOf(FieldLocation location) const;

@@ -49,27 +49,98 @@ void WholeDomainView::SaveObjectState(StateWriter& out) const {
   out.WriteInt(mesh_part_.num_global_nodes);
   out.WriteInt(mesh_part_.num_global_tets);
   out.WriteInt(whole_boundary_faces());
+  out.WriteInt(forward_bcs_ ? whole_vertices_ : 0);
+  out.WriteInt(static_cast<std::int64_t>(saved_conditions()));
   out.WriteInt(mesh_part_.num_local());
   out.WriteInt(part_->boundary_conditions().num_vertices());
   out.WriteInt(part_->boundary().num_triangles());
   out.WriteArray(std::span<const int>(mesh_part_.whole_node.data(),
                                       static_cast<std::size_t>(mesh_part_.num_owned)));
   out.WriteArray(mesh_part_.whole_tet);
-  out.WriteArray(forward_bcs_ ? bc_face_ : std::vector<int>{});
+  out.WriteArray(forward_bcs_ ? std::span<const int>(bc_face_) : std::span<const int>());
+  out.WriteArray(forward_bcs_ ? std::span<const int>(bc_vertex_.data(), owned_vertices_)
+                              : std::span<const int>());
   part_->SaveState(out);
   out.EndSection();
 }
 
+SavedConditions WholeDomainView::saved_conditions() const {
+  if (!part_only_) return SavedConditions::kWhole;  // SimObject's store, on the whole boundary
+  return forward_bcs_ ? SavedConditions::kPart : SavedConditions::kNone;
+}
+
 void WholeDomainView::RestoreAppliedConditions(StateReader& in) {
-  if (!part_only_ || forward_bcs_) {  // a store numbered on the whole boundary
+  if (!part_only_) {  // a store on the whole boundary
     SimObject::RestoreAppliedConditions(in);
     return;
   }
-  if (!BoundaryConditions::SkipApplied(in))
-    in.Fail(fmt::format(
+  read_conditions_ = BoundaryConditions::ReadAnySize(in);
+}
+
+std::string WholeDomainView::PlaceReadConditions(SavedConditions kept) {
+  BoundaryConditions::Applied read = std::move(read_conditions_);
+  read_conditions_ = {};
+  const Index vertices = read.value.cols(), faces = read.pressure.size();
+  if (!forward_bcs_) {
+    if (BoundaryConditions::AppliesNothing(read)) return {};
+    return fmt::format(
         "the checkpoint holds boundary conditions of object '{}', which this run keeps in parts "
         "without a boundary-condition store",
-        name()));
+        name());
+  }
+  BoundaryConditions& store = boundary_conditions();
+  if (kept == SavedConditions::kNone) return {};  // nothing was set: the scene's stay
+  if (kept == SavedConditions::kPart) {           // this part's own (same partition)
+    if (vertices != store.num_vertices() || faces != store.num_faces())
+      return fmt::format(
+          "the checkpoint's part has boundary conditions on {} vertices and {} faces, and this "
+          "rank's part of object '{}' has {} and {}",
+          vertices, faces, name(), store.num_vertices(), store.num_faces());
+    store.RestoreApplied(std::move(read));
+    return {};
+  }
+  // The whole boundary's (a serial object's, or a view's with the whole mesh): this part's rows.
+  if (vertices != whole_vertices_ || faces != whole_faces_)
+    return fmt::format(
+        "the checkpoint has boundary conditions on {} vertices and {} faces, and the whole "
+        "boundary of object '{}' has {} and {}",
+        vertices, faces, name(), whole_vertices_, whole_faces_);
+  BoundaryConditions::Applied mine = store.applied();
+  std::array<double, BoundaryConditions::Applied::kVertexRow> row{};
+  for (std::size_t v = 0; v < bc_vertex_.size(); ++v) {
+    read.VertexRow(bc_vertex_[v], row.data());
+    mine.SetVertexRow(static_cast<Index>(v), row.data());
+  }
+  for (std::size_t f = 0; f < bc_face_.size(); ++f) {
+    read.FaceRow(bc_face_[f], row.data());
+    mine.SetFaceRow(static_cast<Index>(f), row.data());
+  }
+  store.RestoreApplied(std::move(mine));
+  return {};
+}
+
+void WholeDomainView::MoveConditions(StateReader& in, const std::vector<int>& vertex_of,
+                                     std::vector<double>& vertex_rows,
+                                     const std::vector<int>& face_of,
+                                     std::vector<double>& face_rows) {
+  constexpr int kVertexRow = BoundaryConditions::Applied::kVertexRow;
+  constexpr int kFaceRow = BoundaryConditions::Applied::kFaceRow;
+  const MovedRows vertices =
+      MoveRows(bc_vertex_, whole_vertices_, vertex_of, vertex_rows, kVertexRow, comm_);
+  const MovedRows faces = MoveRows(bc_face_, whole_faces_, face_of, face_rows, kFaceRow, comm_);
+  for (const auto& [moved, what] :
+       {std::pair{&vertices, "boundary vertex"}, std::pair{&faces, "boundary face"}})
+    if (moved->missing > 0 || moved->repeated > 0 || moved->outside > 0)
+      in.Fail(fmt::format(
+          "the checkpoint's parts do not hold every {} of this scene's mesh once ({} missing, "
+          "the first {}; {} given twice; {} not in the mesh): it was written for another mesh",
+          what, moved->missing, moved->first_missing, moved->repeated, moved->outside));
+  BoundaryConditions::Applied mine = boundary_conditions().applied();
+  for (std::size_t v = 0; v < bc_vertex_.size(); ++v)
+    mine.SetVertexRow(static_cast<Index>(v), &vertices.rows[v * kVertexRow]);
+  for (std::size_t f = 0; f < bc_face_.size(); ++f)
+    mine.SetFaceRow(static_cast<Index>(f), &faces.rows[f * kFaceRow]);
+  boundary_conditions().RestoreApplied(std::move(mine));
 }
 
 SavedPart WholeDomainView::OneProcessPart() const {
@@ -78,6 +149,8 @@ SavedPart WholeDomainView::OneProcessPart() const {
   saved.whole_nodes = saved.local.nodes = mesh_part_.num_global_nodes;
   saved.whole_tets = saved.local.tets = mesh_part_.num_global_tets;
   saved.whole_faces = saved.local.faces = whole_boundary_faces();
+  saved.whole_vertices = forward_bcs_ ? whole_vertices_ : 0;
+  saved.conditions = SavedConditions::kWhole;  // a serial object's store
   saved.owned.resize(static_cast<std::size_t>(saved.whole_nodes));
   std::iota(saved.owned.begin(), saved.owned.end(), 0);
   saved.tets.resize(static_cast<std::size_t>(saved.whole_tets));
@@ -159,6 +232,7 @@ void WholeDomainView::RestoreFromParts(StateReader& in, const StateReader::Posit
           "the checkpoint's part of the mesh differs from this run's partition on the same rank "
           "count (another mesh, or a partitioner that cut it differently: another PETSc or "
           "PT-Scotch build)";
+    if (refused.empty() && part_only_) refused = PlaceReadConditions(saved.conditions);
     FailTogether(in, refused, comm_);
     part_->RestoreState(in);
   }
@@ -205,6 +279,24 @@ void WholeDomainView::RestoreOnAnotherRankCount(StateReader& in, const StateRead
         "has {}, {} and {}",
         saved.whole_nodes, saved.whole_tets, saved.whole_faces, mesh_part_.num_global_nodes,
         mesh_part_.num_global_tets, whole_faces);
+  // A part-only view's conditions: the whole boundary's are placed now; the parts' move below.
+  const bool move_conditions =
+      part_only_ && forward_bcs_ && saved.conditions == SavedConditions::kPart;
+  std::array<int, 2> moving{move_conditions ? 1 : 0, move_conditions ? 0 : 1};
+  MPI_Allreduce(MPI_IN_PLACE, moving.data(), 2, MPI_INT, MPI_MAX, comm_);
+  if (refused.empty() && moving[0] == 1 && moving[1] == 1)  // every rank must move, or none
+    refused =
+        "the ranks' files keep the object's boundary conditions differently: they are "
+        "not one checkpoint's";
+  BoundaryConditions::Applied own_conditions;
+  if (refused.empty() && part_only_) {
+    if (move_conditions) {
+      own_conditions = std::move(read_conditions_);
+      read_conditions_ = {};
+    } else {
+      refused = PlaceReadConditions(saved.conditions);
+    }
+  }
   FailTogether(in, refused, comm_,
                files.empty() ? std::string()
                              : fmt::format("{} (object '{}')", files.front().string(), name()));
@@ -214,14 +306,37 @@ void WholeDomainView::RestoreOnAnotherRankCount(StateReader& in, const StateRead
   // of every tet and every boundary face (each on one part), with their whole-mesh indices.
   StateRows mine;
   std::vector<int> node_of, tet_of, face_of;
+  std::vector<int> condition_vertex_of, condition_face_of;  // the whole boundary's items
+  std::vector<double> condition_vertex_rows, condition_face_rows;
   std::string common;  // the clock, the widths and the shared bytes: the same in every file
   std::string failed;
-  auto read_part = [&](StateReader& from, const SavedPart& part, std::int64_t expected_rank) {
+  auto read_part = [&](StateReader& from, const SavedPart& part, std::int64_t expected_rank,
+                       const BoundaryConditions::Applied& conditions) {
     if (part.size != saved.size || part.rank != expected_rank)
       from.Fail(
           fmt::format("this file holds rank {}'s part of {} where rank {}'s part of {} was "
                       "expected: the set mixes checkpoints",
                       part.rank, part.size, expected_rank, saved.size));
+    if (move_conditions) {  // the rows of the part's own vertices and of its faces
+      if (part.conditions != SavedConditions::kPart ||
+          conditions.value.cols() != part.boundary_vertices ||
+          conditions.pressure.size() != part.local.faces ||
+          static_cast<std::int64_t>(part.faces.size()) != part.local.faces)
+        from.Fail("the part's boundary conditions do not fit its boundary: a corrupted file");
+      constexpr int kVertexRow = BoundaryConditions::Applied::kVertexRow;
+      constexpr int kFaceRow = BoundaryConditions::Applied::kFaceRow;
+      std::size_t at_row = condition_vertex_rows.size();
+      condition_vertex_rows.resize(at_row + part.vertices.size() * kVertexRow);
+      for (std::size_t v = 0; v < part.vertices.size(); ++v, at_row += kVertexRow)
+        conditions.VertexRow(static_cast<Index>(v), &condition_vertex_rows[at_row]);
+      at_row = condition_face_rows.size();
+      condition_face_rows.resize(at_row + part.faces.size() * kFaceRow);
+      for (std::size_t f = 0; f < part.faces.size(); ++f, at_row += kFaceRow)
+        conditions.FaceRow(static_cast<Index>(f), &condition_face_rows[at_row]);
+      condition_vertex_of.insert(condition_vertex_of.end(), part.vertices.begin(),
+                                 part.vertices.end());
+      condition_face_of.insert(condition_face_of.end(), part.faces.begin(), part.faces.end());
+    }
     StateRows rows;
     const SimObject::SavedHeader header =
         one_process ? ReadOneProcessState(from, at, files.front(), part.local, rows)
@@ -257,17 +372,21 @@ void WholeDomainView::RestoreOnAnotherRankCount(StateReader& in, const StateRead
   };
   try {
     if (rank < saved.size) {
-      read_part(in, saved, rank);
+      read_part(in, saved, rank, own_conditions);
     } else {
       in.SkipRestOfSection();  // rank q % N reads this one
     }
     for (std::int64_t r = rank + ranks; r < saved.size; r += ranks) {
       const std::filesystem::path& file = files[static_cast<std::size_t>(r)];
       StateReader other(ReadCheckpointFile(file), file.string());
-      other.Seek(at);
+      BoundaryConditions::Applied conditions;
+      if (move_conditions)
+        conditions = SeekPartReadingConditions(other, at);
+      else
+        other.Seek(at);
       other.BeginSection(kSavedPartTag, kSavedPartVersion);
       const std::string before = common;
-      read_part(other, ReadSavedPart(other), r);
+      read_part(other, ReadSavedPart(other), r, conditions);
       if (!before.empty() && before != common)
         other.Fail("this file is from another checkpoint than the others this rank read");
       other.EndSection();
@@ -328,6 +447,9 @@ void WholeDomainView::RestoreOnAnotherRankCount(StateReader& in, const StateRead
   else
     move("boundary face", bc_face_, whole_faces, face_of, mine.face, mine.face_width);
   if (!lost.empty()) in.Fail(lost);
+  if (move_conditions)
+    MoveConditions(in, condition_vertex_of, condition_vertex_rows, condition_face_of,
+                   condition_face_rows);
   part_->RestoreStateFrom(time, steps,
                           [&](StateWriter& out) { movable->WriteStateRows(out, mine); });
 }
