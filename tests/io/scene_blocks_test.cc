@@ -130,10 +130,11 @@ TEST(SceneMeshes, ASerialRunBuildsEveryMeshWhole) {
 
 // Objects joined only by connectors that couple parts (FieldCopy, not "nearest") are made in
 // blocks together when all of them can be and share one domain mesh, whose blocks they then
-// ask for (it is never built whole). Another mesh, a "nearest" copy, an unknown connector, an
-// event, or an end that must be whole keeps every object such a connector joins whole, and
-// through them the objects joined to those. A connector of global fields (Glance) joins an
-// object made in blocks to a whole one.
+// ask for (it is never built whole). Another mesh, a "nearest" copy, an unknown connector, or an
+// end that must be whole keeps every object such a connector joins whole, and through them the
+// objects joined to those. A connector of global fields (Glance) joins an object made in blocks
+// to a whole one. An event may name an object made in blocks (it sets the part's conditions and
+// uniform field values).
 TEST(SceneMeshes, ObjectsCoupledPartToPartAreMadeInBlocksTogether) {
   std::map<std::string, Seen> seen;
   auto registry = RecordingRegistry(seen, true);
@@ -177,7 +178,8 @@ TEST(SceneMeshes, ObjectsCoupledPartToPartAreMadeInBlocksTogether) {
   EXPECT_TRUE(seen["ep"].in_blocks);
   EXPECT_TRUE(seen["muscle"].in_blocks);
   EXPECT_TRUE(seen["g"].in_blocks);
-  for (const char* name : {"x", "y", "p", "q", "r", "s", "t", "u", "v", "w", "h"})
+  EXPECT_TRUE(seen["w"].in_blocks);
+  for (const char* name : {"x", "y", "p", "q", "r", "s", "t", "u", "v", "h"})
     EXPECT_FALSE(seen[name].in_blocks) << name;
   ASSERT_TRUE(seen["ep"].block);
   ASSERT_TRUE(seen["muscle"].block);
@@ -228,7 +230,7 @@ TEST(SceneMeshes, ABarycentricCopyLetsObjectsOnOtherMeshesBeMadeInBlocks) {
                                                "scene.json");
   const JsonNode root = doc.root();
   const std::set<std::string> in_blocks =
-      InBlocksObjects(root.At("objects"), root.Find("connectors"), std::nullopt, *registry);
+      InBlocksObjects(root.At("objects"), root.Find("connectors"), *registry);
   EXPECT_EQ(in_blocks, (std::set<std::string>{"ep", "muscle", "probe"}));
 }
 

@@ -30,7 +30,8 @@ Runs the N-version benchmark slab (scenes/slab_ep_0.5mm.json, its first 30 ms) s
     kinetic energy within 1e-6 of their scale (Newton to 1e-8, CG to 1e-6); measured 1e-8; so
     does the cantilever under a total force, a pressure and a traction on face groups and boxes
     and a displacement on a node id, with a reaction probe over a box (a condition that selects
-    nothing is refused once, exit 1); and the cantilever integrated explicitly
+    nothing is refused once, exit 1), and so with events that apply and remove conditions, also
+    checkpointed after them on 2 ranks and resumed on 4; and the cantilever integrated explicitly
     (scenes/cantilever_explicit.json, RK4) split over 2 ranks gives the serial probes within
     1e-9 of their scale (the same arithmetic, summed in another order);
   - the heart (scenes/heart.json, its first beat: 0.8 s) on 2 ranks, its bioelectricity and its
@@ -502,6 +503,34 @@ with tempfile.TemporaryDirectory() as work:
     check(code == 1 and len(errors) == 1 and "boundary_conditions[5]" in text
           and "selects no boundary vertex" in text,
           f"an empty region on 2 ranks: exit {code}: {text}")
+    # Events may name an object made in blocks: they set its part's conditions. The loaded
+    # cantilever pushed sideways from 0.05 s (a total force on its ymax face group) and its tip
+    # load removed at 0.1 s runs in blocks on 2 ranks as serially, within the bounds above.
+    # Checkpointed at 0.15 s on 2 ranks and resumed on 4, it gives the uninterrupted run's
+    # probes within them too: the push and the tip's release come only from the checkpoint (the
+    # scene sets the tip load again, and the events have fired), so the conditions the events
+    # set have moved with the state.
+    scene["objects"]["beam"]["boundary_conditions"].pop()  # the empty region
+    scene["schedule"]["events"] = [
+        {"at": 0.05, "object": "beam",
+         "apply": {"name": "push", "region": {"group": "ymax"}, "total_force": [0, -0.004, 0]}},
+        {"at": 0.1, "object": "beam", "remove": "tip"}]
+    evented = os.path.join(work, "cantilever_events.json")
+    with open(evented, "w") as f:
+        json.dump(scene, f)
+    loaded_scales = (("tip", 0.07), ("clamp", 0.1), ("reaction_box", 0.1))
+    event_runs = run_in_blocks("cantilever_events", evented, (1, 2), "0.2")
+    compare_scaled("cantilever with events on 2 ranks", event_runs[1], event_runs[2],
+                   loaded_scales, 1e-6, 10)
+    moved = os.path.join(work, "cantilever_events_moved")
+    code, text = run(2, moved, "-q", "--checkpoint-every", "0.05", scene=evented, until="0.15")
+    check(code == 0, f"cantilever with events, checkpointed on 2 ranks: exit {code}: {text}")
+    code, text = run(4, moved, "--resume", os.path.join(moved, "checkpoint.gck"), scene=evented,
+                     until="0.2")
+    check(code == 0 and "the checkpoint was written on 2 ranks" in text,
+          f"cantilever with events, resumed on 4 ranks: exit {code}: {text}")
+    compare_scaled("cantilever with events, 2 ranks' checkpoint resumed on 4", event_runs[2],
+                   moved, loaded_scales, 1e-6, 10)
     # A divergence on one rank's part stops every rank, at the serial run's step.
     with open(SCENE) as f:
         scene = json.load(f)

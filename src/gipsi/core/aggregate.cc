@@ -85,7 +85,7 @@ Coordinator BuildAggregateParts(const ObjectBuildContext& ctx, const JsonNode& p
   // Made in blocks (its parts too, by the scene's rule among them) only when nothing outside
   // reads its parts.
   const std::set<std::string> in_blocks =
-      ctx.in_blocks ? InBlocksObjects(part_nodes, p.Find("connectors"), std::nullopt, ctx.registry)
+      ctx.in_blocks ? InBlocksObjects(part_nodes, p.Find("connectors"), ctx.registry)
                     : std::set<std::string>{};
   for (const auto& [name, node] : part_nodes.Members()) {
     BuiltObject built = ctx.build_object(name, node, in_blocks.count(name) > 0);

@@ -40,7 +40,6 @@ bool NamesObject(const JsonNode& node, const std::string& name) {
 
 std::set<std::string> InBlocksObjects(const JsonNode& objects,
                                       const std::optional<JsonNode>& connectors,
-                                      const std::optional<JsonNode>& events,
                                       const TypeRegistry& registry) {
   // Candidates, with their domain mesh if they name one.
   std::map<std::string, std::optional<std::string>> domain;
@@ -48,7 +47,9 @@ std::set<std::string> InBlocksObjects(const JsonNode& objects,
   for (const auto& [name, node] : objects.Members()) {
     const auto rule = registry.splits_in_blocks.find(TypeOf(node));
     if (rule == registry.splits_in_blocks.end() || !rule->second(node)) continue;
-    bool named = events && NamesObject(*events, name);
+    // Events may name it: they set its conditions (on its part's boundary) and uniform values
+    // of its fields, which a part takes as the whole object does.
+    bool named = false;
     for (const auto& [other, other_node] : objects.Members())
       if (other != name && NamesObject(other_node, name)) named = true;
     if (named) continue;

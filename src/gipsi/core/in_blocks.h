@@ -22,7 +22,7 @@ class TypeRegistry;
 
 /// The members of `objects` (a scene's "objects" or an aggregate's "parts") a distributed run may
 /// make in blocks: of a type and with keys it can make so (TypeRegistry::splits_in_blocks), named
-/// by no other object and nothing in `events`, and by the members of `connectors` only as
+/// by no other object (events may name it), and by the members of `connectors` only as
 /// TypeRegistry::connector_part_use allows: one that couples parts joins objects all made in
 /// blocks from one domain mesh (their "domain"), or none; one that uses only global fields and
 /// capabilities, or couples parts split any way, joins any; any other needs its objects whole.
@@ -31,7 +31,6 @@ class TypeRegistry;
 /// the others a part-to-part connector joins it with.
 [[nodiscard]] std::set<std::string> InBlocksObjects(const JsonNode& objects,
                                                     const std::optional<JsonNode>& connectors,
-                                                    const std::optional<JsonNode>& events,
                                                     const TypeRegistry& registry);
 
 }  // namespace gipsi

@@ -48,7 +48,8 @@
 /// part-only ends); 20: coupling objects split differently (PartitionedObject's
 /// InterpolateAtPoints, PartsInterpolation; TypeRegistry::PartUse::kAnyParts); 21: a split
 /// object without its whole domain stores its part's boundary conditions only
-/// (PartitionedObject::SelectConditionItems replaces SelectWholeBoundary).
+/// (PartitionedObject::SelectConditionItems replaces SelectWholeBoundary), and events may name
+/// objects made in blocks (InBlocksObjects takes no events).
 #define GIPSI_PLUGIN_INTERFACE 21
 /// What a plugin's gipsi_plugin_abi_version() returns and the loader requires: the package's
 /// major and minor version with the plugin interface, MAJOR·10⁶ + MINOR·10³ + INTERFACE. A

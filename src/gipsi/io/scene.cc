@@ -609,10 +609,8 @@ Scene LoadSceneFromString(std::string_view text, const std::string& name,
   ObjectBuilder builder(registry, mesh_provider, scene, macro_dt);
   JsonNode objects = root.At("objects");
   if (objects.size() == 0) objects.Expected("at least one object");
-  std::optional<JsonNode> events;
-  if (schedule.is_object()) events = schedule.Find("events");
   const std::set<std::string> in_blocks =
-      InBlocksObjects(objects, root.Find("connectors"), events, registry);
+      InBlocksObjects(objects, root.Find("connectors"), registry);
   for (const auto& [object_name, node] : objects.Members()) {
     stage(fmt::format("object '{}'{}", object_name,
                       node.is_object() && node.Has("type") && node.At("type").is_string()
