@@ -18,6 +18,12 @@ std::string_view ToString(ImplicitSchemeKind kind) {
   return "?";
 }
 
+std::optional<ImplicitSchemeKind> ImplicitSchemeNamed(std::string_view name) {
+  for (const ImplicitSchemeKind kind : kImplicitSchemeKinds)
+    if (name == ToString(kind)) return kind;
+  return std::nullopt;
+}
+
 ImplicitScheme::ImplicitScheme(ImplicitSchemeKind kind, double newmark_beta, double newmark_gamma)
     : kind_(kind), beta_(newmark_beta), gamma_(newmark_gamma) {
   GIPSI_CHECK(beta_ > 0 && gamma_ > 0);

@@ -17,7 +17,9 @@
 ///                   acceleration) is second order and conserves the energy of linear systems.
 ///                   (N. M. Newmark, J. Eng. Mech. Div. ASCE 85(3):67–94, 1959.)
 
+#include <array>
 #include <cstdint>
+#include <optional>
 #include <string_view>
 
 #include "gipsi/base/export.h"
@@ -32,8 +34,15 @@ class StateWriter;
 
 enum class ImplicitSchemeKind { kStatic, kBackwardEuler, kBdf2, kNewmark };
 
+/// Every kind, in the order messages list them.
+inline constexpr std::array<ImplicitSchemeKind, 4> kImplicitSchemeKinds = {
+    ImplicitSchemeKind::kStatic, ImplicitSchemeKind::kBackwardEuler, ImplicitSchemeKind::kBdf2,
+    ImplicitSchemeKind::kNewmark};
+
 /// Name used in scene files: "Static", "BackwardEuler", "BDF2", "Newmark".
 std::string_view ToString(ImplicitSchemeKind kind);
+/// The kind a scene file names (ToString's name), or nullopt for any other name.
+std::optional<ImplicitSchemeKind> ImplicitSchemeNamed(std::string_view name);
 
 /// Scheme state: the history it needs (x_n, v_n, a_n, x_n − x_{n−1}, v_{n−1}). Copyable (for
 /// rolling back a failed step); allocation-free after `Reset`.

@@ -76,10 +76,8 @@ bool SplitsWithIntegrator(const JsonNode& params) {
   if (!integrator) return true;
   if (!integrator->is_string()) return false;  // refused by the serial factory
   const std::string name = integrator->AsString();
-  for (ImplicitSchemeKind kind : {ImplicitSchemeKind::kStatic, ImplicitSchemeKind::kBackwardEuler,
-                                  ImplicitSchemeKind::kBdf2, ImplicitSchemeKind::kNewmark})
-    if (name == ToString(kind)) return true;
-  return name == "RK4" || name == "SymplecticEuler" || name == "ExplicitEuler";
+  return ImplicitSchemeNamed(name) || name == "RK4" || name == "SymplecticEuler" ||
+         name == "ExplicitEuler";
 }
 
 // Adds an object to the summary's list of split objects.

@@ -23,15 +23,12 @@ namespace {
 std::unique_ptr<OdeIntegrator> ParseIntegrator(const JsonNode& node, const TypeRegistry& registry,
                                                ImplicitSchemeKind& scheme) {
   const std::string name = node.AsString();
-  std::vector<std::string> known;
-  for (ImplicitSchemeKind kind : {ImplicitSchemeKind::kStatic, ImplicitSchemeKind::kBackwardEuler,
-                                  ImplicitSchemeKind::kBdf2, ImplicitSchemeKind::kNewmark}) {
-    if (name == ToString(kind)) {
-      scheme = kind;
-      return nullptr;
-    }
-    known.emplace_back(ToString(kind));
+  if (const auto kind = ImplicitSchemeNamed(name)) {
+    scheme = *kind;
+    return nullptr;
   }
+  std::vector<std::string> known;
+  for (const ImplicitSchemeKind kind : kImplicitSchemeKinds) known.emplace_back(ToString(kind));
   if (!registry.integrators.Contains(name)) {
     for (const std::string& other : registry.integrators.Names())
       if (std::find(known.begin(), known.end(), other) == known.end()) known.push_back(other);
