@@ -12,13 +12,14 @@
 //   mpiexec -np 2 build/release/bench/solid_scaling_bench --cells 80 8 8 --steps 20
 //   build/release/bench/solid_scaling_bench --cells 80 8 8 --serial   (the serial FemSolid)
 //
-// Options: --cells NX NY NZ (hexahedra along the beam, 6 tets each; default 80 8 8, 30.7k
-// tets), --steps N timed steps (default 20) after --warmup N (default 2), --pc amg|hypre|
-// jacobi|sgs (default amg: PETSc's GAMG with the rigid-body modes), --type cg|cholmod
-// (cholmod: MUMPS's LDLᵀ when split), --tolerance (CG's, default 1e-6, the serial default),
-// --serial (one rank: the serial FemSolid on the whole mesh instead, for the baseline, with
-// CG and block SGS — or --pc jacobi — or CHOLMOD with --type cholmod). PETSc options with the
-// prefix solid_ (e.g. -solid_ksp_monitor) and -log_view pass through. Run with
+// Options: --cells NX NY NZ (hexahedra along the beam; default 80 8 8, 30.7k tets),
+// --tets-per-cell 5|6 (default 6, Kuhn's cut; 5: a scene's "tets_per_cell": 5), --steps N
+// timed steps (default 20) after --warmup N (default 2), --pc amg|hypre|jacobi|sgs (default
+// amg: PETSc's GAMG with the rigid-body modes), --type cg|cholmod (cholmod: MUMPS's LDLᵀ when
+// split), --tolerance (CG's, default 1e-6, the serial default), --serial (one rank: the serial
+// FemSolid on the whole mesh instead, for the baseline, with CG and block SGS — or --pc
+// jacobi — or CHOLMOD with --type cholmod). PETSc options with the prefix solid_ (e.g.
+// -solid_ksp_monitor) and -log_view pass through. Run with
 // OMP_NUM_THREADS=1 per rank unless measuring threads within ranks.
 
 #include <mpi.h>
@@ -58,6 +59,7 @@ struct Options {
   std::string type = "cg";
   double tolerance = 1e-6;
   bool serial = false;
+  int tets_per_cell = 6;
 };
 
 // Exits 2 with CLI11's message on a bad command line (PETSc options such as -log_view pass
@@ -67,8 +69,9 @@ Options Parse(int argc, char** argv) {
   std::array<int, 3> cells = {o.nx, o.ny, o.nz};
   CLI::App app{"Strong scaling of the split FemSolid on the cantilever"};
   app.allow_extras();
-  app.add_option("--cells", cells, "Hexahedra along the beam (6 tets each)")
-      ->check(CLI::Range(1, 100000));
+  app.add_option("--cells", cells, "Hexahedra along the beam")->check(CLI::Range(1, 100000));
+  app.add_option("--tets-per-cell", o.tets_per_cell, "Tets per hexahedron (5 or 6)")
+      ->check(CLI::IsMember({5, 6}));
   app.add_option("--steps", o.steps, "Timed steps")->check(CLI::Range(1, 100000000));
   app.add_option("--warmup", o.warmup, "Untimed steps first")->check(CLI::NonNegativeNumber);
   app.add_option("--pc", o.pc, "CG's preconditioner")
@@ -132,7 +135,8 @@ int Main(int argc, char** argv) {
   }
   const double t0 = MPI_Wtime();
   const auto whole = std::make_shared<gipsi::Mesh>(gipsi::MakeTetBox(
-      gipsi::Vec3::Zero(), gipsi::Vec3(kLength, kWidth, kHeight), {o.nx, o.ny, o.nz}));
+      gipsi::Vec3::Zero(), gipsi::Vec3(kLength, kWidth, kHeight), {o.nx, o.ny, o.nz},
+      o.tets_per_cell == 5 ? gipsi::HexSplit::kFive : gipsi::HexSplit::kSix));
   const double t_mesh = MPI_Wtime() - t0;
   std::unique_ptr<gipsi::SimObject> object;
   const gipsi::FemSolid* solid = nullptr;  // the FemSolid stepped on this rank

@@ -99,7 +99,10 @@ class PetscSolidSolver final : public LinearSolver {
     } else if (pre == "hypre") {
       GIPSI_PETSC(PCSetType(pc, PCHYPRE));
     } else if (pre == "jacobi") {
-      GIPSI_PETSC(PCSetType(pc, PCPBJACOBI));
+      // Each node's 3×3 block, given as variable blocks of 3 (AnalyzePattern): PETSc 3.18's
+      // PCPBJACOBI reads the block size of the diagonal part, which MatSetPreallocationCOO
+      // leaves at 1 on more than one rank, and so applied a wrong, indefinite preconditioner.
+      GIPSI_PETSC(PCSetType(pc, PCVPBJACOBI));
     } else if (pre == "sgs") {
       GIPSI_PETSC(PCSetType(pc, PCSOR));
       GIPSI_PETSC(PCSORSetSymmetric(pc, SOR_LOCAL_SYMMETRIC_SWEEP));
@@ -187,6 +190,11 @@ class PetscSolidSolver final : public LinearSolver {
     GIPSI_PETSC(MatSetPreallocationCOO(matrix_, static_cast<PetscCount>(entries), rows.data(),
                                        cols.data()));
     if (near_null_ != nullptr) GIPSI_PETSC(MatSetNearNullSpace(matrix_, near_null_));
+    if (!direct_ && options_.preconditioner == "jacobi") {
+      std::vector<PetscInt> blocks(static_cast<std::size_t>(part_.num_owned), 3);
+      GIPSI_PETSC(
+          MatSetVariableBlockSizes(matrix_, static_cast<PetscInt>(blocks.size()), blocks.data()));
+    }
     entries_ = A.nonZeros();
     factorized_ = false;
   }
