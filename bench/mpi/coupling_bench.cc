@@ -1,19 +1,21 @@
-// A barycentric copy between objects split differently (docs/scale-out.md): the N-version
-// slab's monodomain, made in blocks, read at the nodes of a coarser mesh of the slab made in
-// blocks too (the bioelectricity on a fine mesh, the mechanics on a coarse one). Times, per
+// A barycentric (or nearest-item) copy between objects split differently (docs/scale-out.md): the
+// N-version slab's monodomain, made in blocks, read at the nodes of a coarser mesh of the slab made
+// in blocks too (the bioelectricity on a fine mesh, the mechanics on a coarse one). Times, per
 // firing, the parts answering for each rank's points (PartitionedObject::InterpolateAtPoints,
-// what a FieldCopy does now) against the whole-field path it replaces, run in the same process
-// on the same slab: the split object's view gathers V whole on every rank (MPI_Allgatherv) and
-// each rank interpolates its points in the whole mesh. Also the set-up of each (the parts
-// locating the points, against a point map built on the whole mesh). Medians of batches, each
-// batch timed on every rank and its slowest rank counted.
+// or NearestAtPoints with --mapping nearest: what a FieldCopy does now) against the whole-field
+// path it replaces, run in the same process on the same slab: the split object's view gathers V
+// whole on every rank (MPI_Allgatherv) and each rank interpolates its points in the whole mesh (or
+// takes their nearest nodes). Also the set-up of each (the parts locating the points, against a
+// point map built on the whole mesh). Medians of batches, each batch timed on every rank and its
+// slowest rank counted.
 //
 //   mpiexec -np 2 build/release/bench/coupling_bench --cells 100 35 15 --target-cells 20 7 3
 //   build/release/bench/coupling_bench --cells 100 35 15 --target-cells 20 7 3
 //
 // Options: --cells NX NY NZ (the fine slab's hexahedra, 6 tets each; default 100 35 15: 0.2 mm),
-// --target-cells NX NY NZ (the coarse slab's; default 20 7 3: 1 mm), --batches N (default 15)
-// of --reps N (default 20) firings each.
+// --target-cells NX NY NZ (the coarse slab's; default 20 7 3: 1 mm), --mapping
+// barycentric|nearest (default barycentric), --batches N (default 15) of --reps N (default 20)
+// firings each.
 
 #include <mpi.h>
 
@@ -21,6 +23,7 @@
 #include <cstdio>
 #include <memory>
 #include <optional>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -36,6 +39,7 @@ namespace {
 struct Options {
   std::array<int, 3> cells = {100, 35, 15}, target = {20, 7, 3};
   int batches = 15, reps = 20;
+  std::string mapping = "barycentric";
 };
 
 Options Parse(int argc, char** argv) {
@@ -44,6 +48,8 @@ Options Parse(int argc, char** argv) {
   gipsi::bench::AddSlabCells(app, o.cells);
   app.add_option("--target-cells", o.target, "Hexahedra along the coarse slab (6 tets each)")
       ->check(CLI::Range(1, 100000));
+  app.add_option("--mapping", o.mapping, "The copy's mapping")
+      ->check(CLI::IsMember({"barycentric", "nearest"}));
   app.add_option("--batches", o.batches, "Timed batches")->check(CLI::Range(1, 100000000));
   app.add_option("--reps", o.reps, "Firings per batch")->check(CLI::Range(1, 100000000));
   gipsi::bench::ParseOrExit(app, argc, argv);
@@ -94,7 +100,11 @@ int Main(int argc, char** argv) {
   Eigen::MatrixXd at(1, points.cols());
 
   std::unique_ptr<gipsi::PartsInterpolation> parts;
-  const double parts_setup = TimeOnce(world, [&] { parts = tissue.InterpolateAtPoints(points); });
+  const bool nearest = o.mapping == "nearest";
+  const double parts_setup = TimeOnce(world, [&] {
+    parts = nearest ? tissue.NearestAtPoints(gipsi::FieldLocation::kNode, points)
+                    : tissue.InterpolateAtPoints(points);
+  });
   const double parts_fire = gipsi::bench::SlowestRankPerCall(
       world, o.batches, o.reps, [&] { parts->Interpolate(v, at, std::nullopt); });
 
@@ -110,7 +120,9 @@ int Main(int argc, char** argv) {
   }
   Eigen::MatrixXd gathered(1, whole->num_nodes()), at_whole(1, points.cols());
   gipsi::PointMap map;
-  const double whole_setup = TimeOnce(world, [&] { map = viewed.MapFromNodes(points); });
+  const double whole_setup = TimeOnce(world, [&] {
+    map = nearest ? gipsi::PointMap::Nearest(whole->nodes, points) : viewed.MapFromNodes(points);
+  });
   const double whole_fire = gipsi::bench::SlowestRankPerCall(world, o.batches, o.reps, [&] {
     viewed.ReadField(v, gathered);
     map.Apply(gathered, at_whole);
@@ -121,12 +133,12 @@ int Main(int argc, char** argv) {
   MPI_Allreduce(MPI_IN_PLACE, counts, 1, MPI_LONG_LONG, MPI_SUM, world);
   if (rank == 0)
     std::printf(
-        "ranks %d  source %lld tets %lld nodes  target points %lld (all ranks)\n"
+        "%s: ranks %d  source %lld tets %lld nodes  target points %lld (all ranks)\n"
         "set-up: parts %.3g ms  whole mesh %.3g ms\n"
         "firing: parts %.3g ms  whole field %.3g ms  ratio %.3g  (values differ by %.2g)\n",
-        size, static_cast<long long>(whole->num_tets()), static_cast<long long>(whole->num_nodes()),
-        counts[0], 1e3 * parts_setup, 1e3 * whole_setup, 1e3 * parts_fire, 1e3 * whole_fire,
-        whole_fire / parts_fire, differ);
+        o.mapping.c_str(), size, static_cast<long long>(whole->num_tets()),
+        static_cast<long long>(whole->num_nodes()), counts[0], 1e3 * parts_setup, 1e3 * whole_setup,
+        1e3 * parts_fire, 1e3 * whole_fire, whole_fire / parts_fire, differ);
   return 0;
 }
 

@@ -128,13 +128,13 @@ TEST(SceneMeshes, ASerialRunBuildsEveryMeshWhole) {
   EXPECT_EQ(seen["a"].block->tets, expected.tets);
 }
 
-// Objects joined only by connectors that couple parts (FieldCopy, not "nearest") are made in
-// blocks together when all of them can be and share one domain mesh, whose blocks they then
-// ask for (it is never built whole). Another mesh, a "nearest" copy, an unknown connector, or an
-// end that must be whole keeps every object such a connector joins whole, and through them the
-// objects joined to those. A connector of global fields (Glance) joins an object made in blocks
-// to a whole one. An event may name an object made in blocks (it sets the part's conditions and
-// uniform field values).
+// Objects joined only by connectors that couple parts (FieldCopy) are made in blocks together
+// when all of them can be and share one domain mesh, whose blocks they then ask for (it is never
+// built whole); a "nearest" copy couples parts split any way. Another mesh (for an "auto"
+// copy), an unknown connector, or an end that must be whole keeps every object such a connector
+// joins whole, and through them the objects joined to those. A connector of global fields (Glance)
+// joins an object made in blocks to a whole one. An event may name an object made in blocks (it
+// sets the part's conditions and uniform field values).
 TEST(SceneMeshes, ObjectsCoupledPartToPartAreMadeInBlocksTogether) {
   std::map<std::string, Seen> seen;
   auto registry = RecordingRegistry(seen, true);
@@ -179,7 +179,9 @@ TEST(SceneMeshes, ObjectsCoupledPartToPartAreMadeInBlocksTogether) {
   EXPECT_TRUE(seen["muscle"].in_blocks);
   EXPECT_TRUE(seen["g"].in_blocks);
   EXPECT_TRUE(seen["w"].in_blocks);
-  for (const char* name : {"x", "y", "p", "q", "r", "s", "t", "u", "v", "h"})
+  EXPECT_TRUE(seen["u"].in_blocks);
+  EXPECT_TRUE(seen["v"].in_blocks);
+  for (const char* name : {"x", "y", "p", "q", "r", "s", "t", "h"})
     EXPECT_FALSE(seen[name].in_blocks) << name;
   ASSERT_TRUE(seen["ep"].block);
   ASSERT_TRUE(seen["muscle"].block);
@@ -189,10 +191,10 @@ TEST(SceneMeshes, ObjectsCoupledPartToPartAreMadeInBlocksTogether) {
   EXPECT_EQ(scene.meshes.count("slab"), 1U);
 }
 
-// A barycentric FieldCopy (and an excitation–contraction) couples parts split any way, so the
-// objects it joins are made in blocks whatever their meshes, and whether or not its other end
-// is: one on another mesh, one kept whole. A direct copy, or "auto" (which may turn out direct),
-// still needs one mesh, and "nearest" objects whole.
+// A barycentric or nearest FieldCopy (and an excitation–contraction) couples parts split any
+// way, so the objects it joins are made in blocks whatever their meshes, and whether or not its
+// other end is: one on another mesh, one kept whole. A direct copy, or "auto" (which may turn
+// out direct), still needs one mesh.
 TEST(SceneMeshes, ABarycentricCopyLetsObjectsOnOtherMeshesBeMadeInBlocks) {
   std::map<std::string, Seen> seen;
   auto registry = RecordingRegistry(seen, true);
@@ -206,7 +208,7 @@ TEST(SceneMeshes, ABarycentricCopyLetsObjectsOnOtherMeshesBeMadeInBlocks) {
   EXPECT_EQ(use_of(R"({"type": "FieldCopy", "mapping": "direct"})"), PartUse::kPartToPart);
   EXPECT_EQ(use_of(R"({"type": "FieldCopy", "mapping": "auto"})"), PartUse::kPartToPart);
   EXPECT_EQ(use_of(R"({"type": "FieldCopy"})"), PartUse::kPartToPart);
-  EXPECT_EQ(use_of(R"({"type": "FieldCopy", "mapping": "nearest"})"), PartUse::kWhole);
+  EXPECT_EQ(use_of(R"({"type": "FieldCopy", "mapping": "nearest"})"), PartUse::kAnyParts);
   const JsonDocument ec = JsonDocument::Parse(R"({"type": "ExcitationContraction"})", "ec.json");
   EXPECT_EQ(registry->connector_part_use.at("ExcitationContraction")(ec.root()),
             PartUse::kAnyParts);

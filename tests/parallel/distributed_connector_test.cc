@@ -20,7 +20,9 @@
 #include "gipsi/core/coordinator.h"
 #include "gipsi/core/partitioned_object.h"
 #include "gipsi/core/port.h"
+#include "gipsi/geometry/boundary.h"
 #include "gipsi/geometry/generators.h"
+#include "gipsi/geometry/mapping.h"
 #include "gipsi/geometry/mesh_block.h"
 #include "gipsi/models/connectors/excitation_contraction.h"
 #include "gipsi/models/connectors/field_copy.h"
@@ -272,8 +274,8 @@ TEST(SplitCoupling, ExcitationContractionCouplesThePartsWithoutGathers) {
 
 // A FieldCopy of V (scaled to a tension: 2 kPa/mV) between the same split objects copies the
 // parts, item for item onto the nodes and barycentrically onto the tets, with no gather; the
-// values are those of the copy onto a whole muscle at every item. A nearest-item copy reads V
-// whole.
+// values are those of the copy onto a whole muscle at every item. (Nearest-item copies:
+// ANearestCopyJoinsObjectsSplitAnyWay.)
 TEST(SplitCoupling, FieldCopyCopiesThePartsWithoutGathers) {
   const auto mesh = Box();
   const auto tissue = SplitTissue(mesh);
@@ -303,18 +305,27 @@ TEST(SplitCoupling, FieldCopyCopiesThePartsWithoutGathers) {
               1e-12 * copied.cwiseAbs().maxCoeff());
     EXPECT_GT(copied.cwiseAbs().maxCoeff(), 1e5);  // Pa: 2 kPa/mV of tens of mV
   }
-  auto muscle = Muscle(mesh, true);
-  FieldCopy nearest("copy", *tissue, v, *muscle, muscle->FindField("active_tension"),
-                    Mapping::kNearest, 2, "kPa/mV");
-  EXPECT_FALSE(nearest.couples_parts());
 }
+
+// A connector that reads a node field whole, as a connector that does not couple parts does.
+class WholeReader final : public Connector {
+ public:
+  explicit WholeReader(const SimObject& from) : Connector("reader") {
+    BindNoState();
+    UseField("from", from, "V", FieldAccess::kRead);
+  }
+  [[nodiscard]] std::string_view type_name() const override { return "WholeReader"; }
+
+ protected:
+  StepStatus DoFire(double /*t*/) override { return StepStatus::Ok(); }
+};
 
 // Objects made in blocks from one mesh (no rank holds it) are split alike, and the
 // excitation–contraction coupling couples their parts: every muscle tet gets the twitch law at
 // the mean of its corners' V, which the tissue split from the whole box gives too. A coordinator
 // takes the pair, and the coupling to a muscle whole on every rank (the tissue's parts answer
 // for its tets). A connector that cannot couple parts is refused on such an object when the
-// coordinator prepares, naming the connector, the field and why: a nearest-item copy. (A
+// coordinator prepares, naming the connector, the field and why. (A
 // connector of its global fields and capabilities, the heart's cavity coupling, is taken:
 // Mpi.SceneRunMatchesTheSerialRun runs the heart in blocks.)
 TEST(SplitCoupling, ObjectsMadeInBlocksCoupleTheirPartsAndOtherConnectorsAreRefused) {
@@ -369,24 +380,20 @@ TEST(SplitCoupling, ObjectsMadeInBlocksCoupleTheirPartsAndOtherConnectorsAreRefu
       ASSERT_NEAR(tension(0, e), Twitch(mean, 0.0, 0.004), 1e-9) << "tet " << e;
     }
   }
-  {  // a nearest-item copy between objects split alike
+  {  // a connector that reads V whole
     auto source = TissueInBlocks();
-    auto target = MuscleInBlocks();
-    auto copy = std::make_unique<FieldCopy>("copy", *source, source->FindField("V"), *target,
-                                            target->FindField("active_tension"),
-                                            FieldCopy::Mapping::kNearest, 2, "kPa/mV");
-    EXPECT_FALSE(copy->couples_parts());
+    auto reader = std::make_unique<WholeReader>(*source);
+    EXPECT_FALSE(reader->couples_parts());
     Coordinator c;
     c.AddObject(std::move(source), 1e-4);
-    c.AddObject(std::move(target), 1e-4);
-    c.AddConnector(std::move(copy), 1);
+    c.AddConnector(std::move(reader), 1);
     try {
       c.Prepare(1e-4);
       ADD_FAILURE() << "accepted";
     } catch (const WiringError& e) {
-      EXPECT_NE(std::string(e.what()).find("connector 'copy' (FieldCopy) reads field 'V' of 'ep' "
-                                           "(Monodomain) at its 'from' key, but that object is "
-                                           "made in blocks"),
+      EXPECT_NE(std::string(e.what()).find("connector 'reader' (WholeReader) reads field 'V' of "
+                                           "'ep' (Monodomain) at its 'from' key, but that object "
+                                           "is made in blocks"),
                 std::string::npos)
           << e.what();
     }
@@ -551,6 +558,143 @@ TEST(SplitCoupling, ABarycentricCopyJoinsObjectsSplitDifferently) {
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("split differently"), std::string::npos) << e.what();
   }
+}
+
+// The whole source item nearest to each of `at`'s points: the smallest distance, then the
+// lowest index (PointMap::Nearest's rule).
+std::vector<Index> NearestItems(const Points& sources, const Points& at) {
+  std::vector<Index> out(static_cast<std::size_t>(at.cols()));
+  for (Index j = 0; j < at.cols(); ++j) {
+    double best = std::numeric_limits<double>::infinity();
+    for (Index i = 0; i < sources.cols(); ++i) {
+      const double d = (sources.col(i) - at.col(j)).norm();
+      if (d < best) {
+        best = d;
+        out[static_cast<std::size_t>(j)] = i;
+      }
+    }
+  }
+  return out;
+}
+
+// A nearest-item FieldCopy joins objects split any way, with no gather, and gives each item the
+// value of the whole source's nearest item (the lowest index on a tie) bit for bit:
+// - V of the tissue made in blocks (2 kPa/mV) onto the other mesh's muscle, made in blocks or
+//   whole on every rank, at its nodes and at its tets' centroids;
+// - the tension of that split muscle's tets onto the tets of a muscle on the tissue's box (a
+//   tet field's items are the centroids);
+// - a part-only muscle's boundary positions (at rest) onto another's node forces (1 N/m):
+//   each node gets the position of the whole boundary's vertex nearest to it.
+// A coordinator takes a nearest copy between objects made in blocks. A view holding its whole
+// mesh has its boundary fields whole, and its parts do not answer for them.
+TEST(SplitCoupling, ANearestCopyJoinsObjectsSplitAnyWay) {
+  TwoMeshes two;
+  std::unique_ptr<WholeDomainView>& tissue = two.tissue;
+  const FieldId v = tissue->FindField("V");
+  using Mapping = FieldCopy::Mapping;
+  const Points other_centroids =
+      ItemRestPositions(*Muscle(two.other, false), FieldLocation::kElement);
+  std::unique_ptr<WholeDomainView> tensed;  // the split muscle on the other mesh, tensed
+  Eigen::MatrixXd tension;                  // its tets' tension, whole
+  for (const char* field : {"nodal_active_tension", "active_tension"}) {
+    SCOPED_TRACE(field);
+    const bool at_nodes = std::string(field) == "nodal_active_tension";
+    const Points& at = at_nodes ? two.other->nodes : other_centroids;
+    const std::vector<Index> nearest = NearestItems(two.mesh->nodes, at);
+    const PointMap serial = PointMap::Nearest(two.mesh->nodes, at);
+    for (Index j = 0; j < at.cols(); ++j)
+      ASSERT_EQ(serial.indices()(0, j), nearest[static_cast<std::size_t>(j)]) << "item " << j;
+
+    std::unique_ptr<WholeDomainView> split_muscle =
+        MuscleInBlocks(BoxInBlocks(kOtherLo, kOtherHi, kOtherCells));
+    std::unique_ptr<SimObject> whole_muscle = Muscle(two.other, false);
+    FieldCopy onto_parts("copy", *tissue, v, *split_muscle, split_muscle->FindField(field),
+                         Mapping::kNearest, 2, "kPa/mV");
+    FieldCopy onto_whole("copy", *tissue, v, *whole_muscle, whole_muscle->FindField(field),
+                         Mapping::kNearest, 2, "kPa/mV");
+    EXPECT_TRUE(onto_parts.couples_parts());
+    EXPECT_TRUE(onto_whole.couples_parts());
+    const std::int64_t reads_before = tissue->whole_field_reads();
+    ASSERT_TRUE(onto_parts.Fire(0).ok());
+    ASSERT_TRUE(onto_whole.Fire(0).ok());
+    EXPECT_EQ(tissue->whole_field_reads(), reads_before);
+    const double factor = onto_parts.factor();
+    EXPECT_NEAR(factor, 2000, 1e-9);
+    Eigen::MatrixXd expected(1, at.cols());
+    for (Index j = 0; j < at.cols(); ++j)
+      expected(0, j) = factor * two.volts(0, nearest[static_cast<std::size_t>(j)]);
+    EXPECT_GT(expected.cwiseAbs().maxCoeff(), 1e5);
+
+    const Eigen::MatrixXd local = Read(split_muscle->local_part(), field);
+    const std::span<const int> items =
+        at_nodes ? split_muscle->whole_nodes_of_part() : split_muscle->whole_tets_of_part();
+    ASSERT_EQ(static_cast<std::size_t>(local.cols()), items.size());
+    for (Index i = 0; i < local.cols(); ++i)
+      ASSERT_EQ(local(0, i), expected(0, items[static_cast<std::size_t>(i)]))
+          << "whole item " << items[static_cast<std::size_t>(i)];
+    EXPECT_EQ(Read(*whole_muscle, field), expected);
+    if (!at_nodes) {
+      tensed = std::move(split_muscle);
+      tension = expected;
+    }
+  }
+
+  {  // a split muscle's tet field onto the tets of another split muscle, on the tissue's box
+    std::unique_ptr<WholeDomainView> target = MuscleInBlocks();
+    FieldCopy copy("copy", *tensed, tensed->FindField("active_tension"), *target,
+                   target->FindField("active_tension"), Mapping::kNearest, 1);
+    EXPECT_TRUE(copy.couples_parts());
+    const std::int64_t reads_before = tensed->whole_field_reads();
+    ASSERT_TRUE(copy.Fire(0).ok());
+    EXPECT_EQ(tensed->whole_field_reads(), reads_before);
+    const Points centroids = ItemRestPositions(*Muscle(two.mesh, false), FieldLocation::kElement);
+    const std::vector<Index> nearest = NearestItems(other_centroids, centroids);
+    const Eigen::MatrixXd local = Read(target->local_part(), "active_tension");
+    const std::span<const int> tets = target->whole_tets_of_part();
+    for (Index i = 0; i < local.cols(); ++i) {
+      const auto whole = static_cast<std::size_t>(tets[static_cast<std::size_t>(i)]);
+      ASSERT_EQ(local(0, i), tension(0, nearest[whole])) << "whole tet " << whole;
+    }
+  }
+
+  {  // a part-only muscle's boundary positions onto another's node forces
+    std::unique_ptr<WholeDomainView> source =
+        MuscleInBlocks(BoxInBlocks(kOtherLo, kOtherHi, kOtherCells));
+    std::unique_ptr<WholeDomainView> target = MuscleInBlocks();
+    FieldCopy copy("copy", *source, source->FindField("boundary_position"), *target,
+                   target->FindField("external_force"), Mapping::kNearest, 1, "N/m");
+    EXPECT_TRUE(copy.couples_parts());
+    ASSERT_TRUE(copy.Fire(0).ok());
+    Points vertices;
+    MakeBoundary(*two.other).Gather(two.other->nodes, vertices);
+    const std::vector<Index> nearest = NearestItems(vertices, two.mesh->nodes);
+    const Eigen::MatrixXd local = Read(target->local_part(), "external_force");
+    const std::span<const int> nodes = target->whole_nodes_of_part();
+    ASSERT_EQ(static_cast<std::size_t>(local.cols()), nodes.size());
+    for (Index i = 0; i < local.cols(); ++i) {
+      const auto whole = static_cast<std::size_t>(nodes[static_cast<std::size_t>(i)]);
+      ASSERT_EQ(Vec3(local.col(i)), Vec3(vertices.col(nearest[whole]))) << "whole node " << whole;
+    }
+  }
+
+  // A coordinator takes the copy between the tissue and a muscle made in blocks.
+  Coordinator coupled;
+  std::unique_ptr<WholeDomainView> muscle =
+      MuscleInBlocks(BoxInBlocks(kOtherLo, kOtherHi, kOtherCells));
+  SimObject* source = tissue.get();
+  SimObject* target = muscle.get();
+  coupled.AddObject(std::move(tissue), 1e-4);
+  coupled.AddObject(std::move(muscle), 1e-4);
+  coupled.AddConnector(
+      std::make_unique<FieldCopy>("copy", *source, v, *target, target->FindField("active_tension"),
+                                  Mapping::kNearest, 2, "kPa/mV"),
+      1);
+  EXPECT_NO_THROW(coupled.Prepare(1e-4));
+
+  const auto whole_view = Muscle(two.mesh, true);
+  EXPECT_THROW((void)dynamic_cast<const PartitionedObject&>(*whole_view)
+                   .NearestAtPoints(FieldLocation::kBoundaryVertex, two.mesh->nodes),
+               InputError);
 }
 
 // The excitation–contraction coupling between the tissue made in blocks and a muscle on another,

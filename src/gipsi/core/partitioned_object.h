@@ -12,8 +12,9 @@
 /// Coordinator::Prepare refuses any other connector's use of its node or element fields.
 ///
 /// Two split objects cut differently (on two meshes, a fine one for the bioelectricity and a
-/// coarse one for the mechanics) are coupled through InterpolateAtPoints: each process asks the
-/// source's parts for the values at its own target items, and the parts that hold them answer.
+/// coarse one for the mechanics) are coupled through InterpolateAtPoints (or NearestAtPoints
+/// for a nearest-item copy): each process asks the source's parts for the values at its own
+/// target items, and the parts that hold them answer.
 ///
 /// Two split objects cut alike (SplitAlike: the same whole domain, the same part on every
 /// process) can be coupled part to part: a connector reads one's local_part() and writes the
@@ -161,6 +162,17 @@ class PartitionedObject {
   /// point is not finite.
   [[nodiscard]] virtual std::unique_ptr<PartsInterpolation> InterpolateAtPoints(
       const Points& points) const = 0;
+  /// Values of this object's fields at `location` (node, element, or on an object without its
+  /// whole domain boundary vertex or face) at `points`, which each process gives for itself,
+  /// each the value of the whole object's item nearest to the point by rest position (the
+  /// lowest index on a tie, as PointMap::Nearest), sent by the process that holds the item.
+  /// PartsInterpolation::Interpolate copies the item's value, with no correction (a no-data
+  /// marker stays one); its max_distance() is the farthest any point lies from its item.
+  /// Collective; throws InputError on every process if a point is not finite or if there are
+  /// points and the object has no such items, and for a boundary location on an object that
+  /// holds its whole domain (whose boundary fields are whole on every process).
+  [[nodiscard]] virtual std::unique_ptr<PartsInterpolation> NearestAtPoints(
+      FieldLocation location, const Points& points) const = 0;
 };
 
 /// True when `a` and `b` are both PartitionedObjects split alike: on every process their parts

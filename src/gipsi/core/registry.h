@@ -49,8 +49,9 @@
 /// InterpolateAtPoints, PartsInterpolation; TypeRegistry::PartUse::kAnyParts); 21: a split
 /// object without its whole domain stores its part's boundary conditions only
 /// (PartitionedObject::SelectConditionItems replaces SelectWholeBoundary), and events may name
-/// objects made in blocks (InBlocksObjects takes no events).
-#define GIPSI_PLUGIN_INTERFACE 21
+/// objects made in blocks (InBlocksObjects takes no events); 22: nearest-item copies between
+/// split objects (PartitionedObject::NearestAtPoints).
+#define GIPSI_PLUGIN_INTERFACE 22
 /// What a plugin's gipsi_plugin_abi_version() returns and the loader requires: the package's
 /// major and minor version with the plugin interface, MAJOR·10⁶ + MINOR·10³ + INTERFACE. A
 /// plugin thus loads only into the release line it was built against (0.1.x, as the CMake
@@ -234,11 +235,12 @@ class TypeRegistry {
     kGlobal,      ///< it uses only its objects' global fields and capabilities: any of them may
                   ///< be made in blocks
     kAnyParts,    ///< it couples the parts of objects split any way (other meshes, other cuts)
-                  ///< or whole (a barycentric FieldCopy): any of them may be made in blocks
+                  ///< or whole (a barycentric or nearest FieldCopy): any of them may be made in
+                  ///< blocks
   };
   /// Connector types that can join objects made in blocks, and how, from the connector's JSON
-  /// (e.g. a FieldCopy couples any parts with a "barycentric" mapping, parts split alike with
-  /// another, and none with "nearest"): registered with the
+  /// (e.g. a FieldCopy couples any parts with a "barycentric" or "nearest" mapping, and parts
+  /// split alike with another): registered with the
   /// connector. The scene loader makes objects in blocks only where every connector naming them
   /// allows it (ObjectBuildContext::in_blocks).
   std::map<std::string, std::function<PartUse(const JsonNode& params)>, std::less<>>

@@ -14,7 +14,10 @@
 #include <utility>
 #include <vector>
 
+#include <fmt/format.h>
+
 #include "gipsi/base/error.h"
+#include "gipsi/geometry/spatial_grid.h"
 #include "gipsi/parallel/mesh_partition_detail.h"
 
 namespace gipsi {
@@ -68,10 +71,39 @@ struct Choice {
   int position = 0;
 };
 
+// A part's answer for a point: how far the point lies from what the part found, and the key
+// that settles a tie (the answering rank for a barycentric point, the item's whole index for
+// a nearest one: the lowest wins).
+struct Reply {
+  double distance = 0;
+  std::int64_t key = 0;
+};
+
+// How this rank's part answers for points: the box of what it can answer from, and its answer
+// (the part field's columns and weights for each point, with its Reply).
+struct Locator {
+  bool nearest = false;  // the nearest item, else barycentric in the part's tets
+  Box box;
+  std::function<PointMap(const std::vector<Point3>&, std::vector<Reply>&)> locate;
+};
+
+// The box of the columns of `at` (empty: lowest corner +inf, highest -inf, at infinite
+// distance from every point).
+Box BoxOf(const Points& at) {
+  Box box;
+  for (std::size_t k = 0; k < 3; ++k) {
+    const auto row = static_cast<Index>(k);
+    box.lo[k] = at.cols() > 0 ? at.row(row).minCoeff() : std::numeric_limits<double>::infinity();
+    box.hi[k] = at.cols() > 0 ? at.row(row).maxCoeff() : -std::numeric_limits<double>::infinity();
+  }
+  return box;
+}
+
 class Interpolation final : public PartsInterpolation {
  public:
-  Interpolation(const SimObject& part, const MeshPart& mesh_part, const Points& points,
-                MPI_Comm comm, std::function<FieldId(FieldId)> part_field,
+  // `share` is empty for a nearest item (each item is on one rank only).
+  Interpolation(const SimObject& part, Locator locator, const Points& points, MPI_Comm comm,
+                std::function<FieldId(FieldId)> part_field,
                 std::function<void(Eigen::Ref<Eigen::MatrixXd>)> share);
 
   [[nodiscard]] Index num_points() const override { return num_points_; }
@@ -84,7 +116,8 @@ class Interpolation final : public PartsInterpolation {
   // was in what that rank was sent (the round, the position among the points sent to it then).
   struct Nearest {
     double distance = std::numeric_limits<double>::infinity();
-    int rank = std::numeric_limits<int>::max();
+    std::int64_t key = std::numeric_limits<std::int64_t>::max();
+    int rank = -1;
     Choice choice;
   };
   // What a rank located for the others in one round: the points' weights on its part, in the
@@ -94,13 +127,13 @@ class Interpolation final : public PartsInterpolation {
     std::vector<int> begin;
   };
   // Sends `to[r]` (points `index[r]` of this rank's) to rank r, which locates them on its part
-  // and answers their distances; keeps each point's nearest part. Returns what this rank
-  // located for the others. Collective.
+  // and answers (Reply); keeps each point's best answer. Returns what this rank located for the
+  // others. Collective.
   Located Ask(int round, const std::vector<std::vector<Point3>>& to,
               const std::vector<std::vector<Index>>& index, std::vector<Nearest>& nearest) const;
 
   const SimObject& part_;
-  const MeshPart& mesh_part_;
+  Locator locator_;
   MPI_Comm comm_;
   std::function<FieldId(FieldId)> part_field_;
   std::function<void(Eigen::Ref<Eigen::MatrixXd>)> share_;
@@ -118,59 +151,74 @@ class Interpolation final : public PartsInterpolation {
   mutable std::vector<int> send_counts_, send_offsets_, receive_counts_, receive_offsets_;
 };
 
-Interpolation::Interpolation(const SimObject& part, const MeshPart& mesh_part, const Points& points,
+Interpolation::Interpolation(const SimObject& part, Locator locator, const Points& points,
                              MPI_Comm comm, std::function<FieldId(FieldId)> part_field,
                              std::function<void(Eigen::Ref<Eigen::MatrixXd>)> share)
     : part_(part),
-      mesh_part_(mesh_part),
+      locator_(std::move(locator)),
       comm_(comm),
       part_field_(std::move(part_field)),
       share_(std::move(share)),
       num_points_(points.cols()) {
-  const int size = mesh_part.size;
+  int size = 1;
+  MPI_Comm_size(comm, &size);
   const auto ranks = static_cast<std::size_t>(size);
   int bad = points.allFinite() ? 0 : 1;
   MPI_Allreduce(MPI_IN_PLACE, &bad, 1, MPI_INT, MPI_MAX, comm);
   if (bad != 0) throw InputError("a point to interpolate the split object at is not finite");
-  const Mesh& mesh = *mesh_part.mesh;
-  GIPSI_CHECK(mesh.num_nodes() > 0, "a part without nodes");
 
-  // Every part's bounding box, and a slack of 1e-9 of the whole domain's diagonal for points
-  // that lie on a box's side up to rounding.
-  Box mine;
-  for (int k = 0; k < 3; ++k) {
-    mine.lo[static_cast<std::size_t>(k)] = mesh.nodes.row(k).minCoeff();
-    mine.hi[static_cast<std::size_t>(k)] = mesh.nodes.row(k).maxCoeff();
-  }
+  // Every part's box, and a slack of 1e-9 of the whole box's diagonal for points that lie on a
+  // box's side up to rounding.
   std::vector<Box> boxes(ranks);
-  MPI_Allgather(&mine, 6, MPI_DOUBLE, boxes.data(), 6, MPI_DOUBLE, comm);
-  Box all = boxes.front();
+  MPI_Allgather(&locator_.box, 6, MPI_DOUBLE, boxes.data(), 6, MPI_DOUBLE, comm);
+  Box all{{std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity(),
+           std::numeric_limits<double>::infinity()},
+          {-std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity(),
+           -std::numeric_limits<double>::infinity()}};
   for (const Box& box : boxes)
     for (std::size_t k = 0; k < 3; ++k) {
       all.lo[k] = std::min(all.lo[k], box.lo[k]);
       all.hi[k] = std::max(all.hi[k], box.hi[k]);
     }
+  if (!(all.lo[0] <= all.hi[0])) {  // no part has anything to answer from (every rank sees it)
+    auto total = static_cast<std::int64_t>(num_points_);
+    MPI_Allreduce(MPI_IN_PLACE, &total, 1, MPI_INT64_T, MPI_SUM, comm);
+    if (total > 0)
+      throw InputError(
+          fmt::format("the split object has no items to take {} points' values from", total));
+    return;
+  }
   const double slack =
       1e-9 * std::hypot(all.hi[0] - all.lo[0], all.hi[1] - all.lo[1], all.hi[2] - all.lo[2]);
 
   auto point = [&points](Index j) { return Point3{points(0, j), points(1, j), points(2, j)}; };
   std::vector<Nearest> nearest(static_cast<std::size_t>(num_points_));
-  // First the parts whose boxes hold the point; then, for a point no part holds, every other
-  // part whose box is no farther than the nearest part found (which may then be nearer).
+  // Round 0 asks those parts. Round 1 asks every other part whose box is no farther than the
+  // best answer: for a barycentric point only if no part holds it (a point outside the domain
+  // goes to the part nearest to it), for the nearest item always (a neighbouring part's item
+  // may be nearer than any of the holding part's).
   std::array<Located, 2> located;
+  std::vector<double> d(ranks);
   for (const int round : {0, 1}) {
     std::vector<std::vector<Point3>> to(ranks);
     std::vector<std::vector<Index>> index(ranks);
     for (Index j = 0; j < num_points_; ++j) {
       const Nearest& found = nearest[static_cast<std::size_t>(j)];
-      if (round == 1 && found.distance <= slack) continue;
+      if (round == 1 && !locator_.nearest && found.distance <= slack) continue;
       const Point3 p = point(j);
-      for (int r = 0; r < size; ++r) {
-        const double d = BoxDistance(boxes[static_cast<std::size_t>(r)], p);
-        const bool ask = round == 1 ? d > slack && d <= found.distance : d <= slack;
+      for (std::size_t r = 0; r < ranks; ++r) d[r] = BoxDistance(boxes[r], p);
+      // Round 0 asks the parts whose boxes hold the point; for the nearest item also the
+      // nearest box's (the lowest rank on a tie), so that every point has an answer to bound
+      // round 1 by.
+      const auto closest =
+          static_cast<std::size_t>(std::min_element(d.begin(), d.end()) - d.begin());
+      for (std::size_t r = 0; r < ranks; ++r) {
+        const bool first = d[r] <= slack || (locator_.nearest && r == closest);
+        const bool ask =
+            round == 0 ? first : !first && std::isfinite(d[r]) && d[r] <= found.distance;
         if (!ask) continue;
-        to[static_cast<std::size_t>(r)].push_back(p);
-        index[static_cast<std::size_t>(r)].push_back(j);
+        to[r].push_back(p);
+        index[r].push_back(j);
       }
     }
     located[static_cast<std::size_t>(round)] = Ask(round, to, index, nearest);
@@ -213,24 +261,25 @@ Interpolation::Located Interpolation::Ask(int round, const std::vector<std::vect
                                           const std::vector<std::vector<Index>>& index,
                                           std::vector<Nearest>& nearest) const {
   const detail::Received<Point3> got = detail::Exchange(to, comm_);
-  std::vector<double> distance;
-  Located located{Locate(*mesh_part_.mesh, got.items, distance), {}};
-  std::vector<std::vector<double>> reply(to.size());
+  std::vector<Reply> replies;
+  Located located{locator_.locate(got.items, replies), {}};
+  std::vector<std::vector<Reply>> reply(to.size());
   std::size_t k = 0;
   for (std::size_t r = 0; r < to.size(); ++r) {
     located.begin.push_back(static_cast<int>(k));
-    for (int c = 0; c < got.counts[r]; ++c) reply[r].push_back(distance[k++]);
+    for (int c = 0; c < got.counts[r]; ++c) reply[r].push_back(replies[k++]);
   }
-  const detail::Received<double> back = detail::Exchange(reply, comm_);
+  const detail::Received<Reply> back = detail::Exchange(reply, comm_);
   k = 0;
   for (std::size_t r = 0; r < to.size(); ++r) {
     GIPSI_CHECK(back.counts[r] == static_cast<int>(index[r].size()), "answers lost");
     for (std::size_t position = 0; position < index[r].size(); ++position) {
       Nearest& found = nearest[static_cast<std::size_t>(index[r][position])];
-      const double d = back.items[k++];
-      const int rank = static_cast<int>(r);
-      if (d < found.distance || (d == found.distance && rank < found.rank))
-        found = {d, rank, {round, static_cast<int>(position)}};
+      const Reply& answer = back.items[k++];
+      if (answer.distance < found.distance ||
+          (answer.distance == found.distance && answer.key < found.key))
+        found = {
+            answer.distance, answer.key, static_cast<int>(r), {round, static_cast<int>(position)}};
     }
   }
   return located;
@@ -240,16 +289,19 @@ void Interpolation::Interpolate(FieldId id, Eigen::Ref<Eigen::MatrixXd> out,
                                 std::optional<double> no_data) const {
   const FieldId field = part_field_(id);
   const FieldInfo& info = part_.field_info(field);
-  GIPSI_CHECK(info.location == FieldLocation::kNode, "field '{}' is not a node field", info.name);
+  GIPSI_CHECK(locator_.nearest || info.location == FieldLocation::kNode,
+              "field '{}' is not a node field", info.name);
   const Index components = info.components;
   GIPSI_CHECK(out.rows() == components && out.cols() == num_points_,
               "interpolation into {}×{} values, expected {}×{}", out.rows(), out.cols(), components,
               num_points_);
   source_.resize(components, part_.FieldCount(field));
   part_.ReadField(field, source_);
-  share_(source_);
+  if (share_) share_(source_);
   answers_.resize(components, answer_.num_targets());
-  if (no_data) {
+  if (locator_.nearest) {
+    answer_.Apply(source_, answers_);  // the item's value: a marker stays a marker
+  } else if (no_data) {
     answer_.ApplyMarked(source_, answers_, *no_data);
   } else {
     answer_.Apply(source_, answers_);
@@ -285,8 +337,58 @@ std::unique_ptr<PartsInterpolation> MakePartsInterpolation(
     const SimObject& part, const MeshPart& mesh_part, const Points& points, MPI_Comm comm,
     std::function<FieldId(FieldId)> part_field,
     std::function<void(Eigen::Ref<Eigen::MatrixXd>)> share) {
-  return std::make_unique<Interpolation>(part, mesh_part, points, comm, std::move(part_field),
-                                         std::move(share));
+  const Mesh& mesh = *mesh_part.mesh;
+  GIPSI_CHECK(mesh.num_nodes() > 0, "a part without nodes");
+  Locator locator;
+  locator.box = BoxOf(mesh.nodes);
+  const int rank = mesh_part.rank;
+  locator.locate = [&mesh, rank](const std::vector<Point3>& at, std::vector<Reply>& replies) {
+    std::vector<double> distance;
+    PointMap map = Locate(mesh, at, distance);
+    replies.resize(at.size());
+    for (std::size_t j = 0; j < at.size(); ++j) replies[j] = {distance[j], rank};
+    return map;
+  };
+  return std::make_unique<Interpolation>(part, std::move(locator), points, comm,
+                                         std::move(part_field), std::move(share));
+}
+
+std::unique_ptr<PartsInterpolation> MakePartsNearest(const SimObject& part, NearestItems items,
+                                                     const Points& points, MPI_Comm comm,
+                                                     std::function<FieldId(FieldId)> part_field) {
+  GIPSI_CHECK(items.positions.rows() == 3 &&
+                  static_cast<std::size_t>(items.positions.cols()) == items.keys.size() &&
+                  items.keys.size() == items.columns.size(),
+              "nearest items: {} positions, {} keys, {} columns", items.positions.cols(),
+              items.keys.size(), items.columns.size());
+  Locator locator;
+  locator.nearest = true;
+  locator.box = BoxOf(items.positions);
+  auto shared = std::make_shared<const NearestItems>(std::move(items));
+  auto grid = std::make_shared<const SpatialGrid>(shared->positions, shared->positions);
+  locator.locate = [shared, grid](const std::vector<Point3>& at, std::vector<Reply>& replies) {
+    const auto n = static_cast<Index>(at.size());
+    Eigen::Matrix4Xi columns = Eigen::Matrix4Xi::Zero(4, n);
+    Eigen::Matrix4Xd weights = Eigen::Matrix4Xd::Zero(4, n);
+    replies.resize(at.size());
+    for (Index j = 0; j < n; ++j) {
+      const Point3& q = at[static_cast<std::size_t>(j)];
+      const Vec3 p(q[0], q[1], q[2]);
+      double distance = 0;
+      // The part's lowest item on a tie, which is its lowest whole index: parts keep the
+      // whole object's relative order.
+      const int best = grid->FindNearest(
+          p, [&](int i) { return (shared->positions.col(i) - p).norm(); }, distance);
+      GIPSI_CHECK(best >= 0, "a part without items was asked for the nearest");
+      const auto b = static_cast<std::size_t>(best);
+      columns(0, j) = static_cast<int>(shared->columns[b]);
+      weights(0, j) = 1;
+      replies[static_cast<std::size_t>(j)] = {distance, shared->keys[b]};
+    }
+    return PointMap::FromWeights(std::move(columns), std::move(weights), 0);
+  };
+  return std::make_unique<Interpolation>(part, std::move(locator), points, comm,
+                                         std::move(part_field), nullptr);
 }
 
 }  // namespace gipsi

@@ -13,6 +13,12 @@
 /// part nearest to it. The chosen rank keeps the point's weights. Each rank then holds O(its
 /// points + the points it answers for others), and 6 numbers per rank for the boxes.
 ///
+/// The nearest item (MakePartsNearest) goes the same way with each part's own items (each item
+/// of the whole object on one rank only): round 0 asks the parts whose boxes hold the point and
+/// the nearest box's, round 1 every other part whose box is no farther than the nearest item
+/// found, and the nearest item is taken, the lowest whole index on a tie (as PointMap::Nearest
+/// takes the lowest index).
+///
 /// Interpolate (collective, every firing): each rank reads its part's field, takes its shared
 /// nodes' values from their owners, interpolates the points others asked of it and sends the
 /// values back (MPI_Alltoallv with counts fixed at set-up; no allocation once the buffers have
@@ -20,8 +26,10 @@
 
 #include <mpi.h>
 
+#include <cstdint>
 #include <functional>
 #include <memory>
+#include <vector>
 
 #include "gipsi/base/export.h"
 #include "gipsi/core/partitioned_object.h"
@@ -40,6 +48,23 @@ namespace gipsi {
     const SimObject& part, const MeshPart& mesh_part, const Points& points, MPI_Comm comm,
     std::function<FieldId(FieldId)> part_field,
     std::function<void(Eigen::Ref<Eigen::MatrixXd>)> share);
+
+/// The items of a rank's part that a nearest-item copy may take: each item of the whole object
+/// on exactly one rank. Plain struct.
+struct NearestItems {
+  Points positions;                ///< 3 × count rest positions
+  std::vector<std::int64_t> keys;  ///< each item's index in the whole object
+  std::vector<Index> columns;      ///< each item's column in the part's field
+};
+
+/// PartitionedObject::NearestAtPoints for one rank's part: `part`'s field values at `points`
+/// (this rank's), each the value of the nearest of any rank's `items` (their rest positions;
+/// the lowest key on a tie); `part_field` as above. Interpolate copies the item's value (a
+/// no-data marker stays one). Collective; throws InputError on every rank if any rank's point is
+/// not finite, or if there are points and no rank has items.
+[[nodiscard]] std::unique_ptr<PartsInterpolation> MakePartsNearest(
+    const SimObject& part, NearestItems items, const Points& points, MPI_Comm comm,
+    std::function<FieldId(FieldId)> part_field);
 
 }  // namespace gipsi
 GIPSI_EXPORT_END

@@ -17,6 +17,7 @@
 #include "gipsi/base/state.h"
 #include "gipsi/geometry/boundary.h"
 #include "gipsi/geometry/region.h"
+#include "gipsi/models/connectors/item_positions.h"
 #include "gipsi/parallel/parts_interpolation.h"
 #include "gipsi/parallel/petsc_check.h"
 
@@ -42,6 +43,37 @@ std::unique_ptr<PartsInterpolation> WholeDomainView::InterpolateAtPoints(
       *part_, mesh_part_, points, comm_,
       [this](FieldId id) { return part_field_[static_cast<std::size_t>(id.value())]; },
       [this](Eigen::Ref<Eigen::MatrixXd> values) { ShareOwnedNodeValues(values); });
+}
+
+std::unique_ptr<PartsInterpolation> WholeDomainView::NearestAtPoints(FieldLocation location,
+                                                                     const Points& points) const {
+  const bool boundary =
+      location == FieldLocation::kBoundaryVertex || location == FieldLocation::kBoundaryFace;
+  if (location == FieldLocation::kGlobal || (boundary && !part_only_))
+    throw InputError(fmt::format("'{}': no nearest item of a {} field across the parts", name(),
+                                 location == FieldLocation::kGlobal ? "global" : "boundary"));
+  // Each item of the whole object on one rank: owned nodes and boundary vertices come first in
+  // the part's order; tets and boundary faces are all the part's own.
+  const Points all = ItemRestPositions(*part_, location);
+  const Index count = location == FieldLocation::kNode ? static_cast<Index>(mesh_part_.num_owned)
+                      : location == FieldLocation::kBoundaryVertex
+                          ? static_cast<Index>(owned_vertices_)
+                          : all.cols();
+  const std::vector<int>& whole = WholeOfLocal(location);
+  GIPSI_CHECK(count <= all.cols(), "'{}': {} nearest candidates of {} items", name(), count,
+              all.cols());
+  if (static_cast<std::size_t>(count) > whole.size())  // a part-only view without a BoundaryMap
+    throw InputError(
+        fmt::format("'{}': its part's boundary has no numbers on the whole boundary", name()));
+  NearestItems items;
+  items.positions = all.leftCols(count);
+  for (Index i = 0; i < count; ++i) {
+    items.keys.push_back(whole[static_cast<std::size_t>(i)]);
+    items.columns.push_back(i);
+  }
+  return MakePartsNearest(*part_, std::move(items), points, comm_, [this](FieldId id) {
+    return part_field_[static_cast<std::size_t>(id.value())];
+  });
 }
 
 void WholeDomainView::ShareOwnedNodeValues(Eigen::Ref<Eigen::MatrixXd> values) const {

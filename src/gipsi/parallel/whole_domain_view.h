@@ -123,6 +123,10 @@ class WholeDomainView final : public SimObject, public CavityWall, public Partit
   /// kind of view: only the parts are read.
   [[nodiscard]] std::unique_ptr<PartsInterpolation> InterpolateAtPoints(
       const Points& points) const override;
+  /// The nearest item's value at each rank's points: the candidates are the part's owned nodes,
+  /// its tets, or (part-only view) its owned boundary vertices or its boundary faces.
+  [[nodiscard]] std::unique_ptr<PartsInterpolation> NearestAtPoints(
+      FieldLocation location, const Points& points) const override;
   /// How many node or element fields this view has gathered whole (ReadField: an Allgatherv of
   /// the whole field to every rank), so tests can check that a coupling does not.
   [[nodiscard]] std::int64_t whole_field_reads() const { return whole_field_reads_; }

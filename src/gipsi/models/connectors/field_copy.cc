@@ -84,9 +84,17 @@ FieldCopy::FieldCopy(std::string name, SimObject& from, FieldId from_field, SimO
     fail("'barycentric' mapping needs a node field as source");
   const bool onto_items =
       dst.location == FieldLocation::kNode || dst.location == FieldLocation::kElement;
+  // A nearest item may be another process's: a split source's parts answer for each process's
+  // target items (PartitionedObject::NearestAtPoints), except for a boundary field of a source
+  // that holds its whole domain (whole on every process, as its nearest map below reads it).
+  const bool boundary_source = src.location == FieldLocation::kBoundaryVertex ||
+                               src.location == FieldLocation::kBoundaryFace;
+  const bool nearest_parts =
+      mapping_ == Mapping::kNearest && onto_items && src.location != FieldLocation::kGlobal &&
+      (to_split != nullptr ||
+       (from_split != nullptr && !(boundary_source && from_split->holds_whole_domain())));
   // Objects split alike: copied part to part when every target item of a part takes its value
-  // from that part's items (item for item, or inside the part's own tets). A nearest item may
-  // be another process's, so "nearest" reads the source whole.
+  // from that part's items (item for item, or inside the part's own tets).
   if (alike && mapping_ != Mapping::kNearest &&
       (mapping_ == Mapping::kBarycentric || src.location == dst.location)) {
     split_ = from_split;
@@ -113,10 +121,24 @@ FieldCopy::FieldCopy(std::string name, SimObject& from, FieldId from_field, SimO
     if (from_split != nullptr) interpolation_ = from_split->InterpolateAtPoints(dst_pos);
     Log().debug("{}: interpolates {} at the items of {}, each process its own", this->path(),
                 from.path(), to.path());
+  } else if (nearest_parts) {
+    // Each process's target items (its part's, for a split target) take the nearest source
+    // item's value: from the parts that hold it for a split source, else from the whole
+    // source's items on every process.
+    if (to_split != nullptr) {
+      agree_on_ = to_split;
+      to_ = &to_split->local_part();
+      to_field_ = to_->FindField(dst.name);
+      dst_pos = ItemRestPositions(*to_, dst.location);
+    }
+    if (from_split != nullptr && (!boundary_source || !from_split->holds_whole_domain()))
+      interpolation_ = from_split->NearestAtPoints(src.location, dst_pos);
+    Log().debug("{}: takes the nearest item of {} for each item of {}, each process its own",
+                this->path(), from.path(), to.path());
   }
   if (mapping_ == Mapping::kBarycentric && !interpolation_) {
     map_ = from_->MapFromNodes(dst_pos);
-  } else if (mapping_ == Mapping::kNearest) {
+  } else if (mapping_ == Mapping::kNearest && !interpolation_) {
     map_ = PointMap::Nearest(src_pos, dst_pos);
   }
   if (!interpolation_) source_.resize(src.components, from_->FieldCount(from_field_));
@@ -192,15 +214,14 @@ void RegisterFieldCopy(TypeRegistry& registry) {
         }
       },
       "volume coupling: Get a field of one object, map it, Set it on another");
-  // A barycentric copy couples parts split any way (each process asks for the values at its
-  // own target items); a direct one, or "auto" (which may turn out direct), those of objects
-  // split alike; a nearest item may be any process's, so "nearest" needs its objects whole.
+  // A barycentric or nearest copy couples parts split any way (each process asks for the
+  // values at its own target items); a direct one, or "auto" (which may turn out direct), those
+  // of objects split alike.
   registry.connector_part_use["FieldCopy"] = [](const JsonNode& params) {
     const auto mapping = params.Find("mapping");
     const std::string name = mapping && mapping->is_string() ? mapping->AsString() : "auto";
-    return name == "nearest"       ? TypeRegistry::PartUse::kWhole
-           : name == "barycentric" ? TypeRegistry::PartUse::kAnyParts
-                                   : TypeRegistry::PartUse::kPartToPart;
+    return name == "nearest" || name == "barycentric" ? TypeRegistry::PartUse::kAnyParts
+                                                      : TypeRegistry::PartUse::kPartToPart;
   };
 }
 

@@ -22,7 +22,9 @@
 /// differently (another mesh, another cut) or whole asks the source's parts for the values at
 /// the target's items, each process at its own (PartitionedObject::InterpolateAtPoints), and
 /// one from a whole object onto a split one maps onto the target's part; no process gathers a
-/// whole field either. A nearest-item copy reads the source whole.
+/// whole field either. A nearest-item copy goes the same way, each process asking the source's
+/// parts for the nearest item to its own items (PartitionedObject::NearestAtPoints), except
+/// from a boundary field of a split source that holds its whole domain (whole on every process).
 
 #include <memory>
 #include <optional>
@@ -54,7 +56,7 @@ class FieldCopy final : public Connector {
   /// The factor applied: the scale times the conversion of its units into the target's.
   [[nodiscard]] double factor() const { return scale_; }
   /// Whether it copies the objects' parts, process by process: split alike, or a barycentric
-  /// copy from or onto a split object.
+  /// or nearest copy from or onto a split object.
   [[nodiscard]] bool couples_parts() const override {
     return agree_on_ != nullptr || interpolation_ != nullptr;
   }
