@@ -1,5 +1,6 @@
 #include "gipsi/geometry/spatial_grid.h"
 
+#include <limits>
 #include <random>
 #include <set>
 
@@ -41,6 +42,35 @@ TEST(SpatialGrid, NearestMatchesBruteForceInVolumesPlanesLinesAndPoints) {
   line.row(1).setZero();
   ExpectNearestMatchesBruteForce(line, queries);
   ExpectNearestMatchesBruteForce(Points::Constant(3, 4, 0.5), queries);
+}
+
+// Points halfway between neighbours of a regular lattice are as far from both: the lower index
+// is found. (A tie across rings, where the search once stopped a ring early, is met by the parts'
+// grids of SplitCoupling.ANearestCopyJoinsObjectsSplitAnyWay on 4 ranks.)
+TEST(SpatialGrid, NearestTakesTheLowestIndexOnATie) {
+  Points lattice(3, 21 * 9 * 5);  // a 10 × 4 × 2 box's nodes every 0.5
+  for (Index k = 0; k < lattice.cols(); ++k)
+    lattice.col(k) = 0.5 * Vec3(k % 21, (k / 21) % 9, k / (21 * 9));
+  const SpatialGrid grid(lattice, lattice);
+  int ties = 0;
+  for (Index k = 0; k + 1 < lattice.cols(); ++k) {
+    const Vec3 p = 0.5 * (lattice.col(k) + lattice.col(k + 1));
+    Index lowest = 0;
+    double best = std::numeric_limits<double>::infinity();
+    for (Index s = 0; s < lattice.cols(); ++s)
+      if ((lattice.col(s) - p).norm() < best) {
+        best = (lattice.col(s) - p).norm();
+        lowest = s;
+      }
+    ties += (lattice.col(k) - p).norm() == (lattice.col(k + 1) - p).norm();
+    double distance = 0;
+    ASSERT_EQ(grid.FindNearest(
+                  p, [&](int s) { return (lattice.col(s) - p).norm(); }, distance),
+              lowest)
+        << "halfway between " << k << " and " << k + 1;
+    EXPECT_EQ(distance, best);
+  }
+  EXPECT_GT(ties, 400);
 }
 
 TEST(SpatialGrid, CellVisitsEveryBoxContainingThePoint) {

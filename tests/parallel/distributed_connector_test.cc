@@ -585,8 +585,9 @@ std::vector<Index> NearestItems(const Points& sources, const Points& at) {
 //   tet field's items are the centroids);
 // - a part-only muscle's boundary positions (at rest) onto another's node forces (1 N/m):
 //   each node gets the position of the whole boundary's vertex nearest to it.
-// A coordinator takes a nearest copy between objects made in blocks. A view holding its whole
-// mesh has its boundary fields whole, and its parts do not answer for them.
+// Points halfway between neighbouring nodes take the lower one (ties, on the parts' cuts too). A
+// coordinator takes a nearest copy between objects made in blocks. A view holding its whole mesh
+// has its boundary fields whole, and its parts do not answer for them.
 TEST(SplitCoupling, ANearestCopyJoinsObjectsSplitAnyWay) {
   TwoMeshes two;
   std::unique_ptr<WholeDomainView>& tissue = two.tissue;
@@ -675,6 +676,23 @@ TEST(SplitCoupling, ANearestCopyJoinsObjectsSplitAnyWay) {
       const auto whole = static_cast<std::size_t>(nodes[static_cast<std::size_t>(i)]);
       ASSERT_EQ(Vec3(local.col(i)), Vec3(vertices.col(nearest[whole]))) << "whole node " << whole;
     }
+  }
+
+  {  // ties: points halfway between neighbouring nodes (on parts' cuts too) take the lower node
+    Points halfway(3, two.mesh->num_nodes() - 1);
+    for (Index n = 0; n + 1 < two.mesh->num_nodes(); ++n)
+      halfway.col(n) = 0.5 * (two.mesh->nodes.col(n) + two.mesh->nodes.col(n + 1));
+    const std::vector<Index> nearest = NearestItems(two.mesh->nodes, halfway);
+    int ties = 0;
+    for (Index n = 0; n < halfway.cols(); ++n)
+      ties += (two.mesh->nodes.col(n) - halfway.col(n)).norm() ==
+              (two.mesh->nodes.col(n + 1) - halfway.col(n)).norm();
+    EXPECT_GT(ties, 100);
+    const auto parts = tissue->NearestAtPoints(FieldLocation::kNode, halfway);
+    Eigen::MatrixXd values(1, halfway.cols());
+    parts->Interpolate(v, values, std::nullopt);
+    for (Index n = 0; n < halfway.cols(); ++n)
+      ASSERT_EQ(values(0, n), two.volts(0, nearest[static_cast<std::size_t>(n)])) << "point " << n;
   }
 
   // A coordinator takes the copy between the tissue and a muscle made in blocks.

@@ -73,7 +73,9 @@ class SpatialGrid {
           best = item;
         }
       });
-      if (best >= 0 && best_distance <= RingLowerBound(p, c, r)) break;
+      // Strictly nearer than any later ring: an item there as near as the best may have a lower
+      // index, which a tie goes to.
+      if (best >= 0 && best_distance < RingLowerBound(p, c, r)) break;
     }
     return best;
   }

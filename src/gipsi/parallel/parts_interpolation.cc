@@ -186,6 +186,8 @@ Interpolation::Interpolation(const SimObject& part, Locator locator, const Point
     if (total > 0)
       throw InputError(
           fmt::format("the split object has no items to take {} points' values from", total));
+    answer_counts_.assign(ranks, 0);  // nothing to send or receive at a firing
+    asked_counts_.assign(ranks, 0);
     return;
   }
   const double slack =
@@ -361,10 +363,22 @@ std::unique_ptr<PartsInterpolation> MakePartsNearest(const SimObject& part, Near
                   items.keys.size() == items.columns.size(),
               "nearest items: {} positions, {} keys, {} columns", items.positions.cols(),
               items.keys.size(), items.columns.size());
+  // In the order of their keys, so that the grid's lowest item on a tie is the lowest key.
+  std::vector<std::size_t> order(items.keys.size());
+  std::iota(order.begin(), order.end(), std::size_t{0});
+  std::sort(order.begin(), order.end(),
+            [&items](std::size_t a, std::size_t b) { return items.keys[a] < items.keys[b]; });
+  NearestItems sorted;
+  sorted.positions.resize(3, items.positions.cols());
+  for (std::size_t i = 0; i < order.size(); ++i) {
+    sorted.positions.col(static_cast<Index>(i)) = items.positions.col(static_cast<Index>(order[i]));
+    sorted.keys.push_back(items.keys[order[i]]);
+    sorted.columns.push_back(items.columns[order[i]]);
+  }
   Locator locator;
   locator.nearest = true;
-  locator.box = BoxOf(items.positions);
-  auto shared = std::make_shared<const NearestItems>(std::move(items));
+  locator.box = BoxOf(sorted.positions);
+  auto shared = std::make_shared<const NearestItems>(std::move(sorted));
   auto grid = std::make_shared<const SpatialGrid>(shared->positions, shared->positions);
   locator.locate = [shared, grid](const std::vector<Point3>& at, std::vector<Reply>& replies) {
     const auto n = static_cast<Index>(at.size());
@@ -375,8 +389,7 @@ std::unique_ptr<PartsInterpolation> MakePartsNearest(const SimObject& part, Near
       const Point3& q = at[static_cast<std::size_t>(j)];
       const Vec3 p(q[0], q[1], q[2]);
       double distance = 0;
-      // The part's lowest item on a tie, which is its lowest whole index: parts keep the
-      // whole object's relative order.
+      // The part's lowest item on a tie: its lowest key.
       const int best = grid->FindNearest(
           p, [&](int i) { return (shared->positions.col(i) - p).norm(); }, distance);
       GIPSI_CHECK(best >= 0, "a part without items was asked for the nearest");
