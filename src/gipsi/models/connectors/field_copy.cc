@@ -107,34 +107,24 @@ FieldCopy::FieldCopy(std::string name, SimObject& from, FieldId from_field, SimO
     dst_pos = ItemRestPositions(*to_, dst.location);
     Log().debug("{}: copies the parts of {} to those of {}, each process its own (split alike)",
                 this->path(), from.path(), to.path());
-  } else if (mapping_ == Mapping::kBarycentric && onto_items &&
-             (from_split != nullptr || to_split != nullptr)) {
+  } else if (nearest_parts || (mapping_ == Mapping::kBarycentric && onto_items &&
+                               (from_split != nullptr || to_split != nullptr))) {
     // Split differently, or one end whole on every process: a split target's part takes the
     // values at its own items; a split source's values come from the parts that hold the
-    // points (PartitionedObject::InterpolateAtPoints), a whole source's from its own tets.
+    // points or the nearest items (PartitionedObject::InterpolateAtPoints, NearestAtPoints),
+    // a whole source's from its own tets or items.
     if (to_split != nullptr) {
       agree_on_ = to_split;
       to_ = &to_split->local_part();
       to_field_ = to_->FindField(dst.name);
       dst_pos = ItemRestPositions(*to_, dst.location);
     }
-    if (from_split != nullptr) interpolation_ = from_split->InterpolateAtPoints(dst_pos);
-    Log().debug("{}: interpolates {} at the items of {}, each process its own", this->path(),
-                from.path(), to.path());
-  } else if (nearest_parts) {
-    // Each process's target items (its part's, for a split target) take the nearest source
-    // item's value: from the parts that hold it for a split source, else from the whole
-    // source's items on every process.
-    if (to_split != nullptr) {
-      agree_on_ = to_split;
-      to_ = &to_split->local_part();
-      to_field_ = to_->FindField(dst.name);
-      dst_pos = ItemRestPositions(*to_, dst.location);
-    }
-    if (from_split != nullptr && (!boundary_source || !from_split->holds_whole_domain()))
+    if (mapping_ == Mapping::kBarycentric && from_split != nullptr)
+      interpolation_ = from_split->InterpolateAtPoints(dst_pos);
+    else if (from_split != nullptr && !(boundary_source && from_split->holds_whole_domain()))
       interpolation_ = from_split->NearestAtPoints(src.location, dst_pos);
-    Log().debug("{}: takes the nearest item of {} for each item of {}, each process its own",
-                this->path(), from.path(), to.path());
+    Log().debug("{}: maps {} onto the items of {}, each process its own", this->path(), from.path(),
+                to.path());
   }
   if (mapping_ == Mapping::kBarycentric && !interpolation_) {
     map_ = from_->MapFromNodes(dst_pos);
