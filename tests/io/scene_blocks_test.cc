@@ -191,10 +191,10 @@ TEST(SceneMeshes, ObjectsCoupledPartToPartAreMadeInBlocksTogether) {
   EXPECT_EQ(scene.meshes.count("slab"), 1U);
 }
 
-// A barycentric or nearest FieldCopy (and an excitation–contraction) couples parts split any
-// way, so the objects it joins are made in blocks whatever their meshes, and whether or not its
-// other end is: one on another mesh, one kept whole. A direct copy, or "auto" (which may turn
-// out direct), still needs one mesh.
+// A barycentric or nearest FieldCopy (and an excitation–contraction, and a boundary coupling)
+// couples parts split any way, so the objects it joins are made in blocks whatever their meshes,
+// and whether or not its other end is: one on another mesh, one kept whole. A direct copy, or
+// "auto" (which may turn out direct), still needs one mesh.
 TEST(SceneMeshes, ABarycentricCopyLetsObjectsOnOtherMeshesBeMadeInBlocks) {
   std::map<std::string, Seen> seen;
   auto registry = RecordingRegistry(seen, true);
@@ -212,6 +212,9 @@ TEST(SceneMeshes, ABarycentricCopyLetsObjectsOnOtherMeshesBeMadeInBlocks) {
   const JsonDocument ec = JsonDocument::Parse(R"({"type": "ExcitationContraction"})", "ec.json");
   EXPECT_EQ(registry->connector_part_use.at("ExcitationContraction")(ec.root()),
             PartUse::kAnyParts);
+  // A boundary coupling too: the driver's parts answer for the follower's interface vertices.
+  const JsonDocument glue = JsonDocument::Parse(R"({"type": "BoundaryCoupling"})", "glue.json");
+  EXPECT_EQ(registry->connector_part_use.at("BoundaryCoupling")(glue.root()), PartUse::kAnyParts);
 
   const JsonDocument doc = JsonDocument::Parse(R"({
     "objects": {

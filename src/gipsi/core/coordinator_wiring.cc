@@ -88,9 +88,8 @@ void CheckPartOnlyPort(const Connector& c, const PortUse& port) {
   throw WiringError(
       fmt::format("connector '{}' ({}) {} at its '{}' key, but that object is made in blocks in "
                   "this distributed run (each process holds only its part) and the connector "
-                  "does not couple it part to part (ExcitationContraction does, and FieldCopy "
-                  "with a direct or barycentric mapping, between objects made in blocks from "
-                  "one domain mesh)",
+                  "does not couple it part to part (ExcitationContraction, BoundaryCoupling "
+                  "and FieldCopy do: docs/scale-out.md, \"Meshes in blocks\")",
                   c.path(), c.type_name(), end, port.key),
       c.name(), "");
 }

@@ -69,6 +69,31 @@ class PartsInterpolation {
                            std::optional<double> no_data) const = 0;
 };
 
+/// A PartsInterpolation on a split object's boundary (PartitionedObject::InterpolateOnBoundary,
+/// for a boundary coupling of parts): the object's boundary-vertex fields at points each process
+/// gives, each interpolated on the whole boundary's face nearest to the point (barycentric on
+/// the face, the point projected onto it: PointMap::BarycentricOnTriangles) by the process whose
+/// part holds that face (the lowest such process on a tie), and the transpose of that
+/// interpolation, which spreads values at the points back onto the faces' vertices. Not
+/// copyable.
+class BoundaryInterpolation : public PartsInterpolation {
+ public:
+  /// How far each of this process's points lies from the whole boundary (from the nearest point
+  /// of its nearest face), the same for a point whichever process asks.
+  [[nodiscard]] virtual std::span<const double> distances() const = 0;
+  /// Interpolate (above) reads a boundary-vertex field, with no higher-order correction.
+  /// Spread is its transpose: each of this process's points' values (`at_points`, 3 ×
+  /// num_points()) weighted as Interpolate weighs the vertices of the point's face, summed over
+  /// every process's points into `out` (3 × the vertices of the part's boundary,
+  /// SimObject::boundary()): on each vertex this process owns (its node's owner) the whole sum,
+  /// zero on the others, so that a force spread so counts once (a part counts a nodal force on
+  /// its node's owner only). The sums are made in a fixed order: bitwise the same on the same
+  /// processes. Collective: the values go back to the processes that answered, then the shared
+  /// vertices' sums to their owners (O(the points + the part's shared boundary vertices)).
+  virtual void Spread(const Eigen::Ref<const Eigen::MatrixXd>& at_points,
+                      Eigen::Ref<Eigen::MatrixXd> out) const = 0;
+};
+
 /// Interface, implemented beside SimObject; asked for with dynamic_cast.
 class PartitionedObject {
  public:
@@ -173,6 +198,20 @@ class PartitionedObject {
   /// holds its whole domain (whose boundary fields are whole on every process).
   [[nodiscard]] virtual std::unique_ptr<PartsInterpolation> NearestAtPoints(
       FieldLocation location, const Points& points) const = 0;
+  /// On an object without its whole domain (holds_whole_domain() false): interpolation of its
+  /// boundary-vertex fields at `points` on its whole boundary, and the transpose (see
+  /// BoundaryInterpolation), each process giving its own points. Each point is asked of the
+  /// parts whose boundary's box holds it and of the nearest box's, then of every other part
+  /// whose box is no farther than the nearest face found. Collective; throws InputError on
+  /// every process if a point is not finite, if there are points and the whole boundary has no
+  /// faces, or on an object that holds its whole domain (its boundary fields are whole on every
+  /// process: interpolate them there).
+  [[nodiscard]] virtual std::unique_ptr<BoundaryInterpolation> InterpolateOnBoundary(
+      const Points& points) const = 0;
+  /// This process's number among the object's processes (0 to num_processes() - 1), and their
+  /// count: for a connector that splits work on a whole end among them.
+  [[nodiscard]] virtual int process() const = 0;
+  [[nodiscard]] virtual int num_processes() const = 0;
 };
 
 /// True when `a` and `b` are both PartitionedObjects split alike: on every process their parts

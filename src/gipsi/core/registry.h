@@ -50,8 +50,9 @@
 /// object without its whole domain stores its part's boundary conditions only
 /// (PartitionedObject::SelectConditionItems replaces SelectWholeBoundary), and events may name
 /// objects made in blocks (InBlocksObjects takes no events); 22: nearest-item copies between
-/// split objects (PartitionedObject::NearestAtPoints).
-#define GIPSI_PLUGIN_INTERFACE 22
+/// split objects (PartitionedObject::NearestAtPoints); 23: boundary couplings of split objects
+/// (PartitionedObject::InterpolateOnBoundary, BoundaryInterpolation, process()).
+#define GIPSI_PLUGIN_INTERFACE 23
 /// What a plugin's gipsi_plugin_abi_version() returns and the loader requires: the package's
 /// major and minor version with the plugin interface, MAJOR·10⁶ + MINOR·10³ + INTERFACE. A
 /// plugin thus loads only into the release line it was built against (0.1.x, as the CMake

@@ -19,6 +19,11 @@
 /// found, and the nearest item is taken, the lowest whole index on a tie (as PointMap::Nearest
 /// takes the lowest index).
 ///
+/// On the boundary (MakePartsOnBoundary, for a boundary coupling) the candidates are each
+/// part's boundary faces (each face of the whole boundary on one rank), asked in the same two
+/// rounds as the nearest item; the point is projected onto the nearest face, and Spread sends
+/// values at the points back the same way, each shared vertex's sum then to its node's owner.
+///
 /// Interpolate (collective, every firing): each rank reads its part's field, takes its shared
 /// nodes' values from their owners, interpolates the points others asked of it and sends the
 /// values back (MPI_Alltoallv with counts fixed at set-up; no allocation once the buffers have
@@ -64,6 +69,17 @@ struct NearestItems {
 /// not finite, or if there are points and no rank has items.
 [[nodiscard]] std::unique_ptr<PartsInterpolation> MakePartsNearest(
     const SimObject& part, NearestItems items, const Points& points, MPI_Comm comm,
+    std::function<FieldId(FieldId)> part_field);
+
+/// PartitionedObject::InterpolateOnBoundary for one rank's part: `part`'s boundary-vertex fields
+/// at `points` (this rank's), each interpolated on the nearest face of any rank's part boundary
+/// (part.boundary(): the whole boundary's faces on the part's tets, each on one rank), and the
+/// transpose (BoundaryInterpolation::Spread), whose shared vertices' sums go to the owner of
+/// their node in `mesh_part` (`part`'s mesh part). `part_field` as above. Collective; throws
+/// InputError on every rank if any rank's point is not finite, or if there are points and no
+/// rank's part has a boundary face.
+[[nodiscard]] std::unique_ptr<BoundaryInterpolation> MakePartsOnBoundary(
+    const SimObject& part, const MeshPart& mesh_part, const Points& points, MPI_Comm comm,
     std::function<FieldId(FieldId)> part_field);
 
 }  // namespace gipsi

@@ -76,6 +76,16 @@ std::unique_ptr<PartsInterpolation> WholeDomainView::NearestAtPoints(FieldLocati
   });
 }
 
+std::unique_ptr<BoundaryInterpolation> WholeDomainView::InterpolateOnBoundary(
+    const Points& points) const {
+  if (!part_only_)
+    throw InputError(fmt::format(
+        "'{}' holds its whole mesh on every rank: its boundary fields are whole there", name()));
+  return MakePartsOnBoundary(*part_, mesh_part_, points, comm_, [this](FieldId id) {
+    return part_field_[static_cast<std::size_t>(id.value())];
+  });
+}
+
 void WholeDomainView::ShareOwnedNodeValues(Eigen::Ref<Eigen::MatrixXd> values) const {
   const auto n = static_cast<Index>(mesh_part_.whole_node.size());
   const auto owned = static_cast<Index>(mesh_part_.num_owned);

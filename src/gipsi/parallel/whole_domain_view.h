@@ -127,6 +127,12 @@ class WholeDomainView final : public SimObject, public CavityWall, public Partit
   /// its tets, or (part-only view) its owned boundary vertices or its boundary faces.
   [[nodiscard]] std::unique_ptr<PartsInterpolation> NearestAtPoints(
       FieldLocation location, const Points& points) const override;
+  /// A part-only view's boundary-vertex fields at each rank's points, on the parts' boundary
+  /// faces, and the transpose (BoundaryInterpolation); InputError on the other view.
+  [[nodiscard]] std::unique_ptr<BoundaryInterpolation> InterpolateOnBoundary(
+      const Points& points) const override;
+  [[nodiscard]] int process() const override { return mesh_part_.rank; }
+  [[nodiscard]] int num_processes() const override { return mesh_part_.size; }
   /// How many node or element fields this view has gathered whole (ReadField: an Allgatherv of
   /// the whole field to every rank), so tests can check that a coupling does not.
   [[nodiscard]] std::int64_t whole_field_reads() const { return whole_field_reads_; }
