@@ -56,17 +56,6 @@ Options Parse(int argc, char** argv) {
   return o;
 }
 
-// The slowest rank's time of one call of `call` [s].
-template <class Call>
-double TimeOnce(MPI_Comm comm, Call call) {
-  MPI_Barrier(comm);
-  const double start = MPI_Wtime();
-  call();
-  double t = MPI_Wtime() - start;
-  MPI_Allreduce(MPI_IN_PLACE, &t, 1, MPI_DOUBLE, MPI_MAX, comm);
-  return t;
-}
-
 gipsi::EpTissueParams Tissue() {
   gipsi::EpTissueParams p;
   p.cell = std::make_shared<gipsi::AlievPanfilov>();
@@ -101,7 +90,7 @@ int Main(int argc, char** argv) {
 
   std::unique_ptr<gipsi::PartsInterpolation> parts;
   const bool nearest = o.mapping == "nearest";
-  const double parts_setup = TimeOnce(world, [&] {
+  const double parts_setup = gipsi::bench::TimeOnce(world, [&] {
     parts = nearest ? tissue.NearestAtPoints(gipsi::FieldLocation::kNode, points)
                     : tissue.InterpolateAtPoints(points);
   });
@@ -120,7 +109,7 @@ int Main(int argc, char** argv) {
   }
   Eigen::MatrixXd gathered(1, whole->num_nodes()), at_whole(1, points.cols());
   gipsi::PointMap map;
-  const double whole_setup = TimeOnce(world, [&] {
+  const double whole_setup = gipsi::bench::TimeOnce(world, [&] {
     map = nearest ? gipsi::PointMap::Nearest(whole->nodes, points) : viewed.MapFromNodes(points);
   });
   const double whole_fire = gipsi::bench::SlowestRankPerCall(world, o.batches, o.reps, [&] {

@@ -1,6 +1,6 @@
 #pragma once
 // What the MPI benches share: the N-version slab (20 × 7 × 3 mm) and its size in hexahedra
-// (--cells NX NY NZ), the peak resident memory, a median and a timing over the ranks, a parse
+// (--cells NX NY NZ), the peak resident memory, a median and timings over the ranks, a parse
 // that exits 2 with CLI11's message on a bad command line (0 after --help), and a main that
 // reports an error on every rank and ends them all.
 
@@ -52,6 +52,17 @@ double SlowestRankPerCall(MPI_Comm comm, int batches, int reps, Call call) {
     times.push_back(t);
   }
   return Median(times);
+}
+
+// The slowest rank's time of one call of `call` [s]. Collective.
+template <class Call>
+double TimeOnce(MPI_Comm comm, Call call) {
+  MPI_Barrier(comm);
+  const double start = MPI_Wtime();
+  call();
+  double t = MPI_Wtime() - start;
+  MPI_Allreduce(MPI_IN_PLACE, &t, 1, MPI_DOUBLE, MPI_MAX, comm);
+  return t;
 }
 
 // Adds --cells NX NY NZ (hexahedra along the 20 × 7 × 3 mm slab, 6 tets each) into `cells`.
