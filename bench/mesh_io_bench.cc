@@ -1,7 +1,9 @@
 // Reading a Gmsh 4.1 mesh whole (ReadMesh: the file held in memory, one pass) against reading
 // one process's block of it (ReadGmshBlock: two streaming passes through a 1 MiB buffer, the
 // block kept; io/gmsh_block_reader.h), ASCII and binary, on the 0.2 mm N-version slab (315 k
-// tets) written to a temporary file. Run:
+// tets) written to a temporary file; and the same slab as TetGen files, read whole (ReadTetGen)
+// and as one process's block (ReadTetGenBlock: one streaming pass per file, the block kept).
+// Run:
 //   ./build/release/bench/mesh_io_bench --benchmark_repetitions=3
 //     --benchmark_report_aggregates_only=true
 
@@ -19,6 +21,7 @@
 #include "gipsi/geometry/generators.h"
 #include "gipsi/io/gmsh_block_reader.h"
 #include "gipsi/io/mesh_io.h"
+#include "gipsi/io/tetgen_reader.h"
 
 namespace gipsi {
 namespace {
@@ -129,8 +132,47 @@ void BM_ReadGmshBlock(benchmark::State& state) {
   state.SetLabel(state.range(0) != 0 ? "binary" : "ascii");
 }
 
+// The slab as TetGen files (nodes numbered from 1, no attributes or markers), once per process;
+// returns the .node file's path.
+const std::filesystem::path& SlabTetGen() {
+  static const std::filesystem::path node = [] {
+    const Mesh slab = MakeTetBox(Vec3::Zero(), Vec3(0.020, 0.007, 0.003), {100, 35, 15});
+    const auto stem = std::filesystem::temp_directory_path() /
+                      fmt::format("gipsi_mesh_io_bench_{}_tetgen", ::getpid());
+    std::string text = fmt::format("{} 3 0 0\n", slab.num_nodes());
+    for (Index i = 0; i < slab.num_nodes(); ++i)
+      text += fmt::format("{} {:.17g} {:.17g} {:.17g}\n", i + 1, slab.nodes(0, i), slab.nodes(1, i),
+                          slab.nodes(2, i));
+    std::ofstream(std::filesystem::path(stem).concat(".node"), std::ios::binary) << text;
+    text = fmt::format("{} 4 0\n", slab.num_tets());
+    for (Index e = 0; e < slab.num_tets(); ++e)
+      text += fmt::format("{} {} {} {} {}\n", e + 1, slab.tets(0, e) + 1, slab.tets(1, e) + 1,
+                          slab.tets(2, e) + 1, slab.tets(3, e) + 1);
+    std::ofstream(std::filesystem::path(stem).concat(".ele"), std::ios::binary) << text;
+    return std::filesystem::path(stem).concat(".node");
+  }();
+  return node;
+}
+
+void BM_ReadTetGenWhole(benchmark::State& state) {
+  const auto& path = SlabTetGen();
+  Index tets = 0;
+  for (auto _ : state) tets = ReadTetGen(path).num_tets();
+  state.counters["tets"] = static_cast<double>(tets);
+}
+
+// Rank 0 of 2's block: the same work as any rank's (every line of both files is read).
+void BM_ReadTetGenBlock(benchmark::State& state) {
+  const auto& path = SlabTetGen();
+  Index tets = 0;
+  for (auto _ : state) tets = ReadTetGenBlock(path, 0, 2).tets.cols();
+  state.counters["block_tets"] = static_cast<double>(tets);
+}
+
 BENCHMARK(BM_ReadMeshWhole)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_ReadGmshBlock)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_ReadTetGenWhole)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_ReadTetGenBlock)->Unit(benchmark::kMillisecond);
 
 // The temporary files go when the benchmark ends.
 struct Cleanup {
@@ -140,6 +182,11 @@ struct Cleanup {
       std::filesystem::remove(std::filesystem::temp_directory_path() /
                                   fmt::format("gipsi_mesh_io_bench_{}_{}.msh", ::getpid(), kind),
                               ignored);
+    for (const char* extension : {"node", "ele"})
+      std::filesystem::remove(
+          std::filesystem::temp_directory_path() /
+              fmt::format("gipsi_mesh_io_bench_{}_tetgen.{}", ::getpid(), extension),
+          ignored);
   }
 } cleanup;
 

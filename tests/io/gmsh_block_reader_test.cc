@@ -16,6 +16,7 @@
 #include "gipsi/base/error.h"
 #include "gipsi/geometry/generators.h"
 #include "gipsi/io/mesh_io.h"
+#include "io/io_test_util.h"
 #include "temp_dir.h"
 
 namespace gipsi {
@@ -156,26 +157,6 @@ std::string BoxAsGmsh41(const Mesh& box, bool binary, bool sparse) {
   return w.text();
 }
 
-void ExpectSameBlock(const MeshBlock& a, const MeshBlock& b, const std::string& what) {
-  EXPECT_EQ(a.rank, b.rank) << what;
-  EXPECT_EQ(a.size, b.size) << what;
-  EXPECT_EQ(a.num_nodes, b.num_nodes) << what;
-  EXPECT_EQ(a.num_tets, b.num_tets) << what;
-  EXPECT_EQ(a.num_triangles, b.num_triangles) << what;
-  EXPECT_EQ(a.first_triangle, b.first_triangle) << what;
-  EXPECT_EQ(a.nodes, b.nodes) << what;
-  EXPECT_EQ(a.tets, b.tets) << what;
-  EXPECT_EQ(a.triangles, b.triangles) << what;
-  EXPECT_EQ(a.tet_ids, b.tet_ids) << what;
-  EXPECT_EQ(a.tet_id_kind, b.tet_id_kind) << what;
-  ASSERT_EQ(a.groups.size(), b.groups.size()) << what;
-  for (std::size_t g = 0; g < a.groups.size(); ++g) {
-    EXPECT_EQ(a.groups[g].name, b.groups[g].name) << what;
-    EXPECT_EQ(a.groups[g].dim, b.groups[g].dim) << what << ", group " << a.groups[g].name;
-    EXPECT_EQ(a.groups[g].items, b.groups[g].items) << what << ", group " << a.groups[g].name;
-  }
-}
-
 // Every block, on 1, 3 and 7 processes, of a box written as ASCII and binary Gmsh 4.1, with
 // node tags 1..N and with other tags, is the whole-file reader's mesh sliced into that block:
 // nodes, tets, triangles, element tags, and the groups with ReadGmsh's names.
@@ -194,7 +175,7 @@ TEST(GmshBlockReader, EveryBlockIsTheWholeReadersSlice) {
         for (int rank = 0; rank < size; ++rank) {
           const auto block = ReadGmshBlock(path, rank, size);
           ASSERT_TRUE(block.has_value());
-          ExpectSameBlock(
+          test::ExpectSameBlock(
               *block, BlockOfMesh(whole, rank, size),
               fmt::format("binary {}, sparse tags {}, block {} of {}", binary, sparse, rank, size));
         }

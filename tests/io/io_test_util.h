@@ -1,7 +1,7 @@
 #pragma once
 /// @file
 /// Helpers shared by the mesh I/O tests: paths of test inputs, per-test scratch files, byte
-/// builders for binary formats, and capturing InputError messages.
+/// builders for binary formats, capturing InputError messages, and comparing mesh blocks.
 
 #include <cstdint>
 #include <cstring>
@@ -15,6 +15,7 @@
 
 #include "gipsi/base/error.h"
 #include "gipsi/geometry/mesh.h"
+#include "gipsi/geometry/mesh_block.h"
 #include "temp_dir.h"
 #include "test_paths.h"
 
@@ -128,6 +129,27 @@ inline bool LittleEndianHost() {
   char first = 0;
   std::memcpy(&first, &one, 1);
   return first == 1;
+}
+
+/// `a` and `b` are the same block of a mesh (every field of MeshBlock); `what` names the case.
+inline void ExpectSameBlock(const MeshBlock& a, const MeshBlock& b, const std::string& what) {
+  EXPECT_EQ(a.rank, b.rank) << what;
+  EXPECT_EQ(a.size, b.size) << what;
+  EXPECT_EQ(a.num_nodes, b.num_nodes) << what;
+  EXPECT_EQ(a.num_tets, b.num_tets) << what;
+  EXPECT_EQ(a.num_triangles, b.num_triangles) << what;
+  EXPECT_EQ(a.first_triangle, b.first_triangle) << what;
+  EXPECT_EQ(a.nodes, b.nodes) << what;
+  EXPECT_EQ(a.tets, b.tets) << what;
+  EXPECT_EQ(a.triangles, b.triangles) << what;
+  EXPECT_EQ(a.tet_ids, b.tet_ids) << what;
+  EXPECT_EQ(a.tet_id_kind, b.tet_id_kind) << what;
+  ASSERT_EQ(a.groups.size(), b.groups.size()) << what;
+  for (std::size_t g = 0; g < a.groups.size(); ++g) {
+    EXPECT_EQ(a.groups[g].name, b.groups[g].name) << what;
+    EXPECT_EQ(a.groups[g].dim, b.groups[g].dim) << what << ", group " << a.groups[g].name;
+    EXPECT_EQ(a.groups[g].items, b.groups[g].items) << what << ", group " << a.groups[g].name;
+  }
 }
 
 }  // namespace gipsi::test

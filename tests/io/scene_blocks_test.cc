@@ -3,6 +3,8 @@
 // be made when their object asks, and the blocks it makes without the whole mesh (io/scene.h,
 // core/registry.h).
 
+#include <filesystem>
+#include <fstream>
 #include <map>
 #include <memory>
 #include <optional>
@@ -19,7 +21,9 @@
 #include "gipsi/geometry/generators.h"
 #include "gipsi/geometry/mesh_block.h"
 #include "gipsi/io/builtins.h"
+#include "gipsi/io/mesh_io.h"
 #include "gipsi/io/scene.h"
+#include "temp_dir.h"
 
 namespace gipsi {
 namespace {
@@ -111,6 +115,38 @@ TEST(SceneMeshes, AnObjectOnlyProbesReadIsMadeInBlocksWithoutTheWholeMesh) {
   ASSERT_EQ(block.nodes.cols(), expected.nodes.cols());
   EXPECT_LT((block.nodes - expected.nodes).cwiseAbs().maxCoeff(), 1e-15);
   EXPECT_EQ(block.tets, expected.tets);
+}
+
+// A TetGen mesh of an object made in blocks is read in blocks too (every process streams the
+// files and keeps its block): the block, scaled and translated, is the whole mesh's, and the
+// whole mesh is never built.
+TEST(SceneMeshes, ATetGenMeshIsReadInBlocks) {
+  const std::filesystem::path dir = gipsi::testing::TestTempDir();
+  std::ofstream(dir / "pair.node") << "5 3 0 0\n1 0 0 0\n2 1 0 0\n3 0 1 0\n4 0 0 1\n5 1 1 1\n";
+  std::ofstream(dir / "pair.ele") << "2 4 1\n1 1 2 3 4 7\n2 2 3 4 5 8\n";
+  std::map<std::string, Seen> seen;
+  auto registry = RecordingRegistry(seen, true);
+  const std::string text = R"({
+    "meshes": {"pair": {"file": "pair.ele", "scale": 0.01, "translate": [1, 2, 3]}},
+    "objects": {"a": {"type": "Recorder", "domain": "pair", "dt": 0.001, "blocks": true}},
+    "schedule": {"end": 0.01, "dt": 0.001}
+  })";
+  Scene scene = LoadSceneFromString(text, "scene.json", dir, *registry);
+  EXPECT_TRUE(seen["a"].in_blocks);
+  EXPECT_EQ(scene.meshes.count("pair"), 0U);
+  Mesh whole = ReadMesh(dir / "pair.node");
+  whole.Transform(0.01, Vec3(1, 2, 3));
+  const MeshBlock expected = BlockOfMesh(whole, 1, 3);
+  ASSERT_TRUE(seen["a"].block);
+  const MeshBlock& block = *seen["a"].block;
+  EXPECT_EQ(block.num_nodes, 5);
+  EXPECT_EQ(block.num_tets, 2);
+  ASSERT_EQ(block.nodes.cols(), expected.nodes.cols());
+  EXPECT_LT((block.nodes - expected.nodes).cwiseAbs().maxCoeff(), 1e-15);
+  EXPECT_EQ(block.tets, expected.tets);
+  ASSERT_EQ(block.groups.size(), 2U);  // region_7 and region_8, on every block
+  EXPECT_EQ(block.groups[1].name, "region_8");
+  EXPECT_EQ(block.groups[1].items, expected.groups[1].items);
 }
 
 // A serial run builds every mesh whole and makes nothing in blocks; a block asked for is then cut

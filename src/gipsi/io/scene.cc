@@ -19,6 +19,7 @@
 #include "gipsi/geometry/generators.h"
 #include "gipsi/io/gmsh_block_reader.h"
 #include "gipsi/io/mesh_io.h"
+#include "gipsi/io/tetgen_reader.h"
 
 namespace gipsi {
 namespace {
@@ -126,6 +127,20 @@ class SceneMeshes final : public MeshProvider {
             "{}: {}: every process reads this Gmsh file whole to cut its block (format 4.1 "
             "with linear elements is read in blocks)",
             node.file(), file->path());
+    } else if (file && file->is_string() && IsTetGenFile(file->AsString())) {
+      CheckMeshEntry(node);
+      std::filesystem::path path = file->AsString();
+      if (path.is_relative()) path = base_dir_ / path;
+      try {
+        block = ReadTetGenBlock(path, rank, size);
+        if (block->num_nodes == 0)  // as ReadMesh refuses it
+          ThrowInputError(path.string(), "",
+                          fmt::format("the file holds no nodes: an empty mesh, or not a {} file",
+                                      path.extension().string()));
+      } catch (const InputError& e) {
+        file->Fail(e.what());
+      }
+      Transform(node, *block);
     }
     if (!block) {  // read whole, sliced, not kept
       const Mesh whole = BuildMesh(node, base_dir_);
@@ -177,11 +192,17 @@ class SceneMeshes final : public MeshProvider {
                     (translate ? translate->AsVec3() : Vec3::Zero());
   }
 
-  static bool IsGmshFile(const std::string& name) {
+  static std::string LowerExtension(const std::string& name) {
     std::string extension = std::filesystem::path(name).extension().string();
     std::transform(extension.begin(), extension.end(), extension.begin(),
                    [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-    return extension == ".msh";
+    return extension;
+  }
+  static bool IsGmshFile(const std::string& name) { return LowerExtension(name) == ".msh"; }
+  // ReadMesh reads these as TetGen files (io/mesh_io.cc).
+  static bool IsTetGenFile(const std::string& name) {
+    const std::string extension = LowerExtension(name);
+    return extension == ".node" || extension == ".ele" || extension == ".face";
   }
 
   void CheckSize(const JsonNode& node, std::int64_t nodes, std::int64_t cells) const {
