@@ -15,6 +15,7 @@
 #include <utility>
 
 #include "gipsi/base/error.h"
+#include "gipsi/base/log.h"
 #include "gipsi/base/state.h"
 #include "gipsi/parallel/petsc_check.h"
 
@@ -220,6 +221,26 @@ class PetscSolidSolver final : public LinearSolver {
     return factorized_;
   }
 
+  // GAMG on a mesh it coarsens poorly (a box cut into 5 tets per cell: operator complexity 4.6,
+  // against 1.2 on the 6-tet cut and 1.3 on the liver; docs/performance.md) costs that many
+  // times the tangent's work per iteration, where BoomerAMG or block Jacobi were twice as fast.
+  // Said once, on the first hierarchy built, by every rank alike (the complexity is global).
+  void NoteComplexity(PC pc) {
+    if (complexity_noted_) return;
+    complexity_noted_ = true;
+    constexpr double kPoorCoarsening = 3.0;
+    PetscReal grid = 0, operators = 0;
+    GIPSI_PETSC(PCMGGetGridComplexity(pc, &grid, &operators));
+    if (operators > kPoorCoarsening)
+      Log().warn(
+          "a split FemSolid: GAMG's levels hold {:.2g} times the tangent's nonzeros (its operator "
+          "complexity; 1.2-1.3 where it coarsens well), so each CG iteration costs as much more. "
+          "A box cut into 5 tets per cell coarsens so: there \"parallel\": {{\"linear_solver\": "
+          "{{\"preconditioner\": \"hypre\"}}}} (or \"jacobi\") was about twice as fast, or cut "
+          "it into 6 (docs/scale-out.md, \"Solid mechanics\")",
+          operators);
+  }
+
   // Sets the preconditioner up for the matrix's current values (current_).
   bool Build() {
     have_pc_ = false;
@@ -236,6 +257,7 @@ class PetscSolidSolver final : public LinearSolver {
     double failed = code != 0 || reason != PC_NOERROR ? 1.0 : 0.0;
     MPI_Allreduce(MPI_IN_PLACE, &failed, 1, MPI_DOUBLE, MPI_MAX, comm_);
     have_pc_ = failed == 0;
+    if (have_pc_ && !direct_ && options_.preconditioner == "amg") NoteComplexity(pc);
     rebuild_pending_ = false;
     fresh_ = true;
     if (lagged_ && have_pc_ && current_ != pc_source_.data())
@@ -386,6 +408,7 @@ class PetscSolidSolver final : public LinearSolver {
   const double* current_ = nullptr;  // the matrix's values (the caller's, alive till Factorize)
   // A multigrid ("amg", "hypre") kept across tangents while it works (Solve's rule).
   bool lagged_ = false, have_pc_ = false, rebuild_pending_ = true, fresh_ = false;
+  bool complexity_noted_ = false;  // NoteComplexity said its piece
   int baseline_ = 0;               // CG iterations of the first solve with a fresh multigrid
   std::vector<double> pc_source_;  // the values the kept multigrid was built from
 };
