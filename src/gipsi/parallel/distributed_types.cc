@@ -83,21 +83,57 @@ bool SplitsWithIntegrator(const JsonNode& params) {
 // Adds an object to the summary's list of split objects.
 using NoteSplit = std::function<void(const std::string& name, const char* type)>;
 
+// The cuts of the meshes made in blocks, one per mesh of a scene: the objects made in blocks on
+// one mesh (the heart's bioelectricity and muscle) read its blocks and run the partitioner once,
+// and share the part's mesh (each keeps its own copy of the part's index arrays). The cut is
+// deterministic, so this changes no result; it spares a second read of the file and a second
+// partitioning. A mesh is known by its name in the scene and by the scene's document: the entry
+// keeps a node of that document, whose file name string (shared by all its nodes) then stays
+// alive, so its address names that load alone, even after the scene is gone and another is
+// loaded with the same registry. Every rank makes the same calls in the same order (collective).
+class SharedCuts {
+ public:
+  // The part of this rank of the object's domain mesh: cut now, or as an earlier object's. A
+  // mistake in the mesh names its own JSON path; one the cut meets (no tets, fewer tets than
+  // ranks), the object's.
+  MeshPart Cut(const ObjectBuildContext& ctx, MPI_Comm comm, const char* type) {
+    const JsonNode domain = ctx.params.At("domain");
+    const std::string name = domain.AsString();
+    for (const Entry& entry : entries_)
+      if (&entry.document.file() == &domain.file() && entry.mesh == name) return *entry.part;
+    int rank = 0, size = 1;
+    MPI_Comm_rank(comm, &rank);
+    MPI_Comm_size(comm, &size);
+    auto block = std::make_unique<MeshBlock>(ctx.DomainMeshBlock(rank, size));
+    if (block->num_tets == 0)
+      ctx.params.Fail(
+          fmt::format("the {} object needs a tetrahedral domain mesh (this one has none)", type));
+    std::shared_ptr<const MeshPart> part;
+    try {
+      part = std::make_shared<const MeshPart>(PartitionMeshBlocks(*block, comm));
+    } catch (const InputError& e) {
+      ctx.params.Fail(e.what());
+    }
+    entries_.push_back({domain, name, part});
+    return *part;  // the block goes before the object allocates its state
+  }
+
+ private:
+  struct Entry {
+    JsonNode document;  // a node of the scene's document: keeps its file name string alive
+    std::string mesh;
+    std::shared_ptr<const MeshPart> part;
+  };
+  std::vector<Entry> entries_;
+};
+
 // A FemSolid made in blocks (ObjectBuildContext::in_blocks): on a mesh made as one block per rank
 // and cut from the blocks: its boundary and where it lies on the whole mesh's are found by
 // exchanges, its cavities' faces are selected on the parts and gathered, and the view keeps the
 // scene's conditions on the whole boundary's numbering without its geometry.
 
 std::unique_ptr<SimObject> FemSolidInBlocks(const ObjectBuildContext& ctx, FemSolidSpec spec,
-                                            MPI_Comm comm, const NoteSplit& note) {
-  int rank = 0, size = 1;
-  MPI_Comm_rank(comm, &rank);
-  MPI_Comm_size(comm, &size);
-  auto block = std::make_unique<MeshBlock>(ctx.DomainMeshBlock(rank, size));
-  if (block->num_tets == 0)
-    throw InputError("the FemSolid object needs a tetrahedral domain mesh (this one has none)");
-  MeshPart cut = PartitionMeshBlocks(*block, comm);
-  block.reset();  // before the object allocates its state
+                                            MeshPart cut, MPI_Comm comm, const NoteSplit& note) {
   auto distribution = std::make_shared<DistributedSolid>(std::move(cut), comm);
   const MeshPart& mesh_part = distribution->part();
   std::unique_ptr<FemSolid> solid = MakePartSolid(ctx, spec, distribution, comm);
@@ -130,23 +166,18 @@ void RegisterDistributedTypes(TypeRegistry& registry, MPI_Comm comm,
   // its blood's): made in blocks, they make their parts so by the same rule among the parts.
   for (const char* aggregate : {"Aggregate", "Heart"})
     registry.splits_in_blocks[aggregate] = [](const JsonNode&) { return true; };
+  // One cut per mesh made in blocks, shared by the objects on it (the factories' own).
+  auto cuts = std::make_shared<SharedCuts>();
   registry.objects.Replace(
-      "Monodomain", [comm, note](const ObjectBuildContext& ctx) -> std::unique_ptr<SimObject> {
+      "Monodomain",
+      [comm, note, cuts](const ObjectBuildContext& ctx) -> std::unique_ptr<SimObject> {
         CheckEpTissueKeys(ctx, {"parallel"});
         EpTissueParams params = ParseEpTissueParams(ctx);
         // Nothing but probes, outputs and connectors coupling its parts reads it: its mesh is
         // made in blocks and no rank holds it whole.
         if (ctx.in_blocks) {
-          int rank = 0, size = 1;
-          MPI_Comm_rank(comm, &rank);
-          MPI_Comm_size(comm, &size);
-          auto block = std::make_unique<MeshBlock>(ctx.DomainMeshBlock(rank, size));
+          MeshPart cut = cuts->Cut(ctx, comm, "Monodomain");
           try {
-            if (block->num_tets == 0)
-              throw InputError(
-                  "the Monodomain object needs a tetrahedral domain mesh (this one has none)");
-            MeshPart cut = PartitionMeshBlocks(*block, comm);
-            block.reset();  // before the object allocates its state
             auto part = std::make_unique<DistributedMonodomain>(ctx.name, std::move(cut),
                                                                 std::move(params), comm);
             const MeshPart& mesh_part = part->part();
@@ -172,7 +203,7 @@ void RegisterDistributedTypes(TypeRegistry& registry, MPI_Comm comm,
   GIPSI_CHECK(found != nullptr);
   registry.objects.Replace(
       "FemSolid",
-      [comm, note,
+      [comm, note, cuts,
        whole_solid = *found](const ObjectBuildContext& ctx) -> std::unique_ptr<SimObject> {
         if (!SplitsWithIntegrator(ctx.params)) return whole_solid(ctx);
         FemSolidSpec spec = ParseFemSolidSpec(ctx);
@@ -180,8 +211,9 @@ void RegisterDistributedTypes(TypeRegistry& registry, MPI_Comm comm,
         // Nothing but probes, outputs and connectors coupling its parts reads it: its mesh is
         // made in blocks and no rank holds it whole.
         if (ctx.in_blocks) {
+          MeshPart cut = cuts->Cut(ctx, comm, "FemSolid");
           try {
-            return FemSolidInBlocks(ctx, std::move(spec), comm, note);
+            return FemSolidInBlocks(ctx, std::move(spec), std::move(cut), comm, note);
           } catch (const InputError& e) {
             ctx.params.Fail(e.what());
           }
