@@ -173,6 +173,11 @@ TEST(TetGenReader, EveryBlockReportsTheWholeReadersErrors) {
                              "values");
   const auto truncated = WriteBytes(Scratch("cut.node"), "4 3 0 0\n1 0 0 0\n2 1 0 0\n");
   EXPECT_THAT(error(truncated), HasSubstr("cut.node: line 1: declares 4 points"));
+  // A header whose attribute count would overflow the line's token count (a signed overflow).
+  const auto attributes = WriteBytes(Scratch("many.node"), "1 3 9223372036854775807 0\n1 0 0 0\n");
+  EXPECT_EQ(error(attributes), attributes.string() +
+                                   ": line 1: expected a number of attributes up to 1000000, got "
+                                   "9223372036854775807");
 }
 
 }  // namespace

@@ -41,6 +41,19 @@ std::int64_t HeaderValue(const ChunkedFile& r, const std::vector<std::string_vie
   return v;
 }
 
+/// The most attributes a line may declare: a line's token count is added to it, which must not
+/// overflow (a header of 2^63 - 1 attributes would), and no mesh has a million per item.
+constexpr std::int64_t kMostAttributes = 1000000;
+
+/// The header's number of attributes (index `i`), at most kMostAttributes.
+std::int64_t Attributes(const ChunkedFile& r, const std::vector<std::string_view>& t,
+                        std::size_t i) {
+  const std::int64_t v = HeaderValue(r, t, i, 0, "a number of attributes");
+  if (v > kMostAttributes)
+    r.Fail(fmt::format("expected a number of attributes up to {}, got {}", kMostAttributes, v));
+  return v;
+}
+
 /// A group name suffix for an attribute or marker value: integers without decimals.
 std::string ValueName(double v) {
   if (v == std::floor(v) && std::abs(v) < 1e15) return fmt::format("{}", std::int64_t(v));
@@ -118,7 +131,7 @@ class TetGenParser {
     auto h = ReadRecord(r, 1, "the header '<#points> <dim> <#attributes> <#markers>'");
     std::int64_t n = HeaderValue(r, h, 0, 0, "a number of points");
     std::int64_t dim = HeaderValue(r, h, 1, 3, "a dimension");
-    std::int64_t attributes = HeaderValue(r, h, 2, 0, "a number of attributes");
+    std::int64_t attributes = Attributes(r, h, 2);
     std::int64_t markers = HeaderValue(r, h, 3, 0, "a number of boundary markers");
     if (dim != 3) r.Fail(fmt::format("expected dimension 3, got {}", dim));
     if (markers > 1) r.Fail(fmt::format("expected 0 or 1 boundary markers, got {}", markers));
@@ -142,7 +155,7 @@ class TetGenParser {
     auto h = ReadRecord(r, 1, "the header '<#tetrahedra> <nodes per tet> <#attributes>'");
     std::int64_t n = HeaderValue(r, h, 0, 0, "a number of tetrahedra");
     std::int64_t per = HeaderValue(r, h, 1, 4, "a number of nodes per tetrahedron");
-    std::int64_t attributes = HeaderValue(r, h, 2, 0, "a number of attributes");
+    std::int64_t attributes = Attributes(r, h, 2);
     if (per != 4 && per != 10) r.Fail(fmt::format("expected 4 or 10 nodes per tet, got {}", per));
     r.CheckCount(n, 10, "tetrahedra");
     const auto [begin, end] = Block(n);
