@@ -111,12 +111,18 @@ class SceneMeshes final : public MeshProvider {
     const auto file = node.Find("file");
     if (generate && generate->is_string() && generate->AsString() == "box") {
       block = BoxBlock(node, rank, size);
-    } else if (file && file->is_string() && IsGmshFile(file->AsString())) {
+    } else if (file && file->is_string() &&
+               (IsGmshFile(file->AsString()) || IsTetGenFile(file->AsString()))) {
       CheckMeshEntry(node);
+      const bool gmsh = IsGmshFile(file->AsString());
       std::filesystem::path path = file->AsString();
       if (path.is_relative()) path = base_dir_ / path;
       try {
-        block = ReadGmshBlock(path, rank, size);
+        block = gmsh ? ReadGmshBlock(path, rank, size) : ReadTetGenBlock(path, rank, size);
+        if (block && block->num_nodes == 0)  // as ReadMesh refuses it
+          ThrowInputError(path.string(), "",
+                          fmt::format("the file holds no nodes: an empty mesh, or not a {} file",
+                                      path.extension().string()));
       } catch (const InputError& e) {
         file->Fail(e.what());
       }
@@ -127,20 +133,6 @@ class SceneMeshes final : public MeshProvider {
             "{}: {}: every process reads this Gmsh file whole to cut its block (format 4.1 "
             "with linear elements is read in blocks)",
             node.file(), file->path());
-    } else if (file && file->is_string() && IsTetGenFile(file->AsString())) {
-      CheckMeshEntry(node);
-      std::filesystem::path path = file->AsString();
-      if (path.is_relative()) path = base_dir_ / path;
-      try {
-        block = ReadTetGenBlock(path, rank, size);
-        if (block->num_nodes == 0)  // as ReadMesh refuses it
-          ThrowInputError(path.string(), "",
-                          fmt::format("the file holds no nodes: an empty mesh, or not a {} file",
-                                      path.extension().string()));
-      } catch (const InputError& e) {
-        file->Fail(e.what());
-      }
-      Transform(node, *block);
     }
     if (!block) {  // read whole, sliced, not kept
       const Mesh whole = BuildMesh(node, base_dir_);
