@@ -1,5 +1,5 @@
-// Reading one block of a Gmsh 4.1 mesh without the whole mesh (io/gmsh_block_reader.h), against
-// the whole-file reader's mesh sliced into the same block.
+// Reading one block of a Gmsh mesh (formats 1.0, 2.x and 4.1) without the whole mesh
+// (io/gmsh_block_reader.h), against the whole-file reader's mesh sliced into the same block.
 
 #include "gipsi/io/gmsh_block_reader.h"
 
@@ -184,20 +184,123 @@ TEST(GmshBlockReader, EveryBlockIsTheWholeReadersSlice) {
   }
 }
 
-// Formats 1.0 and 2.x, and second-order elements, are not read in blocks (the caller reads the
-// whole file instead); mistakes are named with the file and the line or byte offset.
-TEST(GmshBlockReader, OtherFormatsAreLeftToTheWholeReaderAndMistakesAreNamed) {
+// The same box as Gmsh 1.0 (`version` "1.0": $NOD/$ELM, no names) or 2.2 ("2.2", ASCII or
+// binary): one element per line (binary: blocks of one type), the first tag the physical group.
+std::string BoxAsGmsh2(const Mesh& box, const std::string& version, bool binary, bool sparse) {
+  const bool v1 = version == "1.0";
+  Writer w(binary);
+  if (!v1) {
+    w.Line("$MeshFormat");
+    w.Line(version + (binary ? " 1 8" : " 0 8"));
+    if (binary) {
+      w.Int(1);
+      w.EndSection("$EndMeshFormat");
+    } else {
+      w.Line("$EndMeshFormat");
+    }
+    w.Line("$PhysicalNames");
+    w.Line("3");
+    w.Line("3 10 \"tissue\"");
+    w.Line("2 21 \"tissue\"");
+    w.Line("0 40 \"apex\"");
+    w.Line("$EndPhysicalNames");
+  }
+  auto tag = [sparse](Index i) { return sparse ? 7 + 3 * static_cast<int>(i) : int(i) + 1; };
+  w.Line(v1 ? "$NOD" : "$Nodes");
+  w.Line(std::to_string(box.num_nodes()));
+  for (Index i = 0; i < box.num_nodes(); ++i) {
+    w.Int(tag(i));
+    for (int k = 0; k < 3; ++k) w.Double(box.nodes(k, i));
+    w.EndRecord();
+  }
+  w.EndSection(v1 ? "$ENDNOD" : "$EndNodes");
+
+  struct Item {
+    int type, physical;
+    std::vector<Index> nodes;
+  };
+  std::vector<Item> items = {{15, 40, {0}}, {1, 30, {0, 1}}, {1, 30, {1, 2}}};
+  const Index tris = box.num_triangles();
+  for (Index t = 0; t < tris; ++t)
+    items.push_back({2,
+                     t < tris / 2 ? 20 : 21,
+                     {box.triangles(0, t), box.triangles(1, t), box.triangles(2, t)}});
+  for (Index e = 0; e < box.num_tets(); ++e)
+    items.push_back({4, 10, {box.tets(0, e), box.tets(1, e), box.tets(2, e), box.tets(3, e)}});
+  w.Line(v1 ? "$ELM" : "$Elements");
+  w.Line(std::to_string(items.size()));
+  for (std::size_t i = 0; i < items.size(); ++i) {
+    const Item& item = items[i];
+    if (binary) {  // a block per element, as a writer that does not group them
+      w.Int(item.type);
+      w.Int(1);
+      w.Int(2);
+    }
+    w.Int(static_cast<int>(i) + 1);
+    if (!binary) w.Int(item.type);
+    if (v1) {
+      w.Int(item.physical);
+      w.Int(1);
+      w.Int(static_cast<int>(item.nodes.size()));
+    } else {
+      if (!binary) w.Int(2);
+      w.Int(item.physical);
+      w.Int(1);
+    }
+    for (Index v : item.nodes) w.Int(tag(v));
+    w.EndRecord();
+  }
+  w.EndSection(v1 ? "$ENDELM" : "$EndElements");
+  return w.text();
+}
+
+// Every block of the box as Gmsh 1.0, 2.2 ASCII and 2.2 binary is the whole reader's slice.
+TEST(GmshBlockReader, EveryBlockOfAnOlderFormatIsTheWholeReadersSlice) {
+  const std::filesystem::path dir = testing::TestTempDir();
+  const Mesh box = MakeTetBox(Vec3::Zero(), Vec3(2, 1, 1), {4, 3, 2});
+  for (const auto& [version, binary] :
+       std::vector<std::pair<std::string, bool>>{{"1.0", false}, {"2.2", false}, {"2.2", true}}) {
+    for (bool sparse : {false, true}) {
+      const auto path = dir / fmt::format("box_{}_{}_{}.msh", version, binary, sparse);
+      std::ofstream(path, std::ios::binary) << BoxAsGmsh2(box, version, binary, sparse);
+      const Mesh whole = ReadMesh(path);
+      ASSERT_EQ(whole.num_tets(), box.num_tets());
+      ASSERT_EQ(whole.groups.size(), 5U);
+      if (version != "1.0") EXPECT_EQ(whole.groups[1].name, "tissue_dim2");
+      for (int size : {1, 3, 7}) {
+        for (int rank = 0; rank < size; ++rank) {
+          const auto block = ReadGmshBlock(path, rank, size);
+          ASSERT_TRUE(block.has_value());
+          test::ExpectSameBlock(*block, BlockOfMesh(whole, rank, size),
+                                fmt::format("format {}, binary {}, sparse tags {}, block {} of {}",
+                                            version, binary, sparse, rank, size));
+        }
+      }
+    }
+  }
+}
+
+// Second-order elements and a file of two node sections are not read in blocks (the caller reads
+// the whole file instead); mistakes are named with the file and the line or byte offset.
+TEST(GmshBlockReader, OtherFilesAreLeftToTheWholeReaderAndMistakesAreNamed) {
   const std::filesystem::path dir = testing::TestTempDir();
   auto write = [&](const std::string& name, const std::string& text) {
     const auto path = dir / name;
     std::ofstream(path, std::ios::binary) << text;
     return path;
   };
-  const auto v2 =
-      write("v2.msh", "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n1\n1 0 0 0\n$EndNodes\n");
-  EXPECT_FALSE(ReadGmshBlock(v2, 0, 2).has_value());
-  const auto v1 = write("v1.msh", "$NOD\n1\n1 0 0 0\n$ENDNOD\n");
-  EXPECT_FALSE(ReadGmshBlock(v1, 0, 2).has_value());
+  const std::string v2_head =
+      "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n4\n1 0 0 0\n2 1 0 0\n3 0 1 0\n"
+      "4 0 0 1\n$EndNodes\n";
+  const auto v2_second = write("v2_p2.msh", v2_head +
+                                                "$Elements\n1\n1 11 2 1 1 1 2 3 4 1 2 3 4 1 2\n"
+                                                "$EndElements\n");
+  EXPECT_FALSE(ReadGmshBlock(v2_second, 0, 2).has_value());
+  const auto two_sections =
+      write("two.msh", "$NOD\n1\n1 0 0 0\n$ENDNOD\n$NOD\n1\n2 1 0 0\n$ENDNOD\n");
+  EXPECT_FALSE(ReadGmshBlock(two_sections, 0, 2).has_value());
+  const auto v3 = write("v3.msh", "$MeshFormat\n3.0 0 8\n$EndMeshFormat\n");
+  EXPECT_FALSE(ReadGmshBlock(v3, 0, 2).has_value());  // ReadMesh says why it is refused
   const std::string head =
       "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$Nodes\n1 4 1 4\n3 1 0 4\n1\n2\n3\n4\n"
       "0 0 0\n1 0 0\n0 1 0\n0 0 1\n$EndNodes\n";
@@ -236,6 +339,26 @@ TEST(GmshBlockReader, OtherFormatsAreLeftToTheWholeReaderAndMistakesAreNamed) {
                          "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$Nodes\n1 1 1 1\n"
                          "3 1 0 1\n1\n0 nan 0\n$EndNodes\n");
   EXPECT_THAT(error(nan), HasSubstr("nan.msh: line 8: expected a y coordinate"));
+  // The same in format 2.2 and 1.0.
+  EXPECT_THAT(
+      error(write("undefined2.msh", v2_head + "$Elements\n1\n9 4 2 1 1 1 2 3 5\n$EndElements\n")),
+      HasSubstr("undefined2.msh: line 13: element 9 refers to undefined node 5"));
+  EXPECT_THAT(error(write("truncated2.msh", v2_head + "$Elements\n2\n9 4 2 1 1 1 2 3 4\n")),
+              HasSubstr("truncated2.msh: line 12: declares 2 elements"));
+  EXPECT_THAT(error(write("short2.msh", v2_head + "$Elements\n1\n9 4 2 1 1 1 2 3\n$EndElements\n")),
+              HasSubstr("short2.msh: line 13: expected 4 node indices for a tetrahedron, got 3"));
+  EXPECT_THAT(error(write("few2.msh",
+                          "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n2\n"
+                          "1 0 0 0\n$EndNodes\n")),
+              HasSubstr("few2.msh: line 7: expected 2 nodes as declared, got 1 before $EndNodes"));
+  EXPECT_THAT(error(write("nan1.msh", "$NOD\n2\n1 0 0 0\n2 0 0 inf\n$ENDNOD\n")),
+              HasSubstr("nan1.msh: line 4: expected a z coordinate"));
+  EXPECT_THAT(error(write("count1.msh",
+                          "$NOD\n1\n1 0 0 0\n$ENDNOD\n$ELM\n1\n"
+                          "1 4 1 1 3 1 1 1 1\n$ENDELM\n")),
+              HasSubstr("count1.msh: line 7: expected 3 node indices as declared, got 4"));
+  EXPECT_THAT(error(write("size2.msh", "$MeshFormat\n2.2 0 4\n$EndMeshFormat\n")),
+              HasSubstr("size2.msh: line 2: unsupported data size 4"));
   EXPECT_THAT(error(dir / "missing.msh"),
               HasSubstr("missing.msh: cannot open mesh file for reading"));
   std::filesystem::create_directory(dir / "folder.msh");

@@ -1,5 +1,5 @@
 /// @file
-/// One block of a Gmsh 4.1 mesh, streamed (see the header).
+/// One block of a Gmsh mesh (formats 1.0, 2.x and 4.1), streamed (see the header).
 
 #include "gipsi/io/gmsh_block_reader.h"
 
@@ -32,7 +32,7 @@ using internal::Quote;
 using internal::SplitTokens;
 using Key = std::pair<int, int>;  // (dimension, physical tag)
 
-/// Reads a Gmsh 4.1 file in two passes: the first checks all of it and counts the nodes, tets
+/// Reads a Gmsh file in two passes: the first checks all of it and counts the nodes, tets
 /// and triangles; the second keeps the block's items.
 class BlockParser {
  public:
@@ -61,21 +61,30 @@ class BlockParser {
       if (line == "$MeshFormat") {
         if (!ReadFormat()) return false;
         have_format = true;
-      } else if (line == "$NOD" || line == "$ELM") {
-        return false;  // format 1.0
-      } else if (line == "$Nodes" || line == "$Elements") {
-        const bool nodes = line == "$Nodes";
-        if (!have_format) f_.Fail(fmt::format("{} before $MeshFormat", line));
-        if (nodes) {
+      } else if (line == "$NOD" || line == "$Nodes") {
+        if (line == "$Nodes" && !have_format) f_.Fail("$Nodes before $MeshFormat");
+        if (have_nodes) return false;  // more than one node section: read whole
+        if (line == "$NOD") {
+          major_ = 1;
+          have_format = true;
+          NodesV1V2(extract, "$ENDNOD");
+        } else if (major_ == 4) {
           Nodes(extract);
-          have_nodes = true;
         } else {
-          if (!have_nodes) f_.Fail("$Elements before $Nodes");
-          if (!Elements(extract)) return false;
+          NodesV1V2(extract, "$EndNodes");
         }
+        have_nodes = true;
+      } else if (line == "$ELM" || line == "$Elements") {
+        if (line == "$Elements" && !have_format) f_.Fail("$Elements before $MeshFormat");
+        if (!have_nodes)
+          f_.Fail(fmt::format("{} before {}", line, line == "$ELM" ? "$NOD" : "$Nodes"));
+        const bool done = line == "$ELM" ? ElementsV1V2(extract, "$ENDELM", true)
+                          : major_ == 4  ? Elements(extract)
+                                         : ElementsV1V2(extract, "$EndElements", false);
+        if (!done) return false;
       } else if (line == "$PhysicalNames" && !extract) {
         PhysicalNames();
-      } else if (line == "$Entities" && !extract) {
+      } else if (line == "$Entities" && major_ == 4 && !extract) {
         Entities();
       } else if (line.front() == '$') {
         const std::string name(line.substr(1));
@@ -146,6 +155,7 @@ class BlockParser {
     return n;
   }
 
+  // False for a version the whole reader reports (or refuses).
   bool ReadFormat() {
     const std::string_view line =
         f_.RequireContentLine("the format line 'version file-type data-size'");
@@ -153,12 +163,17 @@ class BlockParser {
     double version = 0;
     if (t.size() < 3 || !internal::TryParseDouble(t[0], &version))
       f_.Fail(fmt::format("expected 'version file-type data-size', got {}", Quote(line)));
-    if (!(version >= 4.1 && version < 5.0)) return false;  // 2.x: read whole
     const std::int64_t file_type = ToInt(t[1], "file-type 0 (ASCII) or 1 (binary)");
     const std::int64_t data_size = ToInt(t[2], "the data size");
+    if (version >= 2.0 && version < 3.0)
+      major_ = 2;
+    else if (version >= 4.1 && version < 5.0)
+      major_ = 4;
+    else
+      return false;
     if (file_type != 0 && file_type != 1)
       f_.Fail(fmt::format("expected file-type 0 (ASCII) or 1 (binary), got {}", file_type));
-    if (data_size != 8 && data_size != 4)
+    if ((major_ == 2 && data_size != 8) || (major_ == 4 && data_size != 8 && data_size != 4))
       f_.Fail(fmt::format("unsupported data size {}", data_size));
     size_bytes_ = static_cast<int>(data_size);
     if (file_type == 1) {
@@ -300,12 +315,149 @@ class BlockParser {
     if (index != num_nodes)
       Fail(fmt::format("expected {} nodes as declared, got {} in the blocks", num_nodes, index));
     section.End("$EndNodes");
-    if (!extract && !dense_) {
-      std::sort(table_.begin(), table_.end());
-      for (std::size_t i = 1; i < table_.size(); ++i)
-        if (table_[i].first == table_[i - 1].first)
-          f_.Fail(fmt::format("in $Nodes: node tag {} is defined twice", table_[i].first));
+    if (!extract) CheckTags("$Nodes");
+  }
+
+  // Sorts the tag table (if there is one) and refuses a tag defined twice in `section`.
+  void CheckTags(std::string_view section) {
+    if (dense_) return;
+    std::sort(table_.begin(), table_.end());
+    for (std::size_t i = 1; i < table_.size(); ++i)
+      if (table_[i].first == table_[i - 1].first)
+        f_.Fail(fmt::format("in {}: node tag {} is defined twice", section, table_[i].first));
+  }
+
+  // A count on its own line (ASCII in binary files too), as ReadGmsh reads it.
+  std::int64_t CountLine(std::string_view what, std::size_t min_bytes_each,
+                         std::string_view items) {
+    const std::int64_t n = f_.ToInt(f_.RequireContentLine(what), what);
+    f_.CheckCount(n, min_bytes_each, items);
+    return n;
+  }
+
+  // Formats 1.0 ($NOD) and 2.x: a count, then `tag x y z` per node (binary 2.x: int32 tag and
+  // three doubles).
+  void NodesV1V2(bool extract, std::string_view end_marker) {
+    const bool binary = binary_file_ && major_ == 2;
+    const std::int64_t n = CountLine("the number of nodes", binary ? 28 : 8, "nodes");
+    if (!extract) {
+      if (n > INT32_MAX) f_.Fail(fmt::format("{} nodes: more than 2^31 - 1", n));
+      num_nodes_ = n;
     }
+    Binary section(this, "$Nodes");
+    binary_ = binary;
+    for (std::int64_t i = 0; i < n; ++i) {
+      std::int64_t tag = 0;
+      Vec3 x;
+      if (binary) {
+        const char* p = f_.Bytes(28, "node records").data();
+        tag = internal::LoadScalar<std::int32_t>(p, swap_);
+        for (int k = 0; k < 3; ++k) {
+          x[k] = internal::LoadScalar<double>(p + 4 + 8 * k, swap_);
+          if (!std::isfinite(x[k])) Fail(fmt::format("node {} has a non-finite coordinate", i));
+        }
+      } else {
+        const std::string_view line = f_.RequireContentLine("a node line 'tag x y z'");
+        const auto t = SplitTokens(line);
+        if (line.front() == '$')
+          f_.Fail(fmt::format("expected {} nodes as declared, got {} before {}", n, i, line));
+        if (t.size() < 4)
+          f_.Fail(fmt::format("expected a node line 'tag x y z', got {} values", t.size()));
+        tag = ToInt(t[0], "a node tag");
+        x = Vec3(ToFinite(t[1], "an x coordinate"), ToFinite(t[2], "a y coordinate"),
+                 ToFinite(t[3], "a z coordinate"));
+      }
+      if (!extract) NoteTag(tag, i);
+      if (extract && i >= node_begin_ && i < node_end_)
+        block_.nodes.col(static_cast<Index>(i - node_begin_)) = x;
+    }
+    section.End(end_marker);
+    if (!extract) CheckTags(major_ == 1 ? "$NOD" : "$Nodes");
+  }
+
+  // Formats 1.0 and 2.x: `tag type ...` per element, the first tag its physical group (0: none).
+  // False (first pass) for a second-order element.
+  bool ElementsV1V2(bool extract, std::string_view end_marker, bool v1) {
+    const bool binary = binary_file_ && major_ == 2 && !v1;
+    const std::int64_t n = CountLine("the number of elements", binary ? 12 : 10, "elements");
+    Binary section(this, "$Elements");
+    binary_ = binary;
+    tet_counter_ = triangle_counter_ = 0;
+    auto add = [&](std::int64_t type, std::int64_t tag, std::int64_t physical) {
+      const ElementInfo info = GetElementInfo(type);
+      keys_.clear();
+      if (physical != 0 && info.dim >= 0) keys_.emplace_back(info.dim, static_cast<int>(physical));
+      if (!extract) {
+        if (type == 11 || type == 9) return false;
+        used_keys_.insert(keys_.begin(), keys_.end());
+      }
+      Element(type, tag, extract);
+      return true;
+    };
+    if (binary) {
+      for (std::int64_t done = 0; done < n;) {
+        const std::int64_t type = Int("an element type");
+        const std::int64_t follow = Int("a number of elements");
+        const std::int64_t num_tags = Int("a number of tags");
+        const ElementInfo info = GetElementInfo(type);
+        if (info.nodes < 0) Fail(fmt::format("unsupported element type {}", type));
+        if (follow <= 0 || follow > n - done || num_tags < 0 || num_tags > 1000)
+          Fail(fmt::format("bad element block header ({} elements, {} tags)", follow, num_tags));
+        const auto ints = static_cast<std::size_t>(1 + num_tags + info.nodes);
+        CheckedCount(follow, 0, 4 * ints, "elements");
+        for (std::int64_t e = 0; e < follow; ++e) {
+          const char* p = f_.Bytes(4 * ints, "element records").data();
+          auto at = [&](std::size_t k) {
+            return internal::LoadScalar<std::int32_t>(p + 4 * k, swap_);
+          };
+          tags_.clear();
+          for (int k = 0; k < info.nodes; ++k)
+            tags_.push_back(at(1 + static_cast<std::size_t>(num_tags + k)));
+          if (!add(type, at(0), num_tags > 0 ? at(1) : 0)) return false;
+        }
+        done += follow;
+      }
+    } else {
+      for (std::int64_t i = 0; i < n; ++i) {
+        const std::string_view line = f_.RequireContentLine("an element line");
+        if (line.front() == '$')
+          f_.Fail(fmt::format("expected {} elements as declared, got {} before {}", n, i, line));
+        const auto t = SplitTokens(line);
+        std::size_t first_node = v1 ? 5 : 3;
+        if (t.size() < first_node)
+          f_.Fail(fmt::format("expected an element line with at least {} values, got {}",
+                              first_node, t.size()));
+        const std::int64_t tag = ToInt(t[0], "an element number");
+        const std::int64_t type = ToInt(t[1], "an element type");
+        std::int64_t physical = 0;
+        if (v1) {
+          physical = ToInt(t[2], "a physical tag");
+          const std::int64_t declared = ToInt(t[4], "a number of nodes");
+          if (declared < 0 || static_cast<std::size_t>(declared) != t.size() - 5)
+            f_.Fail(fmt::format("expected {} node indices as declared, got {}", declared,
+                                t.size() - 5));
+        } else {
+          const std::int64_t num_tags = ToInt(t[2], "a number of tags");
+          if (num_tags < 0 || static_cast<std::size_t>(num_tags) > t.size() - 3)
+            f_.Fail(fmt::format("expected {} tags, got {} values", num_tags, t.size() - 3));
+          if (num_tags > 0) physical = ToInt(t[3], "a physical tag");
+          first_node += static_cast<std::size_t>(num_tags);
+        }
+        CheckNodeCount(GetElementInfo(type), t.size() - first_node);
+        tags_.clear();
+        for (std::size_t k = first_node; k < t.size(); ++k)
+          tags_.push_back(ToInt(t[k], "a node tag"));
+        if (!add(type, tag, physical)) return false;
+      }
+    }
+    section.End(end_marker);
+    return true;
+  }
+
+  void CheckNodeCount(const ElementInfo& info, std::size_t count) const {
+    if (info.nodes >= 0 && count != static_cast<std::size_t>(info.nodes))
+      f_.Fail(
+          fmt::format("expected {} node indices for a {}, got {}", info.nodes, info.name, count));
   }
 
   // False (first pass) for a second-order element: such files are read whole.
@@ -347,9 +499,7 @@ class BlockParser {
         if (line.front() == '$')
           f_.Fail(fmt::format("expected {} elements in the block, got {} before {}", n, e, line));
         const auto t = SplitTokens(line);
-        if (info.nodes >= 0 && t.size() - 1 != static_cast<std::size_t>(info.nodes))
-          f_.Fail(fmt::format("expected {} node indices for a {}, got {}", info.nodes, info.name,
-                              t.size() - 1));
+        CheckNodeCount(info, t.size() - 1);
         tags_.clear();
         for (std::size_t k = 1; k < t.size(); ++k) tags_.push_back(ToInt(t[k], "a node tag"));
         Element(type, ToInt(t[0], "an element tag"), extract);
@@ -447,6 +597,7 @@ class BlockParser {
   ChunkedFile f_;
   int rank_, size_;
   bool binary_file_ = false, binary_ = false, swap_ = false;
+  int major_ = 1;  // Gmsh format: 1 ($NOD), 2 (2.x) or 4 (4.1)
   int size_bytes_ = 8;
   const char* section_ = "";
   // First pass.

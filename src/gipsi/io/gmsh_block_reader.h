@@ -21,9 +21,10 @@ namespace gipsi {
 /// file's physical names and entities; plus 16 bytes per node of the whole mesh when its node
 /// tags are not 1..N (or any run of consecutive tags) in file order.
 ///
-/// Reads format 4.1, ASCII and binary, with linear elements. Returns nothing for a file it does
-/// not read in blocks (formats 1.0 and 2.x, second-order elements): read such a file whole
-/// (ReadMesh) and slice it. Throws InputError naming the file and the line (or byte offset in
+/// Reads formats 1.0, 2.x (ASCII and binary) and 4.1 (ASCII and binary) with linear elements.
+/// Returns nothing for a file it does not read in blocks (second-order elements, more than one
+/// node section, a version ReadGmsh refuses): read such a file whole (ReadMesh), which reads or
+/// refuses it, and slice it. Throws InputError naming the file and the line (or byte offset in
 /// binary data) for the errors ReadGmsh reports.
 std::optional<MeshBlock> ReadGmshBlock(const std::filesystem::path& path, int rank, int size);
 

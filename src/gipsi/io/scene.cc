@@ -130,8 +130,8 @@ class SceneMeshes final : public MeshProvider {
         Transform(node, *block);
       else if (rank == 0)
         Log().info(
-            "{}: {}: every process reads this Gmsh file whole to cut its block (format 4.1 "
-            "with linear elements is read in blocks)",
+            "{}: {}: every process reads this Gmsh file whole to cut its block (linear "
+            "elements in one node section are read in blocks)",
             node.file(), file->path());
     }
     if (!block) {  // read whole, sliced, not kept
