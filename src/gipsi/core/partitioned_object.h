@@ -138,11 +138,11 @@ class PartitionedObject {
   /// Replaces every entry of `values` by its sum, minimum or maximum over the processes.
   /// Collective: O(values.size()) per process.
   virtual void CombineAcross(std::span<double> values, Combine how) const = 0;
-  /// On an object without its whole domain (holds_whole_domain() false): the local indices of
-  /// the vertices of domain()'s boundary whose node this process owns among
-  /// SelectWholeNodes(region). Region probes of boundary-vertex fields reduce them as
-  /// SelectOwnedNodes' nodes (ReadOwnedNodes reads them); on an object with its whole domain
-  /// they read the whole boundary. Collective.
+  /// The local indices of the vertices of this process's part of the whole boundary whose node
+  /// it owns among SelectWholeNodes(region): every vertex of the whole selection on exactly one
+  /// process, whether or not the object also holds its whole domain. Region probes of
+  /// boundary-vertex fields reduce them as SelectOwnedNodes' nodes (ReadOwnedNodes reads them).
+  /// Only on an object with boundary-vertex fields. Collective.
   [[nodiscard]] virtual std::vector<int> SelectOwnedBoundaryVertices(
       const Region& region) const = 0;
 

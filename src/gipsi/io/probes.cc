@@ -282,13 +282,13 @@ Probe ParseProbe(const std::string& name, const JsonNode& node, const Kernel& ke
   } else if (auto r = node.Find("region")) {
     probe.region = true;
     Region region = ParseRegion(*r);
-    // A split object's nodes are reduced where they are owned (whole mesh or not), and so are
-    // the boundary vertices of one without its whole mesh (a vertex is owned with its node).
+    // A split object's nodes and boundary vertices are reduced where they are owned (a vertex
+    // is owned with its node), whether or not it holds its whole mesh.
     bool anywhere = false;  // some process owns a node of the region
-    const auto* owners = location == FieldLocation::kNode
-                             ? dynamic_cast<const PartitionedObject*>(&object)
-                         : location == FieldLocation::kBoundaryVertex ? split
-                                                                      : nullptr;
+    const auto* owners =
+        location == FieldLocation::kNode || location == FieldLocation::kBoundaryVertex
+            ? dynamic_cast<const PartitionedObject*>(&object)
+            : nullptr;
     try {
       if (owners != nullptr) {
         probe.owners = owners;

@@ -60,9 +60,10 @@ struct Probe {
   /// Set when the object holds only its part of the domain (a distributed run's object without
   /// its whole mesh): `items` and `point`'s nodes are then whole-domain node ids, read through it.
   const PartitionedObject* partitioned = nullptr;
-  /// Region probes of node fields on an object split over the processes (with or without its
-  /// whole mesh): `items` are then the local nodes this process owns in the region, reduced
-  /// here and combined across the processes through it (no process gathers the region).
+  /// Region probes of node or boundary-vertex fields on an object split over the processes
+  /// (with or without its whole mesh): `items` are then the local nodes (boundary vertices) this
+  /// process owns in the region, reduced here and combined across the processes through it (no
+  /// process gathers the region).
   const PartitionedObject* owners = nullptr;
   bool region = false;
   Reduce reduce = Reduce::kMean;

@@ -297,7 +297,9 @@ std::vector<int> WholeDomainView::SelectOwnedNodes(const Region& region) const {
 }
 
 std::vector<int> WholeDomainView::SelectOwnedBoundaryVertices(const Region& region) const {
-  GIPSI_CHECK(part_only_, "'{}': a view with the whole mesh reads its whole boundary", name());
+  // A view with its whole mesh has boundary fields only with a BoundaryMap (MapBoundary): its
+  // part's boundary is then its share of the whole boundary, as a part-only view's.
+  GIPSI_CHECK(part_only_ || forward_bcs_, "'{}': no boundary fields on its part", name());
   return BoundaryVerticesOfNodes(part_->boundary(), SelectOwnedNodes(region));
 }
 
