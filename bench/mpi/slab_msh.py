@@ -6,7 +6,8 @@ scenes/slab_ep_0.1mm.json that reads it, for measuring a scene run whose mesh co
 Each cell of the nx x ny x nz grid is cut into six tets along its main diagonal (the Kuhn
 split: a conforming mesh, every tet positively oriented). Plain Python, no NumPy.
 
-Usage: slab_msh.py NX NY NZ OUT   (writes OUT.msh and OUT.json)
+Usage: slab_msh.py NX NY NZ OUT [--vtk]   (writes OUT.msh and OUT.json; with --vtk also the
+same mesh as a legacy VTK unstructured grid, OUT.vtk, ASCII)
 """
 import json
 import os
@@ -14,6 +15,7 @@ import sys
 
 nx, ny, nz = (int(a) for a in sys.argv[1:4])
 out = sys.argv[4]
+vtk = sys.argv[5:] == ["--vtk"]
 
 
 def vertex(i, j, k):
@@ -50,6 +52,19 @@ with open(out + ".msh", "w") as f:
                     tag += 1
         f.write("".join(lines))
     f.write("$EndElements\n")
+if vtk:  # the same nodes and tets, numbered from 0, read back from the file just written
+    with open(out + ".msh") as f:
+        text = f.read().split("$Nodes\n")[1]
+    node_lines = text.split("$EndNodes")[0].splitlines()[2 + n:]
+    tet_lines = text.split("$Elements\n")[1].split("$EndElements")[0].splitlines()[2:]
+    with open(out + ".vtk", "w") as f:
+        f.write(f"# vtk DataFile Version 3.0\nslab\nASCII\nDATASET UNSTRUCTURED_GRID\n"
+                f"POINTS {n} double\n")
+        f.write("".join(line + "\n" for line in node_lines))
+        f.write(f"CELLS {m} {5 * m}\n")
+        f.write("".join("4 " + " ".join(str(int(v) - 1) for v in line.split()[1:]) + "\n"
+                        for line in tet_lines))
+        f.write(f"CELL_TYPES {m}\n" + "10\n" * m)
 
 here = os.path.dirname(os.path.abspath(__file__))
 with open(os.path.join(here, "..", "..", "scenes", "slab_ep_0.1mm.json")) as f:
@@ -58,4 +73,5 @@ scene["meshes"]["slab"] = {"file": os.path.abspath(out + ".msh")}
 scene["outputs"].pop("plots", None)
 with open(out + ".json", "w") as f:
     json.dump(scene, f, indent=1)
-print(f"{out}.msh: {n} nodes, {m} tets; {out}.json reads it")
+print(f"{out}.msh{' and ' + out + '.vtk' if vtk else ''}: {n} nodes, {m} tets; {out}.json reads "
+      f"the first")

@@ -15,8 +15,8 @@ Runs the N-version benchmark slab (scenes/slab_ep_0.5mm.json, its first 30 ms) s
   - the summary names the ranks, and that the slab is made in blocks (no rank holds it whole);
   - region probes (a box's mean, a face group's largest activation time, a sum over node ids)
     and a point probe where the parts meet give the serial values within those bounds;
-  - the slab given as a Gmsh 4.1 file, which each rank reads in blocks, gives the serial run's
-    probes within those bounds on 2 and 4 ranks;
+  - the slab given as a Gmsh 4.1 file and as a legacy VTK file, which each rank reads in blocks,
+    gives the serial run's probes within those bounds on 2 and 4 ranks;
   - the ventricle's activation (scenes/lv_activation.json, its first 50 ms), its transmural
     fibre rule solved over the ranks and so made in blocks, gives the serial probes within those
     bounds on 2 and 4 ranks; so does the benchmark ventricle (scenes/lv_inflation.json) with a
@@ -537,7 +537,7 @@ with tempfile.TemporaryDirectory() as work:
         compare_scaled(f"{label} on 2 ranks", liver_runs[1], liver_runs[2], liver_scales, 1e-6, 10)
     code, text = run(2, os.path.join(work, "liver_read"), scene=os.path.join(work, "liver.json"),
                      until="0.01")
-    check(code == 0 and "reads this Gmsh file whole" not in text,
+    check(code == 0 and "reads this file whole" not in text,
           f"the liver's Gmsh 1.0 file on 2 ranks is read whole: exit {code}: {text}")
     # The cantilever under more kinds of conditions, made in blocks like the others (no rank
     # holds its mesh): a total force on the tip's face group (split over its vertices, counted
@@ -641,23 +641,23 @@ with tempfile.TemporaryDirectory() as work:
     for ranks in (2, 4):
         compare_probes(f"region probes on {ranks} ranks", region_runs[1], region_runs[ranks],
                        ("box_mean", "face_max", "ids_sum", "middle"), {"ids_sum": 3})
-    # The slab's box as a Gmsh 4.1 file (another tet mesh of it, written by
-    # bench/mpi/slab_msh.py: six tets per cell, each cell cut along its main diagonal), which
+    # The slab's box as a Gmsh 4.1 file and as a legacy VTK file (another tet mesh of it, written
+    # by bench/mpi/slab_msh.py: six tets per cell, each cell cut along its main diagonal), which
     # each rank reads in blocks: the serial run's probes, within the bounds above, on 2 and 4
     # ranks.
     written = subprocess.run([sys.executable, os.path.join(SOURCE, "bench", "mpi", "slab_msh.py"),
-                              "40", "14", "6", os.path.join(work, "slab")],
+                              "40", "14", "6", os.path.join(work, "slab"), "--vtk"],
                              capture_output=True, text=True, timeout=60)
     check(written.returncode == 0, f"slab_msh.py: {written.stdout}{written.stderr}")
-    gmsh = os.path.join(work, "slab.msh")
-    with open(SCENE) as f:
-        scene = json.load(f)
-    scene["meshes"]["slab"] = {"file": gmsh}
-    scene["outputs"].pop("plots", None)
-    file_runs = run_variant("from_file", scene)
-    for ranks in (2, 4):
-        compare_probes(f"the slab from a Gmsh file on {ranks} ranks", file_runs[1],
-                       file_runs[ranks], ("far_corner", "activated", "diagonal"))
+    for kind in ("msh", "vtk"):
+        with open(SCENE) as f:
+            scene = json.load(f)
+        scene["meshes"]["slab"] = {"file": os.path.join(work, "slab." + kind)}
+        scene["outputs"].pop("plots", None)
+        file_runs = run_variant("from_" + kind, scene)
+        for ranks in (2, 4):
+            compare_probes(f"the slab from a .{kind} file on {ranks} ranks", file_runs[1],
+                           file_runs[ranks], ("far_corner", "activated", "diagonal"))
     # The object's "parallel" block chooses the distributed diffusion solver: BoomerAMG needs
     # one CG iteration per step, and fewer in all than the default Jacobi; the activated fraction
     # stays the serial one within one node of the 4,305 (the solves agree to their tolerance).

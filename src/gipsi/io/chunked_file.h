@@ -1,16 +1,17 @@
 #pragma once
 /// @file
 /// Internal helper of the mesh readers that read one process's block of a mesh without holding
-/// the file (gmsh_block_reader.h, tetgen_reader.h): a file read front to back through a buffer
-/// of about 1 MiB, handing out lines, tokens and raw bytes with the line number and byte offset
-/// that messages name, as internal::TextReader does for a file held whole. Not part of the
-/// public API.
+/// the file (gmsh_block_reader.h, tetgen_reader.h, vtk_legacy_reader.h): a file read front to
+/// back through a buffer of about 1 MiB, handing out lines, tokens and raw bytes with the line
+/// number and byte offset that messages name, as internal::TextReader does for a file held
+/// whole; and the ranges of a block's items. Not part of the public API.
 
 #include <fcntl.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cerrno>
 #include <cmath>
 #include <cstdint>
@@ -22,6 +23,7 @@
 #include <fmt/format.h>
 
 #include "gipsi/base/error.h"
+#include "gipsi/geometry/mesh_block.h"
 #include "gipsi/io/text_reader.h"
 
 namespace gipsi::internal {
@@ -52,7 +54,8 @@ class ChunkedFile {
     if (!S_ISREG(info.st_mode))
       fail("is not a regular file (a device, pipe or socket), expected a mesh file");
     size_ = static_cast<std::uint64_t>(info.st_size);
-    buffer_.resize(kChunk);
+    // A small file needs no more than itself (and one byte to see its end).
+    buffer_.resize(static_cast<std::size_t>(std::min<std::uint64_t>(kChunk, size_ + 1)));
   }
   ~ChunkedFile() {
     if (fd_ >= 0) ::close(fd_);
@@ -145,7 +148,15 @@ class ChunkedFile {
     return value;
   }
   [[nodiscard]] const std::string& source() const { return source_; }
+  /// The line of the last item handed out, which messages name.
+  [[nodiscard]] int line() const { return last_line_; }
   std::string_view Token(std::string_view what) {
+    std::string_view token;
+    if (!TryToken(&token)) Fail(fmt::format("expected {}, got end of file", what));
+    return token;
+  }
+  /// The next token, as Token; false at the end of the file.
+  bool TryToken(std::string_view* out) {
     for (;;) {
       while (begin_ < end_ && IsBlankByte(buffer_[begin_])) {
         if (buffer_[begin_] == '\n') ++line_;
@@ -163,10 +174,35 @@ class ChunkedFile {
       Fill(held + 1);
       k = begin_ + held;
     }
-    if (k == begin_) Fail(fmt::format("expected {}, got end of file", what));
-    std::string_view token(buffer_.data() + begin_, k - begin_);
+    if (k == begin_) return false;
+    *out = std::string_view(buffer_.data() + begin_, k - begin_);
     begin_ = k;
-    return token;
+    return true;
+  }
+  /// Whether the next token is `word` (letters compared case-insensitively), consuming nothing:
+  /// binary data may follow a header line, so only the bytes of `word` and one more are looked at.
+  bool NextTokenIs(std::string_view word) {
+    std::size_t k = 0;  // from begin_: the first byte that is not blank
+    for (;;) {
+      while (begin_ + k < end_ && IsBlankByte(buffer_[begin_ + k])) ++k;
+      if (eof_ || (begin_ + k < end_ && end_ - begin_ - k > word.size())) break;
+      Fill(k + word.size() + 1);
+    }
+    const std::size_t held = end_ - begin_ - k;
+    if (held < word.size()) return false;
+    for (std::size_t i = 0; i < word.size(); ++i)
+      if (std::tolower(static_cast<unsigned char>(buffer_[begin_ + k + i])) !=
+          std::tolower(static_cast<unsigned char>(word[i])))
+        return false;
+    return held == word.size() || IsBlankByte(buffer_[begin_ + k + word.size()]);
+  }
+  /// Consumes the rest of the current line and its line break (the line of the last item
+  /// handed out stays the one messages name).
+  void SkipRestOfLine() {
+    std::string_view ignored;
+    const int keep = last_line_;
+    (void)NextLine(&ignored);
+    last_line_ = keep;
   }
   std::string_view Bytes(std::size_t n, std::string_view what) {
     if (end_ - begin_ < n) Fill(n);
@@ -202,8 +238,9 @@ class ChunkedFile {
   [[noreturn]] void Fail(std::string_view what) const {
     ThrowInputError(source_, fmt::format("line {}", last_line_), what);
   }
-  [[noreturn]] void FailAtOffset(std::string_view what) const {
-    ThrowInputError(source_, fmt::format("byte offset {}", offset()), what);
+  [[noreturn]] void FailAtOffset(std::string_view what) const { FailAtOffset(what, offset()); }
+  [[noreturn]] void FailAtOffset(std::string_view what, std::uint64_t at) const {
+    ThrowInputError(source_, fmt::format("byte offset {}", at), what);
   }
 
  private:
@@ -245,5 +282,37 @@ class ChunkedFile {
   int line_ = 1, last_line_ = 1;
   bool eof_ = false;
 };
+
+/// The whole-mesh indices of a block's nodes, tets and triangles: [begin, end) each.
+struct BlockRanges {
+  std::int64_t node_begin = 0, node_end = 0, tet_begin = 0, tet_end = 0;
+  std::int64_t triangle_begin = 0, triangle_end = 0;
+};
+
+/// Sets `block`'s counts of the whole mesh and sizes its nodes, tets and triangles for its
+/// rank's share of them; returns the ranges it holds. Refuses (through `file`, naming its last
+/// line) more than 2^31 - 1 tets or triangles.
+inline BlockRanges StartBlock(MeshBlock& block, int rank, int size, std::int64_t nodes,
+                              std::int64_t tets, std::int64_t triangles, const ChunkedFile& file) {
+  if (tets > INT32_MAX || triangles > INT32_MAX)
+    file.Fail(fmt::format("{} tets and {} triangles: more than 2^31 - 1", tets, triangles));
+  block.rank = rank;
+  block.size = size;
+  block.num_nodes = nodes;
+  block.num_tets = tets;
+  block.num_triangles = triangles;
+  BlockRanges r;
+  r.node_begin = BlockBegin(nodes, rank, size);
+  r.node_end = BlockBegin(nodes, rank + 1, size);
+  r.tet_begin = BlockBegin(tets, rank, size);
+  r.tet_end = BlockBegin(tets, rank + 1, size);
+  r.triangle_begin = BlockBegin(triangles, rank, size);
+  r.triangle_end = BlockBegin(triangles, rank + 1, size);
+  block.first_triangle = r.triangle_begin;
+  block.nodes.resize(3, static_cast<Index>(r.node_end - r.node_begin));
+  block.tets.resize(4, static_cast<Index>(r.tet_end - r.tet_begin));
+  block.triangles.resize(3, static_cast<Index>(r.triangle_end - r.triangle_begin));
+  return r;
+}
 
 }  // namespace gipsi::internal

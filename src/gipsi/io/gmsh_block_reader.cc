@@ -308,8 +308,8 @@ class BlockParser {
         const double z = Coord("a z coordinate");
         for (std::int64_t k = 0; parametric != 0 && k < dim; ++k)
           SkipDouble("a parametric coordinate");
-        if (extract && index >= node_begin_ && index < node_end_)
-          block_.nodes.col(static_cast<Index>(index - node_begin_)) = Vec3(x, y, z);
+        if (extract && index >= r_.node_begin && index < r_.node_end)
+          block_.nodes.col(static_cast<Index>(index - r_.node_begin)) = Vec3(x, y, z);
       }
     }
     if (index != num_nodes)
@@ -368,8 +368,8 @@ class BlockParser {
                  ToFinite(t[3], "a z coordinate"));
       }
       if (!extract) NoteTag(tag, i);
-      if (extract && i >= node_begin_ && i < node_end_)
-        block_.nodes.col(static_cast<Index>(i - node_begin_)) = x;
+      if (extract && i >= r_.node_begin && i < r_.node_end)
+        block_.nodes.col(static_cast<Index>(i - r_.node_begin)) = x;
     }
     section.End(end_marker);
     if (!extract) CheckTags(major_ == 1 ? "$NOD" : "$Nodes");
@@ -531,17 +531,17 @@ class BlockParser {
     bool mine = false;
     if (tet) {
       item = tet_counter_++;
-      mine = item >= tet_begin_ && item < tet_end_;
+      mine = item >= r_.tet_begin && item < r_.tet_end;
       if (mine) {
-        const auto column = static_cast<Index>(item - tet_begin_);
+        const auto column = static_cast<Index>(item - r_.tet_begin);
         for (int k = 0; k < 4; ++k) block_.tets(k, column) = indices_[static_cast<std::size_t>(k)];
         block_.tet_ids.push_back(tag);
       }
     } else if (triangle) {
       item = triangle_counter_++;
-      mine = item >= triangle_begin_ && item < triangle_end_;
+      mine = item >= r_.triangle_begin && item < r_.triangle_end;
       if (mine) {
-        const auto column = static_cast<Index>(item - triangle_begin_);
+        const auto column = static_cast<Index>(item - r_.triangle_begin);
         for (int k = 0; k < 3; ++k)
           block_.triangles(k, column) = indices_[static_cast<std::size_t>(k)];
       }
@@ -550,7 +550,7 @@ class BlockParser {
       std::vector<int>& items = block_.groups[group_of_.at(key)].items;
       if (key.first <= 1) {
         for (const int i : indices_)
-          if (i >= node_begin_ && i < node_end_) items.push_back(i);
+          if (i >= r_.node_begin && i < r_.node_end) items.push_back(i);
       } else if (mine && ((key.first == 3 && tet) || (key.first == 2 && triangle))) {
         items.push_back(static_cast<int>(item));
       }
@@ -559,26 +559,9 @@ class BlockParser {
 
   // The block's ranges and storage, and the groups in ReadGmsh's order and names.
   void Prepare() {
-    block_.rank = rank_;
-    block_.size = size_;
-    block_.num_nodes = num_nodes_;
-    block_.num_tets = num_tets_;
-    block_.num_triangles = num_triangles_;
-    if (num_tets_ > INT32_MAX || num_triangles_ > INT32_MAX)
-      f_.Fail(
-          fmt::format("{} tets and {} triangles: more than 2^31 - 1", num_tets_, num_triangles_));
-    node_begin_ = BlockBegin(num_nodes_, rank_, size_);
-    node_end_ = BlockBegin(num_nodes_, rank_ + 1, size_);
-    tet_begin_ = BlockBegin(num_tets_, rank_, size_);
-    tet_end_ = BlockBegin(num_tets_, rank_ + 1, size_);
-    triangle_begin_ = BlockBegin(num_triangles_, rank_, size_);
-    triangle_end_ = BlockBegin(num_triangles_, rank_ + 1, size_);
-    block_.first_triangle = triangle_begin_;
-    block_.nodes.resize(3, static_cast<Index>(node_end_ - node_begin_));
-    block_.tets.resize(4, static_cast<Index>(tet_end_ - tet_begin_));
-    block_.triangles.resize(3, static_cast<Index>(triangle_end_ - triangle_begin_));
+    r_ = internal::StartBlock(block_, rank_, size_, num_nodes_, num_tets_, num_triangles_, f_);
     if (num_tets_ > 0) {
-      block_.tet_ids.reserve(static_cast<std::size_t>(tet_end_ - tet_begin_));
+      block_.tet_ids.reserve(static_cast<std::size_t>(r_.tet_end - r_.tet_begin));
       block_.tet_id_kind = "Gmsh element tag";
     }
     std::set<Key> keys = used_keys_;
@@ -611,8 +594,7 @@ class BlockParser {
   // Second pass.
   MeshBlock block_;
   std::map<Key, std::size_t> group_of_;
-  std::int64_t node_begin_ = 0, node_end_ = 0, tet_begin_ = 0, tet_end_ = 0;
-  std::int64_t triangle_begin_ = 0, triangle_end_ = 0;
+  internal::BlockRanges r_;  // the block's items
   std::int64_t tet_counter_ = 0, triangle_counter_ = 0;
   // Scratch.
   std::vector<Key> keys_;

@@ -20,6 +20,7 @@
 #include "gipsi/io/gmsh_block_reader.h"
 #include "gipsi/io/mesh_io.h"
 #include "gipsi/io/tetgen_reader.h"
+#include "gipsi/io/vtk_legacy_reader.h"
 
 namespace gipsi {
 namespace {
@@ -112,13 +113,16 @@ class SceneMeshes final : public MeshProvider {
     if (generate && generate->is_string() && generate->AsString() == "box") {
       block = BoxBlock(node, rank, size);
     } else if (file && file->is_string() &&
-               (IsGmshFile(file->AsString()) || IsTetGenFile(file->AsString()))) {
+               (IsGmshFile(file->AsString()) || IsTetGenFile(file->AsString()) ||
+                LowerExtension(file->AsString()) == ".vtk")) {
       CheckMeshEntry(node);
-      const bool gmsh = IsGmshFile(file->AsString());
-      std::filesystem::path path = file->AsString();
+      const std::string& name = file->AsString();
+      std::filesystem::path path = name;
       if (path.is_relative()) path = base_dir_ / path;
       try {
-        block = gmsh ? ReadGmshBlock(path, rank, size) : ReadTetGenBlock(path, rank, size);
+        block = IsGmshFile(name)     ? ReadGmshBlock(path, rank, size)
+                : IsTetGenFile(name) ? ReadTetGenBlock(path, rank, size)
+                                     : ReadVtkLegacyBlock(path, rank, size);
         if (block && block->num_nodes == 0)  // as ReadMesh refuses it
           ThrowInputError(path.string(), "",
                           fmt::format("the file holds no nodes: an empty mesh, or not a {} file",
@@ -130,8 +134,9 @@ class SceneMeshes final : public MeshProvider {
         Transform(node, *block);
       else if (rank == 0)
         Log().info(
-            "{}: {}: every process reads this Gmsh file whole to cut its block (linear "
-            "elements in one node section are read in blocks)",
+            "{}: {}: every process reads this file whole to cut its block (Gmsh files with "
+            "linear elements in one node section, and VTK unstructured grids, are read in "
+            "blocks)",
             node.file(), file->path());
     }
     if (!block) {  // read whole, sliced, not kept

@@ -1,7 +1,6 @@
 #include "gipsi/io/vtk_legacy_reader.h"
 
 #include <algorithm>
-#include <cctype>
 #include <cmath>
 #include <cstdint>
 #include <string>
@@ -12,41 +11,18 @@
 #include "gipsi/base/error.h"
 #include "gipsi/io/mesh_builder.h"
 #include "gipsi/io/text_reader.h"
+#include "gipsi/io/vtk_legacy_types.h"
 
 namespace gipsi {
 namespace {
 
-using internal::LoadScalar;
 using internal::Quote;
 using internal::TextReader;
 
-std::string Lower(std::string_view s) {
-  std::string out(s);
-  for (char& c : out) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return out;
-}
+using DataType = internal::VtkDataType;
 
-/// A VTK legacy data type.
-struct DataType {
-  int bytes = 0;  // 0: unknown
-  bool is_float = false;
-  bool is_signed = true;
-};
-
-DataType ParseDataType(std::string_view name) {
-  std::string n = Lower(name);
-  if (n == "float" || n == "vtktypefloat32") return {4, true, true};
-  if (n == "double" || n == "vtktypefloat64") return {8, true, true};
-  if (n == "char" || n == "vtktypeint8") return {1, false, true};
-  if (n == "unsigned_char" || n == "vtktypeuint8" || n == "bit") return {1, false, false};
-  if (n == "short" || n == "vtktypeint16") return {2, false, true};
-  if (n == "unsigned_short" || n == "vtktypeuint16") return {2, false, false};
-  if (n == "int" || n == "vtktypeint32") return {4, false, true};
-  if (n == "unsigned_int" || n == "vtktypeuint32") return {4, false, false};
-  if (n == "long" || n == "vtktypeint64" || n == "vtkidtype") return {8, false, true};
-  if (n == "unsigned_long" || n == "vtktypeuint64") return {8, false, false};
-  return {};
-}
+std::string Lower(std::string_view s) { return internal::VtkLower(s); }
+DataType ParseDataType(std::string_view name) { return internal::ParseVtkDataType(name); }
 
 /// Cells as offsets (size n+1) into a connectivity array, plus where they were declared.
 struct CellArray {
@@ -158,31 +134,14 @@ class VtkLegacyParser {
     const char* p = r_.ReadBytes(static_cast<std::size_t>(n * type.bytes), what).data();
     for (std::int64_t i = 0; i < n; ++i, p += type.bytes) {
       if (type.is_float) {
-        double v =
-            type.bytes == 4 ? double(LoadScalar<float>(p, swap)) : LoadScalar<double>(p, swap);
+        const double v = internal::LoadVtkReal(p, type, swap);
         if (!std::isfinite(v))
           r_.FailAtOffset(fmt::format("expected {} (a finite number), got {}", what, v),
                           start + static_cast<std::size_t>(i * type.bytes));
         sink(i, v);
         continue;
       }
-      std::int64_t v = 0;
-      switch (type.bytes) {
-        case 1:
-          v = type.is_signed ? LoadScalar<std::int8_t>(p, swap) : LoadScalar<std::uint8_t>(p, swap);
-          break;
-        case 2:
-          v = type.is_signed ? LoadScalar<std::int16_t>(p, swap)
-                             : LoadScalar<std::uint16_t>(p, swap);
-          break;
-        case 4:
-          v = type.is_signed ? LoadScalar<std::int32_t>(p, swap)
-                             : LoadScalar<std::uint32_t>(p, swap);
-          break;
-        default:
-          v = LoadScalar<std::int64_t>(p, swap);
-          break;
-      }
+      const std::int64_t v = internal::LoadVtkInt(p, type, swap);
       sink(i, v);
     }
   }
