@@ -2,7 +2,9 @@
 // one process's block of it (ReadGmshBlock: two streaming passes through a 1 MiB buffer, the
 // block kept; io/gmsh_block_reader.h), ASCII and binary, on the 0.2 mm N-version slab (315 k
 // tets) written to a temporary file; and the same slab as TetGen files, read whole (ReadTetGen)
-// and as one process's block (ReadTetGenBlock: one streaming pass per file, the block kept).
+// and as one process's block (ReadTetGenBlock: one streaming pass per file, the block kept);
+// and the same slab as a legacy VTK unstructured grid, ASCII and binary, read whole
+// (ReadVtkLegacy) and as one process's block (ReadVtkLegacyBlock: two streaming passes).
 // Run:
 //   ./build/release/bench/mesh_io_bench --benchmark_repetitions=3
 //     --benchmark_report_aggregates_only=true
@@ -10,6 +12,7 @@
 #include <benchmark/benchmark.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdint>
 #include <cstring>
 #include <filesystem>
@@ -22,6 +25,7 @@
 #include "gipsi/io/gmsh_block_reader.h"
 #include "gipsi/io/mesh_io.h"
 #include "gipsi/io/tetgen_reader.h"
+#include "gipsi/io/vtk_legacy_reader.h"
 
 namespace gipsi {
 namespace {
@@ -169,19 +173,95 @@ void BM_ReadTetGenBlock(benchmark::State& state) {
   state.counters["block_tets"] = static_cast<double>(tets);
 }
 
+// The slab as a legacy VTK unstructured grid (classic cell layout, big-endian when binary),
+// once per process and kind.
+const std::filesystem::path& SlabVtk(bool binary) {
+  auto write = [](bool binary) {
+    const Mesh slab = MakeTetBox(Vec3::Zero(), Vec3(0.020, 0.007, 0.003), {100, 35, 15});
+    const bool swap = [] {
+      const std::uint16_t one = 1;
+      unsigned char first = 0;
+      std::memcpy(&first, &one, 1);
+      return first == 1;
+    }();
+    std::string out =
+        fmt::format("# vtk DataFile Version 3.0\nslab\n{}\nDATASET UNSTRUCTURED_GRID\n",
+                    binary ? "BINARY" : "ASCII");
+    auto put = [&](auto v) {
+      char bytes[sizeof(v)];
+      std::memcpy(bytes, &v, sizeof(v));
+      if (swap) std::reverse(bytes, bytes + sizeof(v));
+      out.append(bytes, sizeof(v));
+    };
+    out += fmt::format("POINTS {} double\n", slab.num_nodes());
+    for (Index i = 0; i < slab.num_nodes(); ++i) {
+      for (int k = 0; k < 3; ++k) {
+        if (binary)
+          put(slab.nodes(k, i));
+        else
+          out += fmt::format("{:.17g} ", slab.nodes(k, i));
+      }
+      if (!binary) out += "\n";
+    }
+    out += fmt::format("\nCELLS {} {}\n", slab.num_tets(), 5 * slab.num_tets());
+    for (Index e = 0; e < slab.num_tets(); ++e) {
+      if (binary) {
+        put(std::int32_t{4});
+        for (int k = 0; k < 4; ++k) put(static_cast<std::int32_t>(slab.tets(k, e)));
+      } else {
+        out += fmt::format("4 {} {} {} {}\n", slab.tets(0, e), slab.tets(1, e), slab.tets(2, e),
+                           slab.tets(3, e));
+      }
+    }
+    out += fmt::format("\nCELL_TYPES {}\n", slab.num_tets());
+    for (Index e = 0; e < slab.num_tets(); ++e) {
+      if (binary)
+        put(std::int32_t{10});
+      else
+        out += "10\n";
+    }
+    const auto path =
+        std::filesystem::temp_directory_path() /
+        fmt::format("gipsi_mesh_io_bench_{}_{}.vtk", ::getpid(), binary ? "binary" : "ascii");
+    std::ofstream(path, std::ios::binary) << out;
+    return path;
+  };
+  static const std::filesystem::path ascii = write(false), binary_path = write(true);
+  return binary ? binary_path : ascii;
+}
+
+void BM_ReadVtkWhole(benchmark::State& state) {
+  const auto& path = SlabVtk(state.range(0) != 0);
+  Index tets = 0;
+  for (auto _ : state) tets = ReadVtkLegacy(path).num_tets();
+  state.counters["tets"] = static_cast<double>(tets);
+}
+
+// Rank 0 of 2's block: the same work as any rank's (the file is read twice through).
+void BM_ReadVtkBlock(benchmark::State& state) {
+  const auto& path = SlabVtk(state.range(0) != 0);
+  Index tets = 0;
+  for (auto _ : state) tets = ReadVtkLegacyBlock(path, 0, 2)->tets.cols();
+  state.counters["block_tets"] = static_cast<double>(tets);
+}
+
 BENCHMARK(BM_ReadMeshWhole)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_ReadGmshBlock)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_ReadTetGenWhole)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_ReadTetGenBlock)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_ReadVtkWhole)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_ReadVtkBlock)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
 
 // The temporary files go when the benchmark ends.
 struct Cleanup {
   ~Cleanup() {
     std::error_code ignored;
     for (const char* kind : {"ascii", "binary"})
-      std::filesystem::remove(std::filesystem::temp_directory_path() /
-                                  fmt::format("gipsi_mesh_io_bench_{}_{}.msh", ::getpid(), kind),
-                              ignored);
+      for (const char* extension : {"msh", "vtk"})
+        std::filesystem::remove(
+            std::filesystem::temp_directory_path() /
+                fmt::format("gipsi_mesh_io_bench_{}_{}.{}", ::getpid(), kind, extension),
+            ignored);
     for (const char* extension : {"node", "ele"})
       std::filesystem::remove(
           std::filesystem::temp_directory_path() /
