@@ -266,7 +266,9 @@ TEST(GmshBlockReader, EveryBlockOfAnOlderFormatIsTheWholeReadersSlice) {
       const Mesh whole = ReadMesh(path);
       ASSERT_EQ(whole.num_tets(), box.num_tets());
       ASSERT_EQ(whole.groups.size(), 5U);
-      if (version != "1.0") EXPECT_EQ(whole.groups[1].name, "tissue_dim2");
+      if (version != "1.0") {
+        EXPECT_EQ(whole.groups[1].name, "tissue_dim2");
+      }
       for (int size : {1, 3, 7}) {
         for (int rank = 0; rank < size; ++rank) {
           const auto block = ReadGmshBlock(path, rank, size);
@@ -280,8 +282,9 @@ TEST(GmshBlockReader, EveryBlockOfAnOlderFormatIsTheWholeReadersSlice) {
   }
 }
 
-// Second-order elements and a file of two node sections are not read in blocks (the caller reads
-// the whole file instead); mistakes are named with the file and the line or byte offset.
+// Second-order elements and a file of two node or element sections are not read in blocks (the
+// caller reads the whole file instead); mistakes are named with the file and the line or byte
+// offset.
 TEST(GmshBlockReader, OtherFilesAreLeftToTheWholeReaderAndMistakesAreNamed) {
   const std::filesystem::path dir = testing::TestTempDir();
   auto write = [&](const std::string& name, const std::string& text) {
@@ -299,6 +302,11 @@ TEST(GmshBlockReader, OtherFilesAreLeftToTheWholeReaderAndMistakesAreNamed) {
   const auto two_sections =
       write("two.msh", "$NOD\n1\n1 0 0 0\n$ENDNOD\n$NOD\n1\n2 1 0 0\n$ENDNOD\n");
   EXPECT_FALSE(ReadGmshBlock(two_sections, 0, 2).has_value());
+  const auto two_element_sections =
+      write("two_elements.msh", v2_head + "$Elements\n1\n1 4 2 1 1 1 2 3 4\n$EndElements\n" +
+                                    "$Elements\n1\n2 4 2 1 1 1 2 4 3\n$EndElements\n");
+  EXPECT_EQ(ReadMesh(two_element_sections).num_tets(), 2);
+  EXPECT_FALSE(ReadGmshBlock(two_element_sections, 0, 2).has_value());
   const auto v3 = write("v3.msh", "$MeshFormat\n3.0 0 8\n$EndMeshFormat\n");
   EXPECT_FALSE(ReadGmshBlock(v3, 0, 2).has_value());  // ReadMesh says why it is refused
   const std::string head =

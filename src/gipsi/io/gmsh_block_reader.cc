@@ -55,7 +55,7 @@ class BlockParser {
   // One pass over the file; false if it is not read in blocks (first pass only).
   bool Pass(bool extract) {
     f_.Rewind();
-    bool have_format = false, have_nodes = false;
+    bool have_format = false, have_nodes = false, have_elements = false;
     std::string_view line;
     while (f_.NextContentLine(&line)) {
       if (line == "$MeshFormat") {
@@ -78,6 +78,8 @@ class BlockParser {
         if (line == "$Elements" && !have_format) f_.Fail("$Elements before $MeshFormat");
         if (!have_nodes)
           f_.Fail(fmt::format("{} before {}", line, line == "$ELM" ? "$NOD" : "$Nodes"));
+        if (have_elements) return false;  // more than one element section: read whole
+        have_elements = true;
         const bool done = line == "$ELM" ? ElementsV1V2(extract, "$ENDELM", true)
                           : major_ == 4  ? Elements(extract)
                                          : ElementsV1V2(extract, "$EndElements", false);
