@@ -23,9 +23,9 @@ namespace gipsi {
 ///
 /// Reads formats 1.0, 2.x (ASCII and binary) and 4.1 (ASCII and binary) with linear elements.
 /// Returns nothing for a file it does not read in blocks (second-order elements, more than one
-/// node or element section, a version ReadGmsh refuses): read such a file whole (ReadMesh), which reads or
-/// refuses it, and slice it. Throws InputError naming the file and the line (or byte offset in
-/// binary data) for the errors ReadGmsh reports.
+/// node or element section, a version ReadGmsh refuses): read such a file whole (ReadMesh), which
+/// reads or refuses it, and slice it. Throws InputError naming the file and the line (or byte
+/// offset in binary data) for the errors ReadGmsh reports.
 std::optional<MeshBlock> ReadGmshBlock(const std::filesystem::path& path, int rank, int size);
 
 }  // namespace gipsi
