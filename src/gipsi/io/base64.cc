@@ -43,50 +43,65 @@ std::string EncodeBase64(std::string_view bytes) {
   return out;
 }
 
-std::optional<std::string> DecodeBase64(std::string_view text, std::size_t* bad_at) {
-  std::string out;
-  out.reserve(text.size() / 4 * 3);
-  std::uint32_t acc = 0;
-  int have = 0;  // characters in the current 4-character group
+bool Base64Decoder::Feed(std::string_view text, std::string& out, std::size_t* bad_at) {
   auto flush = [&] {
-    if (have == 2) out += static_cast<char>(acc >> 4);
-    if (have == 3) {
-      out += static_cast<char>(acc >> 10);
-      out += static_cast<char>((acc >> 2) & 0xff);
+    if (have_ == 2) out += static_cast<char>(acc_ >> 4);
+    if (have_ == 3) {
+      out += static_cast<char>(acc_ >> 10);
+      out += static_cast<char>((acc_ >> 2) & 0xff);
     }
-    acc = 0;
-    have = 0;
+    acc_ = 0;
+    have_ = 0;
   };
   for (std::size_t i = 0; i < text.size(); ++i) {
     auto c = static_cast<unsigned char>(text[i]);
     if (c == ' ' || c == '\n' || c == '\r' || c == '\t') continue;
     if (c == '=') {
-      if (have == 1) {
-        if (bad_at != nullptr) *bad_at = i;
-        return std::nullopt;
+      if (have_ == 1) {
+        if (bad_at != nullptr) *bad_at = fed_ + i;
+        return false;
       }
       flush();
       continue;
     }
     std::int8_t v = kDecode[c];
     if (v < 0) {
-      if (bad_at != nullptr) *bad_at = i;
-      return std::nullopt;
+      if (bad_at != nullptr) *bad_at = fed_ + i;
+      return false;
     }
-    acc = acc << 6 | static_cast<std::uint32_t>(v);
-    if (++have == 4) {
-      out += static_cast<char>(acc >> 16);
-      out += static_cast<char>((acc >> 8) & 0xff);
-      out += static_cast<char>(acc & 0xff);
-      acc = 0;
-      have = 0;
+    acc_ = acc_ << 6 | static_cast<std::uint32_t>(v);
+    if (++have_ == 4) {
+      out += static_cast<char>(acc_ >> 16);
+      out += static_cast<char>((acc_ >> 8) & 0xff);
+      out += static_cast<char>(acc_ & 0xff);
+      acc_ = 0;
+      have_ = 0;
     }
   }
-  if (have == 1) {
-    if (bad_at != nullptr) *bad_at = text.size();
-    return std::nullopt;
+  fed_ += text.size();
+  return true;
+}
+
+bool Base64Decoder::Finish(std::string& out, std::size_t* bad_at) {
+  if (have_ == 1) {
+    if (bad_at != nullptr) *bad_at = fed_;
+    return false;
   }
-  flush();
+  if (have_ == 2) out += static_cast<char>(acc_ >> 4);
+  if (have_ == 3) {
+    out += static_cast<char>(acc_ >> 10);
+    out += static_cast<char>((acc_ >> 2) & 0xff);
+  }
+  acc_ = 0;
+  have_ = 0;
+  return true;
+}
+
+std::optional<std::string> DecodeBase64(std::string_view text, std::size_t* bad_at) {
+  std::string out;
+  out.reserve(text.size() / 4 * 3);
+  Base64Decoder decoder;
+  if (!decoder.Feed(text, out, bad_at) || !decoder.Finish(out, bad_at)) return std::nullopt;
   return out;
 }
 

@@ -53,7 +53,7 @@ class ChunkedFile {
     if (S_ISDIR(info.st_mode)) fail("is a directory, expected a mesh file");
     if (!S_ISREG(info.st_mode))
       fail("is not a regular file (a device, pipe or socket), expected a mesh file");
-    size_ = static_cast<std::uint64_t>(info.st_size);
+    size_ = limit_ = static_cast<std::uint64_t>(info.st_size);
     // A small file needs no more than itself (and one byte to see its end).
     buffer_.resize(static_cast<std::size_t>(std::min<std::uint64_t>(kChunk, size_ + 1)));
   }
@@ -68,11 +68,34 @@ class ChunkedFile {
       ThrowInputError(source_, "", fmt::format("cannot read mesh file: {}", std::strerror(errno)));
     begin_ = end_ = 0;
     base_ = 0;
+    limit_ = size_;
     line_ = last_line_ = 1;
     eof_ = false;
   }
+  /// Reads on from byte `begin` as if the file ended at byte `end` (at most its size). The line
+  /// count restarts at 1: messages about what follows name the offset or their own place.
+  void Seek(std::uint64_t begin, std::uint64_t end) {
+    limit_ = std::min(end, size_);
+    begin = std::min(begin, limit_);
+    if (::lseek(fd_, static_cast<off_t>(begin), SEEK_SET) != static_cast<off_t>(begin))
+      ThrowInputError(source_, "", fmt::format("cannot read mesh file: {}", std::strerror(errno)));
+    begin_ = end_ = 0;
+    base_ = begin;
+    line_ = last_line_ = 1;
+    eof_ = begin == limit_;
+  }
   [[nodiscard]] std::uint64_t offset() const { return base_ + begin_; }
-  [[nodiscard]] std::uint64_t remaining() const { return size_ - offset(); }
+  [[nodiscard]] std::uint64_t remaining() const { return limit_ - offset(); }
+  [[nodiscard]] std::uint64_t size() const { return size_; }
+  /// The next bytes, at most `max` and at least one before the end (empty there), consumed
+  /// without counting their lines: for binary data, or text whose lines the caller counts.
+  std::string_view Take(std::size_t max) {
+    if (begin_ == end_) Fill(1);
+    const std::size_t n = std::min(max, end_ - begin_);
+    std::string_view bytes(buffer_.data() + begin_, n);
+    begin_ += n;
+    return bytes;
+  }
 
   bool NextLine(std::string_view* out) {
     for (;;) {
@@ -263,7 +286,9 @@ class ChunkedFile {
       buffer_.resize(std::max(need, 2 * buffer_.size()));
     }
     while (end_ < need && !eof_) {
-      const ssize_t got = ::read(fd_, buffer_.data() + end_, buffer_.size() - end_);
+      const std::uint64_t room =
+          std::min<std::uint64_t>(buffer_.size() - end_, limit_ - base_ - end_);
+      const ssize_t got = room == 0 ? 0 : ::read(fd_, buffer_.data() + end_, room);
       if (got < 0 && errno == EINTR) continue;
       if (got < 0)
         ThrowInputError(source_, "",
@@ -275,7 +300,7 @@ class ChunkedFile {
 
   std::string source_;
   int fd_ = -1;
-  std::uint64_t size_ = 0;
+  std::uint64_t size_ = 0, limit_ = 0;  // the file's size; where reading stops (Seek)
   std::string buffer_;
   std::size_t begin_ = 0, end_ = 0;  // the unread bytes held
   std::uint64_t base_ = 0;           // file offset of buffer_[0]

@@ -1,8 +1,8 @@
 #pragma once
 /// @file
-/// Internal helper of the legacy VTK readers (vtk_legacy_reader.h: the whole file and one
-/// process's block): the data types a legacy file names and how its big-endian binary values
-/// load. Not part of the public API.
+/// Internal helper of the VTK readers (vtk_legacy_reader.h and vtu_reader.h: the whole file and
+/// one process's block): the data types a legacy or XML file names and how binary values load.
+/// Not part of the public API.
 
 #include <cctype>
 #include <cstdint>
@@ -41,6 +41,25 @@ inline VtkDataType ParseVtkDataType(std::string_view name) {
   if (n == "unsigned_long" || n == "vtktypeuint64") return {8, false, false};
   return {};
 }
+
+/// The type a VTK XML file names ("Float32", "UInt8", ...); bytes 0 for an unknown name.
+inline VtkDataType ParseVtuDataType(std::string_view name) {
+  if (name == "Float32") return {4, true, true};
+  if (name == "Float64") return {8, true, true};
+  if (name == "Int8") return {1, false, true};
+  if (name == "UInt8") return {1, false, false};
+  if (name == "Int16") return {2, false, true};
+  if (name == "UInt16") return {2, false, false};
+  if (name == "Int32") return {4, false, true};
+  if (name == "UInt32") return {4, false, false};
+  if (name == "Int64") return {8, false, true};
+  if (name == "UInt64") return {8, false, false};
+  return {};
+}
+
+/// Largest expansion zlib can achieve (deflate's limit is about 1032:1): a VTK XML array whose
+/// declared size exceeds its compressed bytes by more is refused before anything is allocated.
+constexpr std::uint64_t kMaxZlibRatio = 1100;
 
 /// The binary value of a real `type` at `p` (`swap`: the host is little-endian).
 inline double LoadVtkReal(const char* p, VtkDataType type, bool swap) {

@@ -18,6 +18,7 @@
 #include "gipsi/io/base64.h"
 #include "gipsi/io/mesh_builder.h"
 #include "gipsi/io/text_reader.h"
+#include "gipsi/io/vtk_legacy_types.h"
 
 namespace gipsi {
 namespace {
@@ -25,29 +26,9 @@ namespace {
 using internal::LoadScalar;
 using internal::Quote;
 
-/// Largest expansion zlib can achieve (deflate's limit is about 1032:1).
-constexpr std::uint64_t kMaxZlibRatio = 1100;
-
-/// A VTK XML element type.
-struct ArrayType {
-  int bytes = 0;  // 0: unknown
-  bool is_float = false;
-  bool is_signed = true;
-};
-
-ArrayType ParseArrayType(std::string_view name) {
-  if (name == "Float32") return {4, true, true};
-  if (name == "Float64") return {8, true, true};
-  if (name == "Int8") return {1, false, true};
-  if (name == "UInt8") return {1, false, false};
-  if (name == "Int16") return {2, false, true};
-  if (name == "UInt16") return {2, false, false};
-  if (name == "Int32") return {4, false, true};
-  if (name == "UInt32") return {4, false, false};
-  if (name == "Int64") return {8, false, true};
-  if (name == "UInt64") return {8, false, false};
-  return {};
-}
+using internal::kMaxZlibRatio;
+using internal::LoadVtkInt;
+using internal::LoadVtkReal;
 
 class VtuParser {
  public:
@@ -210,7 +191,7 @@ class VtuParser {
   template <class T>
   std::vector<T> ReadArray(const pugi::xml_node& node, std::uint64_t count) {
     std::string_view type_name = node.attribute("type").value();
-    ArrayType type = ParseArrayType(type_name);
+    internal::VtkDataType type = internal::ParseVtuDataType(type_name);
     if (type.bytes == 0) Fail(node, fmt::format("unsupported type {}", Quote(type_name)));
     constexpr bool kWantInt = std::is_integral_v<T>;
     if (kWantInt && type.is_float) Fail(node, "expected an integer type");
@@ -265,30 +246,12 @@ class VtuParser {
     const char* p = payload.data();
     for (std::size_t i = 0; i < out.size(); ++i, p += type.bytes) {
       if (type.is_float) {
-        double v =
-            type.bytes == 4 ? double(LoadScalar<float>(p, swap_)) : LoadScalar<double>(p, swap_);
+        double v = LoadVtkReal(p, type, swap_);
         if (!std::isfinite(v)) Fail(node, fmt::format("value {} is not finite", i));
         out[i] = static_cast<T>(v);
         continue;
       }
-      std::int64_t v = 0;
-      switch (type.bytes) {
-        case 1:
-          v = type.is_signed ? LoadScalar<std::int8_t>(p, swap_)
-                             : LoadScalar<std::uint8_t>(p, swap_);
-          break;
-        case 2:
-          v = type.is_signed ? LoadScalar<std::int16_t>(p, swap_)
-                             : LoadScalar<std::uint16_t>(p, swap_);
-          break;
-        case 4:
-          v = type.is_signed ? LoadScalar<std::int32_t>(p, swap_)
-                             : LoadScalar<std::uint32_t>(p, swap_);
-          break;
-        default:
-          v = LoadScalar<std::int64_t>(p, swap_);
-          break;
-      }
+      std::int64_t v = LoadVtkInt(p, type, swap_);
       out[i] = static_cast<T>(v);
     }
     return out;
