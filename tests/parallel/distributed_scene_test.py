@@ -644,15 +644,15 @@ with tempfile.TemporaryDirectory() as work:
     for ranks in (2, 4):
         compare_probes(f"region probes on {ranks} ranks", region_runs[1], region_runs[ranks],
                        ("box_mean", "face_max", "ids_sum", "middle"), {"ids_sum": 3})
-    # The slab's box as a Gmsh 4.1 file and as a legacy VTK file (another tet mesh of it, written
-    # by bench/mpi/slab_msh.py: six tets per cell, each cell cut along its main diagonal), which
-    # each rank reads in blocks: the serial run's probes, within the bounds above, on 2 and 4
-    # ranks.
+    # The slab's box as a Gmsh 4.1 file, a legacy VTK file and a compressed VTK XML file
+    # (another tet mesh of it, written by bench/mpi/slab_msh.py: six tets per cell, each cell cut
+    # along its main diagonal), which each rank reads in blocks: the serial run's probes, within
+    # the bounds above, on 2 and 4 ranks.
     written = subprocess.run([sys.executable, os.path.join(SOURCE, "bench", "mpi", "slab_msh.py"),
-                              "40", "14", "6", os.path.join(work, "slab"), "--vtk"],
+                              "40", "14", "6", os.path.join(work, "slab"), "--vtk", "--vtu"],
                              capture_output=True, text=True, timeout=60)
     check(written.returncode == 0, f"slab_msh.py: {written.stdout}{written.stderr}")
-    for kind in ("msh", "vtk"):
+    for kind in ("msh", "vtk", "vtu"):
         with open(SCENE) as f:
             scene = json.load(f)
         scene["meshes"]["slab"] = {"file": os.path.join(work, "slab." + kind)}

@@ -21,6 +21,7 @@
 #include "gipsi/io/mesh_io.h"
 #include "gipsi/io/tetgen_reader.h"
 #include "gipsi/io/vtk_legacy_reader.h"
+#include "gipsi/io/vtu_block_reader.h"
 
 namespace gipsi {
 namespace {
@@ -114,15 +115,17 @@ class SceneMeshes final : public MeshProvider {
       block = BoxBlock(node, rank, size);
     } else if (file && file->is_string() &&
                (IsGmshFile(file->AsString()) || IsTetGenFile(file->AsString()) ||
-                LowerExtension(file->AsString()) == ".vtk")) {
+                LowerExtension(file->AsString()) == ".vtk" ||
+                LowerExtension(file->AsString()) == ".vtu")) {
       CheckMeshEntry(node);
       const std::string& name = file->AsString();
       std::filesystem::path path = name;
       if (path.is_relative()) path = base_dir_ / path;
       try {
-        block = IsGmshFile(name)     ? ReadGmshBlock(path, rank, size)
-                : IsTetGenFile(name) ? ReadTetGenBlock(path, rank, size)
-                                     : ReadVtkLegacyBlock(path, rank, size);
+        block = IsGmshFile(name)                 ? ReadGmshBlock(path, rank, size)
+                : IsTetGenFile(name)             ? ReadTetGenBlock(path, rank, size)
+                : LowerExtension(name) == ".vtk" ? ReadVtkLegacyBlock(path, rank, size)
+                                                 : ReadVtuBlock(path, rank, size);
         if (block && block->num_nodes == 0)  // as ReadMesh refuses it
           ThrowInputError(path.string(), "",
                           fmt::format("the file holds no nodes: an empty mesh, or not a {} file",
@@ -135,8 +138,8 @@ class SceneMeshes final : public MeshProvider {
       else if (rank == 0)
         Log().info(
             "{}: {}: every process reads this file whole to cut its block (Gmsh files with "
-            "linear elements in one node section, and VTK unstructured grids, are read in "
-            "blocks)",
+            "linear elements in one node section, and VTK unstructured grids with linear cells "
+            "in one piece, are read in blocks)",
             node.file(), file->path());
     }
     if (!block) {  // read whole, sliced, not kept
