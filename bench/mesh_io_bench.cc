@@ -4,13 +4,17 @@
 // tets) written to a temporary file; and the same slab as TetGen files, read whole (ReadTetGen)
 // and as one process's block (ReadTetGenBlock: one streaming pass per file, the block kept);
 // and the same slab as a legacy VTK unstructured grid, ASCII and binary, read whole
-// (ReadVtkLegacy) and as one process's block (ReadVtkLegacyBlock: two streaming passes).
+// (ReadVtkLegacy) and as one process's block (ReadVtkLegacyBlock: two streaming passes); and
+// the same slab as a VTK XML grid, in the layout GiPSi writes (inline base64) and in VTK's
+// compressed one (raw appended data, zlib blocks of 32 KiB), read whole (ReadVtu) and as one
+// process's block (ReadVtuBlock: each array streamed through its own buffer).
 // Run:
 //   ./build/release/bench/mesh_io_bench --benchmark_repetitions=3
 //     --benchmark_report_aggregates_only=true
 
 #include <benchmark/benchmark.h>
 #include <unistd.h>
+#include <zlib.h>
 
 #include <algorithm>
 #include <cstdint>
@@ -18,6 +22,8 @@
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <string_view>
+#include <vector>
 
 #include <fmt/format.h>
 
@@ -26,6 +32,9 @@
 #include "gipsi/io/mesh_io.h"
 #include "gipsi/io/tetgen_reader.h"
 #include "gipsi/io/vtk_legacy_reader.h"
+#include "gipsi/io/vtu_block_reader.h"
+#include "gipsi/io/vtu_reader.h"
+#include "gipsi/io/vtu_writer.h"
 
 namespace gipsi {
 namespace {
@@ -245,19 +254,108 @@ void BM_ReadVtkBlock(benchmark::State& state) {
   state.counters["block_tets"] = static_cast<double>(tets);
 }
 
+// VTK's compressed binary block of `data` (UInt64 header: block count, block size, last
+// block's size, each block's compressed size; then the zlib blocks), as vtkXMLWriter writes it.
+std::string CompressedVtuBlock(std::string_view data) {
+  constexpr std::size_t kBlock = 32768;
+  std::vector<std::string> blocks;
+  for (std::size_t p = 0; p < data.size(); p += kBlock) {
+    const std::size_t n = std::min(kBlock, data.size() - p);
+    uLongf size = compressBound(static_cast<uLong>(n));
+    std::string block(size, '\0');
+    compress(reinterpret_cast<Bytef*>(block.data()), &size,
+             reinterpret_cast<const Bytef*>(data.data() + p), static_cast<uLong>(n));
+    block.resize(size);
+    blocks.push_back(std::move(block));
+  }
+  std::string out;
+  auto put = [&](std::uint64_t v) { out.append(reinterpret_cast<const char*>(&v), 8); };
+  put(blocks.size());
+  put(kBlock);
+  put(data.size() % kBlock);
+  for (const auto& b : blocks) put(b.size());
+  for (const auto& b : blocks) out += b;
+  return out;
+}
+
+// The slab as a .vtu: GiPSi's own layout (WriteVtu: inline base64), or VTK's compressed one.
+const std::filesystem::path& SlabVtu(bool compressed) {
+  auto write = [](bool compressed) {
+    const Mesh slab = MakeTetBox(Vec3::Zero(), Vec3(0.020, 0.007, 0.003), {100, 35, 15});
+    const auto path =
+        std::filesystem::temp_directory_path() /
+        fmt::format("gipsi_mesh_io_bench_{}_{}.vtu", ::getpid(), compressed ? "binary" : "ascii");
+    if (!compressed) {
+      WriteVtu(path, slab.nodes, slab.tets, Triangles(3, 0));
+      return path;
+    }
+    std::vector<std::int64_t> conn(slab.tets.data(), slab.tets.data() + slab.tets.size());
+    std::vector<std::int64_t> offsets(static_cast<std::size_t>(slab.num_tets()));
+    for (std::size_t e = 0; e < offsets.size(); ++e) offsets[e] = 4 * std::int64_t(e + 1);
+    const std::string types(offsets.size(), '\x0a');
+    auto bytes = [](const auto& v) {
+      return std::string_view(reinterpret_cast<const char*>(v.data()),
+                              v.size() * sizeof(v.data()[0]));
+    };
+    const std::string arrays[] = {
+        CompressedVtuBlock(std::string_view(reinterpret_cast<const char*>(slab.nodes.data()),
+                                            sizeof(double) * slab.nodes.size())),
+        CompressedVtuBlock(bytes(conn)), CompressedVtuBlock(bytes(offsets)),
+        CompressedVtuBlock(types)};
+    std::size_t at[4] = {};
+    for (int a = 1; a < 4; ++a) at[a] = at[a - 1] + arrays[a - 1].size();
+    std::string out = fmt::format(
+        "<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" "
+        "byte_order=\"LittleEndian\" header_type=\"UInt64\" "
+        "compressor=\"vtkZLibDataCompressor\">\n<UnstructuredGrid>\n"
+        "<Piece NumberOfPoints=\"{}\" NumberOfCells=\"{}\">\n<Points>\n"
+        "<DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"appended\" "
+        "offset=\"{}\"/>\n</Points>\n<Cells>\n"
+        "<DataArray type=\"Int64\" Name=\"connectivity\" format=\"appended\" offset=\"{}\"/>\n"
+        "<DataArray type=\"Int64\" Name=\"offsets\" format=\"appended\" offset=\"{}\"/>\n"
+        "<DataArray type=\"UInt8\" Name=\"types\" format=\"appended\" offset=\"{}\"/>\n"
+        "</Cells>\n</Piece>\n</UnstructuredGrid>\n<AppendedData encoding=\"raw\">\n_",
+        slab.num_nodes(), slab.num_tets(), at[0], at[1], at[2], at[3]);
+    for (const auto& a : arrays) out += a;
+    out += "\n</AppendedData>\n</VTKFile>\n";
+    std::ofstream(path, std::ios::binary) << out;
+    return path;
+  };
+  static const std::filesystem::path inline_path = write(false), compressed_path = write(true);
+  return compressed ? compressed_path : inline_path;
+}
+
+void BM_ReadVtuWhole(benchmark::State& state) {
+  const auto& path = SlabVtu(state.range(0) != 0);
+  Index tets = 0;
+  for (auto _ : state) tets = ReadVtu(path).num_tets();
+  state.counters["tets"] = static_cast<double>(tets);
+}
+
+// Rank 0 of 2's block: the same work as any rank's (every array is decoded through).
+void BM_ReadVtuBlock(benchmark::State& state) {
+  const auto& path = SlabVtu(state.range(0) != 0);
+  Index tets = 0;
+  for (auto _ : state) tets = ReadVtuBlock(path, 0, 2)->tets.cols();
+  state.counters["block_tets"] = static_cast<double>(tets);
+}
+
 BENCHMARK(BM_ReadMeshWhole)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_ReadGmshBlock)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_ReadTetGenWhole)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_ReadTetGenBlock)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_ReadVtkWhole)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_ReadVtkBlock)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
+// Arg 0: GiPSi's inline base64; 1: VTK's compressed appended data.
+BENCHMARK(BM_ReadVtuWhole)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_ReadVtuBlock)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
 
 // The temporary files go when the benchmark ends.
 struct Cleanup {
   ~Cleanup() {
     std::error_code ignored;
     for (const char* kind : {"ascii", "binary"})
-      for (const char* extension : {"msh", "vtk"})
+      for (const char* extension : {"msh", "vtk", "vtu"})
         std::filesystem::remove(
             std::filesystem::temp_directory_path() /
                 fmt::format("gipsi_mesh_io_bench_{}_{}.{}", ::getpid(), kind, extension),
