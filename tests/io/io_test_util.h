@@ -3,6 +3,7 @@
 /// Helpers shared by the mesh I/O tests: paths of test inputs, per-test scratch files, byte
 /// builders for binary formats, capturing InputError messages, and comparing mesh blocks.
 
+#include <algorithm>
 #include <cstdint>
 #include <cstring>
 #include <filesystem>
@@ -10,6 +11,7 @@
 #include <functional>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -129,6 +131,56 @@ inline bool LittleEndianHost() {
   char first = 0;
   std::memcpy(&first, &one, 1);
   return first == 1;
+}
+
+/// A zlib stream made of "stored" (uncompressed) deflate blocks: valid input for any inflater,
+/// written without zlib so that the tests do not share code with the readers.
+inline std::string StoredZlib(std::string_view data) {
+  std::string out = "\x78\x01";
+  std::size_t pos = 0;
+  do {
+    auto n = static_cast<std::uint16_t>(std::min<std::size_t>(65535, data.size() - pos));
+    out += static_cast<char>(pos + n == data.size() ? 1 : 0);
+    Put<std::uint16_t>(out, n, !LittleEndianHost());
+    Put<std::uint16_t>(out, static_cast<std::uint16_t>(~n), !LittleEndianHost());
+    out.append(data.substr(pos, n));
+    pos += n;
+  } while (pos < data.size());
+  std::uint32_t a = 1, b = 0;
+  for (char c : data) {
+    a = (a + static_cast<unsigned char>(c)) % 65521;
+    b = (b + a) % 65521;
+  }
+  Put<std::uint32_t>(out, b << 16 | a, LittleEndianHost());  // big-endian
+  return out;
+}
+
+/// A VTK cell: its type and points.
+struct VtkCell {
+  int type;
+  std::vector<Index> points;
+};
+
+/// The box's tets and triangles as VTK cells, interleaved (a triangle after every third tet),
+/// with a vertex first, a line and an empty polyvertex in the middle: cells the readers skip.
+inline std::vector<VtkCell> BoxCells(const Mesh& box) {
+  std::vector<VtkCell> cells = {{1, {0}}};
+  Index triangle = 0;
+  auto add_triangle = [&] {
+    cells.push_back(
+        {5, {box.triangles(0, triangle), box.triangles(1, triangle), box.triangles(2, triangle)}});
+    ++triangle;
+  };
+  for (Index e = 0; e < box.num_tets(); ++e) {
+    cells.push_back({10, {box.tets(0, e), box.tets(1, e), box.tets(2, e), box.tets(3, e)}});
+    if (e % 3 == 2 && triangle < box.num_triangles()) add_triangle();
+    if (e == box.num_tets() / 2) {
+      cells.push_back({3, {0, 1}});
+      cells.push_back({2, {}});
+    }
+  }
+  while (triangle < box.num_triangles()) add_triangle();
+  return cells;
 }
 
 /// `a` and `b` are the same block of a mesh (every field of MeshBlock); `what` names the case.

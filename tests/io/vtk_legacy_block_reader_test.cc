@@ -17,41 +17,14 @@
 namespace gipsi {
 namespace {
 
+using test::BoxCells;
 using test::Put;
 using test::Scratch;
+using test::VtkCell;
 using test::WriteBytes;
 using ::testing::HasSubstr;
 
 const bool kSwap = test::LittleEndianHost();  // legacy VTK binary is big-endian
-
-struct Cell {
-  int type;
-  std::vector<Index> points;
-};
-
-// The box's tets and triangles as VTK cells, interleaved (a triangle after every third tet),
-// with a vertex first, a line and an empty polyvertex in the middle: cells the readers skip.
-std::vector<Cell> BoxCells(const Mesh& box) {
-  std::vector<Cell> cells = {{1, {0}}};
-  Index triangle = 0;
-  for (Index e = 0; e < box.num_tets(); ++e) {
-    cells.push_back({10, {box.tets(0, e), box.tets(1, e), box.tets(2, e), box.tets(3, e)}});
-    if (e % 3 == 2 && triangle < box.num_triangles()) {
-      cells.push_back(
-          {5,
-           {box.triangles(0, triangle), box.triangles(1, triangle), box.triangles(2, triangle)}});
-      ++triangle;
-    }
-    if (e == box.num_tets() / 2) {
-      cells.push_back({3, {0, 1}});
-      cells.push_back({2, {}});
-    }
-  }
-  for (; triangle < box.num_triangles(); ++triangle)
-    cells.push_back(
-        {5, {box.triangles(0, triangle), box.triangles(1, triangle), box.triangles(2, triangle)}});
-  return cells;
-}
 
 // The box as a legacy VTK unstructured grid: ASCII or BINARY, the classic cell layout or VTK
 // 5.1's OFFSETS/CONNECTIVITY; a FIELD before the points, METADATA after them, and CELL_DATA at
@@ -79,9 +52,9 @@ std::string BoxAsVtk(const Mesh& box, bool binary, bool layout51) {
     s += "\n";
   }
   s += "METADATA\nINFORMATION 0\n\n";
-  const std::vector<Cell> cells = BoxCells(box);
+  const std::vector<VtkCell> cells = BoxCells(box);
   std::vector<std::int64_t> offsets{0}, connectivity, classic, types;
-  for (const Cell& cell : cells) {
+  for (const VtkCell& cell : cells) {
     classic.push_back(static_cast<std::int64_t>(cell.points.size()));
     for (Index p : cell.points) {
       classic.push_back(p);

@@ -27,33 +27,14 @@
 namespace gipsi {
 namespace {
 
+using test::BoxCells;
 using test::InputErrorMessage;
 using test::Put;
 using test::Scratch;
+using test::StoredZlib;
+using test::VtkCell;
 using test::WriteBytes;
 using ::testing::HasSubstr;
-
-/// A zlib stream made of "stored" (uncompressed) deflate blocks: valid input for any inflater,
-/// written here without zlib so that the test does not share code with the reader.
-std::string StoredZlib(std::string_view data) {
-  std::string out = "\x78\x01";
-  std::size_t pos = 0;
-  do {
-    auto n = static_cast<std::uint16_t>(std::min<std::size_t>(65535, data.size() - pos));
-    out += static_cast<char>(pos + n == data.size() ? 1 : 0);
-    Put<std::uint16_t>(out, n, !test::LittleEndianHost());
-    Put<std::uint16_t>(out, static_cast<std::uint16_t>(~n), !test::LittleEndianHost());
-    out.append(data.substr(pos, n));
-    pos += n;
-  } while (pos < data.size());
-  std::uint32_t a = 1, b = 0;
-  for (char c : data) {
-    a = (a + static_cast<unsigned char>(c)) % 65521;
-    b = (b + a) % 65521;
-  }
-  Put<std::uint32_t>(out, b << 16 | a, test::LittleEndianHost());  // big-endian
-  return out;
-}
 
 /// How a file's arrays are stored: every form ReadVtu reads.
 enum class Layout {
@@ -141,35 +122,6 @@ std::vector<Variant> AllVariants() {
     for (bool header64 : {false, true})
       for (bool big_endian : {false, true}) out.push_back({layout, header64, big_endian});
   return out;
-}
-
-struct Cell {
-  int type;
-  std::vector<Index> points;
-};
-
-// The box's tets and triangles as VTK cells, interleaved (a triangle after every third tet),
-// with a vertex first, a line and an empty polyvertex in the middle: cells the readers skip.
-std::vector<Cell> BoxCells(const Mesh& box) {
-  std::vector<Cell> cells = {{1, {0}}};
-  Index triangle = 0;
-  for (Index e = 0; e < box.num_tets(); ++e) {
-    cells.push_back({10, {box.tets(0, e), box.tets(1, e), box.tets(2, e), box.tets(3, e)}});
-    if (e % 3 == 2 && triangle < box.num_triangles()) {
-      cells.push_back(
-          {5,
-           {box.triangles(0, triangle), box.triangles(1, triangle), box.triangles(2, triangle)}});
-      ++triangle;
-    }
-    if (e == box.num_tets() / 2) {
-      cells.push_back({3, {0, 1}});
-      cells.push_back({2, {}});
-    }
-  }
-  for (; triangle < box.num_triangles(); ++triangle)
-    cells.push_back(
-        {5, {box.triangles(0, triangle), box.triangles(1, triangle), box.triangles(2, triangle)}});
-  return cells;
 }
 
 /// Writes the <DataArray> elements of one file, collecting appended data.
@@ -272,11 +224,11 @@ const char* const kInformationKey =
 
 /// `nodes` and `cells` as a .vtu file of one <Piece>, in the variant's layout, with point data,
 /// cell data, an InformationKey in the points' array and XML comments, which the readers skip.
-std::string CellsAsVtu(const Points& nodes, const std::vector<Cell>& cells, const Variant& v) {
+std::string CellsAsVtu(const Points& nodes, const std::vector<VtkCell>& cells, const Variant& v) {
   ArrayWriter arrays(v.layout, v.header64, v.big_endian);
   ArrayWriter inline_arrays(InlineLayout(v.layout), v.header64, v.big_endian);
   std::vector<std::int64_t> offsets, connectivity, types;
-  for (const Cell& cell : cells) {
+  for (const VtkCell& cell : cells) {
     connectivity.insert(connectivity.end(), cell.points.begin(), cell.points.end());
     offsets.push_back(static_cast<std::int64_t>(connectivity.size()));
     types.push_back(cell.type);
@@ -403,11 +355,12 @@ TEST(VtuBlockReader, FilesItDoesNotReadInBlocksAreLeftToTheWholeReader) {
   nodes << 0, 2, 0, 0, 1, 1, 0, 0, 1, 0, 2,  //
       0, 0, 2, 0, 0, 1, 1, 0, 0, 1, 2,       //
       0, 0, 0, 2, 0, 0, 0, 1, 1, 1, 2;
-  const std::vector<Cell> quadratic = {{24, {0, 1, 2, 3, 4, 5, 6, 7, 8, 9}}, {10, {1, 2, 3, 10}}};
+  const std::vector<VtkCell> quadratic = {{24, {0, 1, 2, 3, 4, 5, 6, 7, 8, 9}},
+                                          {10, {1, 2, 3, 10}}};
   for (Layout layout : {Layout::kAscii, Layout::kInlineSeparateHeader, Layout::kAppendedRawZlib})
     left_to_whole_reader(fmt::format("quadratic_tet_{}.vtu", Name(layout)),
                          CellsAsVtu(nodes, quadratic, {layout, true, false}));
-  const std::vector<Cell> triangle = {{22, {0, 1, 2, 4, 5, 6}}, {10, {1, 2, 3, 10}}};
+  const std::vector<VtkCell> triangle = {{22, {0, 1, 2, 4, 5, 6}}, {10, {1, 2, 3, 10}}};
   left_to_whole_reader("quadratic_triangle.vtu", CellsAsVtu(nodes, triangle, {}));
   // Data in a CDATA section (the offsets, ascii; or the points, base64).
   const std::string ascii = BoxAsVtu(box, Layout::kAscii, false, false);
@@ -504,8 +457,8 @@ TEST(VtuBlockReader, MistakesAreNamedAsTheWholeReaderNamesThem) {
   Mesh nan = box, inf = box;
   nan.nodes(1, 3) = std::numeric_limits<double>::quiet_NaN();
   inf.nodes(2, 40) = -std::numeric_limits<double>::infinity();
-  auto cells = [&](const std::function<void(std::vector<Cell>&)>& change, const Variant& v) {
-    std::vector<Cell> c = BoxCells(box);
+  auto cells = [&](const std::function<void(std::vector<VtkCell>&)>& change, const Variant& v) {
+    std::vector<VtkCell> c = BoxCells(box);
     change(c);
     return CellsAsVtu(box.nodes, c, v);
   };
@@ -584,17 +537,18 @@ TEST(VtuBlockReader, MistakesAreNamedAsTheWholeReaderNamesThem) {
       {"falling_offsets_binary",
        Patched<std::int32_t>(r, AppendedStart(r, "offsets") + 4 + 2 * 4, 3, raw_le),
        "offset 3 of cell 2 is below the previous 5"},
-      {"three_point_tet", cells([](std::vector<Cell>& c) { c[5].points.pop_back(); }, separate_be),
+      {"three_point_tet",
+       cells([](std::vector<VtkCell>& c) { c[5].points.pop_back(); }, separate_be),
        "expected 4 point indices for a tetrahedron (cell 5), got 3"},
       {"four_point_triangle",
-       cells([](std::vector<Cell>& c) { c.back().points.push_back(44); }, base64_le),
+       cells([](std::vector<VtkCell>& c) { c.back().points.push_back(44); }, base64_le),
        "expected 3 point indices for a triangle (cell 178), got 4"},
-      {"out_of_range", cells([](std::vector<Cell>& c) { c[6].points[2] = 45; }, raw_zlib_be),
+      {"out_of_range", cells([](std::vector<VtkCell>& c) { c[6].points[2] = 45; }, raw_zlib_be),
        "cell 6 refers to point 45, out of range [0, 45)"},
-      {"negative_index", cells([](std::vector<Cell>& c) { c[150].points[0] = -1; }, base64_le),
+      {"negative_index", cells([](std::vector<VtkCell>& c) { c[150].points[0] = -1; }, base64_le),
        "cell 150 refers to point -1, out of range [0, 45)"},
       {"repeated_point",
-       cells([](std::vector<Cell>& c) { c[8].points[2] = c[8].points[0]; }, base64_zlib_be),
+       cells([](std::vector<VtkCell>& c) { c[8].points[2] = c[8].points[0]; }, base64_zlib_be),
        "cell 8 repeats point"},
       {"header_bytes", WithHeaderWord(r, AppendedStart(r, "Points"), points_bytes - 8, raw_le),
        fmt::format("expected {} bytes of data, the block header says {}", points_bytes,
@@ -721,8 +675,8 @@ TEST(VtuBlockReader, MistakesInWhatTheReadersSkipAreSkippedByBoth) {
   const Variant base64_le{Layout::kAppendedBase64, true, false};
   const std::string a = BoxAsVtu(box, ascii), i = BoxAsVtu(box, inline_le);
   const std::string z = BoxAsVtu(box, zlib_le), b = BoxAsVtu(box, base64_le);
-  std::vector<Cell> stray = BoxCells(box);
-  for (Cell& cell : stray) {
+  std::vector<VtkCell> stray = BoxCells(box);
+  for (VtkCell& cell : stray) {
     if (cell.type == 3) cell.points = {-5, 999, 7, 7};  // a line of four points, out of range
     if (cell.type == 2) cell.points = {45};             // a vertex beyond the last point
   }

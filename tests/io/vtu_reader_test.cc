@@ -20,30 +20,9 @@ using test::InputErrorMessage;
 using test::MeshData;
 using test::Put;
 using test::Scratch;
+using test::StoredZlib;
 using test::WriteBytes;
 using ::testing::HasSubstr;
-
-/// A zlib stream made of "stored" (uncompressed) deflate blocks: valid input for any inflater,
-/// written here without zlib so that the test does not share code with the reader.
-std::string StoredZlib(std::string_view data) {
-  std::string out = "\x78\x01";
-  std::size_t pos = 0;
-  do {
-    auto n = static_cast<std::uint16_t>(std::min<std::size_t>(65535, data.size() - pos));
-    out += static_cast<char>(pos + n == data.size() ? 1 : 0);
-    Put<std::uint16_t>(out, n, !test::LittleEndianHost());
-    Put<std::uint16_t>(out, static_cast<std::uint16_t>(~n), !test::LittleEndianHost());
-    out.append(data.substr(pos, n));
-    pos += n;
-  } while (pos < data.size());
-  std::uint32_t a = 1, b = 0;
-  for (char c : data) {
-    a = (a + static_cast<unsigned char>(c)) % 65521;
-    b = (b + a) % 65521;
-  }
-  Put<std::uint32_t>(out, b << 16 | a, test::LittleEndianHost());  // big-endian
-  return out;
-}
 
 enum class Encoding { kInline, kInlineSeparateHeader, kZlib, kAppendedRaw };
 

@@ -43,16 +43,17 @@ std::string EncodeBase64(std::string_view bytes) {
   return out;
 }
 
+void Base64Decoder::Flush(std::string& out) {
+  if (have_ == 2) out += static_cast<char>(acc_ >> 4);
+  if (have_ == 3) {
+    out += static_cast<char>(acc_ >> 10);
+    out += static_cast<char>((acc_ >> 2) & 0xff);
+  }
+  acc_ = 0;
+  have_ = 0;
+}
+
 bool Base64Decoder::Feed(std::string_view text, std::string& out, std::size_t* bad_at) {
-  auto flush = [&] {
-    if (have_ == 2) out += static_cast<char>(acc_ >> 4);
-    if (have_ == 3) {
-      out += static_cast<char>(acc_ >> 10);
-      out += static_cast<char>((acc_ >> 2) & 0xff);
-    }
-    acc_ = 0;
-    have_ = 0;
-  };
   for (std::size_t i = 0; i < text.size(); ++i) {
     auto c = static_cast<unsigned char>(text[i]);
     if (c == ' ' || c == '\n' || c == '\r' || c == '\t') continue;
@@ -61,7 +62,7 @@ bool Base64Decoder::Feed(std::string_view text, std::string& out, std::size_t* b
         if (bad_at != nullptr) *bad_at = fed_ + i;
         return false;
       }
-      flush();
+      Flush(out);
       continue;
     }
     std::int8_t v = kDecode[c];
@@ -87,13 +88,7 @@ bool Base64Decoder::Finish(std::string& out, std::size_t* bad_at) {
     if (bad_at != nullptr) *bad_at = fed_;
     return false;
   }
-  if (have_ == 2) out += static_cast<char>(acc_ >> 4);
-  if (have_ == 3) {
-    out += static_cast<char>(acc_ >> 10);
-    out += static_cast<char>((acc_ >> 2) & 0xff);
-  }
-  acc_ = 0;
-  have_ = 0;
+  Flush(out);
   return true;
 }
 

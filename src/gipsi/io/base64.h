@@ -33,6 +33,7 @@ class Base64Decoder {
   bool Finish(std::string& out, std::size_t* bad_at = nullptr);
 
  private:
+  void Flush(std::string& out);  // the bytes of a partial group, which padding ends
   std::uint32_t acc_ = 0;
   int have_ = 0;         // characters of the current 4-character group
   std::size_t fed_ = 0;  // characters before the current piece

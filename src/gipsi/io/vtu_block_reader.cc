@@ -27,6 +27,7 @@
 #include "gipsi/io/chunked_file.h"
 #include "gipsi/io/text_reader.h"
 #include "gipsi/io/vtk_legacy_types.h"
+#include "gipsi/io/vtu_markup.h"
 
 namespace gipsi {
 namespace {
@@ -114,41 +115,24 @@ class ByteStream {
 class VtuBlockParser {
  public:
   VtuBlockParser(const std::filesystem::path& path, int rank, int size)
-      : path_(path), source_(path.string()), file_(path), rank_(rank), size_(size) {}
+      : path_(path),
+        source_(path.string()),
+        file_(path),
+        rank_(rank),
+        size_(size),
+        markup_(source_) {}
 
   std::optional<MeshBlock> Read() {
     if (!ScanMarkup()) return std::nullopt;
+    markup_.set_lines(m_.xml);
     pugi::xml_document doc;
-    pugi::xml_parse_result ok = doc.load_buffer(m_.xml.data(), m_.xml.size());
-    if (!ok) {
-      ThrowInputError(source_, fmt::format("line {}", LineOfOffset(std::size_t(ok.offset))),
-                      fmt::format("malformed XML: {}", ok.description()));
-    }
+    markup_.Parse(doc, m_.xml);
     NumberArrays(doc);
-    pugi::xml_node root = doc.child("VTKFile");
-    if (!root) ThrowInputError(source_, "", "expected a <VTKFile> root element");
-    std::string_view type = root.attribute("type").value();
-    if (type != "UnstructuredGrid")
-      Fail(root, fmt::format("expected type=\"UnstructuredGrid\", got {}", Quote(type)));
-    std::string_view order = root.attribute("byte_order").value();
-    bool little = order.empty() || order == "LittleEndian";
-    if (!little && order != "BigEndian")
-      Fail(root,
-           fmt::format("expected byte_order LittleEndian or BigEndian, got {}", Quote(order)));
-    swap_ = little != internal::HostIsLittleEndian();
-    std::string_view header = root.attribute("header_type").value();
-    if (header == "UInt64") {
-      header_bytes_ = 8;
-    } else if (!header.empty() && header != "UInt32") {
-      Fail(root, fmt::format("expected header_type UInt32 or UInt64, got {}", Quote(header)));
-    }
-    std::string_view compressor = root.attribute("compressor").value();
-    compressed_ = !compressor.empty();
-    if (compressed_ && compressor != "vtkZLibDataCompressor")
-      Fail(root, fmt::format("unsupported compressor {} (supported: vtkZLibDataCompressor)",
-                             Quote(compressor)));
-    pugi::xml_node grid = root.child("UnstructuredGrid");
-    if (!grid) Fail(root, "expected an <UnstructuredGrid> element");
+    internal::VtuEncoding encoding;
+    pugi::xml_node grid = markup_.Grid(doc, &encoding);
+    swap_ = encoding.swap;
+    compressed_ = encoding.compressed;
+    header_bytes_ = encoding.header_bytes;
     auto pieces = grid.children("Piece");
     if (pieces.begin() == pieces.end()) Fail(grid, "expected at least one <Piece>");
     if (std::next(pieces.begin()) != pieces.end()) return std::nullopt;
@@ -608,29 +592,11 @@ class VtuBlockParser {
     return m_.texts[it->second];
   }
 
-  int LineOfOffset(std::size_t offset) const {
-    offset = std::min(offset, m_.xml.size());
-    return 1 + LinesIn(std::string_view(m_.xml).substr(0, offset));
-  }
   [[noreturn]] void Fail(const pugi::xml_node& node, std::string_view what) const {
-    std::string name = node.attribute("Name").value();
-    ThrowInputError(source_,
-                    fmt::format("line {} (<{}{}>)", LineOfOffset(std::size_t(node.offset_debug())),
-                                node.name(), name.empty() ? "" : " Name=\"" + name + "\""),
-                    what);
+    markup_.Fail(node, what);
   }
   std::uint64_t Attribute(const pugi::xml_node& node, const char* name) const {
-    std::string_view text = node.attribute(name).value();
-    std::int64_t v = 0;
-    if (!internal::TryParseInt(text, &v) || v < 0)
-      Fail(node,
-           fmt::format("expected a non-negative integer attribute {}, got {}", name, Quote(text)));
-    return static_cast<std::uint64_t>(v);
-  }
-  pugi::xml_node FindArray(const pugi::xml_node& parent, const char* name) const {
-    for (pugi::xml_node a : parent.children("DataArray"))
-      if (std::string_view(a.attribute("Name").value()) == name) return a;
-    Fail(parent, fmt::format("expected a <DataArray Name=\"{}\">", name));
+    return markup_.Attribute(node, name);
   }
 
   // ReadVtu's ReadPiece for the only piece, keeping the block; false for quadratic cells.
@@ -639,10 +605,7 @@ class VtuBlockParser {
     const std::uint64_t num_cells = Attribute(piece, "NumberOfCells");
     if (num_points > static_cast<std::uint64_t>(std::numeric_limits<int>::max()))
       Fail(piece, "too many points");
-    pugi::xml_node points = piece.child("Points").child("DataArray");
-    if (!points) Fail(piece, "expected <Points> with a <DataArray>");
-    if (std::string_view c = points.attribute("NumberOfComponents").value(); c != "3")
-      Fail(points, fmt::format("expected NumberOfComponents=\"3\", got {}", Quote(c)));
+    pugi::xml_node points = markup_.PointsArray(piece);
     const auto nodes = static_cast<std::int64_t>(num_points);
     const std::int64_t node_begin = BlockBegin(nodes, rank_, size_);
     const std::int64_t node_end = BlockBegin(nodes, rank_ + 1, size_);
@@ -660,9 +623,9 @@ class VtuBlockParser {
     if (num_cells > 0) {
       cells = piece.child("Cells");
       if (!cells) Fail(piece, "expected a <Cells> element");
-      offsets_node = FindArray(cells, "offsets");
-      types_node = FindArray(cells, "types");
-      conn_node = FindArray(cells, "connectivity");
+      offsets_node = markup_.FindArray(cells, "offsets");
+      types_node = markup_.FindArray(cells, "types");
+      conn_node = markup_.FindArray(cells, "connectivity");
       {  // ReadVtu reads the offsets whole before it opens the types
         Array offsets(*this, offsets_node, num_cells, true);
         for (std::uint64_t c = 0; c < num_cells; ++c) {
@@ -735,6 +698,7 @@ class VtuBlockParser {
   ChunkedFile file_;
   int rank_, size_;
   Markup m_;
+  internal::VtuMarkup markup_;  // messages: lines counted in m_.xml
   std::unordered_map<const void*, std::size_t> array_index_;
   bool swap_ = false, compressed_ = false;
   int header_bytes_ = 4;

@@ -19,6 +19,7 @@
 #include "gipsi/io/mesh_builder.h"
 #include "gipsi/io/text_reader.h"
 #include "gipsi/io/vtk_legacy_types.h"
+#include "gipsi/io/vtu_markup.h"
 
 namespace gipsi {
 namespace {
@@ -33,46 +34,25 @@ using internal::LoadVtkReal;
 class VtuParser {
  public:
   VtuParser(std::string source, std::string bytes)
-      : source_(std::move(source)), bytes_(std::move(bytes)) {}
+      : source_(std::move(source)), bytes_(std::move(bytes)), m_(source_) {
+    m_.set_lines(bytes_);
+  }
 
   Mesh Parse() {
     SplitAppendedData();
     pugi::xml_document doc;
-    pugi::xml_parse_result ok = doc.load_buffer(xml_.data(), xml_.size());
-    if (!ok) {
-      ThrowInputError(source_, fmt::format("line {}", LineOfOffset(std::size_t(ok.offset))),
-                      fmt::format("malformed XML: {}", ok.description()));
-    }
-    pugi::xml_node root = doc.child("VTKFile");
-    if (!root) ThrowInputError(source_, "", "expected a <VTKFile> root element");
-    std::string_view type = root.attribute("type").value();
-    if (type != "UnstructuredGrid")
-      Fail(root, fmt::format("expected type=\"UnstructuredGrid\", got {}", Quote(type)));
-    std::string_view order = root.attribute("byte_order").value();
-    bool little = order.empty() || order == "LittleEndian";
-    if (!little && order != "BigEndian")
-      Fail(root,
-           fmt::format("expected byte_order LittleEndian or BigEndian, got {}", Quote(order)));
-    swap_ = little != internal::HostIsLittleEndian();
-    std::string_view header = root.attribute("header_type").value();
-    if (header == "UInt64") {
-      header_bytes_ = 8;
-    } else if (!header.empty() && header != "UInt32") {
-      Fail(root, fmt::format("expected header_type UInt32 or UInt64, got {}", Quote(header)));
-    }
-    std::string_view compressor = root.attribute("compressor").value();
-    compressed_ = !compressor.empty();
-    if (compressed_ && compressor != "vtkZLibDataCompressor")
-      Fail(root, fmt::format("unsupported compressor {} (supported: vtkZLibDataCompressor)",
-                             Quote(compressor)));
-    pugi::xml_node grid = root.child("UnstructuredGrid");
-    if (!grid) Fail(root, "expected an <UnstructuredGrid> element");
+    m_.Parse(doc, xml_);
+    internal::VtuEncoding encoding;
+    pugi::xml_node grid = m_.Grid(doc, &encoding);
+    swap_ = encoding.swap;
+    compressed_ = encoding.compressed;
+    header_bytes_ = encoding.header_bytes;
     int pieces = 0;
     for (pugi::xml_node piece : grid.children("Piece")) {
       ReadPiece(piece);
       ++pieces;
     }
-    if (pieces == 0) Fail(grid, "expected at least one <Piece>");
+    if (pieces == 0) m_.Fail(grid, "expected at least one <Piece>");
     Mesh mesh = b_.Build(source_);
     mesh.SeparateEdgeNodes(middle_of_edge_);
     return mesh;
@@ -99,33 +79,12 @@ class VtuParser {
     if (appended_base64_) appended_ = appended_.substr(0, appended_.find('<'));
   }
 
-  int LineOfOffset(std::size_t offset) const {
-    offset = std::min(offset, bytes_.size());
-    return 1 + static_cast<int>(std::count(
-                   bytes_.begin(), bytes_.begin() + static_cast<std::ptrdiff_t>(offset), '\n'));
-  }
-
+  int LineOfOffset(std::size_t offset) const { return m_.LineOfOffset(offset); }
   [[noreturn]] void Fail(const pugi::xml_node& node, std::string_view what) const {
-    std::string name = node.attribute("Name").value();
-    ThrowInputError(source_,
-                    fmt::format("line {} (<{}{}>)", LineOfOffset(std::size_t(node.offset_debug())),
-                                node.name(), name.empty() ? "" : " Name=\"" + name + "\""),
-                    what);
+    m_.Fail(node, what);
   }
-
   std::uint64_t Attribute(const pugi::xml_node& node, const char* name) const {
-    std::string_view text = node.attribute(name).value();
-    std::int64_t v = 0;
-    if (!internal::TryParseInt(text, &v) || v < 0)
-      Fail(node,
-           fmt::format("expected a non-negative integer attribute {}, got {}", name, Quote(text)));
-    return static_cast<std::uint64_t>(v);
-  }
-
-  pugi::xml_node FindArray(const pugi::xml_node& parent, const char* name) const {
-    for (pugi::xml_node a : parent.children("DataArray"))
-      if (std::string_view(a.attribute("Name").value()) == name) return a;
-    Fail(parent, fmt::format("expected a <DataArray Name=\"{}\">", name));
+    return m_.Attribute(node, name);
   }
 
   /// The uncompressed payload of a binary block (header + data), exactly `want` bytes.
@@ -263,18 +222,15 @@ class VtuParser {
     if (num_points > static_cast<std::uint64_t>(std::numeric_limits<int>::max() - b_.num_nodes()))
       Fail(piece, "too many points");
     const int base = b_.num_nodes();
-    pugi::xml_node points = piece.child("Points").child("DataArray");
-    if (!points) Fail(piece, "expected <Points> with a <DataArray>");
-    if (std::string_view c = points.attribute("NumberOfComponents").value(); c != "3")
-      Fail(points, fmt::format("expected NumberOfComponents=\"3\", got {}", Quote(c)));
+    pugi::xml_node points = m_.PointsArray(piece);
     std::vector<double> xyz = ReadArray<double>(points, 3 * num_points);
     b_.coords.insert(b_.coords.end(), xyz.begin(), xyz.end());
     if (num_cells == 0) return;
     pugi::xml_node cells = piece.child("Cells");
     if (!cells) Fail(piece, "expected a <Cells> element");
-    pugi::xml_node offsets_node = FindArray(cells, "offsets");
-    pugi::xml_node types_node = FindArray(cells, "types");
-    pugi::xml_node conn_node = FindArray(cells, "connectivity");
+    pugi::xml_node offsets_node = m_.FindArray(cells, "offsets");
+    pugi::xml_node types_node = m_.FindArray(cells, "types");
+    pugi::xml_node conn_node = m_.FindArray(cells, "connectivity");
     auto offsets = ReadArray<std::int64_t>(offsets_node, num_cells);
     auto types = ReadArray<std::int64_t>(types_node, num_cells);
     std::int64_t previous = 0;
@@ -331,6 +287,7 @@ class VtuParser {
 
   std::string source_;
   std::string bytes_;
+  internal::VtuMarkup m_;  // messages: lines counted in bytes_
   std::string xml_;
   std::string_view appended_;
   bool appended_base64_ = false;
