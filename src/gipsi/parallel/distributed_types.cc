@@ -67,10 +67,10 @@ bool HasDisplayMesh(const JsonNode& params) {
   return display && display->is_object() && display->Has("mesh");
 }
 
-// The integrators a split FemSolid steps with: FemSolid's own implicit schemes and the
-// fixed-step explicit ones of the ODE contract. Any other (the contract's implicit integrator,
-// whose matrix-free Newton is serial; a plugin's, which might adapt its steps from a norm of the
-// state that would differ between ranks) runs whole on every rank, as every object did before.
+// The integrators a split FemSolid steps with: FemSolid's own implicit schemes (whose names
+// take precedence over the ODE contract's "BackwardEuler") and the fixed-step explicit ones of
+// the ODE contract. A plugin's, which might adapt its steps from a norm of the state that would
+// differ between ranks, runs whole on every rank, as every object did before.
 bool SplitsWithIntegrator(const JsonNode& params) {
   const auto integrator = params.Find("integrator");
   if (!integrator) return true;

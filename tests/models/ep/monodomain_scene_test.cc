@@ -126,6 +126,11 @@ TEST(MonodomainScene, BadInputGetsAClearError) {
   EXPECT_THAT(LoadError(SceneText(kCell + R"("conductivity": 0.1, "activation": {
       "apd_repolarisation": 90})")),
               HasSubstr("a fraction in (0, 1)"));
+  // Mechanical conditions, which a Monodomain would have ignored, silently.
+  EXPECT_THAT(LoadError(SceneText(kCell + R"("conductivity": 0.1, "boundary_conditions": [
+      {"name": "base", "region": {"group": "xmin"}, "fix": true}])")),
+              HasSubstr("objects.tissue.boundary_conditions: an EP tissue takes no boundary "
+                        "conditions"));
 }
 
 }  // namespace

@@ -71,6 +71,12 @@ PulseTrain ReadPulses(const JsonNode& node) {
 }  // namespace
 
 void CheckEpTissueKeys(const ObjectBuildContext& ctx, const std::vector<std::string>& extra) {
+  // The common key would be accepted and then ignored: an EP tissue steps no mechanics.
+  if (auto bcs = ctx.params.Find("boundary_conditions"))
+    bcs->Fail(
+        "an EP tissue takes no boundary conditions (they fix, move or load a solid): its "
+        "boundary is insulated (no current leaves it); excite it with \"stimuli\" or "
+        "\"clamps\"");
   std::vector<std::string> keys = ObjectBuildContext::CommonKeys();
   keys.insert(keys.end(), kTissueKeys.begin(), kTissueKeys.end());
   keys.insert(keys.end(), extra.begin(), extra.end());
